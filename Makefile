@@ -1,0 +1,132 @@
+# sfsim -- build, test, run. `make run` and `make test` install missing Debian packages first
+# (scripts/deps.sh), then re-enter make so pkg-config sees them.
+
+CC      ?= cc
+CXX     ?= c++
+CLANG   ?= clang
+OPT     ?= -O2
+WARN    := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wmissing-prototypes
+CFLAGS  := -std=c11 $(OPT) -g $(WARN) -D_GNU_SOURCE $(EXTRA_CFLAGS)
+LDLIBS  := -lm
+INIH    := $(shell pkg-config --cflags --libs inih 2>/dev/null || echo -linih)
+CRIT    := $(shell pkg-config --libs criterion 2>/dev/null || echo -lcriterion)
+
+BUILD   ?= build
+SAN     := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+
+# Library sources: everything but the programs' main files.
+ISA_SRC := isa/isa.c
+ASM_SRC := $(filter-out asm/main_sfasm.c,$(wildcard asm/*.c))
+SIM_SRC := $(filter-out sim/main.c,$(wildcard sim/*.c))
+LIB_SRC := $(ISA_SRC) $(ASM_SRC) $(SIM_SRC)
+TEST_SRC := $(wildcard tests/unit/*.c)
+
+ASMLIB_OBJ = $(patsubst %.c,$(BUILD)/obj/%.o,$(ISA_SRC) $(ASM_SRC))
+LIB_OBJ  = $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC))
+ASAN_OBJ = $(patsubst %.c,$(BUILD)/asan/%.o,$(LIB_SRC))
+
+.PHONY: all deps run test test-asan test-unit fuzz fuzz-run bench docs check-docs clean run-built test-built help
+
+all: bin/sfasm bin/sfsim
+
+help:
+	@echo "make run        install deps, build, run the example program"
+	@echo "make test       install deps, build, run the whole test suite"
+	@echo "make test-asan  the unit tests under AddressSanitizer + UBSan"
+	@echo "make fuzz       build the libFuzzer targets (clang); make fuzz-run FUZZ_SECONDS=600"
+	@echo "make bench      build and run the benchmarks in bench/"
+	@echo "make docs       regenerate docs/isa.md from isa/opcodes.def"
+
+deps:
+	@bash scripts/deps.sh
+
+run: deps
+	@$(MAKE) --no-print-directory run-built
+
+test: deps
+	@$(MAKE) --no-print-directory test-built
+
+$(BUILD)/obj/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -MMD -MP -c $< -o $@
+
+$(BUILD)/asan/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(SAN) -MMD -MP -c $< -o $@
+
+$(BUILD)/libsfasm.a: $(ASMLIB_OBJ)
+	@mkdir -p $(dir $@)
+	$(AR) rcs $@ $^
+
+$(BUILD)/libsfsim.a: $(LIB_OBJ)
+	@mkdir -p $(dir $@)
+	$(AR) rcs $@ $^
+
+$(BUILD)/libsfsim-asan.a: $(ASAN_OBJ)
+	@mkdir -p $(dir $@)
+	$(AR) rcs $@ $^
+
+bin/sfasm: $(BUILD)/obj/asm/main_sfasm.o $(BUILD)/libsfasm.a
+	@mkdir -p bin
+	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS)
+
+bin/sfsim: $(BUILD)/obj/sim/main.o $(BUILD)/libsfsim.a
+	@mkdir -p bin
+	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
+
+# ---- tools and docs -------------------------------------------------------------------------
+$(BUILD)/gen_isadoc: tools/gen_isadoc.c $(BUILD)/libsfasm.a
+	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS)
+
+docs: $(BUILD)/gen_isadoc
+	$(BUILD)/gen_isadoc > docs/isa.md
+
+# ---- tests ----------------------------------------------------------------------------------
+$(BUILD)/tests/unit: $(TEST_SRC) $(BUILD)/libsfsim.a $(BUILD)/gen_isadoc
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
+
+$(BUILD)/tests/unit-asan: $(TEST_SRC) $(BUILD)/libsfsim-asan.a $(BUILD)/gen_isadoc
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(SAN) $(TEST_SRC) $(BUILD)/libsfsim-asan.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
+
+# CLI tests first, Criterion last: its synthesis line closes the run.
+test-built: all $(BUILD)/tests/unit
+	@bash tests/cli/run.sh
+	@$(BUILD)/tests/unit --jobs 2
+
+test-asan: deps
+	@$(MAKE) --no-print-directory $(BUILD)/tests/unit-asan
+	@ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 $(BUILD)/tests/unit-asan --jobs 2
+
+# ---- fuzzing (clang + libFuzzer) -------------------------------------------------------------
+FUZZ_SECONDS ?= 60
+$(BUILD)/fuzz/fuzz_asm: tests/fuzz/fuzz_asm.c $(ISA_SRC) $(ASM_SRC)
+	@mkdir -p $(dir $@)
+	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ -lm
+
+fuzz: $(BUILD)/fuzz/fuzz_asm
+
+fuzz-run: fuzz
+	@mkdir -p $(BUILD)/fuzz/corpus
+	$(BUILD)/fuzz/fuzz_asm -max_total_time=$(FUZZ_SECONDS) -max_len=4096 $(BUILD)/fuzz/corpus tests/fuzz/seeds
+
+# ---- benchmarks -----------------------------------------------------------------------------
+$(BUILD)/bench/core_speed: bench/core_speed.c $(BUILD)/libsfsim.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
+
+bench: deps
+	@$(MAKE) --no-print-directory $(BUILD)/bench/core_speed
+	$(BUILD)/bench/core_speed
+
+# ---- the example `make run` executes --------------------------------------------------------
+run-built: all
+	@echo "== sfsim: assembling kernels/examples/filter_demo.s and running it on the functional core"
+	bin/sfasm kernels/examples/filter_demo.s -o $(BUILD)/filter_demo.sfo
+	bin/sfsim exec $(BUILD)/filter_demo.sfo -c configs/streamray.ini
+
+clean:
+	rm -rf $(BUILD) bin
+
+-include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

@@ -1,0 +1,89 @@
+/* sim/core.h -- the functional core: executes sfsim instructions for any lane count N.
+ *
+ * Owns: architectural state (registers, masks, pc, stage, partition-unit mask queue, the
+ * current/next ray-buffer selector) and the simulated memories; per-stage operation counts.
+ * Must not: count cycles or model any latency (the timing model consumes CoreRecord).
+ *
+ * Memories (sizes from the machine config; all byte-addressed, 32-bit word accesses that
+ * must be 4-byte aligned): two ray buffers (RB0, RB1; "current" and "next" swap on rswap),
+ * ID-stream memory (IDM), scratchpad (SP), scene memory (SM), framebuffer (FB, floats).
+ * Any access outside a memory, a misaligned access, a bad stream or partition, a division
+ * by zero, a pc outside the program or the instruction limit stops the core with a trap
+ * whose message names pc, instruction and source file:line.
+ */
+#ifndef SFSIM_CORE_H
+#define SFSIM_CORE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../asm/object.h"
+#include "../isa/isa.h"
+
+typedef enum CoreMem {
+    CORE_MEM_RB0, CORE_MEM_RB1, CORE_MEM_IDM, CORE_MEM_SPAD, CORE_MEM_SCENE, CORE_MEM_FB,
+    CORE_MEM_COUNT
+} CoreMem;
+
+typedef struct CoreParams {
+    int lanes;                         /* N, 1..ISA_MAX_LANES */
+    uint32_t mem_bytes[CORE_MEM_COUNT]; /* RB0 and RB1 must be equal; each a multiple of 4 */
+} CoreParams;
+
+typedef enum CoreExit { CORE_EXIT_HALT = 0, CORE_EXIT_TRAP = 1, CORE_EXIT_LIMIT = 2 } CoreExit;
+
+/* Counters, per statistics stage (IsaStage). */
+typedef struct CoreStats {
+    uint64_t instructions[ISA_STAGE_COUNT];
+    uint64_t ops[ISA_STAGE_COUNT][ISA_C_COUNT];   /* instructions by Table-5 category */
+    uint64_t vec_instructions[ISA_STAGE_COUNT];   /* instructions with ISA_FL_VEC */
+    uint64_t active_lanes[ISA_STAGE_COUNT];       /* sum of exec-mask lanes of those */
+    uint64_t by_op[ISA_OP_COUNT];                 /* executions per opcode */
+} CoreStats;
+
+/* Per-instruction record for the timing model (produced only when a hook is set). */
+typedef struct CoreRecord {
+    uint32_t pc, next_pc;
+    const IsaInstr *in;
+    uint8_t stage;          /* IsaStage at execution */
+    uint8_t taken;          /* branch taken */
+    uint8_t mem;            /* CoreMem touched (physical buffer for ray buffers), or CORE_MEM_COUNT */
+    uint8_t naddr;          /* number of valid entries in addr (lanes that accessed memory) */
+    uint64_t exec;          /* exec mask as applied (all N lanes for unmasked vector ops) */
+    uint32_t addr[ISA_MAX_LANES]; /* byte addresses, lane order (sfetch/vspld: the N words) */
+} CoreRecord;
+
+typedef void (*CoreHook)(void *ctx, const CoreRecord *rec);
+
+typedef struct Core Core;
+
+/* Build a core for obj (decoded once here; an undecodable word fails). Memories are zeroed,
+ * then the object's DATA and SPAD images are copied to scene memory and scratchpad (error if
+ * they do not fit). m0 = all lanes, other masks empty, registers 0, stage other, pc 0.
+ * NULL with a message on failure. obj must outlive the core. */
+Core *core_new(const CoreParams *p, const AsmObject *obj, char *err, size_t errlen);
+void core_free(Core *c);
+
+/* Run until halt, trap, or max_instr more instructions (0 = no limit). */
+CoreExit core_run(Core *c, uint64_t max_instr);
+/* The trap message after CORE_EXIT_TRAP/CORE_EXIT_LIMIT:
+ * "trap: <reason> at pc <n> (<disassembly>) <file>:<line>". */
+const char *core_trap_message(const Core *c);
+
+void core_set_hook(Core *c, CoreHook hook, void *ctx);
+
+/* State access (for tests, the CLI and the renderer). */
+int core_lanes(const Core *c);
+uint32_t core_pc(const Core *c);
+uint32_t core_sreg(const Core *c, int r);
+void core_set_sreg(Core *c, int r, uint32_t v);
+uint32_t core_vreg(const Core *c, int v, int lane);
+uint64_t core_mreg(const Core *c, int m);
+uint8_t *core_mem(Core *c, CoreMem m, uint32_t *bytes);
+int core_current_rb(const Core *c);              /* 0 or 1: which physical buffer is RBc */
+const CoreStats *core_stats(const Core *c);
+uint64_t core_instructions(const Core *c);       /* total executed */
+
+extern const char *const core_mem_names[CORE_MEM_COUNT]; /* "rb0", "rb1", "idm", "spad", "scene", "fb" */
+
+#endif
