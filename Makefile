@@ -7,7 +7,11 @@ CLANG   ?= clang
 OPT     ?= -O2
 WARN    := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wmissing-prototypes
 CFLAGS  := -std=c11 $(OPT) -g $(WARN) -D_GNU_SOURCE $(EXTRA_CFLAGS)
-LDLIBS  := -lm
+CXXWARN := -Wall -Wextra -Werror
+CXXFLAGS := -std=c++17 $(OPT) -g $(CXXWARN) $(EXTRA_CXXFLAGS)
+# C++ appears only inside the shims that wrap C++ libraries (ARCHITECTURE.md Sec. 2).
+GLTF    := $(shell pkg-config --libs tinygltf 2>/dev/null || echo -ltinygltf)
+LDLIBS  := $(GLTF) -lstdc++ -lm
 INIH    := $(shell pkg-config --cflags --libs inih 2>/dev/null || echo -linih)
 CRIT    := $(shell pkg-config --libs criterion 2>/dev/null || echo -lcriterion)
 
@@ -18,12 +22,14 @@ SAN     := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-re
 ISA_SRC := isa/isa.c
 ASM_SRC := $(filter-out asm/main_sfasm.c,$(wildcard asm/*.c))
 SIM_SRC := $(filter-out sim/main.c,$(wildcard sim/*.c))
-LIB_SRC := $(ISA_SRC) $(ASM_SRC) $(SIM_SRC)
+SCN_SRC := $(wildcard scenes/*.c)
+CXX_SRC := $(wildcard scenes/*.cpp sim/*.cpp)
+LIB_SRC := $(ISA_SRC) $(ASM_SRC) $(SIM_SRC) $(SCN_SRC)
 TEST_SRC := $(wildcard tests/unit/*.c)
 
 ASMLIB_OBJ = $(patsubst %.c,$(BUILD)/obj/%.o,$(ISA_SRC) $(ASM_SRC))
-LIB_OBJ  = $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC))
-ASAN_OBJ = $(patsubst %.c,$(BUILD)/asan/%.o,$(LIB_SRC))
+LIB_OBJ  = $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/obj/%.o,$(CXX_SRC))
+ASAN_OBJ = $(patsubst %.c,$(BUILD)/asan/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/asan/%.o,$(CXX_SRC))
 
 .PHONY: all deps run test test-asan test-unit fuzz fuzz-run bench docs check-docs clean run-built test-built help
 
@@ -54,6 +60,14 @@ $(BUILD)/asan/%.o: %.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(SAN) -MMD -MP -c $< -o $@
 
+$(BUILD)/obj/%.o: %.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS) -MMD -MP -c $< -o $@
+
+$(BUILD)/asan/%.o: %.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS) $(SAN) -MMD -MP -c $< -o $@
+
 $(BUILD)/libsfasm.a: $(ASMLIB_OBJ)
 	@mkdir -p $(dir $@)
 	$(AR) rcs $@ $^
@@ -68,7 +82,7 @@ $(BUILD)/libsfsim-asan.a: $(ASAN_OBJ)
 
 bin/sfasm: $(BUILD)/obj/asm/main_sfasm.o $(BUILD)/libsfasm.a
 	@mkdir -p bin
-	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS)
+	$(CC) $(CFLAGS) $^ -o $@ -lm
 
 bin/sfsim: $(BUILD)/obj/sim/main.o $(BUILD)/libsfsim.a
 	@mkdir -p bin
@@ -76,7 +90,7 @@ bin/sfsim: $(BUILD)/obj/sim/main.o $(BUILD)/libsfsim.a
 
 # ---- tools and docs -------------------------------------------------------------------------
 $(BUILD)/gen_isadoc: tools/gen_isadoc.c $(BUILD)/libsfasm.a
-	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS)
+	$(CC) $(CFLAGS) $^ -o $@ -lm
 
 docs: $(BUILD)/gen_isadoc
 	$(BUILD)/gen_isadoc > docs/isa.md

@@ -1,0 +1,140 @@
+/* scenes/scene.h -- a loaded scene: flattened world-space triangles, materials, textures, lights,
+ * spheres, camera and render settings, and what the scene needs.
+ *
+ * Owns: the in-memory scene every later stage (BVH builder, scene-memory packing, golden model,
+ * kernel selection) reads. Loaders fill it: scenes/gltf_shim.cpp (glTF 2.0 through tinygltf) and
+ * scenes/scene_file.c (scene.ini: a glTF reference plus camera, render, lights, spheres,
+ * material overrides). Must not: build acceleration structures or know the simulated machine.
+ *
+ * Conventions: right-handed, y up (glTF); floats are binary32; colours are linear RGB.
+ */
+#ifndef SFSIM_SCENE_H
+#define SFSIM_SCENE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+typedef enum SceneMatKind {
+    SCENE_MAT_LAMBERT = 0,    /* glTF: metallic == 0 and roughness == 1, no transmission */
+    SCENE_MAT_GLOSSY = 1,     /* coupled glossy: metallic > 0 or roughness < 1 */
+    SCENE_MAT_DIELECTRIC = 2  /* KHR_materials_transmission > 0 (ior from KHR_materials_ior) */
+} SceneMatKind;
+
+typedef enum SceneAlphaMode { SCENE_ALPHA_OPAQUE = 0, SCENE_ALPHA_MASK = 1, SCENE_ALPHA_BLEND = 2 } SceneAlphaMode;
+
+typedef struct SceneMaterial {
+    char *name;
+    SceneMatKind kind;
+    float base_color[3];      /* baseColorFactor rgb */
+    float alpha;              /* baseColorFactor a */
+    int base_texture;         /* index into textures, or -1 */
+    float metallic, roughness;
+    float ior;                /* 1.5 when not given */
+    float transmission;
+    float emission[3];        /* emissiveFactor x KHR_materials_emissive_strength */
+    int emissive_texture;     /* index into textures, or -1 */
+    SceneAlphaMode alpha_mode;
+    float alpha_cutoff;
+    int double_sided;
+} SceneMaterial;
+
+typedef struct SceneTexture {
+    char *name;
+    int width, height;
+    float *rgba;              /* width*height*4, linear (sRGB-decoded for colour textures) */
+} SceneTexture;
+
+typedef enum SceneLightKind {
+    SCENE_LIGHT_POINT = 0,
+    SCENE_LIGHT_SPOT = 1,
+    SCENE_LIGHT_DIRECTIONAL = 2,
+    SCENE_LIGHT_QUAD = 3      /* a rectangle area light from scene.ini: corner + two edges */
+} SceneLightKind;
+
+typedef struct SceneLight {
+    char *name;
+    SceneLightKind kind;
+    float position[3];        /* point, spot; quad: corner */
+    float direction[3];       /* spot, directional: direction the light travels */
+    float edge_u[3], edge_v[3]; /* quad */
+    float color[3];
+    float intensity;          /* point/spot: candela; directional: lux; quad: radiance scale */
+    float inner_cone, outer_cone; /* spot, radians */
+} SceneLight;
+
+typedef struct SceneSphere {
+    char *name;
+    float center[3];
+    float radius;
+    int material;             /* index into materials */
+} SceneSphere;
+
+typedef struct SceneCamera {
+    float position[3], look_at[3], up[3];
+    float fov_y;              /* degrees, vertical */
+    float aperture;           /* lens diameter in scene units; 0 = pinhole */
+    float focus_distance;     /* 0 = distance from position to look_at */
+    int source;               /* SceneCameraSource */
+} SceneCamera;
+
+typedef enum SceneCameraSource { SCENE_CAMERA_DEFAULT = 0, SCENE_CAMERA_GLTF = 1, SCENE_CAMERA_FILE = 2 } SceneCameraSource;
+
+typedef struct SceneRender {
+    int width, height;        /* default 512 x 512 */
+    int spp;                  /* samples per pixel, default 1 */
+    int max_depth;            /* default 3 (001 Sec. 4.2: three bounces) */
+    float background[3];      /* radiance of rays that leave the scene; default 0 */
+    float ambient[3];         /* constant ambient term (001's rtrt setting); default 0 = off */
+} SceneRender;
+
+/* What a scene needs: later stages model only these (ARCHITECTURE.md Sec. 3). */
+enum {
+    SCENE_NEED_LAMBERT     = 1u << 0,
+    SCENE_NEED_GLOSSY      = 1u << 1,
+    SCENE_NEED_DIELECTRIC  = 1u << 2,
+    SCENE_NEED_TEXTURES    = 1u << 3,
+    SCENE_NEED_SPHERES     = 1u << 4,
+    SCENE_NEED_AREA_LIGHTS = 1u << 5,  /* emissive triangles or quad lights */
+    SCENE_NEED_PUNCTUAL    = 1u << 6,  /* point, spot or directional lights */
+    SCENE_NEED_ALPHA       = 1u << 7,  /* alpha mask or blend materials in use */
+    SCENE_NEED_BACKGROUND  = 1u << 8,  /* non-zero background radiance */
+    SCENE_NEED_AMBIENT     = 1u << 9   /* constant ambient term */
+};
+#define SCENE_NEED_LIST(X) \
+    X(SCENE_NEED_LAMBERT, "lambert") X(SCENE_NEED_GLOSSY, "glossy") \
+    X(SCENE_NEED_DIELECTRIC, "dielectric") X(SCENE_NEED_TEXTURES, "textures") \
+    X(SCENE_NEED_SPHERES, "spheres") X(SCENE_NEED_AREA_LIGHTS, "area_lights") \
+    X(SCENE_NEED_PUNCTUAL, "punctual_lights") X(SCENE_NEED_ALPHA, "alpha") \
+    X(SCENE_NEED_BACKGROUND, "background") X(SCENE_NEED_AMBIENT, "ambient")
+
+typedef struct Scene {
+    /* Triangles, flattened to world space. */
+    uint32_t ntris;
+    float *pos;               /* ntris * 9: v0 v1 v2 */
+    float *nrm;               /* ntris * 9 shading normals, or NULL when the file has none */
+    float *uv;                /* ntris * 6 texture coordinates, or NULL */
+    uint32_t *tri_material;   /* ntris material indices */
+
+    SceneMaterial *materials; uint32_t nmaterials;
+    SceneTexture *textures;   uint32_t ntextures;
+    SceneLight *lights;       uint32_t nlights;   /* punctual and quad lights */
+    uint32_t *emissive_tris;  uint32_t nemissive; /* triangles whose material emits */
+    SceneSphere *spheres;     uint32_t nspheres;
+
+    SceneCamera camera;
+    SceneRender render;
+    float bounds_min[3], bounds_max[3];  /* of triangles and spheres */
+    uint32_t needs;           /* SCENE_NEED_* */
+    char *source;             /* the file the scene was loaded from */
+} Scene;
+
+/* Load a scene: a .gltf/.glb file, or a scene.ini that names one. Fills every field (defaults,
+ * camera framing the bounds when none is given, needs). 0, or -1 with a message naming the file
+ * and the element ("scene.glb: accessor 3: index 812 out of range (count 500)"). */
+int scene_load(const char *path, Scene *s, char *err, size_t errlen);
+void scene_free(Scene *s);
+
+/* Writes the needs as a comma-separated list ("lambert,area_lights"). */
+void scene_needs_string(uint32_t needs, char *buf, size_t len);
+
+#endif

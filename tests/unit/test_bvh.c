@@ -1,0 +1,234 @@
+/* tests/unit/test_bvh.c -- the binned SAH builder: invariants, degenerate inputs, determinism,
+ * and that the checker catches broken trees. */
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../../scenes/bvh.h"
+
+static uint32_t rng_state = 12345u;
+static float frand(void)
+{
+    rng_state = rng_state * 1664525u + 1013904223u;
+    return (float)(rng_state >> 8) / 16777216.0f;
+}
+
+/* n random small triangles' boxes in the unit cube. */
+static void random_boxes(uint32_t n, float **lo, float **hi)
+{
+    *lo = malloc(sizeof(float) * 3 * n);
+    *hi = malloc(sizeof(float) * 3 * n);
+    for (uint32_t i = 0; i < n; i++) {
+        for (int k = 0; k < 3; k++) {
+            float c = frand(), e = 0.01f * frand();
+            (*lo)[3 * i + k] = c - e;
+            (*hi)[3 * i + k] = c + e;
+        }
+    }
+}
+
+/* SAH cost (same formula as bvh_sah_cost) of a tree that halves every node at the object
+ * median of its longest centroid axis: the classic baseline a SAH build should beat. */
+static const float *g_cent;
+static int g_axis;
+static int cmp_cent(const void *a, const void *b)
+{
+    float x = g_cent[3 * *(const uint32_t *)a + g_axis], y = g_cent[3 * *(const uint32_t *)b + g_axis];
+    return x < y ? -1 : x > y;
+}
+
+static double area_of(const float *l, const float *h)
+{
+    double d0 = h[0] - l[0], d1 = h[1] - l[1], d2 = h[2] - l[2];
+    return 2.0 * (d0 * d1 + d1 * d2 + d2 * d0);
+}
+
+static double median_rec(uint32_t *idx, uint32_t n, const float *lo, const float *hi,
+                         const float *cent, const BvhParams *p, double root_area)
+{
+    float bl[3] = {INFINITY, INFINITY, INFINITY}, bh[3] = {-INFINITY, -INFINITY, -INFINITY};
+    float cl[3] = {INFINITY, INFINITY, INFINITY}, ch[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) {
+            bl[k] = fminf(bl[k], lo[3 * idx[i] + k]);
+            bh[k] = fmaxf(bh[k], hi[3 * idx[i] + k]);
+            cl[k] = fminf(cl[k], cent[3 * idx[i] + k]);
+            ch[k] = fmaxf(ch[k], cent[3 * idx[i] + k]);
+        }
+    double a = area_of(bl, bh) / root_area;
+    if (n <= (uint32_t)p->max_leaf_size)
+        return a * p->cost_intersect * n;
+    int axis = 0;
+    for (int k = 1; k < 3; k++)
+        if (ch[k] - cl[k] > ch[axis] - cl[axis])
+            axis = k;
+    g_cent = cent;
+    g_axis = axis;
+    qsort(idx, n, sizeof *idx, cmp_cent);
+    return a * p->cost_traversal + median_rec(idx, n / 2, lo, hi, cent, p, root_area) +
+           median_rec(idx + n / 2, n - n / 2, lo, hi, cent, p, root_area);
+}
+
+static double median_tree_cost(const float *lo, const float *hi, uint32_t n, const BvhParams *p)
+{
+    uint32_t *idx = malloc(sizeof *idx * n);
+    float *cent = malloc(sizeof(float) * 3 * n);
+    float bl[3] = {INFINITY, INFINITY, INFINITY}, bh[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t i = 0; i < n; i++) {
+        idx[i] = i;
+        for (int k = 0; k < 3; k++) {
+            cent[3 * i + k] = 0.5f * (lo[3 * i + k] + hi[3 * i + k]);
+            bl[k] = fminf(bl[k], lo[3 * i + k]);
+            bh[k] = fmaxf(bh[k], hi[3 * i + k]);
+        }
+    }
+    double c = median_rec(idx, n, lo, hi, cent, p, area_of(bl, bh));
+    free(idx);
+    free(cent);
+    return c;
+}
+
+Test(bvh_build, random_boxes_keep_invariants)
+{
+    BvhParams p;
+    bvh_default_params(&p);
+    float *lo, *hi;
+    uint32_t n = 20000;
+    random_boxes(n, &lo, &hi);
+    Bvh b;
+    char err[256];
+    cr_assert_eq(bvh_build(&p, lo, hi, n, &b, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(bvh_check(&b, lo, hi, err, sizeof err), 0, "%s", err);
+    cr_expect_eq(b.nnodes, 2 * b.nleaves - 1);
+    for (uint32_t i = 0; i < b.nnodes; i++)
+        if (b.nodes[i].count > 0)
+            cr_expect_leq(b.nodes[i].count, (uint32_t)p.max_leaf_size);
+    /* The SAH tree must cost less than an object-median tree over the same boxes. */
+    double median = median_tree_cost(lo, hi, n, &p);
+    cr_expect_lt(b.sah_cost, median, "sah %g, median split %g", b.sah_cost, median);
+    cr_log_info("SAH cost %.2f, object-median tree %.2f", b.sah_cost, median);
+    cr_expect_float_eq(b.sah_cost, bvh_sah_cost(&b, &p), 1e-9);
+    bvh_free(&b);
+    free(lo);
+    free(hi);
+}
+
+Test(bvh_build, identical_centroids_still_respect_leaf_size)
+{
+    BvhParams p;
+    bvh_default_params(&p);
+    uint32_t n = 1000;
+    float *lo = malloc(sizeof(float) * 3 * n), *hi = malloc(sizeof(float) * 3 * n);
+    for (uint32_t i = 0; i < 3 * n; i++) {
+        lo[i] = -1.0f;
+        hi[i] = 1.0f;
+    }
+    Bvh b;
+    char err[256];
+    cr_assert_eq(bvh_build(&p, lo, hi, n, &b, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(bvh_check(&b, lo, hi, err, sizeof err), 0, "%s", err);
+    for (uint32_t i = 0; i < b.nnodes; i++)
+        if (b.nodes[i].count > 0)
+            cr_expect_leq(b.nodes[i].count, (uint32_t)p.max_leaf_size);
+    bvh_free(&b);
+    free(lo);
+    free(hi);
+}
+
+Test(bvh_build, flat_and_single_primitive)
+{
+    BvhParams p;
+    bvh_default_params(&p);
+    /* Zero-thickness boxes (an axis-aligned plane of triangles) and a single primitive. */
+    uint32_t n = 64;
+    float lo[3 * 64], hi[3 * 64];
+    for (uint32_t i = 0; i < n; i++) {
+        lo[3 * i] = (float)(i % 8);
+        hi[3 * i] = (float)(i % 8) + 1.0f;
+        lo[3 * i + 1] = hi[3 * i + 1] = 0.0f;
+        lo[3 * i + 2] = (float)(i / 8);
+        hi[3 * i + 2] = (float)(i / 8) + 1.0f;
+    }
+    Bvh b;
+    char err[256];
+    cr_assert_eq(bvh_build(&p, lo, hi, n, &b, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(bvh_check(&b, lo, hi, err, sizeof err), 0, "%s", err);
+    cr_expect_gt(b.nleaves, 1u);
+    bvh_free(&b);
+    cr_assert_eq(bvh_build(&p, lo, hi, 1, &b, err, sizeof err), 0, "%s", err);
+    cr_expect_eq(b.nnodes, 1u);
+    cr_expect_eq(b.nodes[0].count, 1u);
+    bvh_free(&b);
+}
+
+Test(bvh_build, deterministic)
+{
+    BvhParams p;
+    bvh_default_params(&p);
+    float *lo, *hi;
+    random_boxes(5000, &lo, &hi);
+    Bvh a, b;
+    char err[256];
+    cr_assert_eq(bvh_build(&p, lo, hi, 5000, &a, err, sizeof err), 0);
+    cr_assert_eq(bvh_build(&p, lo, hi, 5000, &b, err, sizeof err), 0);
+    cr_assert_eq(a.nnodes, b.nnodes);
+    cr_expect_eq(memcmp(a.nodes, b.nodes, sizeof(BvhNode) * a.nnodes), 0);
+    cr_expect_eq(memcmp(a.prim_index, b.prim_index, sizeof(uint32_t) * a.nprims), 0);
+    bvh_free(&a);
+    bvh_free(&b);
+    free(lo);
+    free(hi);
+}
+
+Test(bvh_errors, nan_box_rejected)
+{
+    BvhParams p;
+    bvh_default_params(&p);
+    float lo[6] = {0, 0, 0, 0, NAN, 0}, hi[6] = {1, 1, 1, 1, 1, 1};
+    Bvh b;
+    char err[256];
+    cr_assert_eq(bvh_build(&p, lo, hi, 2, &b, err, sizeof err), -1);
+    cr_expect_str_eq(err, "bvh: primitive 1 has a bad box on axis 1: [nan, 1]");
+    p.bins = 1;
+    cr_assert_eq(bvh_build(&p, lo, hi, 1, &b, err, sizeof err), -1);
+    cr_expect(strstr(err, "bad parameters") != NULL, "%s", err);
+}
+
+Test(bvh_errors, checker_catches_broken_trees)
+{
+    BvhParams p;
+    bvh_default_params(&p);
+    float *lo, *hi;
+    random_boxes(1000, &lo, &hi);
+    Bvh b;
+    char err[256];
+    cr_assert_eq(bvh_build(&p, lo, hi, 1000, &b, err, sizeof err), 0);
+    /* A primitive listed twice in one leaf (and so another missing). */
+    uint32_t leaf = 0;
+    while (b.nodes[leaf].count < 2)
+        leaf++;
+    uint32_t f = b.nodes[leaf].first, saved = b.prim_index[f + 1];
+    b.prim_index[f + 1] = b.prim_index[f];
+    cr_expect_eq(bvh_check(&b, lo, hi, err, sizeof err), -1);
+    cr_expect(strstr(err, "listed twice") != NULL, "%s", err);
+    b.prim_index[f + 1] = saved;
+    /* A primitive outside its leaf's box. */
+    uint32_t pi = b.prim_index[f];
+    float oldlo = lo[3 * pi];
+    lo[3 * pi] = b.nodes[leaf].bmin[0] - 1.0f;
+    cr_expect_eq(bvh_check(&b, lo, hi, err, sizeof err), -1);
+    cr_expect(strstr(err, "sticks out of leaf") != NULL, "%s", err);
+    lo[3 * pi] = oldlo;
+    /* A child that sticks out of its parent. */
+    uint32_t c = b.nodes[0].first;
+    float old = b.nodes[c].bmax[0];
+    b.nodes[c].bmax[0] = b.nodes[0].bmax[0] + 1.0f;
+    cr_expect_eq(bvh_check(&b, lo, hi, err, sizeof err), -1);
+    cr_expect(strstr(err, "sticks out") != NULL, "%s", err);
+    b.nodes[c].bmax[0] = old;
+    cr_expect_eq(bvh_check(&b, lo, hi, err, sizeof err), 0, "%s", err);
+    bvh_free(&b);
+    free(lo);
+    free(hi);
+}
