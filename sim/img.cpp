@@ -1,0 +1,104 @@
+// sim/img.cpp -- the OpenImageIO shim: the only place sfsim touches image files.
+//
+// Owns: writing and reading image files through OpenImageIO. Must not: compute statistics or
+// tone-map beyond the display transfer documented in img.h (that stays in C where it is tested).
+#include <OpenImageIO/imageio.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+extern "C" {
+#include "img.h"
+}
+
+namespace {
+
+int fail(char *err, size_t errlen, const char *path, const std::string &why)
+{
+    std::snprintf(err, errlen, "%s: %s", path, why.empty() ? "image error" : why.c_str());
+    return -1;
+}
+
+int write_image(const char *path, int w, int h, OIIO::TypeDesc type, const void *pixels,
+                char *err, size_t errlen)
+{
+    if (w <= 0 || h <= 0)
+        return fail(err, errlen, path, "image size must be positive");
+    auto out = OIIO::ImageOutput::create(path);
+    if (!out)
+        return fail(err, errlen, path, "no image writer for this file name: " + OIIO::geterror());
+    OIIO::ImageSpec spec(w, h, 3, type);
+    if (!out->open(path, spec))
+        return fail(err, errlen, path, out->geterror());
+    if (!out->write_image(type, pixels) || !out->close())
+        return fail(err, errlen, path, out->geterror());
+    return 0;
+}
+
+float srgb_encode(float x)
+{
+    return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
+}
+
+} // namespace
+
+extern "C" int img_write_linear(const char *path, const float *rgb, int width, int height,
+                                char *err, size_t errlen)
+{
+    return write_image(path, width, height, OIIO::TypeDesc::FLOAT, rgb, err, errlen);
+}
+
+extern "C" int img_write_display(const char *path, const float *rgb, int width, int height,
+                                 float exposure, char *err, size_t errlen)
+{
+    std::vector<unsigned char> px((size_t)width * height * 3);
+    for (size_t i = 0; i < px.size(); i += 3) {
+        bool bad = !std::isfinite(rgb[i]) || !std::isfinite(rgb[i + 1]) || !std::isfinite(rgb[i + 2]);
+        for (int c = 0; c < 3; c++) {
+            float v = bad ? (c == 1 ? 0.0f : 1.0f) : std::fmin(std::fmax(rgb[i + c] * exposure, 0.0f), 1.0f);
+            px[i + c] = (unsigned char)std::lround((bad ? v : srgb_encode(v)) * 255.0f);
+        }
+    }
+    return write_image(path, width, height, OIIO::TypeDesc::UINT8, px.data(), err, errlen);
+}
+
+extern "C" int img_write_rgb8(const char *path, const float *rgb, int width, int height,
+                              char *err, size_t errlen)
+{
+    std::vector<unsigned char> px((size_t)width * height * 3);
+    for (size_t i = 0; i < px.size(); i++) {
+        float v = std::isfinite(rgb[i]) ? std::fmin(std::fmax(rgb[i], 0.0f), 1.0f) : 0.0f;
+        px[i] = (unsigned char)std::lround(v * 255.0f);
+    }
+    return write_image(path, width, height, OIIO::TypeDesc::UINT8, px.data(), err, errlen);
+}
+
+extern "C" int img_read(const char *path, float **rgb, int *width, int *height, char *err,
+                        size_t errlen)
+{
+    *rgb = nullptr;
+    auto in = OIIO::ImageInput::open(path);
+    if (!in)
+        return fail(err, errlen, path, OIIO::geterror());
+    const OIIO::ImageSpec &spec = in->spec();
+    int w = spec.width, h = spec.height, nc = spec.nchannels;
+    if (w <= 0 || h <= 0 || nc <= 0)
+        return fail(err, errlen, path, "empty image");
+    std::vector<float> all((size_t)w * h * nc);
+    if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, all.data()))
+        return fail(err, errlen, path, in->geterror());
+    in->close();
+    float *out = (float *)std::malloc(sizeof(float) * 3 * (size_t)w * h);
+    if (!out)
+        return fail(err, errlen, path, "out of memory");
+    for (size_t p = 0; p < (size_t)w * h; p++)
+        for (int c = 0; c < 3; c++)
+            out[3 * p + c] = all[p * nc + (nc >= 3 ? c : 0)];
+    *rgb = out;
+    *width = w;
+    *height = h;
+    return 0;
+}

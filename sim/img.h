@@ -1,0 +1,39 @@
+/* sim/img.h -- images in and out (through OpenImageIO, in sim/img.cpp) and image comparison
+ * (sim/img_compare.c).
+ *
+ * Owns: file formats, tone mapping for display images, comparison statistics.
+ * Must not: render or know about the simulated machine.
+ *
+ * Pixels are float RGB, row-major, top row first, linear radiance unless said otherwise.
+ */
+#ifndef SFSIM_IMG_H
+#define SFSIM_IMG_H
+
+#include <stddef.h>
+
+/* Write linear float RGB as-is (an EXR keeps full float precision). */
+int img_write_linear(const char *path, const float *rgb, int width, int height, char *err,
+                     size_t errlen);
+/* Write a display image (PNG, JPEG, ...): value x exposure, clamped to [0, 1], sRGB-encoded,
+ * 8 bits per channel; NaN pixels become magenta so they cannot hide. */
+int img_write_display(const char *path, const float *rgb, int width, int height, float exposure,
+                      char *err, size_t errlen);
+/* Write already display-ready RGB in [0, 1] (a heat map, say) as 8-bit without any transfer. */
+int img_write_rgb8(const char *path, const float *rgb, int width, int height, char *err,
+                   size_t errlen);
+/* Read any format OpenImageIO knows into float RGB (*rgb malloc'ed; grey is replicated, alpha
+ * dropped). Values are as stored: linear for EXR, encoded 0..1 for PNG. */
+int img_read(const char *path, float **rgb, int *width, int *height, char *err, size_t errlen);
+
+typedef struct ImgCompare {
+    double rmse;          /* over all channels of finite pixel pairs */
+    double psnr;          /* dB, peak 1.0; INFINITY when identical */
+    double max_abs;       /* largest channel difference */
+    double mean_a, mean_b;/* image means (finite values) */
+    long nan_a, nan_b;    /* channel values that are NaN or Inf */
+} ImgCompare;
+
+/* Compare two images of the same size. */
+void img_compare(const float *a, const float *b, int width, int height, ImgCompare *out);
+
+#endif
