@@ -93,15 +93,21 @@ bin/sfsim: $(BUILD)/obj/sim/main.o $(BUILD)/libsfsim.a
 $(BUILD)/gen_isadoc: tools/gen_isadoc.c $(BUILD)/libsfasm.a
 	$(CC) $(CFLAGS) $^ -o $@ -lm
 
-docs: $(BUILD)/gen_isadoc
+$(BUILD)/gen_layout: tools/gen_layout.c scenes/layout.def
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) tools/gen_layout.c -o $@
+
+docs: $(BUILD)/gen_isadoc $(BUILD)/gen_layout
 	$(BUILD)/gen_isadoc > docs/isa.md
+	$(BUILD)/gen_layout inc > kernels/lib/layout.inc
+	$(BUILD)/gen_layout md > docs/scene-memory.md
 
 # ---- tests ----------------------------------------------------------------------------------
-$(BUILD)/tests/unit: $(TEST_SRC) $(BUILD)/libsfsim.a $(BUILD)/gen_isadoc
+$(BUILD)/tests/unit: $(TEST_SRC) $(BUILD)/libsfsim.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
 
-$(BUILD)/tests/unit-asan: $(TEST_SRC) $(BUILD)/libsfsim-asan.a $(BUILD)/gen_isadoc
+$(BUILD)/tests/unit-asan: $(TEST_SRC) $(BUILD)/libsfsim-asan.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(SAN) $(TEST_SRC) $(BUILD)/libsfsim-asan.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
 

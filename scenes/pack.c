@@ -1,0 +1,324 @@
+/* scenes/pack.c -- writes a Scene and its BVH into the scene-memory layout of layout.def.
+ *
+ * Owns: the packed byte image and the host-side precomputation stored in it (camera vectors,
+ * light records, sRGB table). Must not: decide anything a reader could disagree with: every
+ * value the golden model and the kernels need is computed here once, in one place.
+ */
+#include "pack.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+typedef struct Writer {
+    uint8_t *mem;
+    size_t size, cap;
+    uint32_t base;
+    int oom;
+} Writer;
+
+/* Reserve n words aligned to 64 bytes; returns the scene-memory address. */
+static uint32_t w_alloc(Writer *w, size_t words)
+{
+    size_t off = (w->size + 63) & ~(size_t)63;
+    size_t need = off + 4 * words;
+    if (need > w->cap) {
+        size_t cap = w->cap ? w->cap : 4096;
+        while (cap < need)
+            cap *= 2;
+        uint8_t *m = realloc(w->mem, cap);
+        if (!m) {
+            w->oom = 1;
+            return 0;
+        }
+        memset(m + w->cap, 0, cap - w->cap);
+        w->mem = m;
+        w->cap = cap;
+    }
+    w->size = need;
+    return w->base + (uint32_t)off;
+}
+
+static void put_u32(Writer *w, uint32_t addr, uint32_t v) { memcpy(w->mem + (addr - w->base), &v, 4); }
+static void put_f32(Writer *w, uint32_t addr, float v) { memcpy(w->mem + (addr - w->base), &v, 4); }
+static void put_vec(Writer *w, uint32_t addr, const float *v, int n)
+{
+    for (int i = 0; i < n; i++)
+        put_f32(w, addr + 4u * (uint32_t)i, v[i]);
+}
+
+static uint32_t hdr(uint32_t base, int field) { return base + 4u * (uint32_t)field; }
+
+static uint8_t srgb_encode8(float lin)
+{
+    float x = lin <= 0.0f ? 0.0f : (lin >= 1.0f ? 1.0f : lin);
+    float e = x <= 0.0031308f ? 12.92f * x : 1.055f * powf(x, 1.0f / 2.4f) - 0.055f;
+    return (uint8_t)lrintf(e * 255.0f);
+}
+
+static float srgb_decode8(int code)
+{
+    float c = (float)code / 255.0f;
+    return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
+}
+
+static void camera(const Scene *s, float *cw, float *cu, float *cv, float *lu, float *lv)
+{
+    const SceneCamera *c = &s->camera;
+    double f[3], up[3] = {c->up[0], c->up[1], c->up[2]}, r[3], u[3];
+    double dist = 0.0;
+    for (int k = 0; k < 3; k++) {
+        f[k] = (double)c->look_at[k] - c->position[k];
+        dist += f[k] * f[k];
+    }
+    dist = sqrt(dist);
+    for (int k = 0; k < 3; k++)
+        f[k] /= dist;
+    r[0] = f[1] * up[2] - f[2] * up[1];
+    r[1] = f[2] * up[0] - f[0] * up[2];
+    r[2] = f[0] * up[1] - f[1] * up[0];
+    double rl = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+    for (int k = 0; k < 3; k++)
+        r[k] /= rl;
+    u[0] = r[1] * f[2] - r[2] * f[1];
+    u[1] = r[2] * f[0] - r[0] * f[2];
+    u[2] = r[0] * f[1] - r[1] * f[0];
+    double d = c->focus_distance > 0.0f ? c->focus_distance : dist;
+    double h = tan(0.5 * c->fov_y * M_PI / 180.0) * d;
+    double wdt = h * (double)s->render.width / (double)s->render.height;
+    double lens = 0.5 * c->aperture;
+    for (int k = 0; k < 3; k++) {
+        cw[k] = (float)(f[k] * d);
+        cu[k] = (float)(r[k] * 2.0 * wdt);
+        cv[k] = (float)(u[k] * 2.0 * h);
+        lu[k] = (float)(r[k] * lens);
+        lv[k] = (float)(u[k] * lens);
+    }
+}
+
+static float tri_area(const float *p)
+{
+    float e1[3], e2[3];
+    for (int k = 0; k < 3; k++) {
+        e1[k] = p[3 + k] - p[k];
+        e2[k] = p[6 + k] - p[k];
+    }
+    float cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2],
+          cz = e1[0] * e2[1] - e1[1] * e2[0];
+    return 0.5f * sqrtf(cx * cx + cy * cy + cz * cz);
+}
+
+int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *out, char *err,
+               size_t errlen)
+{
+    memset(out, 0, sizeof *out);
+    if (base % 64) {
+        snprintf(err, errlen, "pack: base address 0x%x is not a multiple of 64", base);
+        return -1;
+    }
+    uint32_t nprims = s->ntris + s->nspheres;
+    float *lo = malloc(sizeof(float) * 3 * (nprims ? nprims : 1));
+    float *hi = malloc(sizeof(float) * 3 * (nprims ? nprims : 1));
+    if (!lo || !hi) {
+        free(lo);
+        free(hi);
+        snprintf(err, errlen, "pack: out of memory");
+        return -1;
+    }
+    for (uint32_t i = 0; i < s->ntris; i++) {
+        const float *p = &s->pos[9 * i];
+        for (int k = 0; k < 3; k++) {
+            lo[3 * i + k] = fminf(p[k], fminf(p[3 + k], p[6 + k]));
+            hi[3 * i + k] = fmaxf(p[k], fmaxf(p[3 + k], p[6 + k]));
+        }
+    }
+    for (uint32_t j = 0; j < s->nspheres; j++) {
+        const SceneSphere *sp = &s->spheres[j];
+        for (int k = 0; k < 3; k++) {
+            lo[3 * (s->ntris + j) + k] = sp->center[k] - sp->radius;
+            hi[3 * (s->ntris + j) + k] = sp->center[k] + sp->radius;
+        }
+    }
+    int rc = bvh_build(bp, lo, hi, nprims, &out->bvh, err, errlen);
+    free(lo);
+    free(hi);
+    if (rc)
+        return -1;
+
+    /* Emissive triangles and file lights become light records. */
+    uint32_t nlights = s->nlights + s->nemissive;
+    Writer w = {NULL, 0, 0, base, 0};
+    uint32_t h = w_alloc(&w, SM_HDR_WORDS);
+    uint32_t nodes = w_alloc(&w, (size_t)SM_NODE_WORDS * out->bvh.nnodes);
+    uint32_t prims = w_alloc(&w, (size_t)SM_PRIM_WORDS * nprims);
+    uint32_t mats = w_alloc(&w, (size_t)SM_MAT_WORDS * s->nmaterials);
+    uint32_t texs = w_alloc(&w, (size_t)SM_TEX_WORDS * s->ntextures);
+    uint32_t lights = w_alloc(&w, (size_t)SM_LIGHT_WORDS * nlights);
+    uint32_t normals = s->nrm ? w_alloc(&w, (size_t)9 * s->ntris) : 0;
+    uint32_t uvs = s->uv ? w_alloc(&w, (size_t)6 * s->ntris) : 0;
+    uint32_t lut = w_alloc(&w, 256);
+    uint32_t *texels = calloc(s->ntextures ? s->ntextures : 1, sizeof(uint32_t));
+    for (uint32_t t = 0; texels && t < s->ntextures; t++)
+        texels[t] = w_alloc(&w, (size_t)s->textures[t].width * (size_t)s->textures[t].height);
+    if (w.oom || !texels || w.size > (size_t)UINT32_MAX - base) {
+        snprintf(err, errlen, "pack: scene does not fit in memory (%zu bytes)", w.size);
+        free(texels);
+        free(w.mem);
+        bvh_free(&out->bvh);
+        return -1;
+    }
+
+    put_u32(&w, hdr(h, SM_HDR_MAGIC), SM_MAGIC);
+    put_u32(&w, hdr(h, SM_HDR_VERSION), SM_VERSION);
+    put_u32(&w, hdr(h, SM_HDR_NPRIMS), nprims);
+    put_u32(&w, hdr(h, SM_HDR_NNODES), out->bvh.nnodes);
+    put_u32(&w, hdr(h, SM_HDR_NMATS), s->nmaterials);
+    put_u32(&w, hdr(h, SM_HDR_NTEX), s->ntextures);
+    put_u32(&w, hdr(h, SM_HDR_NLIGHTS), nlights);
+    put_u32(&w, hdr(h, SM_HDR_NODES), nodes);
+    put_u32(&w, hdr(h, SM_HDR_PRIMS), prims);
+    put_u32(&w, hdr(h, SM_HDR_MATS), mats);
+    put_u32(&w, hdr(h, SM_HDR_TEXS), texs);
+    put_u32(&w, hdr(h, SM_HDR_LIGHTS), lights);
+    put_u32(&w, hdr(h, SM_HDR_NORMALS), normals);
+    put_u32(&w, hdr(h, SM_HDR_UVS), uvs);
+    put_u32(&w, hdr(h, SM_HDR_SRGB_LUT), lut);
+    put_u32(&w, hdr(h, SM_HDR_WIDTH), (uint32_t)s->render.width);
+    put_u32(&w, hdr(h, SM_HDR_HEIGHT), (uint32_t)s->render.height);
+    put_u32(&w, hdr(h, SM_HDR_SPP), (uint32_t)s->render.spp);
+    put_u32(&w, hdr(h, SM_HDR_MAX_DEPTH), (uint32_t)s->render.max_depth);
+    put_vec(&w, hdr(h, SM_HDR_BACKGROUND), s->render.background, 3);
+    put_vec(&w, hdr(h, SM_HDR_AMBIENT), s->render.ambient, 3);
+    put_vec(&w, hdr(h, SM_HDR_CAM_POS), s->camera.position, 3);
+    float cw[3], cu[3], cv[3], lu[3], lv[3];
+    camera(s, cw, cu, cv, lu, lv);
+    put_vec(&w, hdr(h, SM_HDR_CAM_W), cw, 3);
+    put_vec(&w, hdr(h, SM_HDR_CAM_U), cu, 3);
+    put_vec(&w, hdr(h, SM_HDR_CAM_V), cv, 3);
+    put_vec(&w, hdr(h, SM_HDR_LENS_U), lu, 3);
+    put_vec(&w, hdr(h, SM_HDR_LENS_V), lv, 3);
+    float eps = 0.0f;
+    for (int k = 0; k < 3; k++)
+        eps = fmaxf(eps, fmaxf(fabsf(s->bounds_min[k]), fabsf(s->bounds_max[k])));
+    put_f32(&w, hdr(h, SM_HDR_EPSILON), eps);
+    put_u32(&w, hdr(h, SM_HDR_NEEDS), s->needs);
+    put_vec(&w, hdr(h, SM_HDR_BOUNDS_MIN), s->bounds_min, 3);
+    put_vec(&w, hdr(h, SM_HDR_BOUNDS_MAX), s->bounds_max, 3);
+
+    for (uint32_t i = 0; i < out->bvh.nnodes; i++) {
+        const BvhNode *n = &out->bvh.nodes[i];
+        put_vec(&w, sm_rec(nodes, SM_NODE_WORDS, i, SM_NODE_BMIN), n->bmin, 3);
+        put_vec(&w, sm_rec(nodes, SM_NODE_WORDS, i, SM_NODE_BMAX), n->bmax, 3);
+        put_u32(&w, sm_rec(nodes, SM_NODE_WORDS, i, SM_NODE_FIRST), n->first);
+        put_u32(&w, sm_rec(nodes, SM_NODE_WORDS, i, SM_NODE_INFO),
+                n->count > 0 ? n->count : (SM_NODE_INNER | n->axis));
+    }
+    /* Primitives in leaf order, so a leaf's primitives are one contiguous run. */
+    for (uint32_t i = 0; i < nprims; i++) {
+        uint32_t src = out->bvh.prim_index[i];
+        if (src < s->ntris) {
+            put_vec(&w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_V0), &s->pos[9 * src], 9);
+            put_u32(&w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_MAT), s->tri_material[src]);
+            put_u32(&w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_KIND), 0);
+            put_u32(&w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_SRC), src);
+        } else {
+            const SceneSphere *sp = &s->spheres[src - s->ntris];
+            put_vec(&w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_V0), sp->center, 3);
+            put_f32(&w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_V1), sp->radius);
+            put_u32(&w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_MAT), (uint32_t)sp->material);
+            put_u32(&w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_KIND), 1);
+            put_u32(&w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_SRC), src - s->ntris);
+        }
+    }
+    for (uint32_t i = 0; i < s->nmaterials; i++) {
+        const SceneMaterial *m = &s->materials[i];
+        put_u32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_KIND), (uint32_t)m->kind);
+        put_vec(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_BASE), m->base_color, 3);
+        put_u32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_TEX), (uint32_t)m->base_texture);
+        put_f32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_ROUGHNESS), m->roughness);
+        put_f32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_METALLIC), m->metallic);
+        put_f32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_IOR), m->ior);
+        put_vec(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_EMISSION), m->emission, 3);
+        put_u32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_ALPHA_MODE), (uint32_t)m->alpha_mode);
+        put_f32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_ALPHA_CUT), m->alpha_cutoff);
+        put_f32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_ALPHA), m->alpha);
+        put_f32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_TRANSMISSION), m->transmission);
+    }
+    for (uint32_t t = 0; t < s->ntextures; t++) {
+        const SceneTexture *tx = &s->textures[t];
+        put_u32(&w, sm_rec(texs, SM_TEX_WORDS, t, SM_TEX_WIDTH), (uint32_t)tx->width);
+        put_u32(&w, sm_rec(texs, SM_TEX_WORDS, t, SM_TEX_HEIGHT), (uint32_t)tx->height);
+        put_u32(&w, sm_rec(texs, SM_TEX_WORDS, t, SM_TEX_TEXELS), texels[t]);
+        size_t n = (size_t)tx->width * (size_t)tx->height;
+        for (size_t i = 0; i < n; i++) {
+            const float *c = &tx->rgba[4 * i];
+            float a = c[3] <= 0.0f ? 0.0f : (c[3] >= 1.0f ? 1.0f : c[3]);
+            uint32_t word = (uint32_t)srgb_encode8(c[0]) | (uint32_t)srgb_encode8(c[1]) << 8 |
+                            (uint32_t)srgb_encode8(c[2]) << 16 | (uint32_t)lrintf(a * 255.0f) << 24;
+            put_u32(&w, texels[t] + 4u * (uint32_t)i, word);
+        }
+    }
+    free(texels);
+    uint32_t li = 0;
+    for (uint32_t i = 0; i < s->nlights; i++, li++) {
+        const SceneLight *l = &s->lights[i];
+        float rad[3] = {l->color[0] * l->intensity, l->color[1] * l->intensity, l->color[2] * l->intensity};
+        uint32_t kind = l->kind == SCENE_LIGHT_POINT ? SM_LIGHT_POINT
+                      : l->kind == SCENE_LIGHT_SPOT ? SM_LIGHT_SPOT
+                      : l->kind == SCENE_LIGHT_DIRECTIONAL ? SM_LIGHT_DIRECTIONAL : SM_LIGHT_QUAD;
+        put_u32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_KIND), kind);
+        put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_RADIANCE), rad, 3);
+        if (kind == SM_LIGHT_DIRECTIONAL) {
+            put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_P), l->direction, 3);
+        } else {
+            put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_P), l->position, 3);
+        }
+        if (kind == SM_LIGHT_SPOT) {
+            put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_E1), l->direction, 3);
+            put_f32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_COS_INNER), cosf(l->inner_cone));
+            put_f32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_COS_OUTER), cosf(l->outer_cone));
+        }
+        if (kind == SM_LIGHT_QUAD) {
+            put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_E1), l->edge_u, 3);
+            put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_E2), l->edge_v, 3);
+            float cx = l->edge_u[1] * l->edge_v[2] - l->edge_u[2] * l->edge_v[1];
+            float cy = l->edge_u[2] * l->edge_v[0] - l->edge_u[0] * l->edge_v[2];
+            float cz = l->edge_u[0] * l->edge_v[1] - l->edge_u[1] * l->edge_v[0];
+            put_f32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_AREA), sqrtf(cx * cx + cy * cy + cz * cz));
+        }
+    }
+    for (uint32_t e = 0; e < s->nemissive; e++, li++) {
+        uint32_t t = s->emissive_tris[e];
+        const float *p = &s->pos[9 * t];
+        float e1[3] = {p[3] - p[0], p[4] - p[1], p[5] - p[2]}, e2[3] = {p[6] - p[0], p[7] - p[1], p[8] - p[2]};
+        put_u32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_KIND), SM_LIGHT_TRIANGLE);
+        put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_P), p, 3);
+        put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_E1), e1, 3);
+        put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_E2), e2, 3);
+        put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_RADIANCE),
+                s->materials[s->tri_material[t]].emission, 3);
+        put_f32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_AREA), tri_area(p));
+    }
+    if (normals)
+        for (uint32_t i = 0; i < 9 * s->ntris; i++)
+            put_f32(&w, normals + 4 * i, s->nrm[i]);
+    if (uvs)
+        for (uint32_t i = 0; i < 6 * s->ntris; i++)
+            put_f32(&w, uvs + 4 * i, s->uv[i]);
+    for (int c = 0; c < 256; c++)
+        put_f32(&w, lut + 4u * (uint32_t)c, srgb_decode8(c));
+
+    out->mem = w.mem;
+    out->size = (uint32_t)w.size;
+    out->base = base;
+    out->nprims = nprims;
+    out->nlights = nlights;
+    return 0;
+}
+
+void pack_free(PackedScene *p)
+{
+    free(p->mem);
+    bvh_free(&p->bvh);
+    memset(p, 0, sizeof *p);
+}

@@ -1,0 +1,70 @@
+/* scenes/pack.h -- packing a loaded scene and its BVH into simulated scene memory.
+ *
+ * Owns: the byte image of a scene in scene memory, laid out per scenes/layout.def.
+ * Must not: load files or execute anything; readers (golden model, kernels) use the layout
+ * constants below, never their own offsets.
+ */
+#ifndef SFSIM_PACK_H
+#define SFSIM_PACK_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "bvh.h"
+#include "scene.h"
+
+/* Word offsets and record sizes: SM_HDR_WORDS, SM_HDR_MAGIC, SM_NODE_BMIN, ... */
+enum {
+#define SM_RECORD(rec, words, desc) SM_##rec##_WORDS = (words),
+#define SM_FIELD(rec, name, word, count, type, desc) SM_##rec##_##name = (word),
+#include "layout.def"
+#undef SM_RECORD
+#undef SM_FIELD
+};
+
+#define SM_MAGIC 0x4D534653u
+#define SM_VERSION 1u
+#define SM_NODE_INNER 0x80000000u
+
+typedef enum SmLightKind {
+    SM_LIGHT_POINT = 0, SM_LIGHT_SPOT = 1, SM_LIGHT_DIRECTIONAL = 2, SM_LIGHT_QUAD = 3,
+    SM_LIGHT_TRIANGLE = 4
+} SmLightKind;
+
+typedef struct PackedScene {
+    uint8_t *mem;        /* the packed bytes; address `base` of scene memory is mem[0] */
+    uint32_t size;       /* bytes */
+    uint32_t base;       /* scene-memory byte address of the header */
+    Bvh bvh;             /* the tree that was packed (node i = packed node i) */
+    uint32_t nprims;     /* triangles + spheres */
+    uint32_t nlights;
+} PackedScene;
+
+/* Pack s with a BVH built by bp, for loading at scene-memory address base (a multiple of 64).
+ * 0, or -1 with a message (for instance a scene that does not fit 4 GiB of addresses). */
+int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *out, char *err,
+               size_t errlen);
+void pack_free(PackedScene *p);
+
+/* Readers of packed words (addresses are scene-memory byte addresses). */
+static inline uint32_t sm_u32(const PackedScene *p, uint32_t addr)
+{
+    uint32_t v;
+    memcpy(&v, p->mem + (addr - p->base), 4);
+    return v;
+}
+static inline float sm_f32(const PackedScene *p, uint32_t addr)
+{
+    float v;
+    memcpy(&v, p->mem + (addr - p->base), 4);
+    return v;
+}
+/* Address of word `field` of header / record `i` of an array. */
+static inline uint32_t sm_hdr(const PackedScene *p, int field) { return p->base + 4u * (uint32_t)field; }
+static inline uint32_t sm_rec(uint32_t array, uint32_t words, uint32_t i, int field)
+{
+    return array + 4u * (words * i + (uint32_t)field);
+}
+
+#endif
