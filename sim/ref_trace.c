@@ -1,0 +1,255 @@
+/* sim/ref_trace.c -- the golden model's ray/box, ray/triangle and ray/sphere tests and its BVH
+ * traversal over a packed scene.
+ *
+ * Owns: the reference arithmetic for ray queries. Every expression is binary32 and evaluated in
+ * the order written (the build uses ISO C mode, so no contraction into fused multiply-adds),
+ * with the ISA's min/max NaN rule, so the assembly kernels can reproduce each value with the
+ * same sequence of instructions. Must not: shade, sample or allocate per query in the common
+ * case.
+ */
+#include "ref_trace.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+
+/* Conservative far bound for the slab test: 1 + 2 gamma(3) with gamma(n) = n eps / (1 - n eps)
+ * (Ize, "Robust BVH Ray Traversal", JCGT 2013), so rounding in the slab distances cannot make a
+ * ray miss a box it touches. */
+#define REF_SLAB_FAR_SCALE 1.00000072f
+
+void ref_sanitize_dir(float *dir)
+{
+    for (int k = 0; k < 3; k++)
+        if (fabsf(dir[k]) < FLT_MIN)
+            dir[k] = copysignf(FLT_MIN, dir[k]);
+}
+
+void ref_inv_dir(const float *dir, float *inv)
+{
+    for (int k = 0; k < 3; k++)
+        inv[k] = 1.0f / dir[k];
+}
+
+int ref_hit_box(const float *bmin, const float *bmax, const float *org, const float *inv_dir,
+                float tmax)
+{
+    float tn = 0.0f, tf = tmax;
+    for (int k = 0; k < 3; k++) {
+        /* inv_dir is finite (sanitized directions), so no 0 x inf = NaN can arise here. */
+        float t0 = (bmin[k] - org[k]) * inv_dir[k];
+        float t1 = (bmax[k] - org[k]) * inv_dir[k];
+        float lo = ref_fmin(t0, t1);
+        float hi = ref_fmax(t0, t1) * REF_SLAB_FAR_SCALE;
+        tn = ref_fmax(tn, lo);
+        tf = ref_fmin(tf, hi);
+    }
+    return tn <= tf;
+}
+
+/* Watertight ray/triangle test after Woop, Benthin and Wald, "Watertight Ray/Triangle
+ * Intersection", JCGT 2(1), 2013: shear and scale so the ray runs along +z from the origin,
+ * then 2D edge functions whose signs are computed identically for the two triangles sharing an
+ * edge, so a ray through an edge or vertex hits at least one of them. Edge functions that are
+ * exactly zero count as inside (the conservative choice; the paper's double-precision re-test
+ * is left out because the simulated machine has no doubles: it cannot create leaks, only
+ * report a hit on both triangles of an edge, and the closest-hit tie rule picks one). */
+int ref_hit_triangle(const float *v0, const float *v1, const float *v2, const RefRay *r,
+                     float *t, float *u, float *v)
+{
+    float d[3] = {r->dir[0], r->dir[1], r->dir[2]};
+    ref_sanitize_dir(d);
+    float ax = fabsf(d[0]), ay = fabsf(d[1]), az = fabsf(d[2]);
+    int kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
+    int kx = kz == 2 ? 0 : kz + 1;
+    int ky = kx == 2 ? 0 : kx + 1;
+    if (d[kz] < 0.0f) { /* keep the winding, so the sign of det means the same side */
+        int tmp = kx;
+        kx = ky;
+        ky = tmp;
+    }
+    float sx = d[kx] / d[kz], sy = d[ky] / d[kz], sz = 1.0f / d[kz];
+
+    float A[3], B[3], C[3];
+    for (int k = 0; k < 3; k++) {
+        A[k] = v0[k] - r->org[k];
+        B[k] = v1[k] - r->org[k];
+        C[k] = v2[k] - r->org[k];
+    }
+    float Ax = A[kx] - sx * A[kz], Ay = A[ky] - sy * A[kz];
+    float Bx = B[kx] - sx * B[kz], By = B[ky] - sy * B[kz];
+    float Cx = C[kx] - sx * C[kz], Cy = C[ky] - sy * C[kz];
+    float U = Cx * By - Cy * Bx;
+    float V = Ax * Cy - Ay * Cx;
+    float W = Bx * Ay - By * Ax;
+    if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f))
+        return 0;
+    float det = U + V + W;
+    if (det == 0.0f)
+        return 0;
+    float Az = sz * A[kz], Bz = sz * B[kz], Cz = sz * C[kz];
+    float T = U * Az + V * Bz + W * Cz;
+    if (det < 0.0f) { /* seen from behind: flip signs so the range test below holds for both */
+        T = -T;
+        det = -det;
+        U = -U;
+        V = -V;
+        W = -W;
+    }
+    if (!(T > 0.0f) || !(T < r->tmax * det))
+        return 0;
+    float rcp = 1.0f / det;
+    *t = T * rcp;
+    *u = V * rcp;
+    *v = W * rcp;
+    return *t > 0.0f && *t < r->tmax;
+}
+
+/* Ray/sphere with the discriminant computed from the closest-approach vector (Haines,
+ * Guenther and Akenine-Moeller, "Precision Improvements for Ray/Sphere Intersection", Ray
+ * Tracing Gems, 2019), which keeps small spheres far away from losing all precision. */
+int ref_hit_sphere(const float *center, float radius, const RefRay *r, float *t)
+{
+    float d[3] = {r->dir[0], r->dir[1], r->dir[2]};
+    ref_sanitize_dir(d);
+    float oc[3] = {r->org[0] - center[0], r->org[1] - center[1], r->org[2] - center[2]};
+    float a = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    if (!(a > 0.0f))
+        return 0;
+    float b = -(oc[0] * d[0] + oc[1] * d[1] + oc[2] * d[2]); /* a x closest-approach parameter */
+    float s = b / a;
+    float l[3] = {oc[0] + s * d[0], oc[1] + s * d[1], oc[2] + s * d[2]};
+    float r2 = radius * radius;
+    float disc = a * (r2 - (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]));
+    if (disc < 0.0f)
+        return 0;
+    float c = (oc[0] * oc[0] + oc[1] * oc[1] + oc[2] * oc[2]) - r2;
+    float q = b + copysignf(sqrtf(disc), b);
+    if (q == 0.0f)
+        return 0;
+    float t0 = c / q, t1 = q / a;
+    float lo = ref_fmin(t0, t1), hi = ref_fmax(t0, t1);
+    if (lo > 0.0f && lo < r->tmax) {
+        *t = lo;
+        return 1;
+    }
+    if (hi > 0.0f && hi < r->tmax) {
+        *t = hi;
+        return 1;
+    }
+    return 0;
+}
+
+typedef struct Walk {
+    uint32_t small[256];
+    uint32_t *stack;
+} Walk;
+
+static uint32_t *walk_stack(Walk *w, const PackedScene *p)
+{
+    w->stack = p->bvh.depth + 2 <= 256 ? w->small : malloc(sizeof(uint32_t) * (p->bvh.depth + 2));
+    return w->stack;
+}
+
+static void walk_done(Walk *w)
+{
+    if (w->stack != w->small)
+        free(w->stack);
+}
+
+/* Test primitive i of the packed array; 1 with t/u/v on a hit in (0, r->tmax). */
+static int hit_prim(const PackedScene *p, uint32_t prims, uint32_t i, const RefRay *r, float *t,
+                    float *u, float *v)
+{
+    float g[9];
+    uint32_t a = sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_V0);
+    for (int k = 0; k < 9; k++)
+        g[k] = sm_f32(p, a + 4u * (uint32_t)k);
+    if (sm_u32(p, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_KIND)) == 1) {
+        *u = *v = 0.0f;
+        return ref_hit_sphere(g, g[3], r, t);
+    }
+    return ref_hit_triangle(g, g + 3, g + 6, r, t, u, v);
+}
+
+/* Depth-first walk; closest != 0 keeps searching for the nearest hit, else stops at the first. */
+static int walk(const PackedScene *p, const RefRay *r, RefHit *hit, int closest, RefTraceStats *st)
+{
+    hit->prim = REF_NO_HIT;
+    hit->t = r->tmax;
+    hit->u = hit->v = 0.0f;
+    uint32_t nnodes = sm_u32(p, sm_hdr(p, SM_HDR_NNODES));
+    if (nnodes == 0)
+        return 0;
+    uint32_t nodes = sm_u32(p, sm_hdr(p, SM_HDR_NODES)), prims = sm_u32(p, sm_hdr(p, SM_HDR_PRIMS));
+    RefRay q = *r;
+    ref_sanitize_dir(q.dir);
+    float inv[3];
+    ref_inv_dir(q.dir, inv);
+    Walk w;
+    uint32_t *stack = walk_stack(&w, p);
+    if (!stack)
+        abort(); /* out of memory for a traversal stack: nothing sensible to return */
+    uint32_t sp = 0;
+    stack[sp++] = 0;
+    while (sp > 0) {
+        uint32_t n = stack[--sp];
+        float bmin[3], bmax[3];
+        for (int k = 0; k < 3; k++) {
+            bmin[k] = sm_f32(p, sm_rec(nodes, SM_NODE_WORDS, n, SM_NODE_BMIN + k));
+            bmax[k] = sm_f32(p, sm_rec(nodes, SM_NODE_WORDS, n, SM_NODE_BMAX + k));
+        }
+        if (st) {
+            st->nodes_visited++;
+            st->boxes_tested++;
+        }
+        if (!ref_hit_box(bmin, bmax, q.org, inv, q.tmax))
+            continue;
+        uint32_t info = sm_u32(p, sm_rec(nodes, SM_NODE_WORDS, n, SM_NODE_INFO));
+        uint32_t first = sm_u32(p, sm_rec(nodes, SM_NODE_WORDS, n, SM_NODE_FIRST));
+        if (info & SM_NODE_INNER) {
+            /* Front to back: the right child holds the larger centroids on the split axis. */
+            uint32_t axis = info & 3u;
+            int neg = q.dir[axis] < 0.0f;
+            stack[sp++] = neg ? first : first + 1;
+            stack[sp++] = neg ? first + 1 : first;
+            continue;
+        }
+        for (uint32_t i = first; i < first + info; i++) {
+            float t, u, v;
+            if (st)
+                st->prims_tested++;
+            /* Hits at exactly the best distance are still tested so that the lower primitive
+             * index wins a tie whatever the visiting order. */
+            RefRay probe = q;
+            if (closest && hit->prim != REF_NO_HIT)
+                probe.tmax = nextafterf(q.tmax, INFINITY);
+            if (!hit_prim(p, prims, i, &probe, &t, &u, &v))
+                continue;
+            if (hit->prim == REF_NO_HIT || t < hit->t || (t == hit->t && i < hit->prim)) {
+                hit->t = t;
+                hit->u = u;
+                hit->v = v;
+                hit->prim = i;
+                q.tmax = t;
+            }
+            if (!closest) {
+                walk_done(&w);
+                return 1;
+            }
+        }
+    }
+    walk_done(&w);
+    return hit->prim != REF_NO_HIT;
+}
+
+void ref_closest_hit(const PackedScene *p, const RefRay *r, RefHit *hit, RefTraceStats *stats)
+{
+    walk(p, r, hit, 1, stats);
+}
+
+int ref_any_hit(const PackedScene *p, const RefRay *r, RefTraceStats *stats)
+{
+    RefHit h;
+    return walk(p, r, &h, 0, stats);
+}

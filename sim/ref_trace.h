@@ -1,0 +1,57 @@
+/* sim/ref_trace.h -- the golden model's ray queries over a packed scene: closest hit and any
+ * hit, by BVH traversal with the watertight ray/triangle test and a NaN-safe slab test.
+ *
+ * Owns: the reference arithmetic the assembly kernels must reproduce (docs/golden-model.md):
+ * binary32 only, operations in the order written, min/max with the ISA's NaN rule.
+ * Must not: shade, sample or touch images.
+ */
+#ifndef SFSIM_REF_TRACE_H
+#define SFSIM_REF_TRACE_H
+
+#include <stdint.h>
+
+#include "../scenes/pack.h"
+
+#define REF_NO_HIT 0xFFFFFFFFu
+
+typedef struct RefRay {
+    float org[3], dir[3];
+    float tmax;           /* hits must satisfy 0 < t < tmax */
+} RefRay;
+
+typedef struct RefHit {
+    float t, u, v;        /* distance (in units of |dir|) and barycentrics of v1, v2 (spheres: 0) */
+    uint32_t prim;        /* packed primitive index, or REF_NO_HIT */
+} RefHit;
+
+typedef struct RefTraceStats {
+    uint64_t nodes_visited, boxes_tested, prims_tested;
+} RefTraceStats;
+
+/* Closest hit; ties in t go to the lower primitive index, so the answer does not depend on
+ * traversal order. stats may be NULL. */
+void ref_closest_hit(const PackedScene *p, const RefRay *r, RefHit *hit, RefTraceStats *stats);
+/* Any hit with 0 < t < tmax (occlusion); returns 1 if occluded. */
+int ref_any_hit(const PackedScene *p, const RefRay *r, RefTraceStats *stats);
+
+/* The primitive tests themselves (exposed for the hard-case tests). */
+int ref_hit_triangle(const float *v0, const float *v1, const float *v2, const RefRay *r,
+                     float *t, float *u, float *v);
+int ref_hit_sphere(const float *center, float radius, const RefRay *r, float *t);
+/* Ray directions are sanitized where rays are made: a component with |d| < FLT_MIN (a zero of
+ * either sign, or a denormal) becomes FLT_MIN with d's sign. The ray then is never exactly
+ * parallel to an axis plane: its inverse direction is finite, slab distances never compute
+ * 0 x inf = NaN, and a ray starting on a box face enters or leaves the box as its (tiny) sign
+ * says -- consistently for boxes, triangles and spheres (docs/golden-model.md). The queries
+ * below sanitize their ray themselves, so an unsanitized ray gives the same answer. */
+void ref_sanitize_dir(float *dir);
+void ref_inv_dir(const float *dir, float *inv);   /* 1 / d of a sanitized direction */
+/* Slab test of the ray against a box: 1 if it overlaps [0, tmax]. inv_dir from ref_inv_dir. */
+int ref_hit_box(const float *bmin, const float *bmax, const float *org, const float *inv_dir,
+                float tmax);
+
+/* The ISA's min/max (vfmin/vfmax): the second operand is ignored when it is NaN. */
+static inline float ref_fmin(float b, float c) { return c < b ? c : b; }
+static inline float ref_fmax(float b, float c) { return c > b ? c : b; }
+
+#endif

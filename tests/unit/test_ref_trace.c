@@ -1,0 +1,203 @@
+/* tests/unit/test_ref_trace.c -- the golden model's primitive tests and BVH traversal:
+ * hand-checked cases, the zero-direction and on-slab cases, shared-edge watertightness, and
+ * traversal against brute force over every primitive. */
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../../sim/ref_trace.h"
+
+Test(ref_box, zero_direction_components_and_slab_planes)
+{
+    float bmin[3] = {0, 0, 0}, bmax[3] = {1, 1, 1};
+    float dir[3] = {1.0f, 0.0f, -0.0f};
+    float inv[3];
+    ref_sanitize_dir(dir);
+    ref_inv_dir(dir, inv);
+    cr_expect(isfinite(inv[1]) && isfinite(inv[2]) && signbit(inv[2]), "finite inverse keeps the sign of -0");
+    float org_in[3] = {-1.0f, 0.5f, 0.5f};
+    cr_expect(ref_hit_box(bmin, bmax, org_in, inv, 10.0f));
+    float org_on_plane[3] = {-1.0f, 0.0f, 1.0f}; /* exactly on the y = 0 and z = 1 faces */
+    /* y = +0 on the y = 0 face and z = -0 on the z = 1 face: both point into the box. */
+    cr_expect(ref_hit_box(bmin, bmax, org_on_plane, inv, 10.0f), "ray on a face plane, pointing in");
+    float dneg[3] = {1.0f, -0.0f, 0.0f}, invneg[3];
+    ref_sanitize_dir(dneg);
+    ref_inv_dir(dneg, invneg);
+    cr_expect_not(ref_hit_box(bmin, bmax, org_on_plane, invneg, 10.0f),
+                  "signs of zero swapped: the ray leaves through both faces at t = 0");
+    float org_mid[3] = {-1.0f, 0.5f, 0.5f};
+    cr_expect(ref_hit_box(bmin, bmax, org_mid, invneg, 10.0f));
+    float org_out[3] = {-1.0f, 1.5f, 0.5f};
+    cr_expect_not(ref_hit_box(bmin, bmax, org_out, inv, 10.0f));
+    cr_expect_not(ref_hit_box(bmin, bmax, org_in, inv, 0.5f), "box beyond tmax");
+    float flat_min[3] = {0, 0.25f, 0}, flat_max[3] = {1, 0.25f, 1}; /* zero thickness in y */
+    float down[3] = {0, -1, 0}, inv_down[3];
+    ref_sanitize_dir(down);
+    ref_inv_dir(down, inv_down);
+    float above[3] = {0.5f, 2.0f, 0.5f};
+    cr_expect(ref_hit_box(flat_min, flat_max, above, inv_down, 10.0f), "zero-thickness box");
+}
+
+Test(ref_triangle, hit_barycentrics_and_both_sides)
+{
+    float v0[3] = {0, 0, 0}, v1[3] = {1, 0, 0}, v2[3] = {0, 1, 0};
+    RefRay r = {{0.25f, 0.5f, 2.0f}, {0, 0, -1}, 100.0f};
+    float t, u, v;
+    cr_assert(ref_hit_triangle(v0, v1, v2, &r, &t, &u, &v));
+    cr_expect_float_eq(t, 2.0f, 1e-6f);
+    cr_expect_float_eq(u, 0.25f, 1e-6f);
+    cr_expect_float_eq(v, 0.5f, 1e-6f);
+    RefRay back = {{0.25f, 0.5f, -2.0f}, {0, 0, 1}, 100.0f};
+    cr_expect(ref_hit_triangle(v0, v1, v2, &back, &t, &u, &v), "no culling of back faces");
+    cr_expect_float_eq(u, 0.25f, 1e-6f);
+    RefRay shortr = r;
+    shortr.tmax = 2.0f;
+    cr_expect_not(ref_hit_triangle(v0, v1, v2, &shortr, &t, &u, &v), "t must be < tmax");
+    RefRay behind = {{0.25f, 0.5f, -2.0f}, {0, 0, -1}, 100.0f};
+    cr_expect_not(ref_hit_triangle(v0, v1, v2, &behind, &t, &u, &v), "t must be > 0");
+    /* An axis-parallel ray with signed zeros: sanitized, it still hits, with no NaN. */
+    RefRay axis = {{0.25f, 0.5f, 2.0f}, {-0.0f, 0.0f, -1.0f}, 100.0f};
+    cr_expect(ref_hit_triangle(v0, v1, v2, &axis, &t, &u, &v));
+    cr_expect(isfinite(t) && isfinite(u) && isfinite(v));
+}
+
+Test(ref_triangle, shared_edges_do_not_leak)
+{
+    /* A unit quad split along its diagonal; rays aimed at interior points of the diagonal, from
+     * several directions, must hit at least one of the two. (The quad's own corners are on the
+     * mesh boundary: a ray whose rounded origin passes just outside them really misses.) */
+    float a[3] = {0, 0, 0}, b[3] = {1, 0, 0}, c[3] = {1, 1, 0}, d[3] = {0, 1, 0};
+    int leaks = 0, tested = 0;
+    for (int i = 1; i < 64; i++) {
+        float s = (float)i / 64.0f;
+        float target[3] = {s, s, 0.0f};
+        for (int j = 0; j < 16; j++) {
+            float ang = 0.37f * (float)j;
+            RefRay r;
+            r.dir[0] = 0.3f * cosf(ang);
+            r.dir[1] = 0.3f * sinf(ang);
+            r.dir[2] = -1.0f;
+            for (int k = 0; k < 3; k++)
+                r.org[k] = target[k] - 3.0f * r.dir[k];
+            r.tmax = 100.0f;
+            float t, u, v;
+            int h1 = ref_hit_triangle(a, b, c, &r, &t, &u, &v);
+            int h2 = ref_hit_triangle(a, c, d, &r, &t, &u, &v);
+            leaks += !(h1 || h2);
+            tested++;
+        }
+    }
+    /* A fan of six triangles around a shared vertex at the origin: rays aimed at the vertex. */
+    float ring[6][3];
+    for (int k = 0; k < 6; k++) {
+        ring[k][0] = cosf(1.0471976f * (float)k);
+        ring[k][1] = sinf(1.0471976f * (float)k);
+        ring[k][2] = 0.0f;
+    }
+    float centre[3] = {0, 0, 0};
+    for (int j = 0; j < 64; j++) {
+        float ang = 0.1f * (float)j;
+        RefRay r = {{0, 0, 0}, {0.25f * cosf(ang), 0.25f * sinf(ang), j % 2 ? 1.0f : -1.0f}, 100.0f};
+        for (int k = 0; k < 3; k++)
+            r.org[k] = -2.0f * r.dir[k]; /* exact: scaling by a power of two */
+        int hit = 0;
+        float t, u, v;
+        for (int k = 0; k < 6; k++)
+            hit |= ref_hit_triangle(centre, ring[k], ring[(k + 1) % 6], &r, &t, &u, &v);
+        leaks += !hit;
+        tested++;
+    }
+    cr_log_info("shared edge and vertex: %d rays, %d leaks", tested, leaks);
+    cr_expect_eq(leaks, 0, "%d of %d rays through the shared edge leaked", leaks, tested);
+}
+
+Test(ref_sphere, outside_inside_tangent)
+{
+    float c[3] = {0, 0, -5};
+    RefRay r = {{0, 0, 0}, {0, 0, -1}, 100.0f};
+    float t;
+    cr_assert(ref_hit_sphere(c, 1.0f, &r, &t));
+    cr_expect_float_eq(t, 4.0f, 1e-6f);
+    RefRay in = {{0, 0, -5}, {0, 0, -2}, 100.0f};
+    cr_assert(ref_hit_sphere(c, 1.0f, &in, &t));
+    cr_expect_float_eq(t, 0.5f, 1e-6f, "from inside: the far wall, in units of |dir|");
+    RefRay miss = {{0, 1.5f, 0}, {0, 0, -1}, 100.0f};
+    cr_expect_not(ref_hit_sphere(c, 1.0f, &miss, &t));
+    /* A tiny sphere far away keeps its hit (the precision-improved discriminant). */
+    float far[3] = {0, 0, -1e4f};
+    RefRay rf = {{0, 0, 0}, {0, 0, -1}, 1e6f};
+    cr_expect(ref_hit_sphere(far, 1e-2f, &rf, &t));
+    cr_expect_float_eq(t, 1e4f - 1e-2f, 1e-2f);
+}
+
+/* Random triangle soup packed with the real packer; closest hits from traversal must equal
+ * brute force over all primitives with the same tie rule. */
+Test(ref_traversal, matches_brute_force)
+{
+    uint32_t n = 3000;
+    Scene s;
+    memset(&s, 0, sizeof s);
+    float *pos = malloc(sizeof(float) * 9 * n);
+    uint32_t *tm = calloc(n, sizeof(uint32_t));
+    uint32_t st = 99;
+    for (uint32_t i = 0; i < n; i++) {
+        float c[3];
+        for (int k = 0; k < 3; k++) {
+            st = st * 1664525u + 1013904223u;
+            c[k] = (float)(st >> 8) / 16777216.0f * 10.0f - 5.0f;
+        }
+        for (int v = 0; v < 3; v++)
+            for (int k = 0; k < 3; k++) {
+                st = st * 1664525u + 1013904223u;
+                pos[9 * i + 3 * v + k] = c[k] + ((float)(st >> 8) / 16777216.0f - 0.5f) * 0.8f;
+            }
+    }
+    SceneMaterial m;
+    memset(&m, 0, sizeof m);
+    s.ntris = n;
+    s.pos = pos;
+    s.tri_material = tm;
+    s.materials = &m;
+    s.nmaterials = 1;
+    s.camera = (SceneCamera){{0, 0, 10}, {0, 0, 0}, {0, 1, 0}, 45, 0, 0, 0};
+    s.render = (SceneRender){8, 8, 1, 1, {0, 0, 0}, {0, 0, 0}};
+    BvhParams bp;
+    bvh_default_params(&bp);
+    PackedScene p;
+    char err[256];
+    cr_assert_eq(pack_scene(&s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
+    uint32_t prims = sm_u32(&p, sm_hdr(&p, SM_HDR_PRIMS));
+    int mismatches = 0, hits = 0, occl_mismatch = 0;
+    for (int i = 0; i < 2000; i++) {
+        RefRay r;
+        for (int k = 0; k < 3; k++) {
+            st = st * 1664525u + 1013904223u;
+            r.org[k] = (float)(st >> 8) / 16777216.0f * 16.0f - 8.0f;
+            st = st * 1664525u + 1013904223u;
+            r.dir[k] = (float)(st >> 8) / 16777216.0f * 2.0f - 1.0f;
+        }
+        r.tmax = (i % 3 == 0) ? 4.0f : INFINITY;
+        RefHit h;
+        ref_closest_hit(&p, &r, &h, NULL);
+        RefHit b = {r.tmax, 0, 0, REF_NO_HIT};
+        for (uint32_t j = 0; j < n; j++) {
+            float g[9], t, u, v;
+            for (int k = 0; k < 9; k++)
+                g[k] = sm_f32(&p, sm_rec(prims, SM_PRIM_WORDS, j, SM_PRIM_V0) + 4u * (uint32_t)k);
+            if (ref_hit_triangle(g, g + 3, g + 6, &r, &t, &u, &v) &&
+                (b.prim == REF_NO_HIT || t < b.t || (t == b.t && j < b.prim)))
+                b = (RefHit){t, u, v, j};
+        }
+        hits += b.prim != REF_NO_HIT;
+        mismatches += h.prim != b.prim || (b.prim != REF_NO_HIT && h.t != b.t);
+        occl_mismatch += ref_any_hit(&p, &r, NULL) != (b.prim != REF_NO_HIT);
+    }
+    cr_log_info("traversal vs brute force: 2000 rays, %d hits, %d mismatches", hits, mismatches);
+    cr_expect_gt(hits, 200, "the test rays should hit something");
+    cr_expect_eq(mismatches, 0);
+    cr_expect_eq(occl_mismatch, 0);
+    pack_free(&p);
+    free(pos);
+    free(tm);
+}
