@@ -243,6 +243,7 @@ int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *
         put_f32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_ALPHA_CUT), m->alpha_cutoff);
         put_f32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_ALPHA), m->alpha);
         put_f32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_TRANSMISSION), m->transmission);
+        put_u32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_DOUBLE_SIDED), m->double_sided ? 1u : 0u);
     }
     for (uint32_t t = 0; t < s->ntextures; t++) {
         const SceneTexture *tx = &s->textures[t];
@@ -298,6 +299,8 @@ int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *
         put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_RADIANCE),
                 s->materials[s->tri_material[t]].emission, 3);
         put_f32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_AREA), tri_area(p));
+        put_u32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_TWO_SIDED),
+                s->materials[s->tri_material[t]].double_sided ? 1u : 0u);
     }
     if (normals)
         for (uint32_t i = 0; i < 9 * s->ntris; i++)

@@ -1,0 +1,46 @@
+/* sim/reference.h -- the golden model: a plain C path tracer over a packed scene, the
+ * specification the assembly kernel (kernels/pathtrace.s) must reproduce pixel for pixel.
+ *
+ * Owns: the rendering algorithm of docs/golden-model.md -- tiles of sqrt(M) x sqrt(M) pixels,
+ * one pass per sample, breadth-first generations with at most one ray per path per generation,
+ * the counter-based random numbers, the shading models. Must not: model any hardware timing.
+ */
+#ifndef SFSIM_REFERENCE_H
+#define SFSIM_REFERENCE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../scenes/pack.h"
+
+#define REF_MAX_GENERATIONS 64
+
+typedef enum RefRayKind { REF_RAY_CAMERA = 0, REF_RAY_INDIRECT = 1, REF_RAY_SHADOW = 2, REF_RAY_KINDS } RefRayKind;
+
+typedef struct RefParams {
+    int tile;          /* tile edge in pixels: sqrt(M), 32 for M = 1024, 64 for M = 4096 */
+    uint32_t seed;     /* render.seed */
+    int threads;       /* host threads over tiles (results do not depend on it) */
+} RefParams;
+
+typedef struct RefStats {
+    uint64_t rays[REF_RAY_KINDS];                 /* traced, by kind */
+    uint64_t rays_per_generation[REF_MAX_GENERATIONS];
+    uint64_t generations;                         /* deepest generation reached + 1 */
+    uint64_t nodes_visited, prims_tested;
+    uint64_t dropped;                             /* rays with non-finite data, never traced */
+    uint64_t tiles, passes;
+} RefStats;
+
+/* The random number of a path: dimension dim at path vertex `vertex` (0 = the camera), as a
+ * float in [0, 1). path_key = ref_path_key(seed, pixel, sample). */
+uint32_t ref_hash32(uint32_t x);
+uint32_t ref_path_key(uint32_t seed, uint32_t pixel, uint32_t sample);
+float ref_rand(uint32_t path_key, uint32_t vertex, uint32_t dim);
+
+/* Render the whole image: rgb (width * height * 3 floats, zeroed by the caller) receives the
+ * mean radiance per pixel. 0, or -1 with a message. stats may be NULL. */
+int ref_render(const PackedScene *p, const RefParams *rp, float *rgb, RefStats *stats, char *err,
+               size_t errlen);
+
+#endif

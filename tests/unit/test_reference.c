@@ -1,0 +1,200 @@
+/* tests/unit/test_reference.c -- the golden model on scenes built in the test: an analytic
+ * direct-lighting value, determinism across host threads and reruns, no NaN/Inf, and Monte
+ * Carlo convergence at the 1/sqrt(spp) rate. */
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../../sim/img.h"
+#include "../../sim/reference.h"
+
+typedef struct Builder {
+    float pos[9 * 64];
+    uint32_t mat[64];
+    uint32_t emissive[64];
+    uint32_t n, nem;
+    SceneMaterial mats[4];
+} Builder;
+
+/* Quad corner c, edges a and b, as two triangles. */
+static void quad(Builder *b, const float *c, const float *ea, const float *eb, uint32_t m, int emits)
+{
+    float p[4][3];
+    for (int k = 0; k < 3; k++) {
+        p[0][k] = c[k];
+        p[1][k] = c[k] + ea[k];
+        p[2][k] = c[k] + ea[k] + eb[k];
+        p[3][k] = c[k] + eb[k];
+    }
+    int idx[6] = {0, 1, 2, 0, 2, 3};
+    for (int t = 0; t < 2; t++) {
+        for (int v = 0; v < 3; v++)
+            memcpy(&b->pos[9 * b->n + 3 * v], p[idx[3 * t + v]], sizeof(float) * 3);
+        if (emits)
+            b->emissive[b->nem++] = b->n;
+        b->mat[b->n++] = m;
+    }
+}
+
+static void to_scene(Builder *b, Scene *s, int w, int h, int spp, int depth)
+{
+    memset(s, 0, sizeof *s);
+    s->ntris = b->n;
+    s->pos = b->pos;
+    s->tri_material = b->mat;
+    s->materials = b->mats;
+    s->nmaterials = 4;
+    s->emissive_tris = b->emissive;
+    s->nemissive = b->nem;
+    s->render = (SceneRender){w, h, spp, depth, {0, 0, 0}, {0, 0, 0}};
+    for (int k = 0; k < 3; k++) {
+        s->bounds_min[k] = -2.0f;
+        s->bounds_max[k] = 2.0f;
+    }
+}
+
+static void lambert(SceneMaterial *m, float albedo, float emission)
+{
+    memset(m, 0, sizeof *m);
+    m->kind = SCENE_MAT_LAMBERT;
+    m->base_color[0] = m->base_color[1] = m->base_color[2] = albedo;
+    m->emission[0] = m->emission[1] = m->emission[2] = emission;
+    m->base_texture = -1;
+    m->ior = 1.5f;
+}
+
+/* A floor (y = 0, 4 x 4, albedo 0.5) under a small square light (side 0.1 at y = 1, radiance
+ * 100), seen from straight above. */
+static void floor_scene(Builder *b, Scene *s, int spp, int depth)
+{
+    memset(b, 0, sizeof *b);
+    lambert(&b->mats[0], 0.5f, 0.0f);
+    lambert(&b->mats[1], 0.0f, 100.0f);
+    lambert(&b->mats[2], 0.5f, 0.0f);
+    lambert(&b->mats[3], 0.5f, 0.0f);
+    float c0[3] = {-2, 0, -2}, ea[3] = {0, 0, 4}, eb[3] = {4, 0, 0};
+    quad(b, c0, ea, eb, 0, 0);
+    float lc[3] = {-0.05f, 1.0f, -0.05f}, la[3] = {0.1f, 0, 0}, lb[3] = {0, 0, 0.1f};
+    quad(b, lc, la, lb, 1, 1);
+    to_scene(b, s, 16, 16, spp, depth);
+    s->camera = (SceneCamera){{0, 0.5f, 0}, {0, 0, 0}, {0, 0, -1}, 10.0f, 0, 0, SCENE_CAMERA_FILE};
+}
+
+static float *render(const Scene *s, uint32_t seed, int threads, RefStats *st)
+{
+    BvhParams bp;
+    bvh_default_params(&bp);
+    PackedScene p;
+    char err[256];
+    cr_assert_eq(pack_scene(s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
+    float *rgb = calloc(3 * (size_t)s->render.width * s->render.height, sizeof(float));
+    RefParams rp = {32, seed, threads};
+    cr_assert_eq(ref_render(&p, &rp, rgb, st, err, sizeof err), 0, "%s", err);
+    pack_free(&p);
+    return rgb;
+}
+
+Test(reference, direct_light_matches_the_analytic_value)
+{
+    Builder b;
+    Scene s;
+    floor_scene(&b, &s, 256, 0);
+    RefStats st;
+    float *rgb = render(&s, 1, 2, &st);
+    /* The camera looks straight down from y = 0.5 with a 10 degree field: every pixel sees the
+     * floor within 0.05 of the point under the light, where E = L A cos cos / d^2 with
+     * A = 0.01, d ~ 1: radiance = albedo / pi * E = 0.5 / pi * 100 * 0.01 = 0.159 (the finite
+     * light and the 0.05 offset lower it by under 1%). The light quad itself is hidden behind
+     * the camera. */
+    double sum = 0.0;
+    for (int i = 0; i < 16 * 16; i++)
+        sum += rgb[3 * i];
+    double mean = sum / 256.0, expect = 0.5 / M_PI * 100.0 * 0.01;
+    cr_log_info("direct light: mean %.5f, analytic %.5f", mean, expect);
+    cr_expect(fabs(mean - expect) < 0.02 * expect, "mean %.5f vs analytic %.5f", mean, expect);
+    cr_expect_eq(st.rays[REF_RAY_CAMERA], 256u * 256u);
+    cr_expect_eq(st.rays[REF_RAY_SHADOW], 256u * 256u, "max depth 0: every camera hit sends a shadow ray");
+    cr_expect_eq(st.rays[REF_RAY_INDIRECT], 0u);
+    free(rgb);
+}
+
+/* A closed box with an emissive ceiling panel and a sphere-free interior: full paths. */
+static void box_scene(Builder *b, Scene *s, int spp)
+{
+    memset(b, 0, sizeof *b);
+    lambert(&b->mats[0], 0.7f, 0.0f);
+    lambert(&b->mats[1], 0.0f, 10.0f);
+    lambert(&b->mats[2], 0.6f, 0.0f);
+    b->mats[2].base_color[1] = 0.1f;
+    lambert(&b->mats[3], 0.6f, 0.0f);
+    b->mats[3].kind = SCENE_MAT_GLOSSY;
+    b->mats[3].roughness = 0.3f;
+    b->mats[3].metallic = 0.5f;
+    float X[3] = {2, 0, 0}, Y[3] = {0, 2, 0}, Z[3] = {0, 0, 2};
+    float o[3] = {-1, 0, -1};
+    float top[3] = {-1, 2, -1}, right[3] = {1, 0, -1}, back[3] = {-1, 0, -1}, front[3] = {-1, 0, 1};
+    quad(b, o, Z, X, 3, 0);      /* floor (glossy) */
+    quad(b, top, X, Z, 0, 0);    /* ceiling */
+    quad(b, o, Y, Z, 2, 0);      /* left wall (red) */
+    quad(b, right, Z, Y, 0, 0);  /* right wall */
+    quad(b, back, X, Y, 0, 0);   /* back wall */
+    quad(b, front, Y, X, 0, 0);  /* front wall (behind the camera) */
+    float lc[3] = {-0.3f, 1.99f, -0.3f}, la[3] = {0.6f, 0, 0}, lb[3] = {0, 0, 0.6f};
+    quad(b, lc, la, lb, 1, 1);
+    to_scene(b, s, 24, 24, spp, 3);
+    s->camera = (SceneCamera){{0, 1, 0.9f}, {0, 1, -1}, {0, 1, 0}, 70.0f, 0, 0, SCENE_CAMERA_FILE};
+}
+
+Test(reference, identical_bits_for_any_thread_count_and_rerun)
+{
+    Builder b;
+    Scene s;
+    box_scene(&b, &s, 8);
+    float *a = render(&s, 7, 1, NULL), *c = render(&s, 7, 2, NULL), *d = render(&s, 7, 2, NULL);
+    size_t bytes = sizeof(float) * 3 * 24 * 24;
+    cr_expect_eq(memcmp(a, c, bytes), 0, "1 thread vs 2 threads");
+    cr_expect_eq(memcmp(c, d, bytes), 0, "rerun");
+    long bad = 0;
+    double sum = 0.0;
+    for (size_t i = 0; i < 3 * 24 * 24; i++) {
+        bad += !isfinite(a[i]);
+        sum += a[i];
+    }
+    cr_expect_eq(bad, 0, "%ld NaN/Inf values", bad);
+    cr_expect_gt(sum, 0.0, "the box is lit");
+    free(a);
+    free(c);
+    free(d);
+}
+
+Test(reference, rmse_falls_as_one_over_sqrt_spp, .timeout = 60)
+{
+    Builder b;
+    Scene s;
+    box_scene(&b, &s, 1024);
+    float *ref = render(&s, 1000, 2, NULL);
+    int spps[3] = {4, 16, 64};
+    double lx[3], ly[3];
+    for (int i = 0; i < 3; i++) {
+        box_scene(&b, &s, spps[i]);
+        float *img = render(&s, 1, 2, NULL);
+        ImgCompare cmp;
+        img_compare(img, ref, 24, 24, &cmp);
+        lx[i] = log((double)spps[i]);
+        ly[i] = log(cmp.rmse);
+        cr_log_info("spp %d: RMSE %.5f mean %.4f ref mean %.4f max diff %.3f", spps[i], cmp.rmse, cmp.mean_a, cmp.mean_b, cmp.max_abs);
+        free(img);
+    }
+    /* Least-squares slope of log RMSE against log spp; the reference's own noise (1024 spp)
+     * flattens it slightly. */
+    double mx = (lx[0] + lx[1] + lx[2]) / 3, my = (ly[0] + ly[1] + ly[2]) / 3, num = 0, den = 0;
+    for (int i = 0; i < 3; i++) {
+        num += (lx[i] - mx) * (ly[i] - my);
+        den += (lx[i] - mx) * (lx[i] - mx);
+    }
+    double slope = num / den;
+    cr_log_info("convergence slope %.3f (ideal -0.5)", slope);
+    cr_expect(slope < -0.4 && slope > -0.6, "slope %.3f", slope);
+    free(ref);
+}
