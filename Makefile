@@ -15,6 +15,7 @@ OIIO    := $(shell pkg-config --libs OpenImageIO 2>/dev/null || echo -lOpenImage
 LDLIBS  := $(GLTF) $(OIIO) -lstdc++ -lm
 INIH    := $(shell pkg-config --cflags --libs inih 2>/dev/null || echo -linih)
 CRIT    := $(shell pkg-config --libs criterion 2>/dev/null || echo -lcriterion)
+EMBREE  := -lembree3
 
 BUILD   ?= build
 SAN     := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
@@ -26,7 +27,7 @@ SIM_SRC := $(filter-out sim/main.c,$(wildcard sim/*.c))
 SCN_SRC := $(wildcard scenes/*.c)
 CXX_SRC := $(wildcard scenes/*.cpp sim/*.cpp)
 LIB_SRC := $(ISA_SRC) $(ASM_SRC) $(SIM_SRC) $(SCN_SRC)
-TEST_SRC := $(wildcard tests/unit/*.c)
+TEST_SRC := $(wildcard tests/unit/*.c tests/support/*.c)
 
 ASMLIB_OBJ = $(patsubst %.c,$(BUILD)/obj/%.o,$(ISA_SRC) $(ASM_SRC))
 LIB_OBJ  = $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/obj/%.o,$(CXX_SRC))
@@ -105,11 +106,11 @@ docs: $(BUILD)/gen_isadoc $(BUILD)/gen_layout
 # ---- tests ----------------------------------------------------------------------------------
 $(BUILD)/tests/unit: $(TEST_SRC) $(BUILD)/libsfsim.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
+	$(CC) $(CFLAGS) $(TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(EMBREE) $(INIH) $(LDLIBS)
 
 $(BUILD)/tests/unit-asan: $(TEST_SRC) $(BUILD)/libsfsim-asan.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(SAN) $(TEST_SRC) $(BUILD)/libsfsim-asan.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
+	$(CC) $(CFLAGS) $(SAN) $(TEST_SRC) $(BUILD)/libsfsim-asan.a -o $@ $(CRIT) $(EMBREE) $(INIH) $(LDLIBS)
 
 # CLI tests first, Criterion last: its synthesis line closes the run.
 test-built: all $(BUILD)/tests/unit

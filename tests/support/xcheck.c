@@ -1,0 +1,162 @@
+/* tests/support/xcheck.c -- golden-model closest hits against Embree 3 (robust mode). */
+#include "xcheck.h"
+
+#include <embree3/rtcore.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "../../sim/ref_trace.h"
+#include "../../sim/reference.h"
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void make_ray(const PackedScene *p, uint32_t i, uint32_t camera_rays, uint32_t seed, RefRay *r)
+{
+    float bmin[3], bmax[3];
+    for (int k = 0; k < 3; k++) {
+        bmin[k] = sm_f32(p, sm_hdr(p, SM_HDR_BOUNDS_MIN + k));
+        bmax[k] = sm_f32(p, sm_hdr(p, SM_HDR_BOUNDS_MAX + k));
+    }
+    uint32_t key = ref_path_key(seed, i, 0);
+    if (i < camera_rays) {
+        /* Camera rays over a square grid covering the image. */
+        uint32_t side = (uint32_t)ceil(sqrt((double)camera_rays));
+        float px = ((float)(i % side) + ref_rand(key, 0, 0)) / (float)side - 0.5f;
+        float py = 0.5f - ((float)(i / side) + ref_rand(key, 0, 1)) / (float)side;
+        for (int k = 0; k < 3; k++) {
+            r->org[k] = sm_f32(p, sm_hdr(p, SM_HDR_CAM_POS + k));
+            r->dir[k] = sm_f32(p, sm_hdr(p, SM_HDR_CAM_W + k)) + px * sm_f32(p, sm_hdr(p, SM_HDR_CAM_U + k)) +
+                        py * sm_f32(p, sm_hdr(p, SM_HDR_CAM_V + k));
+        }
+    } else {
+        /* Random rays: origin uniform in the bounds, direction uniform on the sphere. */
+        float z = 1.0f - 2.0f * ref_rand(key, 1, 2), phi = 6.2831853f * ref_rand(key, 1, 3);
+        float s = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+        r->dir[0] = s * cosf(phi);
+        r->dir[1] = s * sinf(phi);
+        r->dir[2] = z;
+        for (int k = 0; k < 3; k++)
+            r->org[k] = bmin[k] + ref_rand(key, 1, (uint32_t)k) * (bmax[k] - bmin[k]);
+    }
+    float il = 1.0f / sqrtf(r->dir[0] * r->dir[0] + r->dir[1] * r->dir[1] + r->dir[2] * r->dir[2]);
+    for (int k = 0; k < 3; k++)
+        r->dir[k] *= il;
+    r->tmax = INFINITY;
+}
+
+int xcheck_run(const Scene *scene, const PackedScene *p, uint32_t camera_rays, uint32_t random_rays,
+               uint32_t seed, XcheckResult *out, char *err, size_t errlen)
+{
+    memset(out, 0, sizeof *out);
+    out->first_bad = UINT64_MAX;
+    RTCDevice dev = rtcNewDevice("threads=1");
+    if (!dev) {
+        snprintf(err, errlen, "embree: cannot create a device (error %d)", (int)rtcGetDeviceError(NULL));
+        return -1;
+    }
+    RTCScene es = rtcNewScene(dev);
+    rtcSetSceneFlags(es, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(es, RTC_BUILD_QUALITY_HIGH);
+    if (scene->ntris > 0) {
+        RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+        float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                            3 * sizeof(float), 3 * (size_t)scene->ntris);
+        unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                               3 * sizeof(unsigned), scene->ntris);
+        if (!vb || !ib) {
+            snprintf(err, errlen, "embree: cannot allocate buffers for %u triangles", scene->ntris);
+            rtcReleaseGeometry(g);
+            rtcReleaseScene(es);
+            rtcReleaseDevice(dev);
+            return -1;
+        }
+        memcpy(vb, scene->pos, sizeof(float) * 9 * (size_t)scene->ntris);
+        for (uint32_t i = 0; i < 3 * scene->ntris; i++)
+            ib[i] = i;
+        rtcCommitGeometry(g);
+        rtcAttachGeometry(es, g);
+        rtcReleaseGeometry(g);
+    }
+    rtcCommitScene(es);
+
+    uint32_t n = camera_rays + random_rays;
+    RefHit *ours = malloc(sizeof(RefHit) * n);
+    RefRay *rays = malloc(sizeof(RefRay) * n);
+    if (!ours || !rays) {
+        free(ours);
+        free(rays);
+        rtcReleaseScene(es);
+        rtcReleaseDevice(dev);
+        snprintf(err, errlen, "xcheck: out of memory for %u rays", n);
+        return -1;
+    }
+    for (uint32_t i = 0; i < n; i++)
+        make_ray(p, i, camera_rays, seed, &rays[i]);
+    double t0 = now();
+    for (uint32_t i = 0; i < n; i++)
+        ref_closest_hit(p, &rays[i], &ours[i], NULL);
+    double t1 = now();
+    uint32_t prims = sm_u32(p, sm_hdr(p, SM_HDR_PRIMS));
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    double te = 0.0;
+    for (uint32_t i = 0; i < n; i++) {
+        struct RTCRayHit rh;
+        memset(&rh, 0, sizeof rh);
+        rh.ray.org_x = rays[i].org[0];
+        rh.ray.org_y = rays[i].org[1];
+        rh.ray.org_z = rays[i].org[2];
+        rh.ray.dir_x = rays[i].dir[0];
+        rh.ray.dir_y = rays[i].dir[1];
+        rh.ray.dir_z = rays[i].dir[2];
+        rh.ray.tnear = 0.0f;
+        rh.ray.tfar = INFINITY;
+        rh.ray.mask = 0xFFFFFFFFu;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        double a = now();
+        rtcIntersect1(es, &ctx, &rh);
+        te += now() - a;
+        int ehit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+        int ohit = ours[i].prim != REF_NO_HIT;
+        uint32_t osrc = ohit ? sm_u32(p, sm_rec(prims, SM_PRIM_WORDS, ours[i].prim, SM_PRIM_SRC)) : 0;
+        out->hits += (uint64_t)ohit;
+        int ok;
+        if (!ehit || !ohit) {
+            ok = ehit == ohit;
+        } else {
+            float tol = 1e-5f * fmaxf(1.0f, fmaxf(ours[i].t, rh.ray.tfar));
+            int close = fabsf(ours[i].t - rh.ray.tfar) <= tol;
+            if (osrc == rh.hit.primID) {
+                ok = close;
+            } else if (close) {
+                out->ties++;
+                continue;
+            } else {
+                ok = 0;
+            }
+        }
+        if (ok) {
+            out->agree++;
+        } else {
+            out->disagree++;
+            if (out->first_bad == UINT64_MAX)
+                out->first_bad = i;
+        }
+    }
+    out->rays = n;
+    out->ours_seconds = t1 - t0;
+    out->embree_seconds = te;
+    free(ours);
+    free(rays);
+    rtcReleaseScene(es);
+    rtcReleaseDevice(dev);
+    return 0;
+}

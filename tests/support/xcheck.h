@@ -1,0 +1,30 @@
+/* tests/support/xcheck.h -- cross-check of the golden model's closest hits against Embree on the
+ * same rays (used by tests/unit/test_embree.c and bench/embree_xcheck.c).
+ *
+ * Owns: ray generation for the check (camera rays through the packed camera, random rays from
+ * inside the bounds) and the agreement rule. Must not: change either tracer.
+ */
+#ifndef SFSIM_XCHECK_H
+#define SFSIM_XCHECK_H
+
+#include <stdint.h>
+
+#include "../../scenes/pack.h"
+
+typedef struct XcheckResult {
+    uint64_t rays;
+    uint64_t agree;        /* same primitive (or both miss) and distances within tolerance */
+    uint64_t ties;         /* different primitives at equal distance (within tolerance) */
+    uint64_t disagree;     /* everything else */
+    uint64_t hits;         /* rays our tracer says hit something */
+    double ours_seconds, embree_seconds;
+    uint64_t first_bad;    /* index of the first disagreeing ray, for diagnosis */
+} XcheckResult;
+
+/* Trace `camera_rays` camera rays and `random_rays` random rays through both tracers.
+ * `scene` gives the source triangles Embree builds from; p is its packing. 0, or -1 with a
+ * message (Embree device or build failure). */
+int xcheck_run(const Scene *scene, const PackedScene *p, uint32_t camera_rays, uint32_t random_rays,
+               uint32_t seed, XcheckResult *out, char *err, size_t errlen);
+
+#endif

@@ -1,0 +1,59 @@
+/* tests/unit/test_embree.c -- our BVH and intersector against Embree on the same rays: a
+ * random triangle soup, and every shared scene (camera rays and random rays). Agreement must
+ * be at least 99.99% of rays; equal-distance hits on different triangles count as ties. */
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../support/xcheck.h"
+
+static void expect_agreement(const char *name, const Scene *s, uint32_t ncam, uint32_t nrand)
+{
+    BvhParams bp;
+    bvh_default_params(&bp);
+    PackedScene p;
+    char err[512];
+    cr_assert_eq(pack_scene(s, &bp, 0, &p, err, sizeof err), 0, "%s: %s", name, err);
+    XcheckResult x;
+    cr_assert_eq(xcheck_run(s, &p, ncam, nrand, 17, &x, err, sizeof err), 0, "%s: %s", name, err);
+    double rate = (double)(x.agree + x.ties) / (double)x.rays;
+    cr_log_info("embree %-28s %7u tris %7lu rays: %.4f%% agree, %lu ties, %lu disagree (%lu hits)",
+                name, s->ntris, (unsigned long)x.rays, 100.0 * rate, (unsigned long)x.ties,
+                (unsigned long)x.disagree, (unsigned long)x.hits);
+    cr_expect_geq(rate, 0.9999, "%s: %.4f%% agreement (first bad ray %lu)", name, 100.0 * rate,
+                  (unsigned long)x.first_bad);
+    cr_expect_gt(x.hits, x.rays / 20, "%s: too few hits for the check to mean anything", name);
+    pack_free(&p);
+}
+
+Test(embree, random_triangle_soup)
+{
+    uint32_t n = 20000;
+    Scene s;
+    memset(&s, 0, sizeof s);
+    float *pos = malloc(sizeof(float) * 9 * n);
+    uint32_t *tm = calloc(n, sizeof(uint32_t));
+    uint32_t st = 7;
+    for (uint32_t i = 0; i < 9 * n; i++) {
+        st = st * 1664525u + 1013904223u;
+        float r = (float)(st >> 8) / 16777216.0f;
+        pos[i] = (i % 9 < 3) ? r * 10.0f - 5.0f : pos[9 * (i / 9) + i % 3] + (r - 0.5f) * 0.6f;
+    }
+    SceneMaterial m;
+    memset(&m, 0, sizeof m);
+    s.ntris = n;
+    s.pos = pos;
+    s.tri_material = tm;
+    s.materials = &m;
+    s.nmaterials = 1;
+    s.camera = (SceneCamera){{0, 0, 12}, {0, 0, 0}, {0, 1, 0}, 50, 0, 0, 0};
+    s.render = (SceneRender){64, 64, 1, 1, {0, 0, 0}, {0, 0, 0}};
+    for (int k = 0; k < 3; k++) {
+        s.bounds_min[k] = -5.5f;
+        s.bounds_max[k] = 5.5f;
+    }
+    expect_agreement("random soup", &s, 20000, 80000);
+    free(pos);
+    free(tm);
+}
