@@ -138,9 +138,14 @@ $(BUILD)/bench/core_speed: bench/core_speed.c $(BUILD)/libsfsim.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
 
+$(BUILD)/bench/embree_xcheck: bench/embree_xcheck.c tests/support/xcheck.c $(BUILD)/libsfsim.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $^ -o $@ $(EMBREE) $(INIH) $(LDLIBS)
+
 bench: deps
-	@$(MAKE) --no-print-directory $(BUILD)/bench/core_speed
+	@$(MAKE) --no-print-directory $(BUILD)/bench/core_speed $(BUILD)/bench/embree_xcheck
 	$(BUILD)/bench/core_speed
+	$(BUILD)/bench/embree_xcheck
 
 # ---- the example `make run` executes --------------------------------------------------------
 run-built: all
