@@ -12,7 +12,8 @@ CXXFLAGS := -std=c++17 $(OPT) -g $(CXXWARN) $(EXTRA_CXXFLAGS)
 # C++ appears only inside the shims that wrap C++ libraries (ARCHITECTURE.md Sec. 2).
 GLTF    := $(shell pkg-config --libs tinygltf 2>/dev/null || echo -ltinygltf)
 OIIO    := $(shell pkg-config --libs OpenImageIO 2>/dev/null || echo -lOpenImageIO -lOpenImageIO_Util)
-LDLIBS  := $(GLTF) $(OIIO) -lstdc++ -lm
+CJSON   := $(shell pkg-config --libs libcjson 2>/dev/null || echo -lcjson)
+LDLIBS  := $(GLTF) $(OIIO) $(CJSON) -lstdc++ -lpthread -lm
 INIH    := $(shell pkg-config --cflags --libs inih 2>/dev/null || echo -linih)
 CRIT    := $(shell pkg-config --libs criterion 2>/dev/null || echo -lcriterion)
 EMBREE  := -lembree3

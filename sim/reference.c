@@ -612,6 +612,8 @@ static void render_tile(Worker *w, uint32_t tile)
 
 typedef struct Pool {
     atomic_uint next_tile;
+    atomic_uint done_tiles;
+    const RefParams *rp;
     uint32_t ntiles;
     Worker *workers;
 } Pool;
@@ -626,6 +628,9 @@ static void *thread_main(void *arg)
         if (t >= a->pool->ntiles)
             break;
         render_tile(a->w, t);
+        uint32_t done = atomic_fetch_add(&a->pool->done_tiles, 1u) + 1u;
+        if (a->pool->rp->progress)
+            a->pool->rp->progress(a->pool->rp->progress_ctx, done, a->pool->ntiles);
     }
     return NULL;
 }
@@ -667,6 +672,8 @@ int ref_render(const PackedScene *p, const RefParams *rp, float *rgb, RefStats *
     uint32_t T = (uint32_t)rp->tile;
     Pool pool;
     atomic_init(&pool.next_tile, 0u);
+    atomic_init(&pool.done_tiles, 0u);
+    pool.rp = rp;
     pool.ntiles = ((c.width + T - 1) / T) * ((c.height + T - 1) / T);
     int nthreads = rp->threads < 1 ? 1 : rp->threads;
     if ((uint32_t)nthreads > pool.ntiles)

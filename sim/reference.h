@@ -21,6 +21,10 @@ typedef struct RefParams {
     int tile;          /* tile edge in pixels: sqrt(M), 32 for M = 1024, 64 for M = 4096 */
     uint32_t seed;     /* render.seed */
     int threads;       /* host threads over tiles (results do not depend on it) */
+    /* Called after each finished tile from the worker that finished it (may be NULL); calls
+     * can come from several threads at once. */
+    void (*progress)(void *ctx, uint32_t tiles_done, uint32_t tiles_total);
+    void *progress_ctx;
 } RefParams;
 
 typedef struct RefStats {

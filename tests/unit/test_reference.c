@@ -89,7 +89,7 @@ static float *render(const Scene *s, uint32_t seed, int threads, RefStats *st)
     char err[256];
     cr_assert_eq(pack_scene(s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
     float *rgb = calloc(3 * (size_t)s->render.width * s->render.height, sizeof(float));
-    RefParams rp = {32, seed, threads};
+    RefParams rp = {32, seed, threads, NULL, NULL};
     cr_assert_eq(ref_render(&p, &rp, rgb, st, err, sizeof err), 0, "%s", err);
     pack_free(&p);
     return rgb;

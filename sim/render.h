@@ -1,0 +1,31 @@
+/* sim/render.h -- one `sfsim run`: load the scene, pack it, render, write the images and the
+ * report into the output folder.
+ *
+ * Owns: the orchestration of a run and the files it writes (frame.exr, frame.png, report.json,
+ * report.txt). Must not: implement a renderer or parse the command line.
+ */
+#ifndef SFSIM_RENDER_H
+#define SFSIM_RENDER_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+typedef struct RenderOptions {
+    const char *scene_path;    /* .gltf/.glb or scene.ini */
+    const char *out_dir;       /* created if missing */
+    int stream_rays;           /* M: 1024 or 4096; the tile is sqrt(M) x sqrt(M) pixels */
+    uint32_t seed;
+    int threads;               /* host threads; 0 = all cores */
+    int width, height, spp, max_depth; /* overrides of the scene's [render]; -1 = keep */
+    int bvh_leaf_size, bvh_bins;
+    float exposure;            /* for frame.png */
+    int progress;              /* 1: progress bar on stderr (the CLI sets it when stderr is a tty) */
+} RenderOptions;
+
+void render_default_options(RenderOptions *o);
+
+/* A run in the golden model (--mode reference). 0, or -1 with a message naming the file or
+ * the setting at fault. */
+int render_reference(const RenderOptions *o, char *err, size_t errlen);
+
+#endif
