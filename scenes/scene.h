@@ -134,6 +134,12 @@ typedef struct Scene {
 int scene_load(const char *path, Scene *s, char *err, size_t errlen);
 void scene_free(Scene *s);
 
+/* For loaders and tests: an empty scene with the defaults (512 x 512, 1 spp, max depth 3), and
+ * the completion step scene_load runs after the sources are read (bounds, emissive triangles,
+ * default camera, needs; an error for a scene without geometry). */
+void scene_init(Scene *s, const char *source);
+int scene_finish(Scene *s, char *err, size_t errlen);
+
 /* Writes the needs as a comma-separated list ("lambert,area_lights"). */
 void scene_needs_string(uint32_t needs, char *buf, size_t len);
 

@@ -49,6 +49,7 @@ typedef struct CoreRecord {
     uint8_t taken;          /* branch taken */
     uint8_t mem;            /* CoreMem touched (physical buffer for ray buffers), or CORE_MEM_COUNT */
     uint8_t naddr;          /* number of valid entries in addr (lanes that accessed memory) */
+    uint32_t count;         /* part: stream length in IDs; pmask: bits queued after it; else 0 */
     uint64_t exec;          /* exec mask as applied (all N lanes for unmasked vector ops) */
     uint32_t addr[ISA_MAX_LANES]; /* byte addresses, lane order (sfetch/vspld: the N words) */
 } CoreRecord;

@@ -213,7 +213,9 @@ int render_reference(const RenderOptions *o, char *err, size_t errlen)
     char needs[256];
     scene_needs_string(s.needs, needs, sizeof needs);
     cJSON *nd = cJSON_AddArrayToObject(sc, "needs");
-    for (char *tok = strtok(needs, ","); tok; tok = strtok(NULL, ","))
+    char needs_tok[256];
+    memcpy(needs_tok, needs, sizeof needs_tok);
+    for (char *save = NULL, *tok = strtok_r(needs_tok, ",", &save); tok; tok = strtok_r(NULL, ",", &save))
         cJSON_AddItemToArray(nd, cJSON_CreateString(tok));
     cJSON *bvh = cJSON_AddObjectToObject(sc, "bvh");
     cJSON_AddNumberToObject(bvh, "nodes", p.bvh.nnodes);

@@ -1,0 +1,22 @@
+/* scenes/gltf.h -- the C face of the tinygltf shim (scenes/gltf_shim.cpp).
+ *
+ * Owns: reading glTF 2.0 (.gltf/.glb) into a Scene. Must not: decide defaults, bounds or needs
+ * (scenes/scene.c does, once every source is loaded).
+ */
+#ifndef SFSIM_GLTF_H
+#define SFSIM_GLTF_H
+
+#include <stddef.h>
+
+#include "scene.h"
+
+/* Append the default scene of the glTF file at path to s: its triangles (every vertex through
+ * xf, a column-major 4x4 matrix, NULL for identity), materials, textures, punctual lights, and
+ * the first camera if s has none yet. Material indices of the new triangles point past the
+ * materials s already had. 0, or -1 with "file: element: problem" in err. */
+int gltf_append(const char *path, const double *xf, Scene *s, char *err, size_t errlen);
+/* The same from memory (for the fuzzer): binary selects .glb parsing. */
+int gltf_append_memory(const unsigned char *data, size_t len, int binary, const char *name,
+                       const double *xf, Scene *s, char *err, size_t errlen);
+
+#endif

@@ -1,0 +1,192 @@
+/* scenes/scene.c -- scene_load: dispatch to the glTF shim or the scene.ini reader, then the
+ * defaults, bounds, emissive-triangle list, default camera and needs of the loaded scene.
+ *
+ * Owns: what a loaded scene looks like once complete. Must not: parse files itself (gltf_shim.cpp,
+ * scene_file.c) or build acceleration structures.
+ */
+#include "scene.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "gltf.h"
+#include "scene_file.h"
+
+void scene_init(Scene *s, const char *source)
+{
+    memset(s, 0, sizeof *s);
+    s->render.width = 512;
+    s->render.height = 512;
+    s->render.spp = 1;
+    s->render.max_depth = 3; /* Gribble & Ramani 2008, Sec. 4.2: three bounces */
+    s->camera.source = SCENE_CAMERA_DEFAULT;
+    s->source = strdup(source ? source : "");
+}
+
+static int ends_with(const char *s, const char *suf)
+{
+    size_t a = strlen(s), b = strlen(suf);
+    return a >= b && strcasecmp(s + a - b, suf) == 0;
+}
+
+/* Bounds, emissive triangles, default camera, needs. */
+int scene_finish(Scene *s, char *err, size_t errlen)
+{
+    if (s->ntris == 0 && s->nspheres == 0) {
+        snprintf(err, errlen, "%s: the scene has no geometry", s->source);
+        return -1;
+    }
+    for (int k = 0; k < 3; k++) {
+        s->bounds_min[k] = INFINITY;
+        s->bounds_max[k] = -INFINITY;
+    }
+    for (uint32_t i = 0; i < 9 * s->ntris; i++) {
+        int k = (int)(i % 3);
+        s->bounds_min[k] = fminf(s->bounds_min[k], s->pos[i]);
+        s->bounds_max[k] = fmaxf(s->bounds_max[k], s->pos[i]);
+    }
+    for (uint32_t j = 0; j < s->nspheres; j++)
+        for (int k = 0; k < 3; k++) {
+            s->bounds_min[k] = fminf(s->bounds_min[k], s->spheres[j].center[k] - s->spheres[j].radius);
+            s->bounds_max[k] = fmaxf(s->bounds_max[k], s->spheres[j].center[k] + s->spheres[j].radius);
+        }
+
+    free(s->emissive_tris);
+    s->emissive_tris = NULL;
+    s->nemissive = 0;
+    uint32_t *used = calloc(s->nmaterials ? s->nmaterials : 1, sizeof(uint32_t));
+    if (!used) {
+        snprintf(err, errlen, "%s: out of memory", s->source);
+        return -1;
+    }
+    uint32_t nem = 0;
+    for (uint32_t t = 0; t < s->ntris; t++) {
+        const SceneMaterial *m = &s->materials[s->tri_material[t]];
+        used[s->tri_material[t]] = 1;
+        nem += m->emission[0] + m->emission[1] + m->emission[2] > 0.0f;
+    }
+    for (uint32_t j = 0; j < s->nspheres; j++)
+        used[s->spheres[j].material] = 1;
+    if (nem) {
+        s->emissive_tris = malloc(sizeof(uint32_t) * nem);
+        if (!s->emissive_tris) {
+            free(used);
+            snprintf(err, errlen, "%s: out of memory", s->source);
+            return -1;
+        }
+        for (uint32_t t = 0; t < s->ntris; t++) {
+            const SceneMaterial *m = &s->materials[s->tri_material[t]];
+            if (m->emission[0] + m->emission[1] + m->emission[2] > 0.0f)
+                s->emissive_tris[s->nemissive++] = t;
+        }
+    }
+
+    if (s->camera.source == SCENE_CAMERA_DEFAULT) {
+        /* Frame the bounding sphere from +z with a 45 degree vertical field of view. */
+        float c[3], r = 0.0f;
+        for (int k = 0; k < 3; k++) {
+            c[k] = 0.5f * (s->bounds_min[k] + s->bounds_max[k]);
+            float h = 0.5f * (s->bounds_max[k] - s->bounds_min[k]);
+            r += h * h;
+        }
+        r = sqrtf(r);
+        if (!(r > 0.0f))
+            r = 1.0f;
+        float d = 1.1f * r / sinf(0.5f * 45.0f * (float)M_PI / 180.0f);
+        for (int k = 0; k < 3; k++) {
+            s->camera.look_at[k] = c[k];
+            s->camera.position[k] = c[k];
+            s->camera.up[k] = 0.0f;
+        }
+        s->camera.position[2] += d;
+        s->camera.up[1] = 1.0f;
+        s->camera.fov_y = 45.0f;
+    }
+
+    uint32_t needs = 0;
+    for (uint32_t i = 0; i < s->nmaterials; i++) {
+        if (!used[i])
+            continue;
+        const SceneMaterial *m = &s->materials[i];
+        if (m->emission[0] + m->emission[1] + m->emission[2] > 0.0f)
+            continue; /* a light: shaded by the hit-light filter, not a material shader */
+        needs |= m->kind == SCENE_MAT_LAMBERT ? SCENE_NEED_LAMBERT
+               : m->kind == SCENE_MAT_GLOSSY ? SCENE_NEED_GLOSSY : SCENE_NEED_DIELECTRIC;
+        if (m->base_texture >= 0 && s->uv)
+            needs |= SCENE_NEED_TEXTURES;
+        if (m->alpha_mode != SCENE_ALPHA_OPAQUE)
+            needs |= SCENE_NEED_ALPHA;
+    }
+    free(used);
+    if (s->nspheres)
+        needs |= SCENE_NEED_SPHERES;
+    if (s->nemissive)
+        needs |= SCENE_NEED_AREA_LIGHTS;
+    for (uint32_t i = 0; i < s->nlights; i++)
+        needs |= s->lights[i].kind == SCENE_LIGHT_QUAD ? SCENE_NEED_AREA_LIGHTS : SCENE_NEED_PUNCTUAL;
+    if (s->render.background[0] + s->render.background[1] + s->render.background[2] > 0.0f)
+        needs |= SCENE_NEED_BACKGROUND;
+    if (s->render.ambient[0] + s->render.ambient[1] + s->render.ambient[2] > 0.0f)
+        needs |= SCENE_NEED_AMBIENT;
+    s->needs = needs;
+    return 0;
+}
+
+int scene_load(const char *path, Scene *s, char *err, size_t errlen)
+{
+    scene_init(s, path);
+    int rc;
+    if (ends_with(path, ".ini"))
+        rc = scene_file_load(path, s, err, errlen);
+    else if (ends_with(path, ".gltf") || ends_with(path, ".glb"))
+        rc = gltf_append(path, NULL, s, err, errlen);
+    else {
+        snprintf(err, errlen, "%s: unknown scene type (expected .gltf, .glb or .ini)", path);
+        rc = -1;
+    }
+    if (rc == 0)
+        rc = scene_finish(s, err, errlen);
+    if (rc != 0)
+        scene_free(s);
+    return rc;
+}
+
+void scene_free(Scene *s)
+{
+    for (uint32_t i = 0; i < s->nmaterials; i++)
+        free(s->materials[i].name);
+    for (uint32_t i = 0; i < s->ntextures; i++) {
+        free(s->textures[i].name);
+        free(s->textures[i].rgba);
+    }
+    for (uint32_t i = 0; i < s->nlights; i++)
+        free(s->lights[i].name);
+    for (uint32_t i = 0; i < s->nspheres; i++)
+        free(s->spheres[i].name);
+    free(s->pos);
+    free(s->nrm);
+    free(s->uv);
+    free(s->tri_material);
+    free(s->materials);
+    free(s->textures);
+    free(s->lights);
+    free(s->emissive_tris);
+    free(s->spheres);
+    free(s->source);
+    memset(s, 0, sizeof *s);
+}
+
+void scene_needs_string(uint32_t needs, char *buf, size_t len)
+{
+    size_t n = 0;
+    if (len)
+        buf[0] = 0;
+#define NEED_NAME(bit, name)                                                                     \
+    if ((needs & (bit)) && n < len)                                                              \
+        n += (size_t)snprintf(buf + n, len - n, "%s%s", n ? "," : "", name);
+    SCENE_NEED_LIST(NEED_NAME)
+#undef NEED_NAME
+}

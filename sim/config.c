@@ -1,0 +1,341 @@
+/* sim/config.c -- machine-config keys from sim/config.def: defaults, INI reading through inih,
+ * --set overrides, checks, listings.
+ *
+ * Owns: turning text into CfgMachine values and saying precisely what is wrong with bad text.
+ * Must not: exit, or interpret what a key means for the machine.
+ */
+#include "config.h"
+
+#include <errno.h>
+#include <ini.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef enum CfgType { CFG_INT, CFG_I64, CFG_FLOAT } CfgType;
+
+typedef struct CfgKeyInfo {
+    const char *section, *key;
+    CfgType type;
+    double def, lo, hi;
+    const char *help;
+    size_t offset;
+} CfgKeyInfo;
+
+static const CfgKeyInfo keys[] = {
+#define CFG_KEY(sec, key, type, def, lo, hi, help) \
+    {#sec, #key, CFG_##type, (double)(def), (double)(lo), (double)(hi), help, offsetof(CfgMachine, sec##_##key)},
+#include "config.def"
+#undef CFG_KEY
+};
+#define NKEYS (sizeof keys / sizeof keys[0])
+
+static void add_error(CfgErrors *e, const char *fmt, ...)
+{
+    char line[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    if (n < 0)
+        return;
+    if ((size_t)n >= sizeof line)
+        n = (int)sizeof line - 1;
+    char *t = realloc(e->text, e->len + (size_t)n + 2);
+    if (!t)
+        return;
+    e->text = t;
+    memcpy(e->text + e->len, line, (size_t)n);
+    e->len += (size_t)n;
+    e->text[e->len++] = '\n';
+    e->text[e->len] = 0;
+    e->count++;
+}
+
+void cfg_errors_free(CfgErrors *errs)
+{
+    free(errs->text);
+    memset(errs, 0, sizeof *errs);
+}
+
+static void store(CfgMachine *cfg, const CfgKeyInfo *k, double v)
+{
+    char *p = (char *)cfg + k->offset;
+    if (k->type == CFG_INT) {
+        int32_t x = (int32_t)v;
+        memcpy(p, &x, sizeof x);
+    } else if (k->type == CFG_I64) {
+        int64_t x = (int64_t)v;
+        memcpy(p, &x, sizeof x);
+    } else {
+        memcpy(p, &v, sizeof v);
+    }
+}
+
+static double load(const CfgMachine *cfg, const CfgKeyInfo *k)
+{
+    const char *p = (const char *)cfg + k->offset;
+    if (k->type == CFG_INT) {
+        int32_t x;
+        memcpy(&x, p, sizeof x);
+        return x;
+    }
+    if (k->type == CFG_I64) {
+        int64_t x;
+        memcpy(&x, p, sizeof x);
+        return (double)x;
+    }
+    double x;
+    memcpy(&x, p, sizeof x);
+    return x;
+}
+
+void cfg_defaults(CfgMachine *cfg)
+{
+    memset(cfg, 0, sizeof *cfg);
+    for (size_t i = 0; i < NKEYS; i++)
+        store(cfg, &keys[i], keys[i].def);
+}
+
+static const CfgKeyInfo *find(const char *section, const char *key)
+{
+    for (size_t i = 0; i < NKEYS; i++)
+        if (strcmp(keys[i].section, section) == 0 && strcmp(keys[i].key, key) == 0)
+            return &keys[i];
+    return NULL;
+}
+
+static int section_known(const char *section)
+{
+    for (size_t i = 0; i < NKEYS; i++)
+        if (strcmp(keys[i].section, section) == 0)
+            return 1;
+    return 0;
+}
+
+/* Parse and range-check; returns NULL on success or a static message. */
+static const char *parse_value(const CfgKeyInfo *k, const char *text, double *out, char *buf, size_t buflen)
+{
+    while (*text == ' ' || *text == '\t')
+        text++;
+    if (!*text)
+        return "missing value";
+    char *end;
+    errno = 0;
+    if (k->type == CFG_FLOAT) {
+        *out = strtod(text, &end);
+    } else {
+        long long v = strtoll(text, &end, 0);
+        *out = (double)v;
+    }
+    while (*end == ' ' || *end == '\t')
+        end++;
+    if (end == text || *end) {
+        snprintf(buf, buflen, "expected %s, got '%s'", k->type == CFG_FLOAT ? "a number" : "an integer", text);
+        return buf;
+    }
+    if (errno == ERANGE || !isfinite(*out) || *out < k->lo || *out > k->hi) {
+        if (k->type == CFG_FLOAT)
+            snprintf(buf, buflen, "value %s out of range %g..%g", text, k->lo, k->hi);
+        else
+            snprintf(buf, buflen, "value %s out of range %.0f..%.0f", text, k->lo, k->hi);
+        return buf;
+    }
+    if (strcmp(k->section, "stream") == 0 && strcmp(k->key, "rays") == 0 && *out != 1024 && *out != 4096) {
+        snprintf(buf, buflen, "value %s: must be 1024 or 4096", text);
+        return buf;
+    }
+    return NULL;
+}
+
+typedef struct Reader {
+    FILE *f;
+    const char *path;
+    int line;
+    int long_line;        /* the line being read did not fit inih's buffer */
+    CfgMachine *cfg;
+    CfgErrors *errs;
+} Reader;
+
+/* fgets for inih that counts lines, so the handler knows where it is, and catches lines longer
+ * than inih's buffer instead of letting them be split silently. */
+static char *reader(char *str, int num, void *stream)
+{
+    Reader *r = stream;
+    if (!fgets(str, num, r->f))
+        return NULL;
+    size_t len = strlen(str);
+    if (len > 0 && str[len - 1] == '\n') {
+        r->line++;
+        return str;
+    }
+    if (feof(r->f)) {
+        r->line++;
+        return str;
+    }
+    /* Too long: report, then skip the rest of the line and hand inih an empty one. */
+    r->line++;
+    add_error(r->errs, "%s:%d: line longer than %d characters", r->path, r->line, num - 1);
+    int ch;
+    while ((ch = fgetc(r->f)) != EOF && ch != '\n')
+        ;
+    str[0] = '\n';
+    str[1] = 0;
+    return str;
+}
+
+static int handler(void *user, const char *section, const char *name, const char *value)
+{
+    Reader *r = user;
+    const CfgKeyInfo *k = find(section, name);
+    if (!k) {
+        if (!section_known(section))
+            add_error(r->errs, "%s:%d: key '%s.%s': unknown section [%s]", r->path, r->line, section, name, section);
+        else
+            add_error(r->errs, "%s:%d: key '%s.%s': unknown key", r->path, r->line, section, name);
+        return 1;
+    }
+    double v;
+    char buf[256];
+    const char *msg = parse_value(k, value, &v, buf, sizeof buf);
+    if (msg) {
+        add_error(r->errs, "%s:%d: key '%s.%s': %s", r->path, r->line, section, name, msg);
+        return 1;
+    }
+    store(r->cfg, k, v);
+    return 1;
+}
+
+int cfg_load(CfgMachine *cfg, const char *path, CfgErrors *errs)
+{
+    int before = errs->count;
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        add_error(errs, "%s: cannot open: %s", path, strerror(errno));
+        return errs->count - before;
+    }
+    Reader r = {f, path, 0, 0, cfg, errs};
+    int rc = ini_parse_stream(reader, &r, handler, &r);
+    fclose(f);
+    if (rc > 0)
+        add_error(errs, "%s:%d: syntax error (expected [section] or key = value)", path, rc);
+    else if (rc < 0)
+        add_error(errs, "%s: cannot read", path);
+    return errs->count - before;
+}
+
+int cfg_set(CfgMachine *cfg, const char *assignment, CfgErrors *errs)
+{
+    const char *eq = strchr(assignment, '=');
+    const char *dot = strchr(assignment, '.');
+    if (!eq || !dot || dot > eq) {
+        add_error(errs, "--set %s: expected section.key=value", assignment);
+        return 1;
+    }
+    char section[128], key[128];
+    size_t sl = (size_t)(dot - assignment), kl = (size_t)(eq - dot - 1);
+    if (sl == 0 || kl == 0 || sl >= sizeof section || kl >= sizeof key) {
+        add_error(errs, "--set %s: expected section.key=value", assignment);
+        return 1;
+    }
+    memcpy(section, assignment, sl);
+    section[sl] = 0;
+    memcpy(key, dot + 1, kl);
+    key[kl] = 0;
+    const CfgKeyInfo *k = find(section, key);
+    if (!k) {
+        add_error(errs, "--set %s: unknown key '%s.%s' (sfsim config --dump lists them)", assignment, section, key);
+        return 1;
+    }
+    double v;
+    char buf[256];
+    const char *msg = parse_value(k, eq + 1, &v, buf, sizeof buf);
+    if (msg) {
+        add_error(errs, "--set %s: %s", assignment, msg);
+        return 1;
+    }
+    store(cfg, k, v);
+    return 0;
+}
+
+int cfg_check(const CfgMachine *cfg, CfgErrors *errs)
+{
+    int before = errs->count;
+    if (cfg->raybuf_size_kb % cfg->raybuf_banks != 0)
+        add_error(errs, "config: raybuf.size_kb = %d is not divisible by raybuf.banks = %d", cfg->raybuf_size_kb,
+                  cfg->raybuf_banks);
+    /* Gribble & Ramani 2008, Sec. 4: a stream's records must fit one buffer; a record is at most
+     * 128 bytes (ARCHITECTURE.md Sec. 3), so M rays need M x 128 bytes. */
+    if ((int64_t)cfg->stream_rays * 128 > (int64_t)cfg->raybuf_size_kb * 1024)
+        add_error(errs, "config: stream.rays = %d needs %d KiB of ray buffer at 128 bytes per ray, raybuf.size_kb = %d",
+                  cfg->stream_rays, cfg->stream_rays * 128 / 1024, cfg->raybuf_size_kb);
+    /* Two ID streams (current and next generation) of M IDs each. */
+    if ((int64_t)cfg->stream_rays * 8 > (int64_t)cfg->idm_size_kb * 1024)
+        add_error(errs, "config: stream.rays = %d needs %d KiB of ID-stream memory (two streams), idm.size_kb = %d",
+                  cfg->stream_rays, cfg->stream_rays * 8 / 1024, cfg->idm_size_kb);
+    return errs->count - before;
+}
+
+void cfg_core_params(const CfgMachine *cfg, CoreParams *p)
+{
+    memset(p, 0, sizeof *p);
+    p->lanes = cfg->core_simd_width;
+    p->mem_bytes[CORE_MEM_RB0] = p->mem_bytes[CORE_MEM_RB1] = (uint32_t)cfg->raybuf_size_kb * 1024u;
+    p->mem_bytes[CORE_MEM_IDM] = (uint32_t)cfg->idm_size_kb * 1024u;
+    p->mem_bytes[CORE_MEM_SPAD] = (uint32_t)cfg->spad_size_kb * 1024u;
+    p->mem_bytes[CORE_MEM_SCENE] = (uint32_t)cfg->scene_size_mb * 1024u * 1024u;
+    p->mem_bytes[CORE_MEM_FB] = (uint32_t)cfg->fb_size_kb * 1024u;
+}
+
+static const char *type_name(CfgType t) { return t == CFG_INT ? "int" : t == CFG_I64 ? "int64" : "float"; }
+
+static void fmt_value(const CfgKeyInfo *k, double v, char *buf, size_t len)
+{
+    if (k->type == CFG_FLOAT)
+        snprintf(buf, len, "%g", v);
+    else
+        snprintf(buf, len, "%.0f", v);
+}
+
+void cfg_dump(const CfgMachine *cfg, FILE *out)
+{
+    const char *sec = "";
+    for (size_t i = 0; i < NKEYS; i++) {
+        const CfgKeyInfo *k = &keys[i];
+        if (strcmp(sec, k->section) != 0) {
+            fprintf(out, "%s[%s]\n", i ? "\n" : "", k->section);
+            sec = k->section;
+        }
+        char val[64], def[64], lo[64], hi[64];
+        fmt_value(k, load(cfg, k), val, sizeof val);
+        fmt_value(k, k->def, def, sizeof def);
+        fmt_value(k, k->lo, lo, sizeof lo);
+        fmt_value(k, k->hi, hi, sizeof hi);
+        fprintf(out, "%s = %s\n    ; %s, default %s, range %s..%s: %s\n", k->key, val, type_name(k->type), def, lo, hi,
+                k->help);
+    }
+}
+
+void cfg_markdown(FILE *out)
+{
+    fprintf(out, "# Machine configuration\n\n"
+                 "<!-- GENERATED by `bin/sfsim config --markdown` from sim/config.def; do not edit. -->\n\n"
+                 "A machine config is an INI file (`configs/streamray.ini` is the machine of Gribble & Ramani\n"
+                 "2008, Sec. 3.3). Every key has a type, a default and a range; a key left out takes its\n"
+                 "default. `--set section.key=value` overrides any key on the command line, and\n"
+                 "`bin/sfsim config --dump [-c FILE] [--set ...]` prints the values in force. Unknown sections\n"
+                 "and keys, values that are not numbers, and values out of range are errors naming the file,\n"
+                 "line and key; every error of a file is reported. Cross-key checks: a ray buffer holds M rays\n"
+                 "of 128 bytes; ID-stream memory holds two streams of M IDs; ray-buffer size divides into banks.\n\n"
+                 "| key | type | default | range | meaning |\n|---|---|---|---|---|\n");
+    for (size_t i = 0; i < NKEYS; i++) {
+        const CfgKeyInfo *k = &keys[i];
+        char def[64], lo[64], hi[64];
+        fmt_value(k, k->def, def, sizeof def);
+        fmt_value(k, k->lo, lo, sizeof lo);
+        fmt_value(k, k->hi, hi, sizeof hi);
+        fprintf(out, "| `%s.%s` | %s | %s | %s..%s | %s |\n", k->section, k->key, type_name(k->type), def, lo, hi,
+                k->help);
+    }
+}

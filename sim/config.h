@@ -1,0 +1,50 @@
+/* sim/config.h -- the machine configuration: the keys of sim/config.def as a struct, INI parsing
+ * (inih), --set overrides, checks, and the dump/markdown listings.
+ *
+ * Owns: every machine-config key's type, default, range and help. Must not: interpret keys
+ * (the simulator's parts read the struct).
+ */
+#ifndef SFSIM_CONFIG_H
+#define SFSIM_CONFIG_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "core.h"
+
+typedef struct CfgMachine {
+#define CFG_T_INT int32_t
+#define CFG_T_I64 int64_t
+#define CFG_T_FLOAT double
+#define CFG_KEY(sec, key, type, def, lo, hi, help) CFG_T_##type sec##_##key;
+#include "config.def"
+#undef CFG_KEY
+} CfgMachine;
+
+/* Errors are collected into a buffer, one per line; cfg_* return the number of errors. */
+typedef struct CfgErrors {
+    char *text;      /* malloc'ed, "\n"-separated; NULL when empty */
+    size_t len;
+    int count;
+} CfgErrors;
+
+void cfg_defaults(CfgMachine *cfg);
+/* Read an INI file over cfg. Every problem is reported as "FILE:LINE: key 'sec.key': message"
+ * (or "FILE:LINE: message" for syntax), all of them. */
+int cfg_load(CfgMachine *cfg, const char *path, CfgErrors *errs);
+/* Apply "section.key=value"; errors name the option: "--set core.simd_width=999: ...". */
+int cfg_set(CfgMachine *cfg, const char *assignment, CfgErrors *errs);
+/* Cross-key consistency (e.g. a 4096-ray stream of 128-byte records must fit a ray buffer). */
+int cfg_check(const CfgMachine *cfg, CfgErrors *errs);
+void cfg_errors_free(CfgErrors *errs);
+
+/* Memory sizes and width for the functional core. */
+void cfg_core_params(const CfgMachine *cfg, CoreParams *p);
+
+/* Every key with type, default, range, help and the value in cfg. */
+void cfg_dump(const CfgMachine *cfg, FILE *out);
+/* docs/config.md. */
+void cfg_markdown(FILE *out);
+
+#endif

@@ -1,0 +1,763 @@
+/* sim/core.c -- the functional core: architectural state, memories, and one case per opcode.
+ *
+ * Owns: executing instructions exactly as isa/opcodes.def's DESC column says, for any N in
+ * 1..ISA_MAX_LANES, and counting them per stage and category. Must not: count cycles, model
+ * latency or change behaviour with timing (the timing model reads CoreRecord).
+ *
+ * The program is decoded once in core_new; core_run allocates nothing. The dispatch switch has
+ * a case for every IsaOp and no default label, so -Wswitch (in -Wall, an error under -Werror)
+ * fails the build when an opcode is added to the table without semantics here.
+ */
+#include "core.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char *const core_mem_names[CORE_MEM_COUNT] = {"rb0", "rb1", "idm", "spad", "scene", "fb"};
+static const char *const mem_long[CORE_MEM_COUNT] = {"ray buffer 0", "ray buffer 1", "ID-stream memory",
+                                                     "scratchpad", "scene memory", "framebuffer"};
+
+typedef union VReg {
+    uint32_t u[ISA_MAX_LANES];
+    int32_t i[ISA_MAX_LANES];
+    float f[ISA_MAX_LANES];
+} VReg;
+
+typedef struct Dec {
+    IsaInstr in;
+    uint8_t cat;      /* IsaCategory */
+    uint8_t vec;      /* ISA_FL_VEC */
+    uint8_t masked;   /* format takes an exec mask */
+} Dec;
+
+struct Core {
+    int n;                        /* lanes */
+    uint64_t all;                 /* mask of the N lanes */
+    uint32_t r[ISA_NUM_SREGS];
+    VReg v[ISA_NUM_VREGS];
+    uint64_t m[ISA_NUM_MREGS];
+    uint32_t pc;
+    uint8_t stage;
+    int cur_rb;                   /* physical buffer (0/1) that is RBc */
+    uint8_t *mem[CORE_MEM_COUNT];
+    uint32_t size[CORE_MEM_COUNT];
+    Dec *code;
+    uint32_t ncode;
+    const AsmObject *obj;
+    uint8_t *pq;                  /* partition unit's mask queue, one byte per bit */
+    uint32_t pq_len, pq_cap;
+    uint32_t *part_tmp;           /* scratch for the in-place partition */
+    CoreStats st;
+    uint64_t total;
+    CoreHook hook;
+    void *hook_ctx;
+    CoreRecord rec;
+    char trap[1024];
+};
+
+/* ---- construction ---------------------------------------------------------------------------- */
+
+Core *core_new(const CoreParams *p, const AsmObject *obj, char *err, size_t errlen)
+{
+    if (p->lanes < 1 || p->lanes > ISA_MAX_LANES) {
+        snprintf(err, errlen, "SIMD width %d out of range 1..%d", p->lanes, ISA_MAX_LANES);
+        return NULL;
+    }
+    if (p->mem_bytes[CORE_MEM_RB0] != p->mem_bytes[CORE_MEM_RB1]) {
+        snprintf(err, errlen, "the two ray buffers must have the same size (%u and %u bytes)",
+                 p->mem_bytes[CORE_MEM_RB0], p->mem_bytes[CORE_MEM_RB1]);
+        return NULL;
+    }
+    for (int m = 0; m < CORE_MEM_COUNT; m++) {
+        if (p->mem_bytes[m] % 4 != 0) {
+            snprintf(err, errlen, "%s size %u is not a multiple of 4 bytes", mem_long[m], p->mem_bytes[m]);
+            return NULL;
+        }
+    }
+    if (obj->ndata > p->mem_bytes[CORE_MEM_SCENE] || obj->nspad > p->mem_bytes[CORE_MEM_SPAD]) {
+        snprintf(err, errlen, "program data does not fit: .data %u bytes (scene memory %u), .spad %u bytes (scratchpad %u)",
+                 obj->ndata, p->mem_bytes[CORE_MEM_SCENE], obj->nspad, p->mem_bytes[CORE_MEM_SPAD]);
+        return NULL;
+    }
+    Core *c = calloc(1, sizeof *c);
+    if (!c) {
+        snprintf(err, errlen, "out of memory");
+        return NULL;
+    }
+    c->n = p->lanes;
+    c->all = p->lanes == 64 ? ~0ull : (1ull << p->lanes) - 1;
+    c->obj = obj;
+    c->ncode = obj->ntext;
+    c->code = calloc(obj->ntext ? obj->ntext : 1, sizeof(Dec));
+    int ok = c->code != NULL;
+    for (int m = 0; ok && m < CORE_MEM_COUNT; m++) {
+        c->size[m] = p->mem_bytes[m];
+        c->mem[m] = calloc(p->mem_bytes[m] ? p->mem_bytes[m] : 4, 1);
+        ok = c->mem[m] != NULL;
+    }
+    c->pq_cap = p->mem_bytes[CORE_MEM_IDM] / 4 + ISA_MAX_LANES;
+    c->pq = ok ? malloc(c->pq_cap) : NULL;
+    c->part_tmp = ok ? malloc(sizeof(uint32_t) * (p->mem_bytes[CORE_MEM_IDM] / 4 + 1)) : NULL;
+    if (!ok || !c->pq || !c->part_tmp) {
+        snprintf(err, errlen, "out of memory for the simulated memories");
+        core_free(c);
+        return NULL;
+    }
+    for (uint32_t i = 0; i < obj->ntext; i++) {
+        char derr[256];
+        if (isa_decode(obj->text[i], &c->code[i].in, derr, sizeof derr) != 0) {
+            char where[256];
+            asm_object_where(obj, i, where, sizeof where);
+            snprintf(err, errlen, "instruction %u (%s): %s", i, where, derr);
+            core_free(c);
+            return NULL;
+        }
+        const IsaOpInfo *oi = &isa_ops[c->code[i].in.op];
+        c->code[i].cat = (uint8_t)oi->category;
+        c->code[i].vec = (oi->flags & ISA_FL_VEC) != 0;
+        c->code[i].masked = (uint8_t)isa_formats[oi->format].masked;
+    }
+    if (obj->ndata)
+        memcpy(c->mem[CORE_MEM_SCENE], obj->data, obj->ndata);
+    if (obj->nspad)
+        memcpy(c->mem[CORE_MEM_SPAD], obj->spad, obj->nspad);
+    c->m[0] = c->all;
+    return c;
+}
+
+void core_free(Core *c)
+{
+    if (!c)
+        return;
+    for (int m = 0; m < CORE_MEM_COUNT; m++)
+        free(c->mem[m]);
+    free(c->code);
+    free(c->pq);
+    free(c->part_tmp);
+    free(c);
+}
+
+/* ---- traps ----------------------------------------------------------------------------------- */
+
+/* Compose "trap: <reason> at pc N (<instruction>) <file:line>". Always returns 1. */
+static int trap(Core *c, const char *fmt, ...)
+{
+    char reason[384], dis[128], where[256];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(reason, sizeof reason, fmt, ap);
+    va_end(ap);
+    if (c->pc < c->ncode) {
+        isa_disassemble(&c->code[c->pc].in, 0, dis, sizeof dis);
+        asm_object_where(c->obj, c->pc, where, sizeof where);
+    } else {
+        snprintf(dis, sizeof dis, "no instruction");
+        snprintf(where, sizeof where, "%s", c->ncode ? "after the last instruction" : "empty program");
+    }
+    snprintf(c->trap, sizeof c->trap, "trap: %s at pc %u (%s) %s", reason, c->pc, dis, where);
+    return 1;
+}
+
+const char *core_trap_message(const Core *c) { return c->trap; }
+
+/* 0 if a 4-byte access at addr of memory m is legal, else traps and returns 1. */
+static int check(Core *c, CoreMem m, uint32_t addr, const char *what)
+{
+    if (addr & 3u)
+        return trap(c, "%s %s misaligned: address 0x%08x", mem_long[m], what, addr);
+    if (c->size[m] < 4 || addr > c->size[m] - 4)
+        return trap(c, "%s %s out of range: address 0x%08x (size %u)", mem_long[m], what, addr, c->size[m]);
+    return 0;
+}
+
+static inline uint32_t rd32(const Core *c, CoreMem m, uint32_t a)
+{
+    uint32_t v;
+    memcpy(&v, c->mem[m] + a, 4);
+    return v;
+}
+
+static inline void wr32(Core *c, CoreMem m, uint32_t a, uint32_t v) { memcpy(c->mem[m] + a, &v, 4); }
+
+/* ---- value helpers --------------------------------------------------------------------------- */
+
+static inline float f_of(uint32_t u)
+{
+    float f;
+    memcpy(&f, &u, 4);
+    return f;
+}
+
+static inline uint32_t u_of(float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, 4);
+    return u;
+}
+
+/* The ISA's min/max: the second operand is ignored when it is NaN. */
+static inline float isa_fmin(float b, float c) { return c < b ? c : b; }
+static inline float isa_fmax(float b, float c) { return c > b ? c : b; }
+
+static inline int32_t cvt_f2i(float x)
+{
+    if (x != x)
+        return 0;
+    if (x >= 2147483648.0f)
+        return INT32_MAX;
+    if (x <= -2147483648.0f)
+        return INT32_MIN;
+    return (int32_t)x;
+}
+
+static inline int popcount64(uint64_t x) { return __builtin_popcountll(x); }
+
+/* ---- lane loops ---------------------------------------------------------------------------- */
+/* Compute EXPR (which may use l, B, C, D: the operand registers) for every lane into a temporary,
+ * then merge the exec-mask lanes into the destination. Computing idle lanes is harmless (pure
+ * arithmetic, no traps) and lets the compiler vectorize the loop. FIELD selects u/i/f views. */
+#define VOP(OUT, EXPR)                                                                          \
+    do {                                                                                        \
+        VReg *A_ = &c->v[in->a];                                                                \
+        const VReg *B = &c->v[in->b], *C = &c->v[in->c], *D = &c->v[in->d];                     \
+        VReg t_;                                                                                \
+        (void)B; (void)C; (void)D;                                                              \
+        for (int l = 0; l < n; l++)                                                             \
+            t_.OUT[l] = (EXPR);                                                                 \
+        if (E == c->all) {                                                                      \
+            memcpy(A_->u, t_.u, sizeof(uint32_t) * (size_t)n);                                  \
+        } else {                                                                                \
+            for (int l = 0; l < n; l++)                                                         \
+                A_->u[l] = ((E >> l) & 1u) ? t_.u[l] : A_->u[l];                                \
+        }                                                                                       \
+    } while (0)
+
+/* Compare into mask register a: E & test. */
+#define VCMP(TEST)                                                                              \
+    do {                                                                                        \
+        const VReg *B = &c->v[in->b], *C = &c->v[in->c];                                        \
+        uint64_t res_ = 0;                                                                      \
+        for (int l = 0; l < n; l++)                                                             \
+            res_ |= (uint64_t)((TEST) ? 1u : 0u) << l;                                          \
+        c->m[in->a] = res_ & E;                                                                 \
+    } while (0)
+
+#define SR(i) c->r[i]
+#define SF(i) f_of(c->r[i])
+#define SETF(i, x) (c->r[i] = u_of(x))
+#define IMM (in->imm)
+
+static void record_reset(CoreRecord *rec, uint32_t pc, const IsaInstr *in, uint8_t stage, uint64_t exec)
+{
+    rec->pc = pc;
+    rec->in = in;
+    rec->stage = stage;
+    rec->taken = 0;
+    rec->mem = CORE_MEM_COUNT;
+    rec->naddr = 0;
+    rec->count = 0;
+    rec->exec = exec;
+}
+
+static inline void rec_addr(Core *c, CoreMem m, uint32_t a)
+{
+    if (c->hook) {
+        c->rec.mem = (uint8_t)m;
+        if (c->rec.naddr < ISA_MAX_LANES)
+            c->rec.addr[c->rec.naddr++] = a;
+    }
+}
+
+/* ---- the partition unit ---------------------------------------------------------------------- */
+
+static int do_part(Core *c, const IsaInstr *in)
+{
+    uint32_t b = SR(in->b), e = SR(in->c);
+    if (b > e)
+        return trap(c, "partition: bad stream: begin 0x%08x > end 0x%08x", b, e);
+    if ((b | e) & 3u)
+        return trap(c, "partition: stream bounds 0x%08x..0x%08x not word aligned", b, e);
+    if (e > c->size[CORE_MEM_IDM])
+        return trap(c, "partition: stream end 0x%08x beyond ID-stream memory (size %u)", e, c->size[CORE_MEM_IDM]);
+    uint32_t len = (e - b) / 4;
+    if (c->pq_len < len || c->pq_len >= len + (uint32_t)c->n)
+        return trap(c, "partition: %u mask bits queued for a stream of %u IDs", c->pq_len, len);
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < len; i++)
+        if (c->pq[i])
+            c->part_tmp[k++] = rd32(c, CORE_MEM_IDM, b + 4 * i);
+    uint32_t set = k;
+    for (uint32_t i = 0; i < len; i++)
+        if (!c->pq[i])
+            c->part_tmp[k++] = rd32(c, CORE_MEM_IDM, b + 4 * i);
+    memcpy(c->mem[CORE_MEM_IDM] + b, c->part_tmp, 4 * (size_t)len);
+    SR(in->a) = b + 4 * set;
+    c->pq_len = 0;
+    if (c->hook) {
+        c->rec.mem = CORE_MEM_IDM;
+        c->rec.count = len;
+    }
+    return 0;
+}
+
+/* ---- execution ----------------------------------------------------------------------------- */
+
+/* Execute the instruction at pc. Returns 0 to go on, 1 on halt, -1 on a trap. */
+static int step(Core *c)
+{
+    if (c->pc >= c->ncode) {
+        trap(c, "pc past the end of the program (%u instructions)", c->ncode);
+        return -1;
+    }
+    const Dec *dc = &c->code[c->pc];
+    const IsaInstr *in = &dc->in;
+    const int n = c->n;
+    const uint64_t E = dc->masked ? c->m[in->mask] & c->all : c->all;
+    uint32_t next = c->pc + 1;
+    int halt = 0;
+    uint32_t active = dc->vec ? (uint32_t)popcount64(E) : 0;
+    if (c->hook)
+        record_reset(&c->rec, c->pc, in, c->stage, E);
+    const uint8_t stage = c->stage;
+
+#define BRANCH_TO(cond)                                                                         \
+    do {                                                                                        \
+        if (cond) {                                                                             \
+            if (IMM > c->ncode)                                                                 \
+                return -trap(c, "branch target %u outside the program (%u instructions)", IMM, c->ncode); \
+            next = IMM;                                                                         \
+            if (c->hook)                                                                        \
+                c->rec.taken = 1;                                                               \
+        }                                                                                       \
+    } while (0)
+#define MEMCHK(m, a, what)                                                                      \
+    do {                                                                                        \
+        if (check(c, (m), (a), (what)))                                                         \
+            return -1;                                                                          \
+    } while (0)
+
+    switch ((IsaOp)in->op) {
+    /* control */
+    case ISA_OP_NOP: break;
+    case ISA_OP_HALT: halt = 1; break;
+    case ISA_OP_STAGE:
+        if (IMM >= ISA_STAGE_COUNT)
+            return -trap(c, "bad stage %u (0..%d)", IMM, ISA_STAGE_COUNT - 1);
+        c->stage = (uint8_t)IMM;
+        break;
+    case ISA_OP_JMP: BRANCH_TO(1); break;
+    case ISA_OP_JAL: {
+        uint32_t ret = c->pc + 1;
+        BRANCH_TO(1);
+        SR(in->a) = ret;
+        break;
+    }
+    case ISA_OP_JR:
+        if (SR(in->a) > c->ncode)
+            return -trap(c, "jump target %u outside the program (%u instructions)", SR(in->a), c->ncode);
+        next = SR(in->a);
+        if (c->hook)
+            c->rec.taken = 1;
+        break;
+    case ISA_OP_BEQ: BRANCH_TO(SR(in->a) == SR(in->b)); break;
+    case ISA_OP_BNE: BRANCH_TO(SR(in->a) != SR(in->b)); break;
+    case ISA_OP_BLT: BRANCH_TO((int32_t)SR(in->a) < (int32_t)SR(in->b)); break;
+    case ISA_OP_BGE: BRANCH_TO((int32_t)SR(in->a) >= (int32_t)SR(in->b)); break;
+    case ISA_OP_BLTU: BRANCH_TO(SR(in->a) < SR(in->b)); break;
+    case ISA_OP_BGEU: BRANCH_TO(SR(in->a) >= SR(in->b)); break;
+    case ISA_OP_BMZ: BRANCH_TO((c->m[in->a] & c->all) == 0); break;
+    case ISA_OP_BMNZ: BRANCH_TO((c->m[in->a] & c->all) != 0); break;
+
+    /* scalar integer: uint32_t arithmetic, so overflow wraps without undefined behaviour */
+    case ISA_OP_LI: SR(in->a) = IMM; break;
+    case ISA_OP_MOV: SR(in->a) = SR(in->b); break;
+    case ISA_OP_ADD: SR(in->a) = SR(in->b) + SR(in->c); break;
+    case ISA_OP_SUB: SR(in->a) = SR(in->b) - SR(in->c); break;
+    case ISA_OP_MUL: SR(in->a) = SR(in->b) * SR(in->c); break;
+    case ISA_OP_DIVU:
+        if (SR(in->c) == 0)
+            return -trap(c, "integer division by zero");
+        SR(in->a) = SR(in->b) / SR(in->c);
+        break;
+    case ISA_OP_REMU:
+        if (SR(in->c) == 0)
+            return -trap(c, "integer division by zero");
+        SR(in->a) = SR(in->b) % SR(in->c);
+        break;
+    case ISA_OP_AND: SR(in->a) = SR(in->b) & SR(in->c); break;
+    case ISA_OP_OR: SR(in->a) = SR(in->b) | SR(in->c); break;
+    case ISA_OP_XOR: SR(in->a) = SR(in->b) ^ SR(in->c); break;
+    case ISA_OP_SHL: SR(in->a) = SR(in->b) << (SR(in->c) & 31u); break;
+    case ISA_OP_SHR: SR(in->a) = SR(in->b) >> (SR(in->c) & 31u); break;
+    case ISA_OP_SRA: SR(in->a) = (uint32_t)((int32_t)SR(in->b) >> (SR(in->c) & 31u)); break;
+    case ISA_OP_SLT: SR(in->a) = (int32_t)SR(in->b) < (int32_t)SR(in->c); break;
+    case ISA_OP_SLTU: SR(in->a) = SR(in->b) < SR(in->c); break;
+    case ISA_OP_ADDI: SR(in->a) = SR(in->b) + IMM; break;
+    case ISA_OP_MULI: SR(in->a) = SR(in->b) * IMM; break;
+    case ISA_OP_ANDI: SR(in->a) = SR(in->b) & IMM; break;
+    case ISA_OP_ORI: SR(in->a) = SR(in->b) | IMM; break;
+    case ISA_OP_XORI: SR(in->a) = SR(in->b) ^ IMM; break;
+    case ISA_OP_SHLI: SR(in->a) = SR(in->b) << (IMM & 31u); break;
+    case ISA_OP_SHRI: SR(in->a) = SR(in->b) >> (IMM & 31u); break;
+    case ISA_OP_SRAI: SR(in->a) = (uint32_t)((int32_t)SR(in->b) >> (IMM & 31u)); break;
+    case ISA_OP_SLTI: SR(in->a) = (int32_t)SR(in->b) < (int32_t)IMM; break;
+    case ISA_OP_RDN: SR(in->a) = (uint32_t)n; break;
+
+    /* scalar float */
+    case ISA_OP_FADD: SETF(in->a, SF(in->b) + SF(in->c)); break;
+    case ISA_OP_FSUB: SETF(in->a, SF(in->b) - SF(in->c)); break;
+    case ISA_OP_FMUL: SETF(in->a, SF(in->b) * SF(in->c)); break;
+    case ISA_OP_FDIV: SETF(in->a, SF(in->b) / SF(in->c)); break;
+    case ISA_OP_FMIN: SETF(in->a, isa_fmin(SF(in->b), SF(in->c))); break;
+    case ISA_OP_FMAX: SETF(in->a, isa_fmax(SF(in->b), SF(in->c))); break;
+    case ISA_OP_FMA: SETF(in->a, fmaf(SF(in->b), SF(in->c), SF(in->d))); break;
+    case ISA_OP_FABS: SR(in->a) = SR(in->b) & 0x7FFFFFFFu; break;
+    case ISA_OP_FNEG: SR(in->a) = SR(in->b) ^ 0x80000000u; break;
+    case ISA_OP_FSQRT: SETF(in->a, sqrtf(SF(in->b))); break;
+    case ISA_OP_FLT: SR(in->a) = SF(in->b) < SF(in->c); break;
+    case ISA_OP_FLE: SR(in->a) = SF(in->b) <= SF(in->c); break;
+    case ISA_OP_FEQ: SR(in->a) = SF(in->b) == SF(in->c); break;
+    case ISA_OP_CVTIF: SETF(in->a, (float)(int32_t)SR(in->b)); break;
+    case ISA_OP_CVTFI: SR(in->a) = (uint32_t)cvt_f2i(SF(in->b)); break;
+    case ISA_OP_FFLOOR: SETF(in->a, floorf(SF(in->b))); break;
+
+    /* vector float */
+    case ISA_OP_VFADD: VOP(f, B->f[l] + C->f[l]); break;
+    case ISA_OP_VFSUB: VOP(f, B->f[l] - C->f[l]); break;
+    case ISA_OP_VFMUL: VOP(f, B->f[l] * C->f[l]); break;
+    case ISA_OP_VFDIV: VOP(f, B->f[l] / C->f[l]); break;
+    case ISA_OP_VFMIN: VOP(f, isa_fmin(B->f[l], C->f[l])); break;
+    case ISA_OP_VFMAX: VOP(f, isa_fmax(B->f[l], C->f[l])); break;
+    case ISA_OP_VFMA: VOP(f, fmaf(B->f[l], C->f[l], D->f[l])); break;
+    case ISA_OP_VFABS: VOP(u, B->u[l] & 0x7FFFFFFFu); break;
+    case ISA_OP_VFNEG: VOP(u, B->u[l] ^ 0x80000000u); break;
+    case ISA_OP_VFFLOOR: VOP(f, floorf(B->f[l])); break;
+    case ISA_OP_VCVTIF: VOP(f, (float)B->i[l]); break;
+    case ISA_OP_VCVTFI: VOP(i, cvt_f2i(B->f[l])); break;
+    case ISA_OP_VRCP: VOP(f, 1.0f / B->f[l]); break;
+    case ISA_OP_VSQRT: VOP(f, sqrtf(B->f[l])); break;
+    case ISA_OP_VRSQRT: VOP(f, 1.0f / sqrtf(B->f[l])); break;
+    case ISA_OP_VSIN: VOP(f, sinf(B->f[l])); break;
+    case ISA_OP_VCOS: VOP(f, cosf(B->f[l])); break;
+    case ISA_OP_VEXP2: VOP(f, exp2f(B->f[l])); break;
+    case ISA_OP_VLOG2: VOP(f, log2f(B->f[l])); break;
+
+    /* vector integer */
+    case ISA_OP_VADD: VOP(u, B->u[l] + C->u[l]); break;
+    case ISA_OP_VSUB: VOP(u, B->u[l] - C->u[l]); break;
+    case ISA_OP_VMUL: VOP(u, B->u[l] * C->u[l]); break;
+    case ISA_OP_VAND: VOP(u, B->u[l] & C->u[l]); break;
+    case ISA_OP_VOR: VOP(u, B->u[l] | C->u[l]); break;
+    case ISA_OP_VXOR: VOP(u, B->u[l] ^ C->u[l]); break;
+    case ISA_OP_VSHL: VOP(u, B->u[l] << (C->u[l] & 31u)); break;
+    case ISA_OP_VSHR: VOP(u, B->u[l] >> (C->u[l] & 31u)); break;
+    case ISA_OP_VSRA: VOP(i, B->i[l] >> (C->u[l] & 31u)); break;
+    case ISA_OP_VADDI: VOP(u, B->u[l] + IMM); break;
+    case ISA_OP_VMULI: VOP(u, B->u[l] * IMM); break;
+    case ISA_OP_VANDI: VOP(u, B->u[l] & IMM); break;
+    case ISA_OP_VXORI: VOP(u, B->u[l] ^ IMM); break;
+    case ISA_OP_VSHLI: VOP(u, B->u[l] << (IMM & 31u)); break;
+    case ISA_OP_VSHRI: VOP(u, B->u[l] >> (IMM & 31u)); break;
+
+    /* compares */
+    case ISA_OP_VFLT: VCMP(B->f[l] < C->f[l]); break;
+    case ISA_OP_VFLE: VCMP(B->f[l] <= C->f[l]); break;
+    case ISA_OP_VFEQ: VCMP(B->f[l] == C->f[l]); break;
+    case ISA_OP_VFNE: VCMP(!(B->f[l] == C->f[l])); break;
+    case ISA_OP_VIEQ: VCMP(B->u[l] == C->u[l]); break;
+    case ISA_OP_VILT: VCMP(B->i[l] < C->i[l]); break;
+    case ISA_OP_VILTU: VCMP(B->u[l] < C->u[l]); break;
+
+    /* moves and select */
+    case ISA_OP_VSEL: {
+        uint64_t sel = c->m[in->d];
+        VOP(u, ((sel >> l) & 1u) ? B->u[l] : C->u[l]);
+        break;
+    }
+    case ISA_OP_VMOV: VOP(u, B->u[l]); break;
+    case ISA_OP_VBCAST: {
+        uint32_t x = SR(in->b);
+        VOP(u, x);
+        break;
+    }
+    case ISA_OP_VLI: VOP(u, IMM); break;
+    case ISA_OP_VIOTA: VOP(u, (uint32_t)l); break;
+    case ISA_OP_VEXT:
+        if (IMM >= (uint32_t)n)
+            return -trap(c, "vext lane %u out of range (N = %d)", IMM, n);
+        SR(in->a) = c->v[in->b].u[IMM];
+        break;
+
+    /* masks */
+    case ISA_OP_MAND: c->m[in->a] = c->m[in->b] & c->m[in->c]; break;
+    case ISA_OP_MOR: c->m[in->a] = c->m[in->b] | c->m[in->c]; break;
+    case ISA_OP_MXOR: c->m[in->a] = c->m[in->b] ^ c->m[in->c]; break;
+    case ISA_OP_MANDN: c->m[in->a] = c->m[in->b] & ~c->m[in->c]; break;
+    case ISA_OP_MNOT: c->m[in->a] = ~c->m[in->b] & c->all; break;
+    case ISA_OP_MMOV: c->m[in->a] = c->m[in->b]; break;
+    case ISA_OP_MALL: c->m[in->a] = c->all; break;
+    case ISA_OP_MCLR: c->m[in->a] = 0; break;
+    case ISA_OP_MTAIL: {
+        int32_t k = (int32_t)SR(in->b);
+        c->m[in->a] = k <= 0 ? 0 : (k >= n ? c->all : (1ull << k) - 1);
+        break;
+    }
+    case ISA_OP_MPOP: SR(in->a) = (uint32_t)popcount64(c->m[in->b] & c->all); break;
+    case ISA_OP_MFIRST: {
+        uint64_t x = c->m[in->b] & c->all;
+        SR(in->a) = x ? (uint32_t)__builtin_ctzll(x) : 0xFFFFFFFFu;
+        break;
+    }
+
+    /* ID streams */
+    case ISA_OP_SFETCH: {
+        uint32_t b = SR(in->c), e = SR(in->d);
+        if (b > e)
+            return -trap(c, "bad stream: begin 0x%08x > end 0x%08x", b, e);
+        if ((b | e) & 3u)
+            return -trap(c, "bad stream: bounds 0x%08x..0x%08x not word aligned", b, e);
+        if (e > c->size[CORE_MEM_IDM])
+            return -trap(c, "bad stream: end 0x%08x beyond ID-stream memory (size %u)", e, c->size[CORE_MEM_IDM]);
+        uint32_t avail = (e - b) / 4, k = avail < (uint32_t)n ? avail : (uint32_t)n;
+        VReg *A = &c->v[in->a];
+        for (uint32_t l = 0; l < k; l++) {
+            A->u[l] = rd32(c, CORE_MEM_IDM, b + 4 * l);
+            rec_addr(c, CORE_MEM_IDM, b + 4 * l);
+        }
+        if (k > 0)
+            for (uint32_t l = k; l < (uint32_t)n; l++)
+                A->u[l] = A->u[k - 1];
+        c->m[in->b] = k >= 64 ? ~0ull : (1ull << k) - 1;
+        SR(in->c) = b + 4 * k;
+        active = k;
+        break;
+    }
+    case ISA_OP_SLD: {
+        uint32_t a = SR(in->b) + IMM;
+        MEMCHK(CORE_MEM_IDM, a, "load");
+        SR(in->a) = rd32(c, CORE_MEM_IDM, a);
+        rec_addr(c, CORE_MEM_IDM, a);
+        break;
+    }
+    case ISA_OP_SST: {
+        uint32_t a = SR(in->b) + IMM;
+        MEMCHK(CORE_MEM_IDM, a, "store");
+        wr32(c, CORE_MEM_IDM, a, SR(in->a));
+        rec_addr(c, CORE_MEM_IDM, a);
+        break;
+    }
+    case ISA_OP_SAPP: {
+        uint32_t p = SR(in->a);
+        const VReg *B = &c->v[in->b];
+        for (int l = 0; l < n; l++) {
+            if (!((E >> l) & 1u))
+                continue;
+            MEMCHK(CORE_MEM_IDM, p, "append");
+            wr32(c, CORE_MEM_IDM, p, B->u[l]);
+            rec_addr(c, CORE_MEM_IDM, p);
+            p += 4;
+        }
+        SR(in->a) = p;
+        break;
+    }
+    case ISA_OP_RALLOC: {
+        uint32_t base = SR(in->b), k = 0;
+        VReg *A = &c->v[in->a];
+        for (int l = 0; l < n; l++)
+            if ((E >> l) & 1u)
+                A->u[l] = base + k++;
+        SR(in->b) = base + k;
+        break;
+    }
+
+    /* ray buffers */
+    case ISA_OP_RGAT:
+    case ISA_OP_RGATN:
+    case ISA_OP_RSCT:
+    case ISA_OP_RSCTN: {
+        int nextbuf = in->op == ISA_OP_RGATN || in->op == ISA_OP_RSCTN;
+        int store = in->op == ISA_OP_RSCT || in->op == ISA_OP_RSCTN;
+        CoreMem m = (CoreMem)(CORE_MEM_RB0 + (c->cur_rb ^ nextbuf));
+        uint32_t base = SR(in->c) + IMM;
+        VReg *A = &c->v[in->a];
+        const VReg *B = &c->v[in->b];
+        for (int l = 0; l < n; l++) {
+            if (!((E >> l) & 1u))
+                continue;
+            uint32_t a = base + 4u * B->u[l];
+            MEMCHK(m, a, store ? "scatter" : "gather");
+            if (store)
+                wr32(c, m, a, A->u[l]);
+            else
+                A->u[l] = rd32(c, m, a);
+            rec_addr(c, m, a);
+        }
+        break;
+    }
+    case ISA_OP_RSWAP: c->cur_rb ^= 1; break;
+
+    /* partition unit */
+    case ISA_OP_PMASK: {
+        if (c->pq_len + (uint32_t)n > c->pq_cap)
+            return -trap(c, "partition queue overflow: %u bits queued (capacity %u)", c->pq_len, c->pq_cap);
+        uint64_t mk = c->m[in->a];
+        for (int l = 0; l < n; l++)
+            c->pq[c->pq_len++] = (uint8_t)((mk >> l) & 1u);
+        if (c->hook)
+            c->rec.count = c->pq_len;
+        break;
+    }
+    case ISA_OP_PART:
+        if (do_part(c, in))
+            return -1;
+        break;
+    case ISA_OP_PCLR: c->pq_len = 0; break;
+
+    /* scratchpad */
+    case ISA_OP_SPLD: {
+        uint32_t a = SR(in->b) + IMM;
+        MEMCHK(CORE_MEM_SPAD, a, "load");
+        SR(in->a) = rd32(c, CORE_MEM_SPAD, a);
+        rec_addr(c, CORE_MEM_SPAD, a);
+        break;
+    }
+    case ISA_OP_SPST: {
+        uint32_t a = SR(in->b) + IMM;
+        MEMCHK(CORE_MEM_SPAD, a, "store");
+        wr32(c, CORE_MEM_SPAD, a, SR(in->a));
+        rec_addr(c, CORE_MEM_SPAD, a);
+        break;
+    }
+    case ISA_OP_VSPLD:
+    case ISA_OP_VSPST: {
+        int store = in->op == ISA_OP_VSPST;
+        uint32_t base = SR(in->b) + IMM;
+        VReg *A = &c->v[in->a];
+        for (int l = 0; l < n; l++) {
+            if (!((E >> l) & 1u))
+                continue;
+            uint32_t a = base + 4u * (uint32_t)l;
+            MEMCHK(CORE_MEM_SPAD, a, store ? "store" : "load");
+            if (store)
+                wr32(c, CORE_MEM_SPAD, a, A->u[l]);
+            else
+                A->u[l] = rd32(c, CORE_MEM_SPAD, a);
+            rec_addr(c, CORE_MEM_SPAD, a);
+        }
+        break;
+    }
+
+    /* scene memory */
+    case ISA_OP_LD: {
+        uint32_t a = SR(in->b) + IMM;
+        MEMCHK(CORE_MEM_SCENE, a, "load");
+        SR(in->a) = rd32(c, CORE_MEM_SCENE, a);
+        rec_addr(c, CORE_MEM_SCENE, a);
+        break;
+    }
+    case ISA_OP_ST: {
+        uint32_t a = SR(in->b) + IMM;
+        MEMCHK(CORE_MEM_SCENE, a, "store");
+        wr32(c, CORE_MEM_SCENE, a, SR(in->a));
+        rec_addr(c, CORE_MEM_SCENE, a);
+        break;
+    }
+    case ISA_OP_LDB: {
+        uint32_t a = SR(in->b) + IMM;
+        if (E) { /* one access serves every lane; no lane, no access */
+            MEMCHK(CORE_MEM_SCENE, a, "broadcast load");
+            uint32_t x = rd32(c, CORE_MEM_SCENE, a);
+            rec_addr(c, CORE_MEM_SCENE, a);
+            VOP(u, x);
+        }
+        break;
+    }
+    case ISA_OP_LDG: {
+        VReg *A = &c->v[in->a];
+        const VReg *B = &c->v[in->b];
+        for (int l = 0; l < n; l++) {
+            if (!((E >> l) & 1u))
+                continue;
+            uint32_t a = B->u[l] + IMM;
+            MEMCHK(CORE_MEM_SCENE, a, "gather");
+            A->u[l] = rd32(c, CORE_MEM_SCENE, a);
+            rec_addr(c, CORE_MEM_SCENE, a);
+        }
+        break;
+    }
+
+    /* framebuffer */
+    case ISA_OP_FBADD: {
+        const VReg *A = &c->v[in->a], *B = &c->v[in->b];
+        for (int l = 0; l < n; l++) {
+            if (!((E >> l) & 1u))
+                continue;
+            uint32_t a = B->u[l] + IMM;
+            MEMCHK(CORE_MEM_FB, a, "scatter-add");
+            wr32(c, CORE_MEM_FB, a, u_of(f_of(rd32(c, CORE_MEM_FB, a)) + A->f[l]));
+            rec_addr(c, CORE_MEM_FB, a);
+        }
+        break;
+    }
+    case ISA_OP_COUNT: /* not an opcode: isa_decode never produces it */
+        return -trap(c, "internal error: undecoded instruction");
+    }
+#undef BRANCH_TO
+#undef MEMCHK
+
+    c->st.instructions[stage]++;
+    c->st.ops[stage][dc->cat]++;
+    c->st.by_op[in->op]++;
+    if (dc->vec) {
+        c->st.vec_instructions[stage]++;
+        c->st.active_lanes[stage] += active;
+    }
+    c->total++;
+    if (c->hook) {
+        c->rec.next_pc = halt ? c->pc : next;
+        c->hook(c->hook_ctx, &c->rec);
+    }
+    if (!halt) /* a halted core stays on its halt */
+        c->pc = next;
+    return halt;
+}
+
+CoreExit core_run(Core *c, uint64_t max_instr)
+{
+    c->trap[0] = 0;
+    for (uint64_t done = 0; max_instr == 0 || done < max_instr; done++) {
+        int r = step(c);
+        if (r > 0)
+            return CORE_EXIT_HALT;
+        if (r < 0)
+            return CORE_EXIT_TRAP;
+    }
+    trap(c, "instruction limit of %llu reached", (unsigned long long)max_instr);
+    return CORE_EXIT_LIMIT;
+}
+
+void core_set_hook(Core *c, CoreHook hook, void *ctx)
+{
+    c->hook = hook;
+    c->hook_ctx = ctx;
+}
+
+int core_lanes(const Core *c) { return c->n; }
+uint32_t core_pc(const Core *c) { return c->pc; }
+uint32_t core_sreg(const Core *c, int r) { return c->r[r]; }
+void core_set_sreg(Core *c, int r, uint32_t v) { c->r[r] = v; }
+uint32_t core_vreg(const Core *c, int v, int lane) { return c->v[v].u[lane]; }
+uint64_t core_mreg(const Core *c, int m) { return c->m[m]; }
+int core_current_rb(const Core *c) { return c->cur_rb; }
+const CoreStats *core_stats(const Core *c) { return &c->st; }
+uint64_t core_instructions(const Core *c) { return c->total; }
+
+uint8_t *core_mem(Core *c, CoreMem m, uint32_t *bytes)
+{
+    if (bytes)
+        *bytes = c->size[m];
+    return c->mem[m];
+}

@@ -1,0 +1,485 @@
+/* sim/main.c -- the `sfsim` command line.
+ *
+ * Owns: argument parsing, exit codes and what is printed. Must not: simulate (it calls the
+ * core, the config and the renderers). Exit codes: 0 ok, 1 input or config error, 2 usage,
+ * 3 the simulated program trapped or hit its instruction limit.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "../asm/object.h"
+#include "config.h"
+#include "core.h"
+#include "render.h"
+
+#define SFSIM_VERSION "0.1"
+
+enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_USAGE = 2, EXIT_TRAP = 3 };
+
+static void usage(FILE *out)
+{
+    fprintf(out,
+            "usage: sfsim <command> [options]\n"
+            "\n"
+            "sfsim simulates a stream-filtering ray tracing processor (Gribble & Ramani 2008).\n"
+            "\n"
+            "commands:\n"
+            "  run      render a scene (--mode reference: the golden model)\n"
+            "  exec     run an assembled program (.sfo) on the functional core; print registers\n"
+            "           and counters\n"
+            "  config   list the machine-config keys (--dump) or write their reference (--markdown)\n"
+            "  help     help on a command: sfsim help exec\n"
+            "\n"
+            "options everywhere: --help, --version\n"
+            "exit codes: 0 ok, 1 input or config error, 2 usage error, 3 program trapped or hit its limit\n"
+            "documentation: docs/README.md\n");
+}
+
+static void usage_exec(FILE *out)
+{
+    fprintf(out,
+            "usage: sfsim exec PROG.sfo [options]\n"
+            "\n"
+            "Runs an object produced by sfasm on the functional core (no timing) until halt, a trap,\n"
+            "or the instruction limit, then prints the scalar registers, the non-zero vector lanes,\n"
+            "the masks and the counters per stage (instructions, operations by category, SIMD\n"
+            "utilization = active lanes / (N x vector instructions)).\n"
+            "\n"
+            "options:\n"
+            "  -c, --config FILE        machine config (default: the built-in streamray machine)\n"
+            "  --set SECTION.KEY=VALUE  override a config key (repeatable)\n"
+            "  --width N                SIMD width, same as --set core.simd_width=N\n"
+            "  --max-instructions N     instruction limit, same as --set sim.max_instructions=N\n"
+            "  --dump-mem MEM:ADDR:WORDS  print WORDS words of MEM (rb0 rb1 idm spad scene fb) from\n"
+            "                           byte address ADDR after the run (repeatable)\n"
+            "  -q, --quiet              print only the summary line\n");
+}
+
+static void usage_config(FILE *out)
+{
+    fprintf(out,
+            "usage: sfsim config (--dump | --markdown) [-c FILE] [--set SECTION.KEY=VALUE]...\n"
+            "\n"
+            "  --dump       every key with its value, type, default, range and help\n"
+            "  --markdown   the key reference as Markdown (docs/config.md is this output)\n");
+}
+
+static void usage_run(FILE *out)
+{
+    fprintf(out,
+            "usage: sfsim run -s SCENE -o DIR --mode reference [options]\n"
+            "\n"
+            "Renders SCENE (a .gltf/.glb file or a scene.ini) and writes DIR/frame.exr (linear),\n"
+            "DIR/frame.png (tone-mapped sRGB), DIR/report.json and DIR/report.txt.\n"
+            "\n"
+            "modes:\n"
+            "  reference   the golden model: a plain C path tracer over the packed scene memory\n"
+            "\n"
+            "options:\n"
+            "  -s, --scene FILE         scene (default: scenes/cornell/scene.ini)\n"
+            "  -o, --out DIR            output folder (default: out)\n"
+            "  -c, --config FILE        machine config (stream.rays sets the tile: sqrt(M) pixels)\n"
+            "  --set SECTION.KEY=VALUE  override a config key, or render.width, render.height,\n"
+            "                           render.spp, render.max_depth, render.seed\n"
+            "  -j, --threads N          host threads (default: all cores; results do not change)\n"
+            "  --exposure X             scale before tone mapping frame.png (default 1)\n"
+            "  --no-progress            no progress bar (it is shown only on a terminal anyway)\n");
+}
+
+/* Config from -c/--set options, collected by the commands that take them. */
+typedef struct ConfigArgs {
+    const char *path;
+    const char *sets[256];
+    int nsets;
+} ConfigArgs;
+
+static int build_config(const ConfigArgs *a, CfgMachine *cfg)
+{
+    CfgErrors errs = {0};
+    cfg_defaults(cfg);
+    if (a->path)
+        cfg_load(cfg, a->path, &errs);
+    for (int i = 0; i < a->nsets; i++)
+        cfg_set(cfg, a->sets[i], &errs);
+    if (!errs.count)
+        cfg_check(cfg, &errs);
+    if (errs.count) {
+        fprintf(stderr, "%s", errs.text);
+        fprintf(stderr, "sfsim: %d configuration error%s\n", errs.count, errs.count == 1 ? "" : "s");
+    }
+    int n = errs.count;
+    cfg_errors_free(&errs);
+    return n ? -1 : 0;
+}
+
+static int add_set(ConfigArgs *a, const char *s)
+{
+    if (a->nsets >= (int)(sizeof a->sets / sizeof a->sets[0])) {
+        fprintf(stderr, "sfsim: too many --set options (at most %zu)\n", sizeof a->sets / sizeof a->sets[0]);
+        return -1;
+    }
+    a->sets[a->nsets++] = s;
+    return 0;
+}
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void print_float_of(uint32_t u, char *buf, size_t len)
+{
+    float f;
+    memcpy(&f, &u, 4);
+    snprintf(buf, len, "%.9g", (double)f);
+}
+
+static int dump_mem(Core *c, const char *spec)
+{
+    char name[16];
+    long addr, words;
+    const char *colon = strchr(spec, ':');
+    if (!colon || (size_t)(colon - spec) >= sizeof name ||
+        sscanf(colon + 1, "%li:%li", &addr, &words) != 2 || addr < 0 || words < 0) {
+        fprintf(stderr, "sfsim: --dump-mem %s: expected MEM:ADDR:WORDS\n", spec);
+        return -1;
+    }
+    memcpy(name, spec, (size_t)(colon - spec));
+    name[colon - spec] = 0;
+    int m = -1;
+    for (int i = 0; i < CORE_MEM_COUNT; i++)
+        if (strcmp(name, core_mem_names[i]) == 0)
+            m = i;
+    if (m < 0) {
+        fprintf(stderr, "sfsim: --dump-mem %s: unknown memory '%s' (rb0 rb1 idm spad scene fb)\n", spec, name);
+        return -1;
+    }
+    uint32_t size;
+    uint8_t *mem = core_mem(c, (CoreMem)m, &size);
+    if (addr % 4 || addr > (long)size || words > ((long)size - addr) / 4) {
+        fprintf(stderr, "sfsim: --dump-mem %s: outside %s (%u bytes) or misaligned\n", spec, name, size);
+        return -1;
+    }
+    printf("%s from 0x%08lx:\n", name, addr);
+    for (long i = 0; i < words; i++) {
+        uint32_t w;
+        memcpy(&w, mem + addr + 4 * i, 4);
+        char f[32];
+        print_float_of(w, f, sizeof f);
+        printf("  [0x%08lx] 0x%08x %11d  %s\n", addr + 4 * i, w, (int32_t)w, f);
+    }
+    return 0;
+}
+
+static void print_state(Core *c)
+{
+    int n = core_lanes(c);
+    printf("scalar registers:\n");
+    for (int r = 0; r < ISA_NUM_SREGS; r++) {
+        uint32_t v = core_sreg(c, r);
+        if (!v)
+            continue;
+        char f[32];
+        print_float_of(v, f, sizeof f);
+        printf("  r%-2d = 0x%08x %11d  float %s\n", r, v, (int32_t)v, f);
+    }
+    printf("vector registers (lanes 0..%d; registers with every lane 0 left out):\n", n - 1);
+    for (int v = 0; v < ISA_NUM_VREGS; v++) {
+        int any = 0;
+        for (int l = 0; l < n; l++)
+            any |= core_vreg(c, v, l) != 0;
+        if (!any)
+            continue;
+        printf("  v%-2d =", v);
+        for (int l = 0; l < n; l++)
+            printf("%s%x", l ? " " : " ", core_vreg(c, v, l));
+        printf("\n");
+    }
+    printf("masks (lane 0 first):\n");
+    for (int m = 0; m < ISA_NUM_MREGS; m++) {
+        printf("  m%d = ", m);
+        uint64_t x = core_mreg(c, m);
+        for (int l = 0; l < n; l++)
+            putchar((x >> l) & 1 ? '1' : '0');
+        putchar('\n');
+    }
+    const CoreStats *st = core_stats(c);
+    printf("counters per stage:\n  %-13s %12s %12s %6s", "stage", "instructions", "vector", "util");
+    for (int k = 0; k < ISA_C_COUNT; k++)
+        printf(" %14s", isa_category_keys[k]);
+    printf("\n");
+    for (int s = 0; s < ISA_STAGE_COUNT; s++) {
+        if (!st->instructions[s])
+            continue;
+        double util = st->vec_instructions[s] ? (double)st->active_lanes[s] / ((double)n * (double)st->vec_instructions[s]) : 0.0;
+        printf("  %-13s %12llu %12llu %5.1f%%", isa_stage_keys[s], (unsigned long long)st->instructions[s],
+               (unsigned long long)st->vec_instructions[s], 100.0 * util);
+        for (int k = 0; k < ISA_C_COUNT; k++)
+            printf(" %14llu", (unsigned long long)st->ops[s][k]);
+        printf("\n");
+    }
+}
+
+static int cmd_exec(int argc, char **argv)
+{
+    ConfigArgs ca = {0};
+    const char *prog = NULL, *dumps[64];
+    int ndumps = 0, quiet = 0;
+    char setbuf[2][64];
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        int has_next = i + 1 < argc;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            usage_exec(stdout);
+            return EXIT_OK;
+        } else if ((!strcmp(a, "-c") || !strcmp(a, "--config")) && has_next) {
+            ca.path = argv[++i];
+        } else if (!strcmp(a, "--set") && has_next) {
+            if (add_set(&ca, argv[++i]))
+                return EXIT_USAGE;
+        } else if (!strcmp(a, "--width") && has_next) {
+            snprintf(setbuf[0], sizeof setbuf[0], "core.simd_width=%s", argv[++i]);
+            if (add_set(&ca, setbuf[0]))
+                return EXIT_USAGE;
+        } else if (!strcmp(a, "--max-instructions") && has_next) {
+            snprintf(setbuf[1], sizeof setbuf[1], "sim.max_instructions=%s", argv[++i]);
+            if (add_set(&ca, setbuf[1]))
+                return EXIT_USAGE;
+        } else if (!strcmp(a, "--dump-mem") && has_next) {
+            if (ndumps >= 64) {
+                fprintf(stderr, "sfsim exec: at most 64 --dump-mem options\n");
+                return EXIT_USAGE;
+            }
+            dumps[ndumps++] = argv[++i];
+        } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
+            quiet = 1;
+        } else if (a[0] == '-') {
+            fprintf(stderr, "sfsim exec: unknown option or missing value: %s (sfsim help exec)\n", a);
+            return EXIT_USAGE;
+        } else if (!prog) {
+            prog = a;
+        } else {
+            fprintf(stderr, "sfsim exec: more than one program: %s and %s\n", prog, a);
+            return EXIT_USAGE;
+        }
+    }
+    if (!prog) {
+        fprintf(stderr, "sfsim exec: no program given (sfsim help exec)\n");
+        return EXIT_USAGE;
+    }
+    CfgMachine cfg;
+    if (build_config(&ca, &cfg))
+        return EXIT_INPUT;
+    AsmObject obj;
+    char err[1024];
+    if (asm_object_read(prog, &obj, err, sizeof err) != 0) {
+        fprintf(stderr, "sfsim exec: %s\n", err);
+        return EXIT_INPUT;
+    }
+    CoreParams cp;
+    cfg_core_params(&cfg, &cp);
+    Core *c = core_new(&cp, &obj, err, sizeof err);
+    if (!c) {
+        fprintf(stderr, "sfsim exec: %s: %s\n", prog, err);
+        asm_object_free(&obj);
+        return EXIT_INPUT;
+    }
+    double t0 = now();
+    CoreExit ex = core_run(c, (uint64_t)cfg.sim_max_instructions);
+    double secs = now() - t0;
+    uint64_t ni = core_instructions(c);
+    printf("sfsim exec: %s on N = %d lanes: %s after %llu instructions (%.3f s, %.1f M instructions/s)\n", prog,
+           core_lanes(c), ex == CORE_EXIT_HALT ? "halted" : ex == CORE_EXIT_TRAP ? "trapped" : "stopped at the limit",
+           (unsigned long long)ni, secs, secs > 0 ? 1e-6 * (double)ni / secs : 0.0);
+    int rc = EXIT_OK;
+    if (!quiet)
+        print_state(c);
+    for (int i = 0; i < ndumps; i++)
+        if (dump_mem(c, dumps[i]))
+            rc = EXIT_USAGE;
+    if (ex != CORE_EXIT_HALT) {
+        fprintf(stderr, "sfsim exec: %s\n", core_trap_message(c));
+        rc = EXIT_TRAP;
+    }
+    core_free(c);
+    asm_object_free(&obj);
+    return rc;
+}
+
+static int cmd_config(int argc, char **argv)
+{
+    ConfigArgs ca = {0};
+    int dump = 0, markdown = 0;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            usage_config(stdout);
+            return EXIT_OK;
+        } else if (!strcmp(a, "--dump")) {
+            dump = 1;
+        } else if (!strcmp(a, "--markdown")) {
+            markdown = 1;
+        } else if ((!strcmp(a, "-c") || !strcmp(a, "--config")) && i + 1 < argc) {
+            ca.path = argv[++i];
+        } else if (!strcmp(a, "--set") && i + 1 < argc) {
+            if (add_set(&ca, argv[++i]))
+                return EXIT_USAGE;
+        } else {
+            fprintf(stderr, "sfsim config: unknown option or missing value: %s (sfsim help config)\n", a);
+            return EXIT_USAGE;
+        }
+    }
+    if (dump == markdown) {
+        usage_config(stderr);
+        return EXIT_USAGE;
+    }
+    if (markdown) {
+        cfg_markdown(stdout);
+        return EXIT_OK;
+    }
+    CfgMachine cfg;
+    if (build_config(&ca, &cfg))
+        return EXIT_INPUT;
+    cfg_dump(&cfg, stdout);
+    return EXIT_OK;
+}
+
+static int parse_int(const char *opt, const char *s, long lo, long hi, long *out)
+{
+    char *end;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (end == s || *end || errno || v < lo || v > hi) {
+        fprintf(stderr, "sfsim run: %s %s: expected an integer in %ld..%ld\n", opt, s, lo, hi);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+static int cmd_run(int argc, char **argv)
+{
+    ConfigArgs ca = {0};
+    RenderOptions o;
+    render_default_options(&o);
+    o.scene_path = "scenes/cornell/scene.ini";
+    o.out_dir = "out";
+    o.progress = isatty(2);
+    const char *mode = "reference";
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        int has_next = i + 1 < argc;
+        long v;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            usage_run(stdout);
+            return EXIT_OK;
+        } else if ((!strcmp(a, "-s") || !strcmp(a, "--scene")) && has_next) {
+            o.scene_path = argv[++i];
+        } else if ((!strcmp(a, "-o") || !strcmp(a, "--out")) && has_next) {
+            o.out_dir = argv[++i];
+        } else if ((!strcmp(a, "-c") || !strcmp(a, "--config")) && has_next) {
+            ca.path = argv[++i];
+        } else if (!strcmp(a, "--mode") && has_next) {
+            mode = argv[++i];
+        } else if ((!strcmp(a, "-j") || !strcmp(a, "--threads")) && has_next) {
+            if (parse_int(a, argv[++i], 1, 1024, &v))
+                return EXIT_USAGE;
+            o.threads = (int)v;
+        } else if (!strcmp(a, "--exposure") && has_next) {
+            char *end;
+            o.exposure = strtof(argv[++i], &end);
+            if (*end || !(o.exposure > 0.0f)) {
+                fprintf(stderr, "sfsim run: --exposure %s: expected a positive number\n", argv[i]);
+                return EXIT_USAGE;
+            }
+        } else if (!strcmp(a, "--no-progress")) {
+            o.progress = 0;
+        } else if (!strcmp(a, "--set") && has_next) {
+            const char *s = argv[++i];
+            static const struct { const char *key; long lo, hi; } render_keys[] = {
+                {"render.width=", 1, 16384}, {"render.height=", 1, 16384}, {"render.spp=", 1, 1 << 20},
+                {"render.max_depth=", 0, 63}, {"render.seed=", 0, 4294967295L}};
+            int handled = 0;
+            for (size_t k = 0; k < sizeof render_keys / sizeof render_keys[0]; k++) {
+                size_t kl = strlen(render_keys[k].key);
+                if (strncmp(s, render_keys[k].key, kl) != 0)
+                    continue;
+                if (parse_int("--set", s + kl, render_keys[k].lo, render_keys[k].hi, &v))
+                    return EXIT_USAGE;
+                if (k == 0) o.width = (int)v;
+                if (k == 1) o.height = (int)v;
+                if (k == 2) o.spp = (int)v;
+                if (k == 3) o.max_depth = (int)v;
+                if (k == 4) o.seed = (uint32_t)v;
+                handled = 1;
+            }
+            if (!handled && add_set(&ca, s))
+                return EXIT_USAGE;
+        } else {
+            fprintf(stderr, "sfsim run: unknown option or missing value: %s (sfsim help run)\n", a);
+            return EXIT_USAGE;
+        }
+    }
+    if (strcmp(mode, "reference") != 0) {
+        fprintf(stderr, "sfsim run: --mode %s: this build renders with --mode reference only\n", mode);
+        return EXIT_USAGE;
+    }
+    CfgMachine cfg;
+    if (build_config(&ca, &cfg))
+        return EXIT_INPUT;
+    o.stream_rays = cfg.stream_rays;
+    char err[2048];
+    if (render_reference(&o, err, sizeof err) != 0) {
+        fprintf(stderr, "sfsim run: %s\n", err);
+        return EXIT_INPUT;
+    }
+    printf("sfsim run: wrote %s/frame.png, frame.exr, report.txt, report.json\n", o.out_dir);
+    return EXIT_OK;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return EXIT_USAGE;
+    }
+    const char *cmd = argv[1];
+    if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h")) {
+        usage(stdout);
+        return EXIT_OK;
+    }
+    if (!strcmp(cmd, "--version")) {
+        printf("sfsim %s\n", SFSIM_VERSION);
+        return EXIT_OK;
+    }
+    if (!strcmp(cmd, "help")) {
+        if (argc < 3)
+            usage(stdout);
+        else if (!strcmp(argv[2], "exec"))
+            usage_exec(stdout);
+        else if (!strcmp(argv[2], "config"))
+            usage_config(stdout);
+        else if (!strcmp(argv[2], "run"))
+            usage_run(stdout);
+        else {
+            fprintf(stderr, "sfsim help: unknown command '%s'\n", argv[2]);
+            return EXIT_USAGE;
+        }
+        return EXIT_OK;
+    }
+    if (!strcmp(cmd, "exec"))
+        return cmd_exec(argc - 2, argv + 2);
+    if (!strcmp(cmd, "config"))
+        return cmd_config(argc - 2, argv + 2);
+    if (!strcmp(cmd, "run"))
+        return cmd_run(argc - 2, argv + 2);
+    fprintf(stderr, "sfsim: unknown command '%s'\n\n", cmd);
+    usage(stderr);
+    return EXIT_USAGE;
+}
