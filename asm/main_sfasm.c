@@ -1,0 +1,191 @@
+/* asm/main_sfasm.c -- the sfasm command line: assemble a file, or disassemble an object.
+ *
+ * Owns: argument parsing, output naming and exit codes (0 ok, 1 assembly or I/O errors, 2 usage).
+ * Must not: assemble or format anything itself (asm/ does).
+ */
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "asm.h"
+
+#define SFASM_VERSION "1.0"
+
+typedef struct Args {
+    AsmDefine *defines; int ndefines;
+    const char **include_dirs; int ninclude_dirs;
+    const char *input, *output, *disasm;
+    int source;
+} Args;
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: sfasm [options] FILE.s [-o FILE.sfo]\n"
+            "       sfasm -d FILE.sfo [--source]\n"
+            "\n"
+            "Assembles sfsim assembly into an object (.sfo), or disassembles an object to stdout.\n"
+            "\n"
+            "options:\n"
+            "  -o OUT          output object (default: the input with .sfo instead of .s)\n"
+            "  -D NAME[=VAL]   define symbol NAME (VAL an integer, default 1)\n"
+            "  -I DIR          search DIR for .include files (after the including file's directory)\n"
+            "  -d FILE.sfo     disassemble FILE.sfo to stdout\n"
+            "  --source        with -d: add each instruction's file:line as a comment\n"
+            "  --help          this text\n"
+            "  --version       the version\n"
+            "\n"
+            "exit status: 0 success, 1 assembly or I/O errors, 2 usage errors\n"
+            "documentation: docs/assembler.md, docs/object-format.md\n");
+}
+
+__attribute__((format(printf, 1, 2)))
+static int usage_error(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "sfasm: ");
+    vfprintf(stderr, fmt, ap);
+    fprintf(stderr, "\n(try 'sfasm --help')\n");
+    va_end(ap);
+    return 2;
+}
+
+static int parse_define(Args *a, char *spec)
+{
+    char *eq = strchr(spec, '=');
+    long long v = 1;
+    if (eq) {
+        char *end;
+        *eq = '\0';
+        errno = 0;
+        v = strtoll(eq + 1, &end, 0);
+        if (eq[1] == '\0' || *end != '\0' || errno == ERANGE)
+            return usage_error("-D %s: the value must be an integer", spec);
+    }
+    if (spec[0] == '\0')
+        return usage_error("-D needs a NAME");
+    a->defines[a->ndefines++] = (AsmDefine){spec, v};
+    return 0;
+}
+
+/* Value of an option given as "-X VALUE" or "-XVALUE"; NULL if missing. */
+static char *opt_value(int argc, char **argv, int *i)
+{
+    if (argv[*i][2] != '\0')
+        return argv[*i] + 2;
+    if (*i + 1 >= argc)
+        return NULL;
+    return argv[++*i];
+}
+
+static int parse_args(int argc, char **argv, Args *a)
+{
+    a->defines = calloc((size_t)argc, sizeof *a->defines);
+    a->include_dirs = calloc((size_t)argc, sizeof *a->include_dirs);
+    if (!a->defines || !a->include_dirs)
+        return usage_error("out of memory");
+    for (int i = 1; i < argc; i++) {
+        char *arg = argv[i], *val;
+        if (strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0) {
+            usage(stdout);
+            return -1;
+        }
+        if (strcmp(arg, "--version") == 0) {
+            printf("sfasm %s (object format version %u)\n", SFASM_VERSION, ASM_OBJ_VERSION);
+            return -1;
+        }
+        if (strcmp(arg, "--source") == 0) {
+            a->source = 1;
+        } else if (arg[0] == '-' && (arg[1] == 'D' || arg[1] == 'I' || arg[1] == 'o' || arg[1] == 'd') &&
+                   (arg[2] == '\0' || arg[1] == 'D' || arg[1] == 'I')) {
+            if (!(val = opt_value(argc, argv, &i)))
+                return usage_error("option %s needs a value", arg);
+            if (arg[1] == 'D' && parse_define(a, val) != 0)
+                return 2;
+            if (arg[1] == 'I')
+                a->include_dirs[a->ninclude_dirs++] = val;
+            if (arg[1] == 'o')
+                a->output = val;
+            if (arg[1] == 'd')
+                a->disasm = val;
+        } else if (arg[0] == '-' && arg[1] != '\0') {
+            return usage_error("unknown option '%s'", arg);
+        } else if (a->input) {
+            return usage_error("more than one input file ('%s')", arg);
+        } else {
+            a->input = arg;
+        }
+    }
+    if (a->disasm && (a->input || a->output))
+        return usage_error("-d takes only an object file");
+    if (!a->disasm && a->source)
+        return usage_error("--source goes with -d");
+    if (!a->disasm && !a->input)
+        return usage_error("no input file");
+    return 0;
+}
+
+static int disassemble(const Args *a)
+{
+    AsmObject obj;
+    char err[512];
+    if (asm_object_read(a->disasm, &obj, err, sizeof err) < 0) {
+        fprintf(stderr, "sfasm: %s\n", err);
+        return 1;
+    }
+    asm_disassemble(&obj, stdout, a->source);
+    asm_object_free(&obj);
+    return fflush(stdout) == 0 ? 0 : 1;
+}
+
+/* FILE.s -> FILE.sfo; any other name gets .sfo appended. */
+static char *default_output(const char *in)
+{
+    size_t n = strlen(in);
+    char *out = malloc(n + 5);
+    if (!out)
+        return NULL;
+    memcpy(out, in, n + 1);
+    if (n > 2 && strcmp(in + n - 2, ".s") == 0)
+        out[n - 2] = '\0';
+    strcat(out, ".sfo");
+    return out;
+}
+
+static int assemble(const Args *a)
+{
+    AsmOptions opt = {a->defines, a->ndefines, a->include_dirs, a->ninclude_dirs, stderr};
+    AsmObject obj;
+    int errors = asm_assemble_file(a->input, &opt, &obj);
+    if (errors) {
+        fprintf(stderr, "sfasm: %d error%s\n", errors, errors == 1 ? "" : "s");
+        return 1;
+    }
+    char *out = a->output ? NULL : default_output(a->input), err[512];
+    int rc = -1;
+    if (!a->output && !out)
+        snprintf(err, sizeof err, "out of memory");
+    else
+        rc = asm_object_write(&obj, a->output ? a->output : out, err, sizeof err);
+    if (rc < 0)
+        fprintf(stderr, "sfasm: %s\n", err);
+    free(out);
+    asm_object_free(&obj);
+    return rc < 0 ? 1 : 0;
+}
+
+int main(int argc, char **argv)
+{
+    Args a = {0};
+    int rc = parse_args(argc, argv, &a);
+    if (rc == 0)
+        rc = a.disasm ? disassemble(&a) : assemble(&a);
+    else if (rc < 0)
+        rc = 0;
+    free(a.defines);
+    free(a.include_dirs);
+    return rc;
+}

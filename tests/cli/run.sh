@@ -1,0 +1,258 @@
+#!/usr/bin/env bash
+# tests/cli/run.sh -- end-to-end tests of bin/sfasm and bin/sfsim, run as a user runs them:
+# exit codes, messages that name file:line(:col), disassembly round trips, traps, configs.
+# `make test` runs it before the Criterion suite. Exit status: 0 when every test passed.
+#
+# Exit codes under test -- sfasm: 0 ok, 1 errors, 2 usage; sfsim: 0 ok, 1 input/config error,
+# 2 usage, 3 trap or instruction limit.
+set -u
+
+cd "$(dirname "$0")/../.." || exit 2
+SFASM=${SFASM:-bin/sfasm}
+SFSIM=${SFSIM:-bin/sfsim}
+T=$(mktemp -d "${TMPDIR:-/tmp}/sfsim-cli.XXXXXX") || exit 2
+trap 'rm -rf "$T"' EXIT
+
+pass=0
+fail=0
+name=""
+failed=0
+reasons=""
+cmdline=""
+rc=0
+
+begin() { name=$1; failed=0; reasons=""; cmdline=""; }
+
+# run CMD ARGS...: stdout to $T/out, stderr to $T/err, status in $rc.
+run() {
+    cmdline="$*"
+    "$@" >"$T/out" 2>"$T/err"
+    rc=$?
+}
+
+no() { failed=1; reasons="$reasons    - $*"$'\n'; }
+
+want_rc() { [ "$rc" -eq "$1" ] || no "exit status $rc, expected $1"; }
+want_out() { grep -qiE -- "$1" "$T/out" || no "stdout does not match /$1/"; }
+want_err() { grep -qiE -- "$1" "$T/err" || no "stderr does not match /$1/"; }
+want_any() { cat "$T/out" "$T/err" | grep -qiE -- "$1" || no "output does not match /$1/"; }
+want_no_err() { [ ! -s "$T/err" ] || no "unexpected stderr"; }
+
+end() {
+    if [ "$failed" -eq 0 ]; then
+        pass=$((pass + 1))
+    else
+        fail=$((fail + 1))
+        echo "FAIL: $name"
+        printf '%s' "$reasons"
+        [ -n "$cmdline" ] && echo "    command: $cmdline"
+        [ -s "$T/out" ] && sed -n '1,15s/^/    stdout| /p' "$T/out"
+        [ -s "$T/err" ] && sed -n '1,15s/^/    stderr| /p' "$T/err"
+    fi
+}
+
+for tool in "$SFASM" "$SFSIM"; do
+    if [ ! -x "$tool" ]; then
+        echo "cli: $tool is missing (run make)"
+        echo "cli: 0 passed, 1 failed"
+        exit 1
+    fi
+done
+
+# ---- sfasm --------------------------------------------------------------------------------
+
+begin "sfasm --help exits 0 and prints usage"
+run "$SFASM" --help
+want_rc 0; want_out "usage"
+end
+
+begin "sfasm without arguments is a usage error (2)"
+run "$SFASM"
+want_rc 2; want_err "usage|--help"
+end
+
+begin "sfasm with an unknown option is a usage error (2)"
+run "$SFASM" --no-such-option tests/cli/ok.s
+want_rc 2
+end
+
+begin "sfasm reports every error as file:line:col and exits 1"
+run "$SFASM" tests/cli/errors.s -o "$T/errors.sfo"
+want_rc 1
+want_err "tests/cli/errors.s:3:[0-9]+: .*frob"
+want_err "tests/cli/errors.s:4:[0-9]+: "
+want_err "tests/cli/errors.s:5:[0-9]+: .*r40"
+want_err "tests/cli/errors.s:6:[0-9]+: .*nowhere"
+[ -e "$T/errors.sfo" ] && no "an object was written despite the errors"
+end
+
+begin "sfasm on a missing file names it and exits 1"
+run "$SFASM" tests/cli/no_such_file.s -o "$T/x.sfo"
+want_rc 1; want_err "no_such_file.s"
+end
+
+begin "sfasm assembles a program into an object"
+run "$SFASM" tests/cli/ok.s -o "$T/ok.sfo"
+want_rc 0; want_no_err
+if [ -s "$T/ok.sfo" ]; then
+    [ "$(head -c 3 "$T/ok.sfo")" = "SFO" ] || no "the object does not start with the SFO magic"
+else
+    no "no object written"
+fi
+end
+
+begin "sfasm -d then reassembling gives identical bytes"
+run "$SFASM" -d "$T/ok.sfo"
+want_rc 0
+cp "$T/out" "$T/round.s"
+grep -q "halt" "$T/round.s" || no "the disassembly has no halt"
+if "$SFASM" "$T/round.s" -o "$T/round1.sfo" 2>"$T/err"; then
+    "$SFASM" -d "$T/round1.sfo" >"$T/round.s" 2>>"$T/err" || no "sfasm -d of the reassembled object failed"
+    cmp -s "$T/out" "$T/round.s" || no "disassembling the reassembled object gives different text"
+    if "$SFASM" "$T/round.s" -o "$T/round2.sfo" 2>>"$T/err"; then
+        cmp -s "$T/round1.sfo" "$T/round2.sfo" || no "objects from the same disassembly differ (cmp)"
+    else
+        no "the second reassembly failed"
+    fi
+else
+    no "the disassembly does not reassemble"
+fi
+end
+
+begin "sfasm -d round trip of every tests/isa program (TEXT, DATA, SPAD)"
+cmdline="sfasm FILE; sfasm -d; sfasm; sfasm -d; cmp"
+: >"$T/out"; : >"$T/err"
+n=0
+for f in tests/isa/*.s; do
+    b=$(basename "$f" .s)
+    n=$((n + 1))
+    if ! "$SFASM" "$f" -o "$T/p.sfo" 2>>"$T/err"; then no "$f does not assemble"; continue; fi
+    if ! "$SFASM" -d "$T/p.sfo" >"$T/p1.s" 2>>"$T/err"; then no "$f: sfasm -d failed"; continue; fi
+    if ! "$SFASM" "$T/p1.s" -o "$T/p1.sfo" 2>>"$T/err"; then no "$f: its disassembly does not assemble"; continue; fi
+    "$SFASM" -d "$T/p1.sfo" >"$T/p2.s" 2>>"$T/err"
+    cmp -s "$T/p1.s" "$T/p2.s" || no "$b: disassembly changes after a round trip"
+done
+[ "$n" -gt 0 ] || no "no programs in tests/isa"
+end
+
+begin "sfasm -D NAME=VALUE defines a symbol"
+run "$SFASM" tests/cli/define.s -o "$T/define.sfo" -D VALUE=1234
+want_rc 0
+end
+
+begin "sfasm without the -D symbol reports it undefined"
+run "$SFASM" tests/cli/define.s -o "$T/define2.sfo"
+want_rc 1; want_err "tests/cli/define.s:3:[0-9]+: .*VALUE"
+end
+
+# ---- sfsim --------------------------------------------------------------------------------
+
+begin "sfsim --help exits 0 and prints usage"
+run "$SFSIM" --help
+want_rc 0; want_out "usage"
+end
+
+begin "sfsim without arguments is a usage error (2)"
+run "$SFSIM"
+want_rc 2
+end
+
+begin "sfsim with an unknown command is a usage error (2)"
+run "$SFSIM" frobnicate
+want_rc 2
+end
+
+begin "sfsim exec of a halting program exits 0 and prints registers"
+run "$SFSIM" exec "$T/ok.sfo"
+want_rc 0
+want_out "r1"
+want_out "(42|0x0*2a)"
+want_out "(49|0x0*31)"
+end
+
+begin "sfsim exec --width sets N (read back with rdn)"
+run "$SFSIM" exec "$T/ok.sfo" --width 16
+want_rc 0
+want_out "r2[^0-9a-z]+(= *)?(16|0x0*10)([^0-9]|$)"
+end
+
+begin "sfsim exec --width out of range is an error"
+run "$SFSIM" exec "$T/ok.sfo" --width 65
+[ "$rc" -eq 1 ] || [ "$rc" -eq 2 ] || no "exit status $rc, expected 1 or 2"
+want_err "65|width|lanes"
+end
+
+begin "sfsim exec of a -D program shows the defined value"
+run "$SFSIM" exec "$T/define.sfo"
+want_rc 0; want_out "(1234|0x0*4d2)"
+end
+
+begin "sfsim exec: an out-of-bounds read traps with file:line (exit 3)"
+"$SFASM" tests/cli/oob.s -o "$T/oob.sfo" 2>/dev/null || no "oob.s does not assemble"
+run "$SFSIM" exec "$T/oob.sfo"
+want_rc 3; want_any "trap:"; want_any "tests/cli/oob.s:4"
+end
+
+begin "sfsim exec --max-instructions stops an endless loop (exit 3)"
+"$SFASM" tests/cli/loop.s -o "$T/loop.sfo" 2>/dev/null || no "loop.s does not assemble"
+run timeout 20 "$SFSIM" exec "$T/loop.sfo" --max-instructions 1000
+want_rc 3; want_any "trap:"; want_any "tests/cli/loop.s:[45]"
+end
+
+begin "sfsim exec: a stream with begin > end traps in sfetch (exit 3)"
+"$SFASM" tests/cli/badstream.s -o "$T/badstream.sfo" 2>/dev/null || no "badstream.s does not assemble"
+run "$SFSIM" exec "$T/badstream.sfo"
+want_rc 3; want_any "trap:"; want_any "sfetch"; want_any "tests/cli/badstream.s:5"
+end
+
+begin "sfsim exec of a missing object exits 1 naming it"
+run "$SFSIM" exec "$T/no_such.sfo"
+want_rc 1; want_err "no_such.sfo"
+end
+
+begin "sfsim exec of a truncated object exits 1"
+head -c 20 "$T/ok.sfo" >"$T/trunc.sfo"
+run "$SFSIM" exec "$T/trunc.sfo"
+want_rc 1; want_err "trunc.sfo"
+end
+
+begin "sfsim exec of a source file instead of an object exits 1"
+run "$SFSIM" exec tests/cli/ok.s
+want_rc 1; want_err "ok.s"
+end
+
+begin "sfsim config --dump prints the configuration"
+run "$SFSIM" config --dump
+want_rc 0
+[ -s "$T/out" ] || no "empty output"
+want_out "="
+cp "$T/out" "$T/dump.ini"
+end
+
+begin "sfsim accepts its own config dump (-c)"
+run "$SFSIM" exec "$T/ok.sfo" -c "$T/dump.ini"
+want_rc 0; want_out "(42|0x0*2a)"
+end
+
+begin "sfsim -c with an unknown key names file, line and key (exit 1)"
+run "$SFSIM" exec "$T/ok.sfo" -c tests/cli/bad_key.ini
+want_rc 1; want_err "tests/cli/bad_key.ini:4: .*no_such_key"
+end
+
+begin "sfsim -c with a malformed line names file and line (exit 1)"
+run "$SFSIM" exec "$T/ok.sfo" -c tests/cli/bad_syntax.ini
+want_rc 1; want_err "tests/cli/bad_syntax.ini:3"
+end
+
+begin "sfsim -c with a missing file exits 1"
+run "$SFSIM" exec "$T/ok.sfo" -c tests/cli/no_such.ini
+want_rc 1; want_err "no_such.ini"
+end
+
+begin "sfsim --set with an unknown key exits 1"
+run "$SFSIM" exec "$T/ok.sfo" --set no_such.key=1
+want_rc 1; want_err "no_such"
+end
+
+echo "cli: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]
