@@ -28,7 +28,12 @@ SIM_SRC := $(filter-out sim/main.c,$(wildcard sim/*.c))
 SCN_SRC := $(wildcard scenes/*.c)
 CXX_SRC := $(wildcard scenes/*.cpp sim/*.cpp)
 LIB_SRC := $(ISA_SRC) $(ASM_SRC) $(SIM_SRC) $(SCN_SRC)
-TEST_SRC := $(wildcard tests/unit/*.c tests/support/*.c)
+# Two Criterion binaries: tests/io (image files, Embree, scene files: they link OpenImageIO,
+# Embree and tinygltf, whose ~270 shared libraries make every forked test process start slowly)
+# and tests/unit (everything else, linked --as-needed so it starts fast). unit runs last.
+TEST_SRC := $(wildcard tests/unit/*.c)
+IO_TEST_SRC := $(wildcard tests/io/*.c tests/support/*.c)
+LDAS    := -Wl,--as-needed
 
 ASMLIB_OBJ = $(patsubst %.c,$(BUILD)/obj/%.o,$(ISA_SRC) $(ASM_SRC))
 LIB_OBJ  = $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/obj/%.o,$(CXX_SRC))
@@ -107,20 +112,34 @@ docs: $(BUILD)/gen_isadoc $(BUILD)/gen_layout
 # ---- tests ----------------------------------------------------------------------------------
 $(BUILD)/tests/unit: $(TEST_SRC) $(BUILD)/libsfsim.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(EMBREE) $(INIH) $(LDLIBS)
+	$(CC) $(CFLAGS) $(LDAS) $(TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
+
+$(BUILD)/tests/io: $(IO_TEST_SRC) $(BUILD)/libsfsim.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(LDAS) $(IO_TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(EMBREE) $(INIH) $(LDLIBS)
 
 $(BUILD)/tests/unit-asan: $(TEST_SRC) $(BUILD)/libsfsim-asan.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(SAN) $(TEST_SRC) $(BUILD)/libsfsim-asan.a -o $@ $(CRIT) $(EMBREE) $(INIH) $(LDLIBS)
+	$(CC) $(CFLAGS) $(SAN) $(LDAS) $(TEST_SRC) $(BUILD)/libsfsim-asan.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
+
+$(BUILD)/tests/io-asan: $(IO_TEST_SRC) $(BUILD)/libsfsim-asan.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(SAN) $(LDAS) $(IO_TEST_SRC) $(BUILD)/libsfsim-asan.a -o $@ $(CRIT) $(EMBREE) $(INIH) $(LDLIBS)
 
 # CLI tests first, Criterion last: its synthesis line closes the run.
-test-built: all $(BUILD)/tests/unit
+TEST_ENV = SFSIM_BUILD=$(BUILD) SFSIM_GEN_ISADOC=$(BUILD)/gen_isadoc
+
+test-built: all $(BUILD)/tests/unit $(BUILD)/tests/io
 	@bash tests/cli/run.sh
-	@$(BUILD)/tests/unit --jobs 2
+	@$(TEST_ENV) $(BUILD)/tests/io --jobs 2
+	@$(TEST_ENV) $(BUILD)/tests/unit --jobs 2
+
+ASAN_ENV = ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp
 
 test-asan: deps
-	@$(MAKE) --no-print-directory $(BUILD)/tests/unit-asan
-	@ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 $(BUILD)/tests/unit-asan --jobs 2
+	@$(MAKE) --no-print-directory $(BUILD)/tests/unit-asan $(BUILD)/tests/io-asan
+	@$(TEST_ENV) $(ASAN_ENV) $(BUILD)/tests/io-asan --jobs 2
+	@$(TEST_ENV) $(ASAN_ENV) $(BUILD)/tests/unit-asan --jobs 2
 
 # ---- fuzzing (clang + libFuzzer) -------------------------------------------------------------
 FUZZ_SECONDS ?= 60

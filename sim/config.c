@@ -19,13 +19,15 @@ typedef struct CfgKeyInfo {
     const char *section, *key;
     CfgType type;
     double def, lo, hi;
+    long long ilo, ihi;  /* exact bounds of integer keys */
     const char *help;
     size_t offset;
 } CfgKeyInfo;
 
 static const CfgKeyInfo keys[] = {
 #define CFG_KEY(sec, key, type, def, lo, hi, help) \
-    {#sec, #key, CFG_##type, (double)(def), (double)(lo), (double)(hi), help, offsetof(CfgMachine, sec##_##key)},
+    {#sec, #key, CFG_##type, (double)(def), (double)(lo), (double)(hi), (long long)(lo), (long long)(hi), help, \
+     offsetof(CfgMachine, sec##_##key)},
 #include "config.def"
 #undef CFG_KEY
 };
@@ -59,17 +61,20 @@ void cfg_errors_free(CfgErrors *errs)
     memset(errs, 0, sizeof *errs);
 }
 
-static void store(CfgMachine *cfg, const CfgKeyInfo *k, double v)
+/* A parsed value: integers keep all 64 bits (a double would round above 2^53). */
+typedef struct CfgValue { double f; long long i; } CfgValue;
+
+static void store(CfgMachine *cfg, const CfgKeyInfo *k, CfgValue v)
 {
     char *p = (char *)cfg + k->offset;
     if (k->type == CFG_INT) {
-        int32_t x = (int32_t)v;
+        int32_t x = (int32_t)v.i;
         memcpy(p, &x, sizeof x);
     } else if (k->type == CFG_I64) {
-        int64_t x = (int64_t)v;
+        int64_t x = (int64_t)v.i;
         memcpy(p, &x, sizeof x);
     } else {
-        memcpy(p, &v, sizeof v);
+        memcpy(p, &v.f, sizeof v.f);
     }
 }
 
@@ -95,7 +100,7 @@ void cfg_defaults(CfgMachine *cfg)
 {
     memset(cfg, 0, sizeof *cfg);
     for (size_t i = 0; i < NKEYS; i++)
-        store(cfg, &keys[i], keys[i].def);
+        store(cfg, &keys[i], (CfgValue){keys[i].def, (long long)keys[i].def});
 }
 
 static const CfgKeyInfo *find(const char *section, const char *key)
@@ -114,8 +119,8 @@ static int section_known(const char *section)
     return 0;
 }
 
-/* Parse and range-check; returns NULL on success or a static message. */
-static const char *parse_value(const CfgKeyInfo *k, const char *text, double *out, char *buf, size_t buflen)
+/* Parse and range-check; returns NULL on success or a message in buf. */
+static const char *parse_value(const CfgKeyInfo *k, const char *text, CfgValue *out, char *buf, size_t buflen)
 {
     while (*text == ' ' || *text == '\t')
         text++;
@@ -123,11 +128,16 @@ static const char *parse_value(const CfgKeyInfo *k, const char *text, double *ou
         return "missing value";
     char *end;
     errno = 0;
+    int bad_range;
     if (k->type == CFG_FLOAT) {
-        *out = strtod(text, &end);
+        out->f = strtod(text, &end);
+        out->i = 0;
+        bad_range = errno == ERANGE || !isfinite(out->f) || out->f < k->lo || out->f > k->hi;
     } else {
-        long long v = strtoll(text, &end, 0);
-        *out = (double)v;
+        out->i = strtoll(text, &end, 0);
+        out->f = (double)out->i;
+        /* Bounds compared as integers: the table's limits are exact in long long. */
+        bad_range = errno == ERANGE || out->i < k->ilo || out->i > k->ihi;
     }
     while (*end == ' ' || *end == '\t')
         end++;
@@ -135,14 +145,14 @@ static const char *parse_value(const CfgKeyInfo *k, const char *text, double *ou
         snprintf(buf, buflen, "expected %s, got '%s'", k->type == CFG_FLOAT ? "a number" : "an integer", text);
         return buf;
     }
-    if (errno == ERANGE || !isfinite(*out) || *out < k->lo || *out > k->hi) {
+    if (bad_range) {
         if (k->type == CFG_FLOAT)
             snprintf(buf, buflen, "value %s out of range %g..%g", text, k->lo, k->hi);
         else
-            snprintf(buf, buflen, "value %s out of range %.0f..%.0f", text, k->lo, k->hi);
+            snprintf(buf, buflen, "value %s out of range %lld..%lld", text, k->ilo, k->ihi);
         return buf;
     }
-    if (strcmp(k->section, "stream") == 0 && strcmp(k->key, "rays") == 0 && *out != 1024 && *out != 4096) {
+    if (strcmp(k->section, "stream") == 0 && strcmp(k->key, "rays") == 0 && out->i != 1024 && out->i != 4096) {
         snprintf(buf, buflen, "value %s: must be 1024 or 4096", text);
         return buf;
     }
@@ -153,10 +163,23 @@ typedef struct Reader {
     FILE *f;
     const char *path;
     int line;
-    int long_line;        /* the line being read did not fit inih's buffer */
+    int last_syntax_error;  /* line of the last syntax error this reader reported */
     CfgMachine *cfg;
     CfgErrors *errs;
 } Reader;
+
+/* inih reports only the first malformed line; check each line here so all are reported. A
+ * line is fine when blank, a comment, a [section], an indented continuation, or has = or :. */
+static int syntax_ok(const char *line)
+{
+    if (*line == ' ' || *line == '\t')
+        return 1;
+    if (*line == 0 || *line == '\n' || *line == '\r' || *line == ';' || *line == '#')
+        return 1;
+    if (*line == '[')
+        return strchr(line, ']') != NULL;
+    return strchr(line, '=') != NULL || strchr(line, ':') != NULL;
+}
 
 /* fgets for inih that counts lines, so the handler knows where it is, and catches lines longer
  * than inih's buffer instead of letting them be split silently. */
@@ -166,12 +189,15 @@ static char *reader(char *str, int num, void *stream)
     if (!fgets(str, num, r->f))
         return NULL;
     size_t len = strlen(str);
-    if (len > 0 && str[len - 1] == '\n') {
+    int complete = (len > 0 && str[len - 1] == '\n') || feof(r->f);
+    if (complete) {
         r->line++;
-        return str;
-    }
-    if (feof(r->f)) {
-        r->line++;
+        if (!syntax_ok(str)) {
+            add_error(r->errs, "%s:%d: syntax error (expected [section] or key = value)", r->path, r->line);
+            r->last_syntax_error = r->line;
+            str[0] = '\n';
+            str[1] = 0;
+        }
         return str;
     }
     /* Too long: report, then skip the rest of the line and hand inih an empty one. */
@@ -196,7 +222,7 @@ static int handler(void *user, const char *section, const char *name, const char
             add_error(r->errs, "%s:%d: key '%s.%s': unknown key", r->path, r->line, section, name);
         return 1;
     }
-    double v;
+    CfgValue v;
     char buf[256];
     const char *msg = parse_value(k, value, &v, buf, sizeof buf);
     if (msg) {
@@ -218,7 +244,7 @@ int cfg_load(CfgMachine *cfg, const char *path, CfgErrors *errs)
     Reader r = {f, path, 0, 0, cfg, errs};
     int rc = ini_parse_stream(reader, &r, handler, &r);
     fclose(f);
-    if (rc > 0)
+    if (rc > 0 && rc != r.last_syntax_error)
         add_error(errs, "%s:%d: syntax error (expected [section] or key = value)", path, rc);
     else if (rc < 0)
         add_error(errs, "%s: cannot read", path);
@@ -248,7 +274,7 @@ int cfg_set(CfgMachine *cfg, const char *assignment, CfgErrors *errs)
         add_error(errs, "--set %s: unknown key '%s.%s' (sfsim config --dump lists them)", assignment, section, key);
         return 1;
     }
-    double v;
+    CfgValue v;
     char buf[256];
     const char *msg = parse_value(k, eq + 1, &v, buf, sizeof buf);
     if (msg) {
