@@ -134,7 +134,7 @@ static const char *parse_value(const CfgKeyInfo *k, const char *text, CfgValue *
         out->i = 0;
         bad_range = errno == ERANGE || !isfinite(out->f) || out->f < k->lo || out->f > k->hi;
     } else {
-        out->i = strtoll(text, &end, 0);
+        out->i = strtoll(text, &end, 10); /* decimal: "010" is ten, not octal eight */
         out->f = (double)out->i;
         /* Bounds compared as integers: the table's limits are exact in long long. */
         bad_range = errno == ERANGE || out->i < k->ilo || out->i > k->ihi;
@@ -216,7 +216,9 @@ static int handler(void *user, const char *section, const char *name, const char
     Reader *r = user;
     const CfgKeyInfo *k = find(section, name);
     if (!k) {
-        if (!section_known(section))
+        if (!section[0])
+            add_error(r->errs, "%s:%d: key '%s' is not in a [section]", r->path, r->line, name);
+        else if (!section_known(section))
             add_error(r->errs, "%s:%d: key '%s.%s': unknown section [%s]", r->path, r->line, section, name, section);
         else
             add_error(r->errs, "%s:%d: key '%s.%s': unknown key", r->path, r->line, section, name);

@@ -315,6 +315,8 @@ static int step(Core *c)
     const Dec *dc = &c->code[c->pc];
     const IsaInstr *in = &dc->in;
     const int n = c->n;
+    if (n < 1 || n > ISA_MAX_LANES) /* core_new guarantees it; tells the compiler the lane bound */
+        __builtin_unreachable();
     const uint64_t E = dc->masked ? c->m[in->mask] & c->all : c->all;
     uint32_t next = c->pc + 1;
     int halt = 0;
@@ -532,7 +534,11 @@ static int step(Core *c)
                 A->u[l] = A->u[k - 1];
         c->m[in->b] = k >= 64 ? ~0ull : (1ull << k) - 1;
         SR(in->c) = b + 4 * k;
+        /* Utilization counts the lanes that carry a ray: a stream's last, partial vector is the
+         * paper's first source of under-utilization (Gribble & Ramani 2008, Sec. 4.1). */
         active = k;
+        if (c->hook)
+            c->rec.exec = c->m[in->b];
         break;
     }
     case ISA_OP_SLD: {
@@ -587,7 +593,12 @@ static int step(Core *c)
         for (int l = 0; l < n; l++) {
             if (!((E >> l) & 1u))
                 continue;
-            uint32_t a = base + 4u * B->u[l];
+            /* In 64 bits, so a huge ray ID cannot wrap around onto a valid address. */
+            uint64_t a64 = (uint64_t)base + 4u * (uint64_t)B->u[l];
+            if (a64 > UINT32_MAX)
+                return -trap(c, "%s %s out of range: ray ID %u at base 0x%08x (size %u)", mem_long[m],
+                             store ? "scatter" : "gather", B->u[l], base, c->size[m]);
+            uint32_t a = (uint32_t)a64;
             MEMCHK(m, a, store ? "scatter" : "gather");
             if (store)
                 wr32(c, m, a, A->u[l]);

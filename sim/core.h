@@ -37,7 +37,8 @@ typedef struct CoreStats {
     uint64_t instructions[ISA_STAGE_COUNT];
     uint64_t ops[ISA_STAGE_COUNT][ISA_C_COUNT];   /* instructions by Table-5 category */
     uint64_t vec_instructions[ISA_STAGE_COUNT];   /* instructions with ISA_FL_VEC */
-    uint64_t active_lanes[ISA_STAGE_COUNT];       /* sum of exec-mask lanes of those */
+    uint64_t active_lanes[ISA_STAGE_COUNT];       /* sum of their active lanes: exec-mask lanes, and
+                                                     for sfetch the n lanes that received an ID */
     uint64_t by_op[ISA_OP_COUNT];                 /* executions per opcode */
 } CoreStats;
 
@@ -50,7 +51,8 @@ typedef struct CoreRecord {
     uint8_t mem;            /* CoreMem touched (physical buffer for ray buffers), or CORE_MEM_COUNT */
     uint8_t naddr;          /* number of valid entries in addr (lanes that accessed memory) */
     uint32_t count;         /* part: stream length in IDs; pmask: bits queued after it; else 0 */
-    uint64_t exec;          /* exec mask as applied (all N lanes for unmasked vector ops) */
+    uint64_t exec;          /* exec mask as applied (all N lanes for unmasked ops; sfetch: the
+                               lanes that received an ID) */
     uint32_t addr[ISA_MAX_LANES]; /* byte addresses, lane order (sfetch/vspld: the N words) */
 } CoreRecord;
 
