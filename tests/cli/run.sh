@@ -254,5 +254,40 @@ run "$SFSIM" exec "$T/ok.sfo" --set no_such.key=1
 want_rc 1; want_err "no_such"
 end
 
+# ---- sfsim run --mode reference and sfsim compare ----------------------------------------------
+begin "sfsim run --mode reference renders the Cornell box with a report"
+run "$SFSIM" run --mode reference -s scenes/cornell/scene.ini -o "$T/ref1" --set render.width=48 \
+    --set render.height=32 --set render.spp=2 -j 1 --no-progress
+want_rc 0
+for f in frame.png frame.exr report.txt report.json; do [ -s "$T/ref1/$f" ] || no "missing $f"; done
+grep -qE '"mode":[[:space:]]+"reference"' "$T/ref1/report.json" 2>/dev/null || no "report.json has no mode"
+grep -qE '"nonfinite":[[:space:]]+0,?$' "$T/ref1/report.json" 2>/dev/null || no "report.json: non-finite pixels"
+end
+
+begin "sfsim run gives the same image on 2 threads (compare: RMSE 0)"
+run "$SFSIM" run --mode reference -s scenes/cornell/scene.ini -o "$T/ref2" --set render.width=48 \
+    --set render.height=32 --set render.spp=2 -j 2 --no-progress
+want_rc 0
+run "$SFSIM" compare "$T/ref1/frame.exr" "$T/ref2/frame.exr"
+want_rc 0; want_out "RMSE +0$"; want_out "max diff +0$"
+end
+
+begin "sfsim run with a missing scene names it (exit 1)"
+run "$SFSIM" run --mode reference -s tests/cli/no_such_scene.ini -o "$T/ref3" --no-progress
+want_rc 1; want_err "no_such_scene.ini"
+end
+
+begin "sfsim compare of different sizes exits 1"
+run "$SFSIM" run --mode reference -s scenes/cornell/scene.ini -o "$T/ref4" --set render.width=16 \
+    --set render.height=16 --set render.spp=1 --no-progress
+run "$SFSIM" compare "$T/ref1/frame.exr" "$T/ref4/frame.exr"
+want_rc 1; want_err "sizes differ"
+end
+
+begin "sfsim run with an unknown mode is a usage error (exit 2)"
+run "$SFSIM" run --mode nonsense -o "$T/ref5"
+want_rc 2; want_err "nonsense"
+end
+
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
