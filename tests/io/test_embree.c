@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../../scenes/scene.h"
 #include "../support/xcheck.h"
 
 static void expect_agreement(const char *name, const Scene *s, uint32_t ncam, uint32_t nrand)
@@ -57,3 +58,28 @@ Test(embree, random_triangle_soup)
     free(pos);
     free(tm);
 }
+
+/* Every shared scene: its camera (the scene.ini's when the project ships one, else the file's or
+ * the default) and random rays from inside its bounds. Ties are hits on different triangles at
+ * the same distance (coplanar or duplicated geometry), which neither tracer is wrong about. */
+static void shared_scene(const char *path)
+{
+    Scene s;
+    char err[1024];
+    cr_assert_eq(scene_load(path, &s, err, sizeof err), 0, "%s", err);
+    expect_agreement(path, &s, 25000, 75000);
+    scene_free(&s);
+}
+
+Test(embree_shared, cornell_original) { shared_scene("scenes/cornell/scene.ini"); }
+Test(embree_shared, cornell_spheres) { shared_scene("../shared/scenes/cornell-box/CornellBox-Sphere.glb"); }
+Test(embree_shared, glass_vase_flowers) { shared_scene("../shared/scenes/glass-vase-flowers/GlassVaseFlowers.glb"); }
+Test(embree_shared, lights_punctual_lamp) { shared_scene("../shared/scenes/lights-punctual-lamp/LightsPunctualLamp.glb"); }
+Test(embree_shared, sponza) { shared_scene("../shared/scenes/sponza-dabrovic/sponza.glb"); }
+Test(embree_shared, toy_car) { shared_scene("../shared/scenes/toy-car/ToyCar.glb"); }
+Test(embree_shared, transmission_test) { shared_scene("../shared/scenes/transmission-test/TransmissionTest.glb"); }
+Test(embree_shared, stanford_bunny) { shared_scene("../shared/scenes/stanford-bunny/bunny.glb"); }
+Test(embree_shared, lamborghini, .timeout = 300) { shared_scene("../shared/scenes/lamborghini/lamborghini.glb"); }
+Test(embree_shared, lost_empire, .timeout = 300) { shared_scene("../shared/scenes/lost-empire/lost_empire.glb"); }
+Test(embree_shared, conference, .timeout = 300) { shared_scene("../shared/scenes/conference/conference.glb"); }
+Test(embree_shared, metal_rough_spheres, .timeout = 300) { shared_scene("../shared/scenes/metal-rough-spheres/MetalRoughSpheresNoTextures.glb"); }
