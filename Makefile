@@ -47,7 +47,8 @@ help:
 	@echo "make run        install deps, build, run the example program"
 	@echo "make test       install deps, build, run the whole test suite"
 	@echo "make test-asan  the unit tests under AddressSanitizer + UBSan"
-	@echo "make fuzz       build the libFuzzer targets (clang); make fuzz-run FUZZ_SECONDS=600"
+	@echo "make fuzz       build the libFuzzer targets, assembler and scene loader (clang);"
+	@echo "                make fuzz-run FUZZ_SECONDS=600 runs each for that long"
 	@echo "make bench      build and run the benchmarks in bench/"
 	@echo "make docs       regenerate docs/isa.md from isa/opcodes.def"
 
@@ -147,11 +148,24 @@ $(BUILD)/fuzz/fuzz_asm: tests/fuzz/fuzz_asm.c $(ISA_SRC) $(ASM_SRC)
 	@mkdir -p $(dir $@)
 	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ -lm
 
-fuzz: $(BUILD)/fuzz/fuzz_asm
+# The scene-loader fuzzer compiles tinygltf and stb_image into the shim so the sanitizers see
+# inside them (the project's normal build links Debian's libtinygltf).
+$(BUILD)/fuzz/gltf_shim.o: scenes/gltf_shim.cpp scenes/gltf.h scenes/scene.h
+	@mkdir -p $(dir $@)
+	$(CLANG)++ -std=c++17 -g -O1 -fsanitize=fuzzer-no-link,address,undefined -isystem /usr/include/stb \
+	    -DSFSIM_TINYGLTF_IMPLEMENTATION -c $< -o $@
+
+$(BUILD)/fuzz/fuzz_scene: tests/fuzz/fuzz_scene.c scenes/scene.c scenes/scene_file.c $(BUILD)/fuzz/gltf_shim.o
+	@mkdir -p $(dir $@)
+	$(CLANG)++ -x c -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined \
+	    $(filter %.c,$^) -x none $(filter %.o,$^) -o $@ -linih -lm
+
+fuzz: $(BUILD)/fuzz/fuzz_asm $(BUILD)/fuzz/fuzz_scene
 
 fuzz-run: fuzz
-	@mkdir -p $(BUILD)/fuzz/corpus
+	@mkdir -p $(BUILD)/fuzz/corpus $(BUILD)/fuzz/scene_corpus
 	$(BUILD)/fuzz/fuzz_asm -max_total_time=$(FUZZ_SECONDS) -max_len=4096 $(BUILD)/fuzz/corpus tests/fuzz/seeds
+	$(BUILD)/fuzz/fuzz_scene -max_total_time=$(FUZZ_SECONDS) -max_len=65536 -timeout=30 $(BUILD)/fuzz/scene_corpus tests/scenes
 
 # ---- benchmarks -----------------------------------------------------------------------------
 $(BUILD)/bench/core_speed: bench/core_speed.c $(BUILD)/libsfsim.a

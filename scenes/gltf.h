@@ -15,8 +15,9 @@
  * the first camera if s has none yet. Material indices of the new triangles point past the
  * materials s already had. 0, or -1 with "file: element: problem" in err. */
 int gltf_append(const char *path, const double *xf, Scene *s, char *err, size_t errlen);
-/* The same from memory (for the fuzzer): binary selects .glb parsing. */
-int gltf_append_memory(const unsigned char *data, size_t len, int binary, const char *name,
-                       const double *xf, Scene *s, char *err, size_t errlen);
+/* The same from memory (the fuzzer, tests): GLB when data starts with "glTF", JSON otherwise;
+ * name is used in messages; external files are not read (data URIs and the GLB chunk only). */
+int gltf_append_memory(const unsigned char *data, size_t len, const char *name, const double *xf, Scene *s,
+                       char *err, size_t errlen);
 
 #endif

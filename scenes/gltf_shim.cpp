@@ -1,18 +1,34 @@
-// scenes/gltf_shim.cpp -- glTF 2.0 through tinygltf (Debian's libtinygltf), behind a C API.
+// scenes/gltf_shim.cpp -- glTF 2.0 through tinygltf (Debian's libtinygltf 2.7), behind a C API.
 //
-// Owns: walking a glTF document (nodes, transforms, meshes, accessors, materials, textures,
-// KHR_lights_punctual, cameras) and validating everything it reads, so a malformed file gives an
-// error naming the file and the element instead of a crash. Must not: pick defaults, compute
-// bounds or needs (scenes/scene.c), or build acceleration structures.
+// Owns: walking a glTF document (default scene, node transforms, meshes, accessors, materials,
+// base-colour and emissive textures, KHR_lights_punctual, the first camera) and validating
+// everything it reads, so a malformed file gives an error naming the file and the element instead
+// of a crash. Must not: pick scene defaults, compute bounds or needs (scenes/scene.c), build
+// acceleration structures, or print anything.
+//
+// The only C++ in the project besides the OpenImageIO shim (ARCHITECTURE.md Sec. 2). Exceptions
+// never cross the C boundary.
+// The fuzz build (tests/fuzz/fuzz_scene.c) compiles tinygltf and stb_image into this file, so
+// the sanitizers and the fuzzer's coverage reach inside them; every other build links Debian's
+// libtinygltf.
+#ifdef SFSIM_TINYGLTF_IMPLEMENTATION
+#define TINYGLTF_IMPLEMENTATION
+#define STB_IMAGE_IMPLEMENTATION
+#define TINYGLTF_NO_STB_IMAGE_WRITE
+#endif
 #include <tiny_gltf.h>
 
+#include <cerrno>
+#include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <set>
 #include <string>
 #include <vector>
+
+#include <sys/stat.h>
 
 extern "C" {
 #include "gltf.h"
@@ -20,8 +36,10 @@ extern "C" {
 
 namespace {
 
+// ---- small matrix helpers (double precision; column-major like glTF) --------------------------
+
 struct Mat4 {
-    double m[16]; // column-major
+    double m[16];
 };
 
 Mat4 identity()
@@ -35,11 +53,11 @@ Mat4 mul(const Mat4 &a, const Mat4 &b)
 {
     Mat4 r{};
     for (int c = 0; c < 4; c++)
-        for (int rr = 0; rr < 4; rr++) {
+        for (int row = 0; row < 4; row++) {
             double s = 0.0;
             for (int k = 0; k < 4; k++)
-                s += a.m[k * 4 + rr] * b.m[c * 4 + k];
-            r.m[c * 4 + rr] = s;
+                s += a.m[k * 4 + row] * b.m[c * 4 + k];
+            r.m[c * 4 + row] = s;
         }
     return r;
 }
@@ -56,52 +74,41 @@ void xform_dir(const Mat4 &m, const double *p, double *out)
         out[r] = m.m[r] * p[0] + m.m[4 + r] * p[1] + m.m[8 + r] * p[2];
 }
 
-// Inverse transpose of the upper 3x3, for normals (3x3 column-major into out).
+double det3(const Mat4 &m)
+{
+    return m.m[0] * (m.m[5] * m.m[10] - m.m[9] * m.m[6]) - m.m[4] * (m.m[1] * m.m[10] - m.m[9] * m.m[2]) +
+           m.m[8] * (m.m[1] * m.m[6] - m.m[5] * m.m[2]);
+}
+
+// The inverse transpose of the upper 3x3 (column-major 3x3), which carries normals; false for a
+// singular matrix.
 bool normal_matrix(const Mat4 &m, double *out)
 {
     double a = m.m[0], b = m.m[4], c = m.m[8], d = m.m[1], e = m.m[5], f = m.m[9], g = m.m[2], h = m.m[6],
            i = m.m[10];
-    double det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g);
-    if (!(std::fabs(det) > 1e-300))
+    double det = det3(m);
+    if (!(std::fabs(det) > 1e-300) || !std::isfinite(det))
         return false;
-    double id = 1.0 / det;
-    // cofactor matrix / det = inverse transpose
-    double cof[9] = {(e * i - f * h), -(d * i - f * g), (d * h - e * g), -(b * i - c * h), (a * i - c * g),
-                     -(a * h - b * g), (b * f - c * e), -(a * f - c * d), (a * e - b * d)};
-    // cof is row-major [row][col] of the cofactor matrix; out is column-major of (inverse)^T = cof/det
+    // The cofactor matrix divided by the determinant is the inverse transpose.
+    double cof[9] = {e * i - f * h, -(d * i - f * g), d * h - e * g, -(b * i - c * h), a * i - c * g,
+                     -(a * h - b * g), b * f - c * e, -(a * f - c * d), a * e - b * d};
     for (int r = 0; r < 3; r++)
         for (int col = 0; col < 3; col++)
-            out[col * 3 + r] = cof[r * 3 + col] * id;
+            out[col * 3 + r] = cof[r * 3 + col] / det;
     return true;
 }
 
-struct Loader {
-    const tinygltf::Model &m;
-    std::string file;
-    Scene *s;
-    Mat4 pre;
-    std::string err;
-    uint32_t mat_base = 0, tex_base = 0;
-    std::vector<int> image_to_tex; // image index -> SceneTexture index (or -1 not loaded yet)
-    // accumulated geometry
-    std::vector<float> pos, nrm, uv;
-    std::vector<uint32_t> tmat;
-    bool any_normals = false, any_uvs = false;
-    std::vector<SceneMaterial> mats;
-    std::vector<SceneTexture> texs;
-    std::vector<SceneLight> lights;
-    bool camera_set = false;
-    SceneCamera camera{};
-
-    Loader(const tinygltf::Model &model, const char *name, Scene *scene) : m(model), file(name), s(scene) {}
-
-    bool fail(const std::string &what)
-    {
-        if (err.empty())
-            err = file + ": " + what;
+bool normalize(double *v)
+{
+    double l = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (!(l > 0.0) || !std::isfinite(l))
         return false;
-    }
-};
+    for (int k = 0; k < 3; k++)
+        v[k] /= l;
+    return true;
+}
+
+// ---- names for messages ----------------------------------------------------------------------
 
 std::string elem(const char *kind, int index, const std::string &name)
 {
@@ -111,7 +118,73 @@ std::string elem(const char *kind, int index, const std::string &name)
     return r;
 }
 
-// A validated view of an accessor: element i, component k.
+const char *mode_name(int mode)
+{
+    switch (mode) {
+    case TINYGLTF_MODE_POINTS: return "POINTS";
+    case TINYGLTF_MODE_LINE: return "LINES";
+    case TINYGLTF_MODE_LINE_LOOP: return "LINE_LOOP";
+    case TINYGLTF_MODE_LINE_STRIP: return "LINE_STRIP";
+    case TINYGLTF_MODE_TRIANGLES: return "TRIANGLES";
+    case TINYGLTF_MODE_TRIANGLE_STRIP: return "TRIANGLE_STRIP";
+    case TINYGLTF_MODE_TRIANGLE_FAN: return "TRIANGLE_FAN";
+    default: return "unknown";
+    }
+}
+
+const char *ctype_name(int ctype)
+{
+    switch (ctype) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: return "BYTE";
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return "UNSIGNED_BYTE";
+    case TINYGLTF_COMPONENT_TYPE_SHORT: return "SHORT";
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return "UNSIGNED_SHORT";
+    case TINYGLTF_COMPONENT_TYPE_INT: return "INT";
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return "UNSIGNED_INT";
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return "FLOAT";
+    default: return "unknown";
+    }
+}
+
+// One line from tinygltf's multi-line error and warning text.
+std::string one_line(std::string s)
+{
+    for (char &c : s)
+        if (c == '\n' || c == '\r')
+            c = ' ';
+    while (!s.empty() && s.back() == ' ')
+        s.pop_back();
+    return s;
+}
+
+// ---- accessors -------------------------------------------------------------------------------
+
+int component_size(int ctype)
+{
+    switch (ctype) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+    default: return 0; // INT is not a legal glTF accessor component type
+    }
+}
+
+int type_components(int type)
+{
+    switch (type) {
+    case TINYGLTF_TYPE_SCALAR: return 1;
+    case TINYGLTF_TYPE_VEC2: return 2;
+    case TINYGLTF_TYPE_VEC3: return 3;
+    case TINYGLTF_TYPE_VEC4: return 4;
+    default: return 0; // matrices never describe vertices or indices
+    }
+}
+
+// A checked view of an accessor's data: element i, component k, as a double (normalized
+// integers mapped to [0,1] or [-1,1] as glTF 2.0 Sec. 3.11 says).
 struct View {
     const unsigned char *base = nullptr;
     size_t stride = 0, count = 0;
@@ -127,10 +200,7 @@ struct View {
             std::memcpy(&f, p + 4 * k, 4);
             return f;
         }
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: {
-            double v = p[k];
-            return normalized ? v / 255.0 : v;
-        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[k] / 255.0 : p[k];
         case TINYGLTF_COMPONENT_TYPE_BYTE: {
             double v = (signed char)p[k];
             return normalized ? std::fmax(v / 127.0, -1.0) : v;
@@ -150,69 +220,224 @@ struct View {
             std::memcpy(&u, p + 4 * k, 4);
             return u;
         }
-        default:
-            return 0.0;
+        default: return 0.0;
+        }
+    }
+
+    uint32_t index(size_t i) const
+    {
+        const unsigned char *p = base + i * stride;
+        switch (ctype) {
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return p[0];
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+            uint16_t u;
+            std::memcpy(&u, p, 2);
+            return u;
+        }
+        default: {
+            uint32_t u;
+            std::memcpy(&u, p, 4);
+            return u;
+        }
         }
     }
 };
 
-int component_size(int ctype)
+// ---- images: kept encoded while tinygltf parses, decoded only when a material uses them --------
+
+// tinygltf calls this for images given by data URI or external file (the bytes are ours to copy)
+// and for images in a bufferView. The latter are not touched here: tinygltf 2.7 hands over
+// &buffer.data[byteOffset] without checking that the view lies inside its buffer, so those bytes
+// are read later, after our own check (decode_image). Decoding lazily also skips normal, occlusion
+// and metallic-roughness maps, which nothing here uses.
+struct Stash {
+    std::vector<std::vector<unsigned char>> encoded; // by image index
+};
+
+bool keep_encoded(tinygltf::Image *image, const int idx, std::string *, std::string *, int, int,
+                  const unsigned char *bytes, int size, void *user)
 {
-    switch (ctype) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
-    case TINYGLTF_COMPONENT_TYPE_SHORT:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
-    default: return 0;
-    }
+    Stash *st = static_cast<Stash *>(user);
+    if (image->bufferView >= 0 || idx < 0 || size <= 0)
+        return true;
+    if ((size_t)idx >= st->encoded.size())
+        st->encoded.resize((size_t)idx + 1);
+    st->encoded[(size_t)idx].assign(bytes, bytes + size);
+    return true;
 }
 
-int type_components(int type)
+// Loading from memory (the fuzzer, tests) never reads files: only data URIs and the GLB chunk.
+bool no_file_exists(const std::string &, void *) { return false; }
+std::string same_path(const std::string &p, void *) { return p; }
+bool no_read(std::vector<unsigned char> *, std::string *err, const std::string &path, void *)
 {
-    switch (type) {
-    case TINYGLTF_TYPE_SCALAR: return 1;
-    case TINYGLTF_TYPE_VEC2: return 2;
-    case TINYGLTF_TYPE_VEC3: return 3;
-    case TINYGLTF_TYPE_VEC4: return 4;
-    default: return 0;
-    }
+    if (err)
+        *err += "external file '" + path + "' cannot be read when loading from memory\n";
+    return false;
+}
+bool no_write(std::string *err, const std::string &, const std::vector<unsigned char> &, void *)
+{
+    if (err)
+        *err += "writing is not supported\n";
+    return false;
 }
 
-bool accessor_view(Loader &L, int index, const std::string &where, int want_comp, View &v)
+// Loading from a file: external buffers and images are read by tinygltf, but through this reader,
+// which refuses what is not a regular file (tinygltf sizes a file by seeking to its end, and a
+// directory or device answers with nonsense such as 2^63 bytes).
+bool regular_file_exists(const std::string &path, void *)
+{
+    struct stat st;
+    return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+bool read_regular_file(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *)
+{
+    struct stat st;
+    if (stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) {
+        if (err)
+            *err += "'" + path + "' is not a regular file\n";
+        return false;
+    }
+    FILE *f = std::fopen(path.c_str(), "rb");
+    if (!f) {
+        if (err)
+            *err += "cannot open '" + path + "': " + std::strerror(errno) + "\n";
+        return false;
+    }
+    out->resize((size_t)st.st_size);
+    size_t n = out->empty() ? 0 : std::fread(out->data(), 1, out->size(), f);
+    std::fclose(f);
+    if (n != out->size()) {
+        if (err)
+            *err += "cannot read '" + path + "'\n";
+        return false;
+    }
+    return true;
+}
+
+float srgb8_table[256];
+bool srgb8_ready = false;
+
+float srgb_to_linear(double c)
+{
+    return (float)(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+}
+
+// ---- the loader ------------------------------------------------------------------------------
+
+// Emissive texture analysis: which texels emit, as an OR pyramid for conservative rectangle
+// queries (the emitting part of a material with an emissive texture, see split_emissive).
+struct EmitMap {
+    int w = 0, h = 0;
+    std::vector<std::vector<unsigned char>> lv; // level k: ceil(w / 2^k) x ceil(h / 2^k) flags
+    std::vector<int> lw, lh;
+
+    bool any(int x0, int x1, int y0, int y1) const // inclusive texel ranges inside the image
+    {
+        size_t k = 0;
+        while (k + 1 < lv.size() && ((x1 >> k) - (x0 >> k) > 3 || (y1 >> k) - (y0 >> k) > 3))
+            k++;
+        for (int y = y0 >> k; y <= (y1 >> k); y++)
+            for (int x = x0 >> k; x <= (x1 >> k); x++)
+                if (lv[k][(size_t)y * (size_t)lw[k] + (size_t)x])
+                    return true;
+        return false;
+    }
+};
+
+struct MatInfo {
+    int index = -1;      // SceneMaterial index (absolute) of the material as loaded
+    int emit_twin = -1;  // the emitting part when an emissive texture only partly emits, else -1
+    int emit_texcoord = 0;
+    const EmitMap *map = nullptr;
+};
+
+struct Loader {
+    const tinygltf::Model &m;
+    std::string file;
+    Scene *s;
+    Mat4 pre = identity();
+    std::string err;
+    const Stash *stash = nullptr;
+    bool quantized = false; // KHR_mesh_quantization: integer positions, normals, texcoords are legal
+    uint32_t mat_base = 0, tex_base = 0;
+    std::vector<int> image_to_tex; // image index -> absolute SceneTexture index, -1 not decoded
+    std::vector<MatInfo> minfo;    // by glTF material index
+    std::vector<EmitMap> maps;     // by local texture index (empty map: not analysed)
+    int default_mat = -1;
+    // Triangles go straight into the Scene's arrays, after its `old` triangles; only commit()
+    // makes them count (Scene.ntris), so a failed file leaves the Scene as it was, with larger
+    // arrays. Materials, textures and lights wait here until commit().
+    size_t old = 0, cur = 0, cap = 0; // triangles: the Scene's, this file's so far, room for
+    std::vector<SceneMaterial> mats;
+    std::vector<SceneTexture> texs;
+    std::vector<SceneLight> lights;
+    bool camera_set = false;
+    SceneCamera camera{};
+
+    Loader(const tinygltf::Model &model, const char *name, Scene *scene) : m(model), file(name), s(scene) {}
+    ~Loader()
+    {
+        for (auto &mm : mats)
+            std::free(mm.name);
+        for (auto &t : texs) {
+            std::free(t.name);
+            std::free(t.rgba);
+        }
+        for (auto &l : lights)
+            std::free(l.name);
+    }
+    Loader(const Loader &) = delete;
+    Loader &operator=(const Loader &) = delete;
+
+    bool fail(const std::string &what)
+    {
+        if (err.empty())
+            err = file + ": " + what;
+        return false;
+    }
+    SceneMaterial &mat(int absolute) { return mats[(size_t)(absolute - (int)mat_base)]; }
+};
+
+bool accessor_view(Loader &L, int index, const std::string &where, View &v)
 {
     const auto &m = L.m;
-    if (index < 0 || index >= (int)m.accessors.size())
+    if (index < 0 || (size_t)index >= m.accessors.size())
         return L.fail(where + ": accessor " + std::to_string(index) + " does not exist");
-    const auto &a = m.accessors[index];
-    std::string an = where + ": accessor " + std::to_string(index);
+    const auto &a = m.accessors[(size_t)index];
+    std::string an = where + ": " + elem("accessor", index, a.name);
     if (a.sparse.isSparse)
         return L.fail(an + ": sparse accessors are not supported");
     int cs = component_size(a.componentType), nc = type_components(a.type);
-    if (!cs || !nc)
-        return L.fail(an + ": unsupported component type " + std::to_string(a.componentType) + " or type " +
-                      std::to_string(a.type));
-    if (want_comp && nc != want_comp)
-        return L.fail(an + ": has " + std::to_string(nc) + " components, expected " + std::to_string(want_comp));
-    if (a.bufferView < 0 || a.bufferView >= (int)m.bufferViews.size())
-        return L.fail(an + ": missing or bad bufferView " + std::to_string(a.bufferView));
-    const auto &bv = m.bufferViews[a.bufferView];
-    if (bv.buffer < 0 || bv.buffer >= (int)m.buffers.size())
+    if (!cs)
+        return L.fail(an + ": component type " + std::to_string(a.componentType) + " is not a glTF accessor type");
+    if (!nc)
+        return L.fail(an + ": type " + std::to_string(a.type) + " is not SCALAR or VEC2..VEC4");
+    if (a.bufferView < 0 || (size_t)a.bufferView >= m.bufferViews.size())
+        return L.fail(an + ": has no data (bufferView " + std::to_string(a.bufferView) + ")");
+    const auto &bv = m.bufferViews[(size_t)a.bufferView];
+    if (bv.buffer < 0 || (size_t)bv.buffer >= m.buffers.size())
         return L.fail(an + ": bufferView " + std::to_string(a.bufferView) + " names missing buffer " +
                       std::to_string(bv.buffer));
-    const auto &buf = m.buffers[bv.buffer];
-    size_t elem_size = (size_t)cs * (size_t)nc;
+    const auto &buf = m.buffers[(size_t)bv.buffer];
+    size_t size = buf.data.size(), elem_size = (size_t)cs * (size_t)nc;
     size_t stride = bv.byteStride ? bv.byteStride : elem_size;
     if (stride < elem_size)
-        return L.fail(an + ": byteStride " + std::to_string(bv.byteStride) + " smaller than an element");
-    size_t start = bv.byteOffset + a.byteOffset;
-    size_t need = a.count ? start + stride * (a.count - 1) + elem_size : start;
-    if (bv.byteOffset > buf.data.size() || bv.byteLength > buf.data.size() - bv.byteOffset ||
-        a.byteOffset > bv.byteLength || need > bv.byteOffset + bv.byteLength || need > buf.data.size())
-        return L.fail(an + ": data outside buffer " + std::to_string(bv.buffer) + " (" +
-                      std::to_string(buf.data.size()) + " bytes)");
-    v.base = buf.data.data() + start;
+        return L.fail(an + ": byteStride " + std::to_string(bv.byteStride) + " is smaller than an element (" +
+                      std::to_string(elem_size) + " bytes)");
+    // Every sum below is checked against overflow before it is formed.
+    std::string where_buf = " (bufferView " + std::to_string(a.bufferView) + ": offset " +
+                            std::to_string(bv.byteOffset) + ", length " + std::to_string(bv.byteLength) + "; buffer " +
+                            std::to_string(bv.buffer) + ": " + std::to_string(size) + " bytes)";
+    if (bv.byteOffset > size || bv.byteLength > size - bv.byteOffset)
+        return L.fail(an + ": bufferView lies outside its buffer" + where_buf);
+    if (a.count) {
+        if (a.byteOffset > bv.byteLength || elem_size > bv.byteLength - a.byteOffset ||
+            a.count - 1 > (bv.byteLength - a.byteOffset - elem_size) / stride)
+            return L.fail(an + ": " + std::to_string(a.count) + " elements at offset " + std::to_string(a.byteOffset) +
+                          " run past the end of the bufferView" + where_buf);
+    }
+    v.base = buf.data.data() + bv.byteOffset + (a.count ? a.byteOffset : 0);
     v.stride = stride;
     v.count = a.count;
     v.ctype = a.componentType;
@@ -221,99 +446,234 @@ bool accessor_view(Loader &L, int index, const std::string &where, int want_comp
     return true;
 }
 
-double ext_number(const tinygltf::ExtensionMap &ext, const char *name, const char *key, double def, bool *present)
+double ext_number(const tinygltf::ExtensionMap &ext, const char *name, const char *key, double def)
 {
     auto it = ext.find(name);
-    if (present)
-        *present = it != ext.end();
     if (it == ext.end() || !it->second.IsObject() || !it->second.Has(key))
         return def;
     const auto &v = it->second.Get(key);
     return v.IsNumber() ? v.GetNumberAsDouble() : def;
 }
 
-float srgb_to_linear(double c)
+// Decode glTF image `img` into a SceneTexture (linear RGBA floats).
+bool decode_image(Loader &L, int img, SceneTexture &tx)
 {
-    return (float)(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+    const auto &m = L.m;
+    const auto &im = m.images[(size_t)img];
+    std::string what = elem("image", img, im.name);
+    const unsigned char *bytes = nullptr;
+    size_t len = 0;
+    if (im.bufferView >= 0) {
+        if ((size_t)im.bufferView >= m.bufferViews.size())
+            return L.fail(what + ": bufferView " + std::to_string(im.bufferView) + " does not exist");
+        const auto &bv = m.bufferViews[(size_t)im.bufferView];
+        if (bv.buffer < 0 || (size_t)bv.buffer >= m.buffers.size())
+            return L.fail(what + ": bufferView " + std::to_string(im.bufferView) + " names missing buffer " +
+                          std::to_string(bv.buffer));
+        const auto &buf = m.buffers[(size_t)bv.buffer];
+        if (bv.byteOffset > buf.data.size() || bv.byteLength > buf.data.size() - bv.byteOffset)
+            return L.fail(what + ": bufferView " + std::to_string(im.bufferView) + " lies outside buffer " +
+                          std::to_string(bv.buffer) + " (" + std::to_string(buf.data.size()) + " bytes)");
+        bytes = buf.data.data() + bv.byteOffset;
+        len = bv.byteLength;
+    } else if ((size_t)img < L.stash->encoded.size() && !L.stash->encoded[(size_t)img].empty()) {
+        bytes = L.stash->encoded[(size_t)img].data();
+        len = L.stash->encoded[(size_t)img].size();
+    } else {
+        return L.fail(what + ": no image data (uri '" + im.uri + "' could not be read)");
+    }
+    if (len == 0 || len > (size_t)INT_MAX)
+        return L.fail(what + ": " + std::to_string(len) + " bytes of image data");
+    tinygltf::Image dec;
+    std::string ierr, iwarn;
+    // nullptr options: tinygltf's default, every image expanded to RGBA (8 or 16 bits per channel).
+    if (!tinygltf::LoadImageData(&dec, img, &ierr, &iwarn, 0, 0, bytes, (int)len, nullptr))
+        return L.fail(what + ": cannot decode: " + one_line(ierr));
+    if (dec.width <= 0 || dec.height <= 0 || dec.component != 4 || (dec.bits != 8 && dec.bits != 16))
+        return L.fail(what + ": decoded to an unusable format");
+    size_t px = (size_t)dec.width * (size_t)dec.height, bpc = (size_t)dec.bits / 8;
+    if (dec.image.size() < px * 4 * bpc)
+        return L.fail(what + ": pixel data shorter than its size");
+    if (!srgb8_ready) {
+        for (int i = 0; i < 256; i++)
+            srgb8_table[i] = srgb_to_linear(i / 255.0);
+        srgb8_ready = true;
+    }
+    tx.name = strdup(im.name.c_str());
+    tx.width = dec.width;
+    tx.height = dec.height;
+    tx.rgba = (float *)std::malloc(sizeof(float) * 4 * px);
+    if (!tx.rgba || !tx.name) {
+        std::free(tx.rgba);
+        std::free(tx.name);
+        tx.rgba = nullptr;
+        tx.name = nullptr;
+        return L.fail(what + ": out of memory");
+    }
+    const unsigned char *d = dec.image.data();
+    for (size_t i = 0; i < 4 * px; i++) {
+        bool alpha = (i & 3) == 3; // alpha is linear in glTF; colour channels are sRGB-encoded
+        if (bpc == 1) {
+            tx.rgba[i] = alpha ? d[i] / 255.0f : srgb8_table[d[i]];
+        } else {
+            uint16_t u;
+            std::memcpy(&u, d + 2 * i, 2);
+            tx.rgba[i] = alpha ? u / 65535.0f : srgb_to_linear(u / 65535.0);
+        }
+    }
+    return true;
 }
 
-// The SceneTexture index of glTF texture `t` (decoding its image once), or -1.
+// The absolute SceneTexture index of glTF texture `t` (decoding its image once), or -1.
 bool texture_index(Loader &L, int t, const std::string &where, int &out)
 {
     out = -1;
     if (t < 0)
         return true;
     const auto &m = L.m;
-    if (t >= (int)m.textures.size())
+    if ((size_t)t >= m.textures.size())
         return L.fail(where + ": texture " + std::to_string(t) + " does not exist");
-    int img = m.textures[t].source;
+    int img = m.textures[(size_t)t].source;
     if (img < 0)
-        return true; // a texture without a source image: no texture
-    if (img >= (int)m.images.size())
+        return true; // no source image (e.g. only an extension's): no texture
+    if ((size_t)img >= m.images.size())
         return L.fail(where + ": texture " + std::to_string(t) + " names missing image " + std::to_string(img));
-    if (L.image_to_tex[img] >= 0) {
-        out = L.image_to_tex[img];
+    if (L.image_to_tex[(size_t)img] >= 0) {
+        out = L.image_to_tex[(size_t)img];
         return true;
     }
-    const auto &im = m.images[img];
-    if (im.width <= 0 || im.height <= 0 || im.component < 1 || im.component > 4 ||
-        (im.bits != 8 && im.bits != 16))
-        return L.fail(elem("image", img, im.name) + ": could not be decoded (" + std::to_string(im.width) + "x" +
-                      std::to_string(im.height) + ", " + std::to_string(im.component) + " channels, " +
-                      std::to_string(im.bits) + " bits)");
-    size_t px = (size_t)im.width * (size_t)im.height, bpc = im.bits / 8;
-    if (im.image.size() < px * (size_t)im.component * bpc)
-        return L.fail(elem("image", img, im.name) + ": pixel data shorter than its size");
     SceneTexture tx{};
-    tx.name = strdup(im.name.c_str());
-    tx.width = im.width;
-    tx.height = im.height;
-    tx.rgba = (float *)std::malloc(sizeof(float) * 4 * px);
-    if (!tx.rgba || !tx.name) {
-        std::free(tx.rgba);
-        std::free(tx.name);
-        return L.fail("out of memory for image " + std::to_string(img));
-    }
-    for (size_t i = 0; i < px; i++) {
-        double ch[4] = {0, 0, 0, 1};
-        for (int k = 0; k < im.component; k++) {
-            size_t o = (i * (size_t)im.component + (size_t)k) * bpc;
-            ch[k] = bpc == 1 ? im.image[o] / 255.0 : (im.image[o] | im.image[o + 1] << 8) / 65535.0;
-        }
-        if (im.component <= 2) { // grey (+ alpha)
-            ch[3] = im.component == 2 ? ch[1] : 1.0;
-            ch[1] = ch[2] = ch[0];
-        }
-        for (int k = 0; k < 3; k++)
-            tx.rgba[4 * i + k] = srgb_to_linear(ch[k]);
-        tx.rgba[4 * i + 3] = (float)ch[3];
-    }
+    if (!decode_image(L, img, tx))
+        return false;
     out = (int)(L.tex_base + L.texs.size());
     L.texs.push_back(tx);
-    L.image_to_tex[img] = out;
+    L.maps.emplace_back();
+    L.image_to_tex[(size_t)img] = out;
     return true;
 }
 
+// Texels darker than this (linear, every channel) do not emit: it keeps JPEG noise in the black
+// parts of an emissive texture from turning whole models into lights.
+const float EMIT_BLACK = 1.0f / 256.0f;
+
+// Builds (once) the emitting-texel pyramid of texture `tex` (absolute); returns whether any texel
+// emits and whether all do.
+const EmitMap &emit_map(Loader &L, int tex, bool &any, bool &all)
+{
+    EmitMap &em = L.maps[(size_t)(tex - (int)L.tex_base)];
+    const SceneTexture &t = L.texs[(size_t)(tex - (int)L.tex_base)];
+    if (em.lv.empty()) {
+        em.w = t.width;
+        em.h = t.height;
+        std::vector<unsigned char> l0((size_t)t.width * (size_t)t.height);
+        for (size_t i = 0; i < l0.size(); i++) {
+            const float *p = &t.rgba[4 * i];
+            l0[i] = p[0] > EMIT_BLACK || p[1] > EMIT_BLACK || p[2] > EMIT_BLACK;
+        }
+        em.lv.push_back(std::move(l0));
+        em.lw.push_back(t.width);
+        em.lh.push_back(t.height);
+        while (em.lw.back() > 1 || em.lh.back() > 1) {
+            int pw = em.lw.back(), ph = em.lh.back(), w = (pw + 1) / 2, h = (ph + 1) / 2;
+            const auto &prev = em.lv.back();
+            std::vector<unsigned char> cur((size_t)w * (size_t)h, 0);
+            for (int y = 0; y < ph; y++)
+                for (int x = 0; x < pw; x++)
+                    cur[(size_t)(y / 2) * (size_t)w + (size_t)(x / 2)] |= prev[(size_t)y * (size_t)pw + (size_t)x];
+            em.lv.push_back(std::move(cur));
+            em.lw.push_back(w);
+            em.lh.push_back(h);
+        }
+    }
+    any = em.lv.back()[0] != 0;
+    all = true;
+    for (unsigned char f : em.lv[0])
+        if (!f) {
+            all = false;
+            break;
+        }
+    return em;
+}
+
+// A texel range [a, b] of a repeating texture of n texels, as up to two ranges inside it.
+int wrap_ranges(double lo, double hi, int n, int r[4])
+{
+    double fl = std::floor(lo);
+    lo -= fl;
+    hi -= fl;
+    // Bilinear filtering at u reads texels floor(u n - 1/2) and the next one; nearest reads
+    // floor(u n), which lies between.
+    long a = (long)std::floor(lo * n - 0.5), b = (long)std::floor(hi * n - 0.5) + 1;
+    if (b - a + 1 >= n) {
+        r[0] = 0;
+        r[1] = n - 1;
+        return 1;
+    }
+    long a2 = ((a % n) + n) % n, b2 = a2 + (b - a);
+    if (b2 < n) {
+        r[0] = (int)a2;
+        r[1] = (int)b2;
+        return 1;
+    }
+    r[0] = (int)a2;
+    r[1] = n - 1;
+    r[2] = 0;
+    r[3] = (int)(b2 - n);
+    return 2;
+}
+
+// Does the triangle with texture coordinates uv (3 x 2) touch an emitting texel?
+bool uv_emits(const EmitMap &em, const double *uv)
+{
+    double u0 = std::fmin(uv[0], std::fmin(uv[2], uv[4])), u1 = std::fmax(uv[0], std::fmax(uv[2], uv[4]));
+    double v0 = std::fmin(uv[1], std::fmin(uv[3], uv[5])), v1 = std::fmax(uv[1], std::fmax(uv[3], uv[5]));
+    if (u1 - u0 >= 1.0 || v1 - v0 >= 1.0 || std::fabs(u0) > 1e6 || std::fabs(v0) > 1e6)
+        return em.lv.back()[0] != 0;
+    int xr[4], yr[4];
+    int nx = wrap_ranges(u0, u1, em.w, xr), ny = wrap_ranges(v0, v1, em.h, yr);
+    for (int i = 0; i < nx; i++)
+        for (int j = 0; j < ny; j++)
+            if (em.any(xr[2 * i], xr[2 * i + 1], yr[2 * j], yr[2 * j + 1]))
+                return true;
+    return false;
+}
+
+// glTF materials -> SceneMaterial (ARCHITECTURE.md Sec. 1 mapping).
 bool load_materials(Loader &L)
 {
     const auto &m = L.m;
+    L.minfo.assign(m.materials.size(), MatInfo{});
     for (size_t i = 0; i < m.materials.size(); i++) {
         const auto &gm = m.materials[i];
         std::string where = elem("material", (int)i, gm.name);
-        SceneMaterial sm{};
-        sm.name = strdup(gm.name.c_str());
         const auto &pbr = gm.pbrMetallicRoughness;
+        SceneMaterial sm{};
+        std::string name = gm.name.empty() ? "material_" + std::to_string(i) : gm.name;
+        bool has_color = pbr.baseColorFactor.size() == 4;
         for (int k = 0; k < 3; k++)
-            sm.base_color[k] = pbr.baseColorFactor.size() == 4 ? (float)pbr.baseColorFactor[k] : 1.0f;
-        sm.alpha = pbr.baseColorFactor.size() == 4 ? (float)pbr.baseColorFactor[3] : 1.0f;
-        sm.metallic = (float)pbr.metallicFactor;
-        sm.roughness = (float)pbr.roughnessFactor;
-        bool has_tr = false;
-        sm.transmission = (float)ext_number(gm.extensions, "KHR_materials_transmission", "transmissionFactor", 0.0, &has_tr);
-        sm.ior = (float)ext_number(gm.extensions, "KHR_materials_ior", "ior", 1.5, nullptr);
-        double strength = ext_number(gm.extensions, "KHR_materials_emissive_strength", "emissiveStrength", 1.0, nullptr);
+            sm.base_color[k] = has_color ? (float)pbr.baseColorFactor[(size_t)k] : 1.0f;
+        sm.alpha = has_color ? (float)pbr.baseColorFactor[3] : 1.0f;
+        sm.metallic = (float)pbr.metallicFactor;   // tinygltf's default is glTF's: 1
+        sm.roughness = (float)pbr.roughnessFactor; // likewise 1
+        sm.transmission = (float)ext_number(gm.extensions, "KHR_materials_transmission", "transmissionFactor", 0.0);
+        sm.ior = (float)ext_number(gm.extensions, "KHR_materials_ior", "ior", 1.5);
+        double strength = ext_number(gm.extensions, "KHR_materials_emissive_strength", "emissiveStrength", 1.0);
         for (int k = 0; k < 3; k++)
-            sm.emission[k] = gm.emissiveFactor.size() == 3 ? (float)(gm.emissiveFactor[k] * strength) : 0.0f;
+            sm.emission[k] = gm.emissiveFactor.size() == 3 ? (float)(gm.emissiveFactor[(size_t)k] * strength) : 0.0f;
+        for (int k = 0; k < 3; k++)
+            if (!std::isfinite(sm.base_color[k]) || !std::isfinite(sm.emission[k]) || sm.base_color[k] < 0.0f ||
+                sm.emission[k] < 0.0f)
+                return L.fail(where + ": colour component is negative or not finite");
+        if (!std::isfinite(sm.alpha) || !std::isfinite(sm.metallic) || !std::isfinite(sm.roughness) ||
+            !std::isfinite(sm.transmission) || !std::isfinite((float)gm.alphaCutoff))
+            return L.fail(where + ": a factor is not finite");
+        if (!(sm.ior >= 1.0f) || !std::isfinite(sm.ior)) {
+            // KHR_materials_ior: 0 means 1 / infinity (a perfect mirror); anything else below 1 is invalid.
+            if (sm.ior == 0.0f)
+                sm.ior = 1.0f;
+            else
+                return L.fail(where + ": KHR_materials_ior ior " + std::to_string(sm.ior) + " is below 1");
+        }
         // ARCHITECTURE.md Sec. 1: transmission > 0 -> dielectric; metallic > 0 or roughness < 1 ->
         // coupled glossy; otherwise Lambertian.
         if (sm.transmission > 0.0f)
@@ -322,36 +682,65 @@ bool load_materials(Loader &L)
             sm.kind = SCENE_MAT_GLOSSY;
         else
             sm.kind = SCENE_MAT_LAMBERT;
-        for (int k = 0; k < 3; k++)
-            if (!std::isfinite(sm.base_color[k]) || !std::isfinite(sm.emission[k]))
-                return L.fail(where + ": non-finite colour");
-        if (!std::isfinite(sm.metallic) || !std::isfinite(sm.roughness) || !std::isfinite(sm.ior) || sm.ior <= 0.0f)
-            return L.fail(where + ": non-finite or non-positive factor");
-        int tex;
-        if (!texture_index(L, pbr.baseColorTexture.index, where, tex))
-            return false;
-        sm.base_texture = tex;
-        if (!texture_index(L, gm.emissiveTexture.index, where, tex))
-            return false;
-        sm.emissive_texture = tex;
-        sm.alpha_mode = gm.alphaMode == "MASK" ? SCENE_ALPHA_MASK : gm.alphaMode == "BLEND" ? SCENE_ALPHA_BLEND : SCENE_ALPHA_OPAQUE;
+        sm.alpha_mode = gm.alphaMode == "MASK"    ? SCENE_ALPHA_MASK
+                        : gm.alphaMode == "BLEND" ? SCENE_ALPHA_BLEND
+                                                  : SCENE_ALPHA_OPAQUE;
         sm.alpha_cutoff = (float)gm.alphaCutoff;
         sm.double_sided = gm.doubleSided ? 1 : 0;
+        int tex;
+        if (!texture_index(L, pbr.baseColorTexture.index, where + " baseColorTexture", tex))
+            return false;
+        sm.base_texture = tex;
+        sm.emissive_texture = -1;
+        bool emits = sm.emission[0] > 0.0f || sm.emission[1] > 0.0f || sm.emission[2] > 0.0f;
+        if (emits && !texture_index(L, gm.emissiveTexture.index, where + " emissiveTexture", tex))
+            return false;
+        if (emits)
+            sm.emissive_texture = tex;
+        sm.name = strdup(name.c_str());
+        if (!sm.name)
+            return L.fail("out of memory");
         L.mats.push_back(sm);
+        MatInfo &mi = L.minfo[i];
+        mi.index = (int)(L.mat_base + L.mats.size() - 1);
+        if (emits && tex >= 0) {
+            // An emissive texture that is black in places: the triangles that only see black texels
+            // do not emit. The material splits into a non-emitting part (this one) and an emitting
+            // twin of the same name, so later stages, which sample no emissive texture, light only
+            // what glows (docs/scenes.md, "Emissive textures").
+            bool any, all;
+            const EmitMap &em = emit_map(L, tex, any, all);
+            SceneMaterial &me = L.mat(mi.index);
+            if (!any) {
+                for (int k = 0; k < 3; k++)
+                    me.emission[k] = 0.0f;
+                me.emissive_texture = -1;
+            } else if (!all) {
+                SceneMaterial twin = me;
+                twin.name = strdup(me.name);
+                for (int k = 0; k < 3; k++)
+                    me.emission[k] = 0.0f;
+                me.emissive_texture = -1;
+                if (!twin.name)
+                    return L.fail("out of memory");
+                L.mats.push_back(twin);
+                L.minfo[i].emit_twin = (int)(L.mat_base + L.mats.size() - 1);
+                L.minfo[i].emit_texcoord = gm.emissiveTexture.texCoord;
+                L.minfo[i].map = &em;
+            }
+        }
     }
     return true;
 }
 
-// The material used when a primitive names none: glTF's default (white, metallic 1,
-// roughness 1), which the mapping makes coupled glossy; added once, on first use.
+// glTF's default material (white, metallic 1, roughness 1: coupled glossy) for primitives that
+// name none; added once per file, on first use.
 int default_material(Loader &L)
 {
-    static const char *name = "(glTF default material)";
-    for (size_t i = 0; i < L.mats.size(); i++)
-        if (L.mats[i].name && std::strcmp(L.mats[i].name, name) == 0)
-            return (int)(L.mat_base + i);
+    if (L.default_mat >= 0)
+        return L.default_mat;
     SceneMaterial sm{};
-    sm.name = strdup(name);
+    sm.name = strdup("(glTF default material)");
     sm.kind = SCENE_MAT_GLOSSY;
     sm.base_color[0] = sm.base_color[1] = sm.base_color[2] = 1.0f;
     sm.alpha = 1.0f;
@@ -360,398 +749,684 @@ int default_material(Loader &L)
     sm.ior = 1.5f;
     sm.base_texture = sm.emissive_texture = -1;
     sm.alpha_cutoff = 0.5f;
+    if (!sm.name)
+        return -1;
     L.mats.push_back(sm);
-    return (int)(L.mat_base + L.mats.size() - 1);
+    L.default_mat = (int)(L.mat_base + L.mats.size() - 1);
+    return L.default_mat;
 }
 
-bool load_primitive(Loader &L, const Mat4 &world, int mesh, int pi)
+// ---- the Scene's triangle arrays ---------------------------------------------------------------
+
+void geometric_normals(const float *pos, float *nrm, size_t from, size_t to)
+{
+    for (size_t t = from; t < to; t++) {
+        const float *p = &pos[9 * t];
+        double e1[3], e2[3], g[3];
+        for (int k = 0; k < 3; k++) {
+            e1[k] = (double)p[3 + k] - p[k];
+            e2[k] = (double)p[6 + k] - p[k];
+        }
+        g[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        g[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        g[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        if (!normalize(g)) // a degenerate triangle: any unit vector keeps later stages NaN-free
+            g[0] = g[2] = 0.0, g[1] = 1.0;
+        for (int c = 0; c < 3; c++)
+            for (int k = 0; k < 3; k++)
+                nrm[9 * t + 3 * (size_t)c + (size_t)k] = (float)g[k];
+    }
+}
+
+// Room for `more` triangles after the ones written so far (the counting pass in load() usually
+// reserved everything at once).
+bool reserve(Loader &L, size_t more)
+{
+    Scene *s = L.s;
+    size_t need = L.old + L.cur + more;
+    if (need > 0x3FFFFFFFu)
+        return L.fail("too many triangles (" + std::to_string(need) + "; scene memory addresses at most 2^30)");
+    if (need <= L.cap && s->pos)
+        return true;
+    size_t cap = std::max(need, L.cap + L.cap / 2) + 1; // + 1: never a zero-size allocation
+    float *pos = (float *)std::realloc(s->pos, sizeof(float) * 9 * cap);
+    if (pos)
+        s->pos = pos;
+    uint32_t *tm = pos ? (uint32_t *)std::realloc(s->tri_material, sizeof(uint32_t) * cap) : nullptr;
+    if (tm)
+        s->tri_material = tm;
+    float *nrm = tm && s->nrm ? (float *)std::realloc(s->nrm, sizeof(float) * 9 * cap) : nullptr;
+    if (nrm)
+        s->nrm = nrm;
+    float *uv = tm && s->uv ? (float *)std::realloc(s->uv, sizeof(float) * 6 * cap) : nullptr;
+    if (uv)
+        s->uv = uv;
+    if (!pos || !tm || (s->nrm && !nrm) || (s->uv && !uv))
+        return L.fail("out of memory for " + std::to_string(need) + " triangles");
+    L.cap = cap;
+    return true;
+}
+
+// The first vertex normals of the scene: every earlier triangle gets its geometric normal.
+bool add_normals(Loader &L)
+{
+    float *n = (float *)std::malloc(sizeof(float) * 9 * (L.cap ? L.cap : 1));
+    if (!n)
+        return L.fail("out of memory for normals");
+    geometric_normals(L.s->pos, n, 0, L.old + L.cur);
+    L.s->nrm = n;
+    return true;
+}
+
+// The first texture coordinates of the scene: zero for every earlier triangle.
+bool add_uvs(Loader &L)
+{
+    float *t = (float *)std::calloc(6 * (L.cap ? L.cap : 1), sizeof(float));
+    if (!t)
+        return L.fail("out of memory for texture coordinates");
+    L.s->uv = t;
+    return true;
+}
+
+bool check_float_or_quantized(Loader &L, const View &v, const std::string &what, bool allow_normalized)
+{
+    if (v.ctype == TINYGLTF_COMPONENT_TYPE_FLOAT)
+        return true;
+    if (L.quantized && v.ctype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+        return true;
+    if (allow_normalized && v.normalized &&
+        (v.ctype == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || v.ctype == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT))
+        return true;
+    return L.fail(what + ": component type " + ctype_name(v.ctype) + (v.normalized ? " (normalized)" : "") +
+                  " is not allowed here" +
+                  (allow_normalized ? " (FLOAT or normalized UNSIGNED_BYTE/SHORT)" : " (FLOAT)"));
+}
+
+bool load_primitive(Loader &L, const Mat4 &full, int mesh, int pi)
 {
     const auto &m = L.m;
-    const auto &gm = m.meshes[mesh];
-    const auto &p = gm.primitives[pi];
+    const auto &gm = m.meshes[(size_t)mesh];
+    const auto &p = gm.primitives[(size_t)pi];
     std::string where = elem("mesh", mesh, gm.name) + " primitive " + std::to_string(pi);
     int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
     if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN)
-        return L.fail(where + ": mode " + std::to_string(mode) + " is not a triangle primitive (points and lines cannot be ray traced)");
+        return L.fail(where + ": mode " + std::to_string(mode) + " (" + mode_name(mode) +
+                      ") is not a triangle primitive; only TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN can be "
+                      "ray traced");
     auto pa = p.attributes.find("POSITION");
     if (pa == p.attributes.end())
         return L.fail(where + ": no POSITION attribute");
     View vp, vn, vt, vi;
-    if (!accessor_view(L, pa->second, where + " POSITION", 3, vp))
+    if (!accessor_view(L, pa->second, where + " POSITION", vp))
         return false;
-    if (vp.ctype != TINYGLTF_COMPONENT_TYPE_FLOAT)
-        return L.fail(where + " POSITION: accessor " + std::to_string(pa->second) + " is not float");
-    bool has_n = false, has_t = false;
+    if (vp.ncomp != 3)
+        return L.fail(where + " POSITION: accessor " + std::to_string(pa->second) + " is not VEC3");
+    if (!check_float_or_quantized(L, vp, where + " POSITION: accessor " + std::to_string(pa->second), false))
+        return false;
     auto na = p.attributes.find("NORMAL");
-    if (na != p.attributes.end()) {
-        if (!accessor_view(L, na->second, where + " NORMAL", 3, vn))
+    bool has_n = na != p.attributes.end();
+    if (has_n) {
+        if (!accessor_view(L, na->second, where + " NORMAL", vn))
             return false;
-        if (vn.count != vp.count)
-            return L.fail(where + " NORMAL: " + std::to_string(vn.count) + " normals for " + std::to_string(vp.count) + " vertices");
-        has_n = true;
+        if (vn.ncomp != 3 || vn.count != vp.count)
+            return L.fail(where + " NORMAL: accessor " + std::to_string(na->second) + " must be VEC3 with " +
+                          std::to_string(vp.count) + " elements (has " + std::to_string(vn.ncomp) + " components, " +
+                          std::to_string(vn.count) + " elements)");
+        if (!check_float_or_quantized(L, vn, where + " NORMAL: accessor " + std::to_string(na->second), false))
+            return false;
     }
     auto ta = p.attributes.find("TEXCOORD_0");
-    if (ta != p.attributes.end()) {
-        if (!accessor_view(L, ta->second, where + " TEXCOORD_0", 2, vt))
+    bool has_t = ta != p.attributes.end();
+    if (has_t) {
+        if (!accessor_view(L, ta->second, where + " TEXCOORD_0", vt))
             return false;
-        if (vt.count != vp.count)
-            return L.fail(where + " TEXCOORD_0: " + std::to_string(vt.count) + " coordinates for " + std::to_string(vp.count) + " vertices");
-        has_t = true;
+        if (vt.ncomp != 2 || vt.count != vp.count)
+            return L.fail(where + " TEXCOORD_0: accessor " + std::to_string(ta->second) + " must be VEC2 with " +
+                          std::to_string(vp.count) + " elements (has " + std::to_string(vt.ncomp) + " components, " +
+                          std::to_string(vt.count) + " elements)");
+        if (!check_float_or_quantized(L, vt, where + " TEXCOORD_0: accessor " + std::to_string(ta->second), true))
+            return false;
     }
+    // Indices: any unsigned integer type, each below the vertex count.
     std::vector<uint32_t> idx;
     if (p.indices >= 0) {
-        if (!accessor_view(L, p.indices, where + " indices", 1, vi))
+        if (!accessor_view(L, p.indices, where + " indices", vi))
             return false;
+        std::string an = where + " indices: accessor " + std::to_string(p.indices);
+        if (vi.ncomp != 1)
+            return L.fail(an + ": is not SCALAR");
         if (vi.ctype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && vi.ctype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
             vi.ctype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
-            return L.fail(where + " indices: accessor " + std::to_string(p.indices) + " is not an unsigned integer type");
+            return L.fail(an + ": component type " + ctype_name(vi.ctype) + " is not an unsigned integer type");
+        if (vi.normalized)
+            return L.fail(an + ": indices must not be normalized");
         idx.resize(vi.count);
         for (size_t i = 0; i < vi.count; i++) {
-            double v = vi.get(i, 0);
-            if (v >= (double)vp.count)
-                return L.fail(where + ": index " + std::to_string((unsigned long long)v) + " out of range (vertex count " +
+            uint32_t v = vi.index(i);
+            if (v >= vp.count)
+                return L.fail(where + ": index " + std::to_string(v) + " out of range (vertex count " +
                               std::to_string(vp.count) + ")");
-            idx[i] = (uint32_t)v;
+            idx[i] = v;
         }
     } else {
+        if (vp.count > 0xFFFFFFFFu)
+            return L.fail(where + ": more than 2^32 vertices");
         idx.resize(vp.count);
         for (size_t i = 0; i < vp.count; i++)
             idx[i] = (uint32_t)i;
     }
-    // Triangle list from the mode.
+    if (mode == TINYGLTF_MODE_TRIANGLES && idx.size() % 3 != 0)
+        return L.fail(where + ": " + std::to_string(idx.size()) + (p.indices >= 0 ? " indices" : " vertices") +
+                      " do not make whole triangles (not a multiple of 3)");
+    // The triangle list.
     std::vector<uint32_t> tri;
     if (mode == TINYGLTF_MODE_TRIANGLES) {
-        tri.assign(idx.begin(), idx.begin() + (idx.size() / 3) * 3);
-    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
-        for (size_t i = 2; i < idx.size(); i++) {
-            bool odd = (i % 2) == 1;
-            tri.push_back(idx[odd ? i - 1 : i - 2]);
-            tri.push_back(idx[odd ? i - 2 : i - 1]);
-            tri.push_back(idx[i]);
-        }
+        tri.swap(idx);
     } else {
         for (size_t i = 2; i < idx.size(); i++) {
-            tri.push_back(idx[0]);
-            tri.push_back(idx[i - 1]);
-            tri.push_back(idx[i]);
+            if (mode == TINYGLTF_MODE_TRIANGLE_FAN) {
+                tri.insert(tri.end(), {idx[0], idx[i - 1], idx[i]});
+            } else if (i % 2 == 0) {
+                tri.insert(tri.end(), {idx[i - 2], idx[i - 1], idx[i]});
+            } else {
+                tri.insert(tri.end(), {idx[i - 1], idx[i - 2], idx[i]}); // keeps the winding
+            }
         }
     }
-    int mat;
+    int mat, twin = -1;
+    const MatInfo *mi = nullptr;
     if (p.material >= 0) {
-        if (p.material >= (int)m.materials.size())
+        if ((size_t)p.material >= m.materials.size())
             return L.fail(where + ": material " + std::to_string(p.material) + " does not exist");
-        mat = (int)L.mat_base + p.material;
-    } else {
-        mat = default_material(L);
+        mi = &L.minfo[(size_t)p.material];
+        mat = mi->index;
+        twin = mi->emit_twin;
+    } else if ((mat = default_material(L)) < 0) {
+        return L.fail("out of memory");
     }
-    Mat4 full = mul(L.pre, world);
     double nm[9];
     bool nm_ok = normal_matrix(full, nm);
-    // Transform every vertex once.
-    std::vector<float> wp(3 * vp.count), wn(has_n ? 3 * vp.count : 0);
+    bool flip = det3(full) < 0.0; // a mirroring transform reverses the winding (glTF 2.0 Sec. 3.7.4)
+    // Every vertex once.
+    std::vector<float> wp(3 * vp.count), wn(has_n ? 3 * vp.count : 0), wt(has_t ? 2 * vp.count : 0);
     for (size_t v = 0; v < vp.count; v++) {
         double in[3] = {vp.get(v, 0), vp.get(v, 1), vp.get(v, 2)}, out[3];
         xform_point(full, in, out);
         for (int k = 0; k < 3; k++) {
-            if (!std::isfinite(in[k]) || !std::isfinite(out[k]) || std::fabs(out[k]) > 1e30)
-                return L.fail(where + ": vertex " + std::to_string(v) + " has a non-finite coordinate");
-            wp[3 * v + k] = (float)out[k];
+            if (!std::isfinite(in[k]))
+                return L.fail(where + " POSITION: vertex " + std::to_string(v) + " coordinate " + std::to_string(k) +
+                              " is not finite (" + std::to_string(in[k]) + ")");
+            if (!std::isfinite(out[k]) || std::fabs(out[k]) > 1e30)
+                return L.fail(where + " POSITION: vertex " + std::to_string(v) +
+                              " is not finite after the node transforms");
+            wp[3 * v + (size_t)k] = (float)out[k];
         }
         if (has_n) {
             double n[3] = {vn.get(v, 0), vn.get(v, 1), vn.get(v, 2)}, o[3] = {n[0], n[1], n[2]};
             if (nm_ok)
                 for (int r = 0; r < 3; r++)
                     o[r] = nm[r] * n[0] + nm[3 + r] * n[1] + nm[6 + r] * n[2];
-            double len = std::sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
+            if (!normalize(o)) // zero or non-finite normals fall back to the geometric normal
+                o[0] = o[1] = o[2] = 0.0;
             for (int k = 0; k < 3; k++)
-                wn[3 * v + k] = len > 0.0 && std::isfinite(len) ? (float)(o[k] / len) : 0.0f;
+                wn[3 * v + (size_t)k] = (float)o[k];
         }
+        if (has_t)
+            for (int k = 0; k < 2; k++) {
+                double t = vt.get(v, k);
+                if (!std::isfinite(t) || std::fabs(t) > 1e30)
+                    return L.fail(where + " TEXCOORD_0: vertex " + std::to_string(v) + " is not finite");
+                wt[2 * v + (size_t)k] = (float)t;
+            }
     }
-    for (size_t t = 0; t + 2 < tri.size(); t += 3) {
+    size_t nt = tri.size() / 3;
+    if (!reserve(L, nt) || (has_n && !L.s->nrm && !add_normals(L)) || (has_t && !L.s->uv && !add_uvs(L)))
+        return false;
+    float *P = L.s->pos + 9 * (L.old + L.cur), *N = L.s->nrm ? L.s->nrm + 9 * (L.old + L.cur) : nullptr;
+    float *T = L.s->uv ? L.s->uv + 6 * (L.old + L.cur) : nullptr;
+    uint32_t *M = L.s->tri_material + L.old + L.cur;
+    bool twin_uv = twin >= 0 && has_t && mi->emit_texcoord == 0;
+    for (size_t t = 0; t < nt; t++) {
+        uint32_t c3[3] = {tri[3 * t], tri[3 * t + 1], tri[3 * t + 2]};
+        if (flip)
+            std::swap(c3[1], c3[2]);
         float g[9];
         for (int c = 0; c < 3; c++)
             for (int k = 0; k < 3; k++) {
-                g[3 * c + k] = wp[3 * tri[t + c] + k];
-                L.pos.push_back(g[3 * c + k]);
+                g[3 * c + k] = wp[3 * (size_t)c3[c] + (size_t)k];
+                *P++ = g[3 * c + k];
             }
-        // Vertex normals; the geometric normal where the primitive has none (or a zero one).
         double e1[3], e2[3], gn[3];
         for (int k = 0; k < 3; k++) {
-            e1[k] = g[3 + k] - g[k];
-            e2[k] = g[6 + k] - g[k];
+            e1[k] = (double)g[3 + k] - g[k];
+            e2[k] = (double)g[6 + k] - g[k];
         }
         gn[0] = e1[1] * e2[2] - e1[2] * e2[1];
         gn[1] = e1[2] * e2[0] - e1[0] * e2[2];
         gn[2] = e1[0] * e2[1] - e1[1] * e2[0];
-        double gl = std::sqrt(gn[0] * gn[0] + gn[1] * gn[1] + gn[2] * gn[2]);
-        for (int c = 0; c < 3; c++) {
-            const float *vnrm = has_n ? &wn[3 * tri[t + c]] : nullptr;
-            bool usable = vnrm && (vnrm[0] != 0.0f || vnrm[1] != 0.0f || vnrm[2] != 0.0f);
-            for (int k = 0; k < 3; k++)
-                L.nrm.push_back(usable ? vnrm[k] : (gl > 0.0 ? (float)(gn[k] / gl) : 0.0f));
-            for (int k = 0; k < 2; k++)
-                L.uv.push_back(has_t ? (float)vt.get(tri[t + c], k) : 0.0f);
+        if (!normalize(gn)) { // a degenerate triangle: any unit vector keeps later stages NaN-free
+            gn[0] = gn[2] = 0.0;
+            gn[1] = 1.0;
         }
-        L.tmat.push_back((uint32_t)mat);
+        double tuv[6];
+        for (int c = 0; c < 3; c++) {
+            const float *vn3 = has_n ? &wn[3 * (size_t)c3[c]] : nullptr;
+            bool usable = vn3 && (vn3[0] != 0.0f || vn3[1] != 0.0f || vn3[2] != 0.0f);
+            if (N)
+                for (int k = 0; k < 3; k++)
+                    *N++ = usable ? vn3[k] : (float)gn[k];
+            for (int k = 0; k < 2; k++) {
+                float u = has_t ? wt[2 * (size_t)c3[c] + (size_t)k] : 0.0f;
+                if (T)
+                    *T++ = u;
+                tuv[2 * c + k] = u;
+            }
+        }
+        uint32_t tm = (uint32_t)mat;
+        if (twin >= 0 && (!twin_uv || uv_emits(*mi->map, tuv)))
+            tm = (uint32_t)twin;
+        *M++ = tm;
     }
-    L.any_normals |= has_n;
-    L.any_uvs |= has_t;
+    L.cur += nt;
     return true;
 }
 
-Mat4 local_matrix(const tinygltf::Node &n)
+bool local_matrix(Loader &L, int node, const tinygltf::Node &n, Mat4 &r)
 {
-    Mat4 r = identity();
-    if (n.matrix.size() == 16) {
-        for (int i = 0; i < 16; i++)
+    r = identity();
+    if (!n.matrix.empty()) {
+        if (n.matrix.size() != 16)
+            return L.fail(elem("node", node, n.name) + ": matrix has " + std::to_string(n.matrix.size()) +
+                          " numbers, not 16");
+        for (size_t i = 0; i < 16; i++)
             r.m[i] = n.matrix[i];
-        return r;
+    } else {
+        Mat4 t = identity(), q = identity(), s = identity();
+        if (!n.translation.empty() && n.translation.size() != 3)
+            return L.fail(elem("node", node, n.name) + ": translation does not have 3 numbers");
+        if (!n.rotation.empty() && n.rotation.size() != 4)
+            return L.fail(elem("node", node, n.name) + ": rotation does not have 4 numbers");
+        if (!n.scale.empty() && n.scale.size() != 3)
+            return L.fail(elem("node", node, n.name) + ": scale does not have 3 numbers");
+        if (n.translation.size() == 3)
+            for (size_t k = 0; k < 3; k++)
+                t.m[12 + k] = n.translation[k];
+        if (n.rotation.size() == 4) { // unit quaternion (x, y, z, w); normalized here to be forgiving
+            double x = n.rotation[0], y = n.rotation[1], z = n.rotation[2], w = n.rotation[3];
+            double l = std::sqrt(x * x + y * y + z * z + w * w);
+            if (!(l > 0.0) || !std::isfinite(l))
+                return L.fail(elem("node", node, n.name) + ": rotation is not a unit quaternion");
+            x /= l, y /= l, z /= l, w /= l;
+            q.m[0] = 1 - 2 * (y * y + z * z);
+            q.m[1] = 2 * (x * y + z * w);
+            q.m[2] = 2 * (x * z - y * w);
+            q.m[4] = 2 * (x * y - z * w);
+            q.m[5] = 1 - 2 * (x * x + z * z);
+            q.m[6] = 2 * (y * z + x * w);
+            q.m[8] = 2 * (x * z + y * w);
+            q.m[9] = 2 * (y * z - x * w);
+            q.m[10] = 1 - 2 * (x * x + y * y);
+        }
+        if (n.scale.size() == 3)
+            for (size_t k = 0; k < 3; k++)
+                s.m[5 * k] = n.scale[k];
+        r = mul(t, mul(q, s));
     }
-    Mat4 t = identity(), q = identity(), s = identity();
-    if (n.translation.size() == 3)
-        for (int k = 0; k < 3; k++)
-            t.m[12 + k] = n.translation[k];
-    if (n.rotation.size() == 4) {
-        double x = n.rotation[0], y = n.rotation[1], z = n.rotation[2], w = n.rotation[3];
-        q.m[0] = 1 - 2 * (y * y + z * z);
-        q.m[1] = 2 * (x * y + z * w);
-        q.m[2] = 2 * (x * z - y * w);
-        q.m[4] = 2 * (x * y - z * w);
-        q.m[5] = 1 - 2 * (x * x + z * z);
-        q.m[6] = 2 * (y * z + x * w);
-        q.m[8] = 2 * (x * z + y * w);
-        q.m[9] = 2 * (y * z - x * w);
-        q.m[10] = 1 - 2 * (x * x + y * y);
-    }
-    if (n.scale.size() == 3)
-        for (int k = 0; k < 3; k++)
-            s.m[5 * k] = n.scale[k];
-    return mul(t, mul(q, s));
+    for (double v : r.m)
+        if (!std::isfinite(v))
+            return L.fail(elem("node", node, n.name) + ": transform is not finite");
+    return true;
 }
 
-bool visit(Loader &L, int node, const Mat4 &parent, std::vector<int> &path)
+bool load_camera(Loader &L, int node, const tinygltf::Node &n, const Mat4 &full)
 {
     const auto &m = L.m;
-    if (node < 0 || node >= (int)m.nodes.size())
-        return L.fail("node " + std::to_string(node) + " does not exist");
-    for (int p : path)
-        if (p == node)
-            return L.fail(elem("node", node, m.nodes[node].name) + ": is its own ancestor (a cycle)");
-    if (path.size() > 256)
-        return L.fail(elem("node", node, m.nodes[node].name) + ": hierarchy deeper than 256 levels");
-    const auto &n = m.nodes[node];
-    Mat4 world = mul(parent, local_matrix(n));
-    Mat4 full = mul(L.pre, world);
-    if (n.mesh >= 0) {
-        if (n.mesh >= (int)m.meshes.size())
-            return L.fail(elem("node", node, n.name) + ": mesh " + std::to_string(n.mesh) + " does not exist");
-        for (size_t pi = 0; pi < m.meshes[n.mesh].primitives.size(); pi++)
-            if (!load_primitive(L, world, n.mesh, (int)pi))
-                return false;
+    if ((size_t)n.camera >= m.cameras.size())
+        return L.fail(elem("node", node, n.name) + ": camera " + std::to_string(n.camera) + " does not exist");
+    const auto &cam = m.cameras[(size_t)n.camera];
+    if (cam.type != "perspective")
+        return true; // orthographic cameras are skipped: the path tracer's camera is a (thin) lens
+    double yfov = cam.perspective.yfov * 180.0 / M_PI;
+    if (!(yfov > 0.0 && yfov < 180.0))
+        return L.fail(elem("camera", n.camera, cam.name) + ": yfov " + std::to_string(cam.perspective.yfov) +
+                      " is not between 0 and pi");
+    // A glTF camera looks down its local -z with +y up.
+    double o[3] = {0, 0, 0}, f[3] = {0, 0, -1}, u[3] = {0, 1, 0}, po[3], fd[3], ud[3];
+    xform_point(full, o, po);
+    xform_dir(full, f, fd);
+    xform_dir(full, u, ud);
+    if (!normalize(fd) || !normalize(ud))
+        return L.fail(elem("node", node, n.name) + ": camera transform is singular");
+    for (int k = 0; k < 3; k++) {
+        L.camera.position[k] = (float)po[k];
+        L.camera.look_at[k] = (float)(po[k] + fd[k]);
+        L.camera.up[k] = (float)ud[k];
     }
-    if (n.camera >= 0 && !L.camera_set) {
-        if (n.camera >= (int)m.cameras.size())
-            return L.fail(elem("node", node, n.name) + ": camera " + std::to_string(n.camera) + " does not exist");
-        const auto &cam = m.cameras[n.camera];
-        if (cam.type == "perspective") {
-            double o[3] = {0, 0, 0}, f[3] = {0, 0, -1}, u[3] = {0, 1, 0}, po[3], fd[3], ud[3];
-            xform_point(full, o, po);
-            xform_dir(full, f, fd);
-            xform_dir(full, u, ud);
-            for (int k = 0; k < 3; k++) {
-                L.camera.position[k] = (float)po[k];
-                L.camera.look_at[k] = (float)(po[k] + fd[k]);
-                L.camera.up[k] = (float)ud[k];
-            }
-            L.camera.fov_y = (float)(cam.perspective.yfov * 180.0 / M_PI);
-            L.camera.source = SCENE_CAMERA_GLTF;
-            L.camera_set = true;
-        }
-    }
-    auto le = n.extensions.find("KHR_lights_punctual");
-    if (le != n.extensions.end() && le->second.IsObject() && le->second.Has("light")) {
-        const auto &lv = le->second.Get("light");
-        int li = lv.IsInt() ? lv.Get<int>() : -1;
-        if (li < 0 || li >= (int)m.lights.size())
-            return L.fail(elem("node", node, n.name) + ": KHR_lights_punctual light " + std::to_string(li) + " does not exist");
-        const auto &gl = m.lights[li];
-        SceneLight sl{};
-        sl.name = strdup(gl.name.c_str());
-        double o[3] = {0, 0, 0}, f[3] = {0, 0, -1}, po[3], fd[3];
-        xform_point(full, o, po);
-        xform_dir(full, f, fd);
-        double fl = std::sqrt(fd[0] * fd[0] + fd[1] * fd[1] + fd[2] * fd[2]);
-        for (int k = 0; k < 3; k++) {
-            sl.position[k] = (float)po[k];
-            sl.direction[k] = fl > 0 ? (float)(fd[k] / fl) : 0.0f;
-            sl.color[k] = gl.color.size() == 3 ? (float)gl.color[k] : 1.0f;
-        }
-        sl.intensity = (float)gl.intensity;
-        if (gl.type == "point") {
-            sl.kind = SCENE_LIGHT_POINT;
-        } else if (gl.type == "spot") {
-            sl.kind = SCENE_LIGHT_SPOT;
-            sl.inner_cone = (float)gl.spot.innerConeAngle;
-            sl.outer_cone = (float)gl.spot.outerConeAngle;
-        } else if (gl.type == "directional") {
-            sl.kind = SCENE_LIGHT_DIRECTIONAL;
-        } else {
-            std::free(sl.name);
-            return L.fail("light " + std::to_string(li) + ": unknown type '" + gl.type + "'");
-        }
-        L.lights.push_back(sl);
-    }
-    path.push_back(node);
-    for (int c : n.children)
-        if (!visit(L, c, world, path))
-            return false;
-    path.pop_back();
+    L.camera.fov_y = (float)yfov;
+    L.camera.aperture = 0.0f;
+    L.camera.focus_distance = 0.0f;
+    L.camera.source = SCENE_CAMERA_GLTF;
+    L.camera_set = true;
     return true;
 }
 
-const std::set<std::string> supported_required = {"KHR_materials_emissive_strength", "KHR_materials_transmission",
-                                                  "KHR_materials_ior", "KHR_lights_punctual",
-                                                  "KHR_texture_transform", "KHR_materials_volume"};
+bool load_light(Loader &L, int node, const tinygltf::Node &n, const Mat4 &full)
+{
+    const auto &m = L.m;
+    auto le = n.extensions.find("KHR_lights_punctual");
+    if (le == n.extensions.end())
+        return true;
+    std::string where = elem("node", node, n.name) + ": KHR_lights_punctual";
+    if (!le->second.IsObject() || !le->second.Has("light") || !le->second.Get("light").IsInt())
+        return L.fail(where + ": no light index");
+    int li = le->second.Get("light").GetNumberAsInt();
+    if (li < 0 || (size_t)li >= m.lights.size())
+        return L.fail(where + ": light " + std::to_string(li) + " does not exist");
+    const auto &gl = m.lights[(size_t)li];
+    std::string lw = elem("light", li, gl.name);
+    SceneLight sl{};
+    if (gl.type == "point")
+        sl.kind = SCENE_LIGHT_POINT;
+    else if (gl.type == "spot")
+        sl.kind = SCENE_LIGHT_SPOT;
+    else if (gl.type == "directional")
+        sl.kind = SCENE_LIGHT_DIRECTIONAL;
+    else
+        return L.fail(lw + ": unknown type '" + gl.type + "'");
+    // A punctual light sits at its node's origin and shines down its local -z.
+    double o[3] = {0, 0, 0}, f[3] = {0, 0, -1}, po[3], fd[3];
+    xform_point(full, o, po);
+    xform_dir(full, f, fd);
+    if (sl.kind != SCENE_LIGHT_POINT && !normalize(fd))
+        return L.fail(where + ": the node's transform gives the light no direction");
+    if (sl.kind == SCENE_LIGHT_POINT && !normalize(fd))
+        fd[0] = fd[2] = 0.0, fd[1] = -1.0;
+    if (!gl.color.empty() && gl.color.size() != 3)
+        return L.fail(lw + ": color does not have 3 numbers");
+    for (int k = 0; k < 3; k++) {
+        sl.position[k] = (float)po[k];
+        sl.direction[k] = (float)fd[k];
+        sl.color[k] = gl.color.size() == 3 ? (float)gl.color[(size_t)k] : 1.0f;
+        if (!std::isfinite(sl.color[k]) || sl.color[k] < 0.0f)
+            return L.fail(lw + ": color is negative or not finite");
+    }
+    sl.intensity = (float)gl.intensity;
+    if (!std::isfinite(sl.intensity) || sl.intensity < 0.0f)
+        return L.fail(lw + ": intensity is negative or not finite");
+    if (sl.kind == SCENE_LIGHT_SPOT) {
+        sl.inner_cone = (float)gl.spot.innerConeAngle;
+        sl.outer_cone = (float)gl.spot.outerConeAngle;
+        if (!(sl.inner_cone >= 0.0f && sl.inner_cone < sl.outer_cone && sl.outer_cone <= (float)(M_PI / 2) + 1e-6f))
+            return L.fail(lw + ": spot cone angles must satisfy 0 <= inner < outer <= pi/2");
+    }
+    sl.name = strdup(gl.name.empty() ? ("light_" + std::to_string(li)).c_str() : gl.name.c_str());
+    if (!sl.name)
+        return L.fail("out of memory");
+    L.lights.push_back(sl);
+    return true;
+}
 
-template <class T> T *append(T *arr, uint32_t n, const std::vector<T> &more)
+bool visit(Loader &L, int node, const Mat4 &parent, int depth)
+{
+    const auto &m = L.m;
+    const auto &n = m.nodes[(size_t)node];
+    // The parent checks in load() make the hierarchy a forest, so this runs once per node; the
+    // depth bound only protects the stack.
+    if (depth > 1000)
+        return L.fail(elem("node", node, n.name) + ": hierarchy deeper than 1000 levels");
+    Mat4 local;
+    if (!local_matrix(L, node, n, local))
+        return false;
+    Mat4 world = mul(parent, local), full = mul(L.pre, world);
+    if (n.mesh >= 0) {
+        if ((size_t)n.mesh >= m.meshes.size())
+            return L.fail(elem("node", node, n.name) + ": mesh " + std::to_string(n.mesh) + " does not exist");
+        for (size_t pi = 0; pi < m.meshes[(size_t)n.mesh].primitives.size(); pi++)
+            if (!load_primitive(L, full, n.mesh, (int)pi))
+                return false;
+    }
+    if (n.camera >= 0 && !L.camera_set && !load_camera(L, node, n, full))
+        return false;
+    if (!load_light(L, node, n, full))
+        return false;
+    for (int c : n.children)
+        if (!visit(L, c, world, depth + 1))
+            return false;
+    return true;
+}
+
+// Required extensions this loader honours. Everything else that a file requires is an error;
+// extensions that are only used are ignored (docs/scenes.md lists them).
+const char *const supported_required[] = {"KHR_materials_emissive_strength", "KHR_materials_transmission",
+                                          "KHR_materials_ior", "KHR_lights_punctual", "KHR_mesh_quantization"};
+
+template <class T> bool append(T *&arr, uint32_t n, const std::vector<T> &more)
 {
     if (more.empty())
-        return arr;
-    T *r = (T *)std::realloc(arr, sizeof(T) * (n + more.size()));
+        return true;
+    T *r = (T *)std::realloc(arr, sizeof(T) * ((size_t)n + more.size()));
     if (!r)
-        return nullptr;
+        return false;
+    arr = r;
     std::memcpy(r + n, more.data(), sizeof(T) * more.size());
-    return r;
+    return true;
 }
 
-int finish(Loader &L, char *err, size_t errlen)
+// Makes the file's triangles count and moves its materials, textures and lights into the Scene.
+bool commit(Loader &L)
 {
-    auto cleanup = [&]() {
-        for (auto &mm : L.mats)
-            std::free(mm.name);
-        for (auto &t : L.texs) {
-            std::free(t.name);
-            std::free(t.rgba);
-        }
-        for (auto &l : L.lights)
-            std::free(l.name);
-    };
-    if (!L.err.empty()) {
-        std::snprintf(err, errlen, "%s", L.err.c_str());
-        cleanup();
-        return -1;
-    }
     Scene *s = L.s;
-    uint32_t nt = (uint32_t)L.tmat.size();
-    if ((uint64_t)s->ntris + nt > 0x3FFFFFFFu) {
-        std::snprintf(err, errlen, "%s: too many triangles (%u + %u)", L.file.c_str(), s->ntris, nt);
-        cleanup();
-        return -1;
-    }
-    // Normals/UVs: arrays exist for the whole scene once any source has them.
-    bool want_n = s->nrm || L.any_normals, want_t = s->uv || L.any_uvs;
-    float *pos = (float *)std::realloc(s->pos, sizeof(float) * 9 * ((size_t)s->ntris + nt + 1));
-    float *nrm = want_n ? (float *)std::realloc(s->nrm, sizeof(float) * 9 * ((size_t)s->ntris + nt + 1)) : nullptr;
-    float *uv = want_t ? (float *)std::realloc(s->uv, sizeof(float) * 6 * ((size_t)s->ntris + nt + 1)) : nullptr;
-    uint32_t *tm = (uint32_t *)std::realloc(s->tri_material, sizeof(uint32_t) * ((size_t)s->ntris + nt + 1));
-    if (pos) s->pos = pos;
-    if (nrm) {
-        if (!s->nrm) // earlier triangles had no normals: give them zero (= use the geometric normal)
-            std::memset(nrm, 0, sizeof(float) * 9 * (size_t)s->ntris);
-        s->nrm = nrm;
-    }
-    if (uv) {
-        if (!s->uv)
-            std::memset(uv, 0, sizeof(float) * 6 * (size_t)s->ntris);
-        s->uv = uv;
-    }
-    if (tm) s->tri_material = tm;
-    SceneMaterial *mats = append(s->materials, s->nmaterials, L.mats);
-    SceneTexture *texs = append(s->textures, s->ntextures, L.texs);
-    SceneLight *lights = append(s->lights, s->nlights, L.lights);
-    if (!pos || (want_n && !nrm) || (want_t && !uv) || !tm || (!L.mats.empty() && !mats) ||
-        (!L.texs.empty() && !texs) || (!L.lights.empty() && !lights)) {
-        std::snprintf(err, errlen, "%s: out of memory", L.file.c_str());
-        if (mats) s->materials = mats;
-        if (texs) s->textures = texs;
-        if (lights) s->lights = lights;
-        cleanup();
-        return -1;
-    }
-    std::memcpy(s->pos + 9 * (size_t)s->ntris, L.pos.data(), sizeof(float) * L.pos.size());
-    if (want_n)
-        std::memcpy(s->nrm + 9 * (size_t)s->ntris, L.nrm.data(), sizeof(float) * L.nrm.size());
-    if (want_t)
-        std::memcpy(s->uv + 6 * (size_t)s->ntris, L.uv.data(), sizeof(float) * L.uv.size());
-    std::memcpy(s->tri_material + s->ntris, L.tmat.data(), sizeof(uint32_t) * L.tmat.size());
-    s->ntris += nt;
-    s->materials = mats ? mats : s->materials;
+    if (!append(s->materials, s->nmaterials, L.mats) || !append(s->textures, s->ntextures, L.texs) ||
+        !append(s->lights, s->nlights, L.lights))
+        return L.fail("out of memory");
+    s->ntris = (uint32_t)(L.old + L.cur);
     s->nmaterials += (uint32_t)L.mats.size();
-    s->textures = texs ? texs : s->textures;
     s->ntextures += (uint32_t)L.texs.size();
-    s->lights = lights ? lights : s->lights;
     s->nlights += (uint32_t)L.lights.size();
+    L.mats.clear(); // owned by the Scene now
+    L.texs.clear();
+    L.lights.clear();
     if (L.camera_set && s->camera.source == SCENE_CAMERA_DEFAULT)
         s->camera = L.camera;
-    return 0;
+    return true;
 }
 
-int load(tinygltf::TinyGLTF &loader, bool ok, const std::string &gerr, const std::string &warn,
-         const tinygltf::Model &model, const char *name, const double *xf, Scene *s, char *err, size_t errlen)
+// Triangles the primitives under `roots` will produce, so the arrays grow once. Malformed
+// accessors count nothing here; the real pass reports them.
+size_t count_triangles(const Loader &L, const std::vector<int> &roots)
 {
-    (void)loader;
-    (void)warn;
+    const auto &m = L.m;
+    size_t total = 0;
+    std::vector<int> stack(roots.rbegin(), roots.rend());
+    while (!stack.empty()) {
+        const auto &n = m.nodes[(size_t)stack.back()];
+        stack.pop_back();
+        for (int c : n.children)
+            stack.push_back(c);
+        if (n.mesh < 0 || (size_t)n.mesh >= m.meshes.size())
+            continue;
+        for (const auto &p : m.meshes[(size_t)n.mesh].primitives) {
+            int acc = p.indices;
+            if (acc < 0) {
+                auto pa = p.attributes.find("POSITION");
+                acc = pa == p.attributes.end() ? -1 : pa->second;
+            }
+            if (acc < 0 || (size_t)acc >= m.accessors.size())
+                continue;
+            const auto &a = m.accessors[(size_t)acc];
+            size_t cnt = a.count, tris;
+            if (p.mode == TINYGLTF_MODE_TRIANGLES || p.mode < 0)
+                tris = cnt / 3;
+            else // strips and fans; other modes fail later
+                tris = cnt >= 2 ? cnt - 2 : 0;
+            // An accessor cannot hold more elements than its buffer has bytes.
+            if (a.bufferView < 0 || (size_t)a.bufferView >= m.bufferViews.size())
+                continue;
+            const auto &bv = m.bufferViews[(size_t)a.bufferView];
+            if (bv.buffer < 0 || (size_t)bv.buffer >= m.buffers.size() ||
+                cnt > m.buffers[(size_t)bv.buffer].data.size())
+                continue;
+            total += tris;
+            if (total > 0x3FFFFFFFu)
+                return total;
+        }
+    }
+    return total;
+}
+
+int load(bool ok, const std::string &gerr, const std::string &warn, const tinygltf::Model &model, const Stash &stash,
+         const char *name, const double *xf, Scene *s, char *err, size_t errlen)
+{
     if (!ok) {
-        std::string e = gerr.empty() ? "not a readable glTF file" : gerr;
-        while (!e.empty() && (e.back() == '\n' || e.back() == '\r'))
-            e.pop_back();
+        std::string e = one_line(gerr.empty() ? "not a readable glTF file" : gerr);
+        if (!warn.empty())
+            e += " (tinygltf warnings: " + one_line(warn) + ")";
         std::snprintf(err, errlen, "%s: %s", name, e.c_str());
         return -1;
     }
-    for (const auto &ext : model.extensionsRequired)
-        if (!supported_required.count(ext)) {
+    for (const auto &ext : model.extensionsRequired) {
+        bool known = false;
+        for (const char *k : supported_required)
+            known |= ext == k;
+        if (!known) {
             std::snprintf(err, errlen, "%s: required extension %s is not supported", name, ext.c_str());
             return -1;
         }
+    }
     Loader L(model, name, s);
     if (xf)
         std::memcpy(L.pre.m, xf, sizeof L.pre.m);
-    else
-        L.pre = identity();
+    L.stash = &stash;
+    for (const auto &ext : model.extensionsUsed)
+        L.quantized |= ext == "KHR_mesh_quantization";
     L.mat_base = s->nmaterials;
     L.tex_base = s->ntextures;
     L.image_to_tex.assign(model.images.size(), -1);
-    if (load_materials(L)) {
-        std::vector<int> path;
-        if (!model.scenes.empty()) {
-            int sc = model.defaultScene >= 0 && model.defaultScene < (int)model.scenes.size() ? model.defaultScene : 0;
-            for (int n : model.scenes[sc].nodes)
-                if (!visit(L, n, identity(), path))
-                    break;
-        } else {
-            // No scenes: every node that is nobody's child is a root.
-            std::vector<bool> child(model.nodes.size(), false);
-            for (const auto &n : model.nodes)
-                for (int c : n.children)
-                    if (c >= 0 && c < (int)child.size())
-                        child[c] = true;
-            for (size_t n = 0; n < model.nodes.size(); n++)
-                if (!child[n] && !visit(L, (int)n, identity(), path))
-                    break;
+    L.maps.reserve(model.images.size()); // EmitMap pointers in MatInfo stay valid
+
+    // The hierarchy must be a forest (glTF 2.0 Sec. 3.5.3): one parent per node, roots have none.
+    // Checking it first bounds the walk to one visit per node whatever the file says.
+    std::vector<int> parent(model.nodes.size(), -1);
+    bool good = true;
+    for (size_t i = 0; good && i < model.nodes.size(); i++)
+        for (int c : model.nodes[i].children) {
+            if (c < 0 || (size_t)c >= model.nodes.size()) {
+                good = L.fail(elem("node", (int)i, model.nodes[i].name) + ": child " + std::to_string(c) +
+                              " does not exist");
+                break;
+            }
+            if (parent[(size_t)c] >= 0 || (size_t)c == i) {
+                good = L.fail(elem("node", c, model.nodes[(size_t)c].name) +
+                              ": has more than one parent or is its own child (the node hierarchy must be a tree)");
+                break;
+            }
+            parent[(size_t)c] = (int)i;
         }
+    // A node inside a cycle has its parent inside the cycle, so no walk from a root (a node
+    // without a parent) reaches it: cycles are unreachable, not infinite.
+    std::vector<int> roots;
+    if (good && !model.scenes.empty()) {
+        int sc = model.defaultScene >= 0 ? model.defaultScene : 0;
+        if ((size_t)sc >= model.scenes.size())
+            good = L.fail("default scene " + std::to_string(sc) + " does not exist");
+        else {
+            std::vector<bool> seen(model.nodes.size(), false);
+            for (int n : model.scenes[(size_t)sc].nodes) {
+                if (n < 0 || (size_t)n >= model.nodes.size()) {
+                    good = L.fail(elem("scene", sc, model.scenes[(size_t)sc].name) + ": node " + std::to_string(n) +
+                                  " does not exist");
+                    break;
+                }
+                if (parent[(size_t)n] >= 0 || seen[(size_t)n]) {
+                    good = L.fail(elem("scene", sc, model.scenes[(size_t)sc].name) + ": " +
+                                  elem("node", n, model.nodes[(size_t)n].name) +
+                                  " is not a root node or is listed twice");
+                    break;
+                }
+                seen[(size_t)n] = true;
+                roots.push_back(n);
+            }
+        }
+    } else if (good) {
+        // No scenes: every node without a parent is a root.
+        for (size_t n = 0; n < model.nodes.size(); n++)
+            if (parent[n] < 0)
+                roots.push_back((int)n);
     }
-    return finish(L, err, errlen);
+    L.old = s->ntris;
+    if (good && load_materials(L) && reserve(L, count_triangles(L, roots)))
+        for (int n : roots)
+            if (!visit(L, n, identity(), 0))
+                break;
+    if (L.err.empty())
+        commit(L);
+    if (!L.err.empty()) {
+        std::snprintf(err, errlen, "%s", L.err.c_str());
+        return -1;
+    }
+    return 0;
 }
 
-bool has_suffix(const std::string &s, const char *suf)
+// tinygltf 2.7 turns "extras" and "extensions" into its Value type recursively, one C++ frame per
+// level of JSON nesting: a few tens of thousands of '[' overflow the stack. glTF itself nests a
+// dozen levels deep, so deeper documents are refused before tinygltf sees them.
+const int MAX_JSON_DEPTH = 512;
+
+bool json_too_deep(const unsigned char *p, size_t n)
 {
-    size_t n = std::strlen(suf);
-    if (s.size() < n)
-        return false;
-    for (size_t i = 0; i < n; i++)
-        if (std::tolower((unsigned char)s[s.size() - n + i]) != suf[i])
-            return false;
-    return true;
+    int depth = 0;
+    bool in_string = false;
+    for (size_t i = 0; i < n; i++) {
+        unsigned char c = p[i];
+        if (in_string) {
+            if (c == '\\')
+                i++;
+            else if (c == '"')
+                in_string = false;
+        } else if (c == '"') {
+            in_string = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > MAX_JSON_DEPTH)
+                return true;
+        } else if (c == ']' || c == '}') {
+            depth--;
+        }
+    }
+    return false;
+}
+
+// Loads a glTF held in memory: binary when it starts with the GLB magic. base_dir is where
+// external files are looked for; fs says whether they may be read at all.
+int load_memory(const unsigned char *data, size_t len, const char *name, const std::string &base_dir,
+                const tinygltf::FsCallbacks &fs, const double *xf, Scene *s, char *err, size_t errlen)
+{
+    if (len > 0xFFFFFFFFu) {
+        std::snprintf(err, errlen, "%s: larger than 4 GiB", name);
+        return -1;
+    }
+    bool binary = len >= 4 && std::memcmp(data, "glTF", 4) == 0;
+    const unsigned char *json = data;
+    size_t json_len = len;
+    if (binary && len >= 20) { // the JSON chunk; tinygltf checks the header itself
+        uint32_t chunk;
+        std::memcpy(&chunk, data + 12, 4);
+        json = data + 20;
+        json_len = std::min((size_t)chunk, len - 20);
+    }
+    if (json_too_deep(json, json_len)) {
+        std::snprintf(err, errlen, "%s: JSON nested deeper than %d levels", name, MAX_JSON_DEPTH);
+        return -1;
+    }
+    tinygltf::Model model;
+    tinygltf::TinyGLTF loader;
+    Stash stash;
+    loader.SetImageLoader(keep_encoded, &stash);
+    loader.SetFsCallbacks(fs);
+    std::string gerr, warn;
+    unsigned int n = (unsigned int)len;
+    bool ok = binary ? loader.LoadBinaryFromMemory(&model, &gerr, &warn, data, n, base_dir)
+                     : loader.LoadASCIIFromString(&model, &gerr, &warn, (const char *)data, n, base_dir);
+    return load(ok, gerr, warn, model, stash, name, xf, s, err, errlen);
 }
 
 } // namespace
@@ -759,34 +1434,40 @@ bool has_suffix(const std::string &s, const char *suf)
 extern "C" int gltf_append(const char *path, const double *xf, Scene *s, char *err, size_t errlen)
 {
     try {
-        tinygltf::Model model;
-        tinygltf::TinyGLTF loader;
-        std::string gerr, warn;
-        FILE *f = std::fopen(path, "rb");
-        if (!f) {
+        // The file is read here, not by tinygltf: it sizes files by seeking to their end, which
+        // on a directory or a device gives nonsense (a directory "holds" 2^63 bytes), and the
+        // JSON is checked before tinygltf parses it (json_too_deep).
+        struct stat st;
+        if (stat(path, &st) != 0) {
             std::snprintf(err, errlen, "%s: cannot open: %s", path, std::strerror(errno));
             return -1;
         }
-        std::fclose(f);
-        bool ok = has_suffix(path, ".glb") ? loader.LoadBinaryFromFile(&model, &gerr, &warn, path)
-                                           : loader.LoadASCIIFromFile(&model, &gerr, &warn, path);
-        return load(loader, ok, gerr, warn, model, path, xf, s, err, errlen);
+        if (!S_ISREG(st.st_mode)) {
+            std::snprintf(err, errlen, "%s: not a regular file", path);
+            return -1;
+        }
+        std::vector<unsigned char> data;
+        std::string rerr;
+        if (!read_regular_file(&data, &rerr, path, nullptr)) {
+            std::snprintf(err, errlen, "%s: %s", path, one_line(rerr).c_str());
+            return -1;
+        }
+        const char *slash = std::strrchr(path, '/');
+        std::string base_dir = slash ? std::string(path, (size_t)(slash - path) + 1) : std::string();
+        tinygltf::FsCallbacks fs = {regular_file_exists, same_path, read_regular_file, no_write, nullptr};
+        return load_memory(data.data(), data.size(), path, base_dir, fs, xf, s, err, errlen);
     } catch (const std::exception &e) {
         std::snprintf(err, errlen, "%s: %s", path, e.what());
         return -1;
     }
 }
 
-extern "C" int gltf_append_memory(const unsigned char *data, size_t len, int binary, const char *name,
-                                  const double *xf, Scene *s, char *err, size_t errlen)
+extern "C" int gltf_append_memory(const unsigned char *data, size_t len, const char *name, const double *xf,
+                                  Scene *s, char *err, size_t errlen)
 {
     try {
-        tinygltf::Model model;
-        tinygltf::TinyGLTF loader;
-        std::string gerr, warn;
-        bool ok = binary ? loader.LoadBinaryFromMemory(&model, &gerr, &warn, data, (unsigned int)len, "")
-                         : loader.LoadASCIIFromString(&model, &gerr, &warn, (const char *)data, (unsigned int)len, "");
-        return load(loader, ok, gerr, warn, model, name, xf, s, err, errlen);
+        tinygltf::FsCallbacks fs = {no_file_exists, same_path, no_read, no_write, nullptr};
+        return load_memory(data, len, name, std::string(), fs, xf, s, err, errlen);
     } catch (const std::exception &e) {
         std::snprintf(err, errlen, "%s: %s", name, e.what());
         return -1;

@@ -43,7 +43,7 @@ int scene_finish(Scene *s, char *err, size_t errlen)
         s->bounds_min[k] = INFINITY;
         s->bounds_max[k] = -INFINITY;
     }
-    for (uint32_t i = 0; i < 9 * s->ntris; i++) {
+    for (size_t i = 0; i < 9 * (size_t)s->ntris; i++) {
         int k = (int)(i % 3);
         s->bounds_min[k] = fminf(s->bounds_min[k], s->pos[i]);
         s->bounds_max[k] = fmaxf(s->bounds_max[k], s->pos[i]);
@@ -85,25 +85,30 @@ int scene_finish(Scene *s, char *err, size_t errlen)
     }
 
     if (s->camera.source == SCENE_CAMERA_DEFAULT) {
-        /* Frame the bounding sphere from +z with a 45 degree vertical field of view. */
-        float c[3], r = 0.0f;
+        /* Look at the centre of the bounds from +z, 45 degrees vertically, from the distance at
+         * which the bounding sphere fits the narrower of the two fields of view, plus 5%. */
+        double c[3], r = 0.0;
         for (int k = 0; k < 3; k++) {
-            c[k] = 0.5f * (s->bounds_min[k] + s->bounds_max[k]);
-            float h = 0.5f * (s->bounds_max[k] - s->bounds_min[k]);
+            c[k] = 0.5 * ((double)s->bounds_min[k] + s->bounds_max[k]);
+            double h = 0.5 * ((double)s->bounds_max[k] - s->bounds_min[k]);
             r += h * h;
         }
-        r = sqrtf(r);
-        if (!(r > 0.0f))
-            r = 1.0f;
-        float d = 1.1f * r / sinf(0.5f * 45.0f * (float)M_PI / 180.0f);
+        r = sqrt(r);
+        if (!(r > 0.0))
+            r = 1.0;
+        double half_y = 0.5 * 45.0 * M_PI / 180.0, aspect = (double)s->render.width / (double)s->render.height;
+        double half = aspect < 1.0 ? atan(tan(half_y) * aspect) : half_y;
+        float d = (float)(1.05 * r / sin(half));
         for (int k = 0; k < 3; k++) {
-            s->camera.look_at[k] = c[k];
-            s->camera.position[k] = c[k];
+            s->camera.look_at[k] = (float)c[k];
+            s->camera.position[k] = (float)c[k];
             s->camera.up[k] = 0.0f;
         }
         s->camera.position[2] += d;
         s->camera.up[1] = 1.0f;
         s->camera.fov_y = 45.0f;
+        s->camera.aperture = 0.0f;
+        s->camera.focus_distance = 0.0f;
     }
 
     uint32_t needs = 0;

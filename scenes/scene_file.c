@@ -1,11 +1,18 @@
-/* scenes/scene_file.c -- scene.ini: a glTF reference (or several, placed with transforms) plus
- * what glTF lacks: camera, render settings, lights, spheres, material overrides.
+/* scenes/scene_file.c -- scene.ini: glTF files (placed with transforms) plus what glTF lacks:
+ * camera, render settings, lights, spheres, material overrides (docs/scenes.md).
  *
- * Owns: reading and checking scene.ini. Every problem is reported with file, line and key, all
- * of them in one run. Must not: finish the scene or read glTF itself (gltf_shim.cpp).
+ * Owns: reading and checking scene.ini. Every problem is reported as "FILE:LINE: key
+ * 'section.key': message" (or "section [name]: message"), all of them in one run. Must not:
+ * finish the scene (scene_finish) or read glTF itself (gltf_shim.cpp).
+ *
+ * inih does the splitting into sections, keys and values; a reader callback sees every line
+ * first, to know line numbers and section headers, to report every syntax error (inih reports
+ * only the first), and to strip indentation, which inih would otherwise take for a continuation
+ * of the previous value.
  */
 #include "scene_file.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <ini.h>
 #include <math.h>
@@ -13,6 +20,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "gltf.h"
 
@@ -21,36 +29,177 @@ typedef struct Entry {
     int line;
 } Entry;
 
+typedef struct Section {
+    char *name;
+    int line;
+} Section;
+
+typedef struct Diag {
+    int line;   /* the messages come out in line order, */
+    size_t seq; /* and in the order found within a line */
+    char *text;
+} Diag;
+
 typedef struct Parse {
     FILE *f;
     const char *path;
     int line;
     Entry *e;
     size_t n, cap;
-    /* diagnostics */
-    char *err;
-    size_t errlen, used;
-    int nerr, dropped;
+    Section *sec;
+    size_t nsec, capsec;
+    int oom;
+    Diag *d;
+    size_t nd, capd;
+    int nerr;
 } Parse;
 
-static void diag(Parse *p, const char *fmt, ...)
+static void diag(Parse *p, int line, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+static void diag(Parse *p, int line, const char *fmt, ...)
 {
-    char line[1024];
+    char *msg = NULL, *text = NULL;
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(line, sizeof line, fmt, ap);
+    int n = vasprintf(&msg, fmt, ap);
     va_end(ap);
     p->nerr++;
-    size_t need = strlen(line) + (p->used ? 1 : 0);
-    /* Keep room for the closing "... and N more" line so nothing is dropped silently. */
-    if (p->used + need + 48 >= p->errlen) {
-        p->dropped++;
+    if (n >= 0)
+        n = line > 0 ? asprintf(&text, "%s:%d: %s", p->path, line, msg) : asprintf(&text, "%s: %s", p->path, msg);
+    free(msg);
+    if (n < 0)
+        return; /* out of memory: counted, not shown */
+    if (p->nd == p->capd) {
+        size_t cap = p->capd ? 2 * p->capd : 16;
+        Diag *d = realloc(p->d, cap * sizeof *d);
+        if (!d) {
+            free(text);
+            return;
+        }
+        p->d = d;
+        p->capd = cap;
+    }
+    p->d[p->nd].line = line;
+    p->d[p->nd].seq = p->nd;
+    p->d[p->nd].text = text;
+    p->nd++;
+}
+
+static int by_line(const void *a, const void *b)
+{
+    const Diag *x = a, *y = b;
+    if (x->line != y->line)
+        return x->line < y->line ? -1 : 1;
+    return x->seq < y->seq ? -1 : x->seq > y->seq;
+}
+
+/* All messages, in line order, one per line; what does not fit is counted in a last line. */
+static void write_diags(Parse *p, char *err, size_t errlen)
+{
+    size_t used = 0;
+    int shown = 0;
+    if (errlen)
+        err[0] = 0;
+    if (p->nd > 1)
+        qsort(p->d, p->nd, sizeof *p->d, by_line);
+    for (size_t i = 0; i < p->nd; i++) {
+        size_t len = strlen(p->d[i].text);
+        if (used + len + 1 + 40 < errlen) {
+            if (used)
+                err[used++] = '\n';
+            memcpy(err + used, p->d[i].text, len + 1);
+            used += len;
+            shown++;
+        }
+        free(p->d[i].text);
+    }
+    free(p->d);
+    if (shown < p->nerr && used < errlen)
+        snprintf(err + used, errlen - used, "%s... and %d more error%s", used ? "\n" : "", p->nerr - shown,
+                 p->nerr - shown == 1 ? "" : "s");
+}
+
+/* ---- lines ----------------------------------------------------------------------------------- */
+
+static int add_section(Parse *p, const char *name, size_t len)
+{
+    if (p->nsec == p->capsec) {
+        size_t cap = p->capsec ? 2 * p->capsec : 16;
+        Section *s = realloc(p->sec, cap * sizeof *s);
+        if (!s)
+            return -1;
+        p->sec = s;
+        p->capsec = cap;
+    }
+    char *copy = strndup(name, len);
+    if (!copy)
+        return -1;
+    p->sec[p->nsec].name = copy;
+    p->sec[p->nsec].line = p->line;
+    p->nsec++;
+    return 0;
+}
+
+static int is_comment(const char *s) { return *s == ';' || *s == '#'; }
+
+/* Checks one line; a bad line is reported and handed to inih as an empty one. */
+static void check_line(Parse *p, char *str)
+{
+    char *s = str;
+    if (p->line == 1 && (unsigned char)s[0] == 0xEF && (unsigned char)s[1] == 0xBB && (unsigned char)s[2] == 0xBF)
+        s += 3; /* UTF-8 byte order mark */
+    while (*s == ' ' || *s == '\t')
+        s++;
+    if (s != str)
+        memmove(str, s, strlen(s) + 1);
+    size_t len = strlen(str);
+    while (len && (str[len - 1] == '\n' || str[len - 1] == '\r' || str[len - 1] == ' ' || str[len - 1] == '\t'))
+        len--;
+    if (len == 0 || is_comment(str))
+        return;
+    if (str[0] == '[') {
+        char *close = memchr(str, ']', len);
+        char *after = close ? close + 1 : NULL;
+        while (after && (*after == ' ' || *after == '\t'))
+            after++;
+        if (!close || (after < str + len && !is_comment(after))) {
+            diag(p, p->line, "syntax error: a section header is '[name]' alone on its line");
+            str[0] = '\n', str[1] = 0;
+            return;
+        }
+        const char *a = str + 1, *b = close;
+        while (a < b && isspace((unsigned char)*a))
+            a++;
+        while (b > a && isspace((unsigned char)b[-1]))
+            b--;
+        if (a == b) {
+            diag(p, p->line, "syntax error: empty section name");
+            str[0] = '\n', str[1] = 0;
+            return;
+        }
+        if (add_section(p, a, (size_t)(b - a)) != 0)
+            p->oom = 1;
         return;
     }
-    if (p->used)
-        p->err[p->used++] = '\n';
-    memcpy(p->err + p->used, line, strlen(line) + 1);
-    p->used += strlen(line);
+    char *eq = memchr(str, '=', len);
+    if (!eq || eq == str) {
+        diag(p, p->line, "syntax error: expected 'key = value' or '[section]', got '%.*s'",
+             (int)(len > 60 ? 60 : len), str);
+        str[0] = '\n', str[1] = 0;
+        return;
+    }
+    if (memchr(str, ':', (size_t)(eq - str))) {
+        /* inih would split "a: b = c" at the colon */
+        diag(p, p->line, "syntax error: ':' in key '%.*s'", (int)(eq - str), str);
+        str[0] = '\n', str[1] = 0;
+        return;
+    }
+    if (p->nsec == 0) {
+        const char *k = eq;
+        while (k > str && (k[-1] == ' ' || k[-1] == '\t'))
+            k--;
+        diag(p, p->line, "key '%.*s': outside any section", (int)(k - str), str);
+        str[0] = '\n', str[1] = 0;
+    }
 }
 
 static char *reader(char *str, int num, void *stream)
@@ -61,13 +210,15 @@ static char *reader(char *str, int num, void *stream)
     p->line++;
     size_t len = strlen(str);
     if (len > 0 && str[len - 1] != '\n' && !feof(p->f)) {
-        diag(p, "%s:%d: line longer than %d characters", p->path, p->line, num - 1);
+        diag(p, p->line, "line longer than %d characters", num - 2);
         int ch;
         while ((ch = fgetc(p->f)) != EOF && ch != '\n')
             ;
         str[0] = '\n';
         str[1] = 0;
+        return str;
     }
+    check_line(p, str);
     return str;
 }
 
@@ -77,80 +228,143 @@ static int on_entry(void *user, const char *section, const char *key, const char
     if (p->n == p->cap) {
         size_t cap = p->cap ? 2 * p->cap : 32;
         Entry *e = realloc(p->e, cap * sizeof *e);
-        if (!e)
-            return 0;
+        if (!e) {
+            p->oom = 1;
+            return 1;
+        }
         p->e = e;
         p->cap = cap;
     }
-    Entry *e = &p->e[p->n++];
+    Entry *e = &p->e[p->n];
     e->section = strdup(section);
     e->key = strdup(key);
     e->value = strdup(value);
     e->line = p->line;
-    return e->section && e->key && e->value;
+    if (!e->section || !e->key || !e->value) {
+        free(e->section);
+        free(e->key);
+        free(e->value);
+        p->oom = 1;
+        return 1;
+    }
+    p->n++;
+    return 1;
 }
 
 /* ---- values ---------------------------------------------------------------------------------- */
 
+static void bad_value(Parse *p, const Entry *e, const char *what)
+{
+    diag(p, e->line, "key '%s.%s': %s, got '%s'", e->section, e->key, what, e->value);
+}
+
+/* n finite numbers separated by blanks. */
 static int parse_floats(Parse *p, const Entry *e, float *out, int n)
 {
     const char *s = e->value;
+    float v[4];
     for (int i = 0; i < n; i++) {
         char *end;
         errno = 0;
-        double v = strtod(s, &end);
-        if (end == s || errno || !isfinite(v) || fabs(v) > 3.4e38) {
-            diag(p, "%s:%d: key '%s.%s': expected %d number%s, got '%s'", p->path, e->line, e->section, e->key, n,
-                 n == 1 ? "" : "s", e->value);
+        double d = strtod(s, &end);
+        if (end == s || errno || !isfinite(d) || fabs(d) > 3.4e38 || (*end && !isspace((unsigned char)*end))) {
+            bad_value(p, e, n == 1 ? "expected a number" : n == 2 ? "expected 2 numbers" : "expected 3 numbers");
             return -1;
         }
-        out[i] = (float)v;
+        v[i] = (float)d;
         s = end;
     }
-    while (*s == ' ' || *s == '\t')
+    while (isspace((unsigned char)*s))
         s++;
     if (*s) {
-        diag(p, "%s:%d: key '%s.%s': expected %d number%s, got '%s'", p->path, e->line, e->section, e->key, n,
-             n == 1 ? "" : "s", e->value);
+        bad_value(p, e, n == 1 ? "expected a number" : n == 2 ? "expected 2 numbers" : "expected 3 numbers");
         return -1;
     }
+    memcpy(out, v, sizeof(float) * (size_t)n);
     return 0;
 }
 
-static int parse_int(Parse *p, const Entry *e, int lo, int hi, int *out)
+static int count_words(const char *s)
+{
+    int n = 0;
+    while (*s) {
+        while (isspace((unsigned char)*s))
+            s++;
+        if (!*s)
+            break;
+        n++;
+        while (*s && !isspace((unsigned char)*s))
+            s++;
+    }
+    return n;
+}
+
+static int parse_range(Parse *p, const Entry *e, float lo, float hi, float *out)
+{
+    float v;
+    if (parse_floats(p, e, &v, 1) != 0)
+        return -1;
+    if (!(v >= lo && v <= hi)) {
+        char what[96];
+        snprintf(what, sizeof what, "expected a number from %g to %g", lo, hi);
+        bad_value(p, e, what);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+/* A number > 0 (positive) or >= 0. */
+static int parse_sign(Parse *p, const Entry *e, int positive, float *out)
+{
+    float v;
+    if (parse_floats(p, e, &v, 1) != 0)
+        return -1;
+    if (positive ? !(v > 0.0f) : !(v >= 0.0f)) {
+        bad_value(p, e, positive ? "expected a positive number" : "expected a number >= 0");
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+static int parse_nonneg3(Parse *p, const Entry *e, float *out)
+{
+    float v[3];
+    if (parse_floats(p, e, v, 3) != 0)
+        return -1;
+    if (v[0] < 0.0f || v[1] < 0.0f || v[2] < 0.0f) {
+        bad_value(p, e, "expected 3 numbers, none negative");
+        return -1;
+    }
+    memcpy(out, v, sizeof v);
+    return 0;
+}
+
+static int parse_int(Parse *p, const Entry *e, long lo, long hi, int *out)
 {
     char *end;
     errno = 0;
     long v = strtol(e->value, &end, 10);
-    while (*end == ' ' || *end == '\t')
+    while (isspace((unsigned char)*end))
         end++;
     if (end == e->value || *end || errno) {
-        diag(p, "%s:%d: key '%s.%s': expected an integer, got '%s'", p->path, e->line, e->section, e->key, e->value);
+        bad_value(p, e, "expected an integer");
         return -1;
     }
     if (v < lo || v > hi) {
-        diag(p, "%s:%d: key '%s.%s': value %ld out of range %d..%d", p->path, e->line, e->section, e->key, v, lo, hi);
+        char what[96];
+        snprintf(what, sizeof what, "expected an integer from %ld to %ld", lo, hi);
+        bad_value(p, e, what);
         return -1;
     }
     *out = (int)v;
     return 0;
 }
 
-static int positive(Parse *p, const Entry *e, float v, int allow_zero)
-{
-    if (v > 0.0f || (allow_zero && v == 0.0f))
-        return 0;
-    diag(p, "%s:%d: key '%s.%s': must be %s, got '%s'", p->path, e->line, e->section, e->key,
-         allow_zero ? "zero or positive" : "positive", e->value);
-    return -1;
-}
+/* ---- sections -------------------------------------------------------------------------------- */
 
-static void unknown_key(Parse *p, const Entry *e)
-{
-    diag(p, "%s:%d: key '%s.%s': unknown key", p->path, e->line, e->section, e->key);
-}
-
-/* The part after "kind." of a section name, or NULL. */
+/* The NAME of a "kind.NAME" section, or NULL. */
 static const char *named(const char *section, const char *kind)
 {
     size_t n = strlen(kind);
@@ -159,71 +373,107 @@ static const char *named(const char *section, const char *kind)
     return NULL;
 }
 
-/* Directory of path, for relative glTF references. */
-static void resolve(const char *ini, const char *rel, char *out, size_t len)
+static int section_line(const Parse *p, const char *name)
 {
-    if (rel[0] == '/') {
-        snprintf(out, len, "%s", rel);
-        return;
-    }
-    const char *slash = strrchr(ini, '/');
-    if (!slash)
-        snprintf(out, len, "%s", rel);
-    else
-        snprintf(out, len, "%.*s/%s", (int)(slash - ini), ini, rel);
+    for (size_t i = 0; i < p->nsec; i++)
+        if (!strcmp(p->sec[i].name, name))
+            return p->sec[i].line;
+    return 0;
 }
 
-/* ---- sections ------------------------------------------------------------------------------ */
-
-static void placement(Parse *p, const char *section, double *xf, const char **file, int *line)
+/* The (first) entry of `key` in `section`, or NULL. */
+static const Entry *get(const Parse *p, const char *section, const char *key)
 {
-    float t[3] = {0, 0, 0}, sc[3] = {1, 1, 1}, ry = 0.0f;
-    *file = NULL;
     for (size_t i = 0; i < p->n; i++) {
         const Entry *e = &p->e[i];
-        if (strcmp(e->section, section) != 0)
-            continue;
-        if (!strcmp(e->key, "file")) {
-            *file = e->value;
-            *line = e->line;
-        } else if (!strcmp(e->key, "translate")) {
-            parse_floats(p, e, t, 3);
-        } else if (!strcmp(e->key, "scale")) {
-            /* one number, or three */
-            float one;
-            if (strchr(e->value, ' ') || strchr(e->value, '\t'))
-                parse_floats(p, e, sc, 3);
-            else if (parse_floats(p, e, &one, 1) == 0)
-                sc[0] = sc[1] = sc[2] = one;
-        } else if (!strcmp(e->key, "rotate_y")) {
-            parse_floats(p, e, &ry, 1);
-        } else {
-            unknown_key(p, e);
-        }
+        if (!strcmp(e->section, section) && !strcmp(e->key, key))
+            return e;
     }
-    /* xf = T * Ry * S, column-major */
-    double c = cos(ry * M_PI / 180.0), s = sin(ry * M_PI / 180.0);
-    double m[16] = {c * sc[0], 0, -s * sc[0], 0, 0, sc[1], 0, 0, s * sc[2], 0, c * sc[2], 0, t[0], t[1], t[2], 1};
-    memcpy(xf, m, sizeof m);
+    return NULL;
 }
 
-static int find_material(const Scene *s, const char *name)
+static void missing(Parse *p, const char *section, const char *key, const char *why)
 {
-    for (uint32_t i = 0; i < s->nmaterials; i++)
-        if (s->materials[i].name && strcmp(s->materials[i].name, name) == 0)
-            return (int)i;
-    return -1;
+    diag(p, section_line(p, section), "section [%s]: key '%s' is required%s", section, key, why);
+}
+
+/* Directory of the ini, for relative glTF paths. */
+static char *resolve(const char *ini, const char *rel)
+{
+    const char *slash = strrchr(ini, '/');
+    char *out = NULL;
+    if (rel[0] == '/' || !slash) {
+        out = strdup(rel);
+    } else if (asprintf(&out, "%.*s/%s", (int)(slash - ini), ini, rel) < 0) {
+        out = NULL;
+    }
+    return out;
+}
+
+static int load_gltf(Parse *p, Scene *s, const Entry *file, const double *xf)
+{
+    if (!file->value[0]) {
+        bad_value(p, file, "expected the path of a .gltf or .glb file");
+        return -1;
+    }
+    char *full = resolve(p->path, file->value);
+    char gerr[2048];
+    int rc;
+    if (!full) {
+        diag(p, 0, "out of memory");
+        return -1;
+    }
+    if ((rc = gltf_append(full, xf, s, gerr, sizeof gerr)) != 0)
+        diag(p, file->line, "key '%s.%s': %s", file->section, file->key, gerr);
+    free(full);
+    return rc;
+}
+
+/* [gltf.NAME]: file, translate, scale (one number or three), rotate_y (degrees). The
+ * placement is x' = T Ry S x. */
+static int gltf_section(Parse *p, Scene *s, const char *section)
+{
+    float t[3] = {0, 0, 0}, sc[3] = {1, 1, 1}, ry = 0.0f;
+    int bad = 0;
+    const Entry *e, *file = get(p, section, "file");
+    if ((e = get(p, section, "translate")))
+        bad |= parse_floats(p, e, t, 3);
+    if ((e = get(p, section, "scale"))) {
+        if (count_words(e->value) == 3) {
+            bad |= parse_floats(p, e, sc, 3);
+        } else if (parse_floats(p, e, sc, 1) == 0) {
+            sc[1] = sc[2] = sc[0];
+        } else {
+            bad = -1;
+        }
+        if (!bad && (sc[0] == 0.0f || sc[1] == 0.0f || sc[2] == 0.0f)) {
+            bad_value(p, e, "expected non-zero scale factors");
+            bad = -1;
+        }
+    }
+    if ((e = get(p, section, "rotate_y")))
+        bad |= parse_floats(p, e, &ry, 1);
+    if (!file) {
+        missing(p, section, "file", "");
+        return -1;
+    }
+    if (bad)
+        return -1;
+    double c = cos(ry * M_PI / 180.0), sn = sin(ry * M_PI / 180.0);
+    double xf[16] = {c * sc[0], 0, -sn * sc[0], 0, 0, sc[1], 0, 0, sn * sc[2], 0, c * sc[2], 0, t[0], t[1], t[2], 1};
+    return load_gltf(p, s, file, xf);
 }
 
 static int add_material(Scene *s, const char *name)
 {
-    SceneMaterial *m = realloc(s->materials, sizeof *m * (s->nmaterials + 1));
+    SceneMaterial *m = realloc(s->materials, sizeof *m * ((size_t)s->nmaterials + 1));
     if (!m)
         return -1;
     s->materials = m;
     SceneMaterial *x = &m[s->nmaterials];
     memset(x, 0, sizeof *x);
-    x->name = strdup(name);
+    if (!(x->name = strdup(name)))
+        return -1;
     x->kind = SCENE_MAT_LAMBERT;
     x->base_color[0] = x->base_color[1] = x->base_color[2] = 0.8f;
     x->alpha = 1.0f;
@@ -234,248 +484,343 @@ static int add_material(Scene *s, const char *name)
     return (int)s->nmaterials++;
 }
 
+/* [material.NAME]: a new material, or an override of every glTF material called NAME. Only
+ * the keys given change; without 'kind', the kind follows the glTF mapping again (metallic > 0
+ * or roughness < 1: glossy) unless the material is a dielectric. */
 static void material_section(Parse *p, Scene *s, const char *section, const char *name)
 {
-    int mi = find_material(s, name);
-    if (mi < 0 && (mi = add_material(s, name)) < 0) {
-        diag(p, "%s: out of memory", p->path);
+    int kind = -1, have_double = 0, dsided = 0, bad = 0;
+    float base[3], em[3], rough = 0, metal = 0, ior = 0;
+    const Entry *ek = get(p, section, "kind"), *eb = get(p, section, "base_color"), *ee = get(p, section, "emission"),
+                *er = get(p, section, "roughness"), *em_ = get(p, section, "metallic"), *ei = get(p, section, "ior"),
+                *ed = get(p, section, "double_sided");
+    if (ek) {
+        if (!strcmp(ek->value, "lambert"))
+            kind = SCENE_MAT_LAMBERT;
+        else if (!strcmp(ek->value, "glossy"))
+            kind = SCENE_MAT_GLOSSY;
+        else if (!strcmp(ek->value, "dielectric"))
+            kind = SCENE_MAT_DIELECTRIC;
+        else {
+            bad_value(p, ek, "expected lambert, glossy or dielectric");
+            bad = 1;
+        }
+    }
+    bad |= eb && parse_nonneg3(p, eb, base) != 0;
+    bad |= ee && parse_nonneg3(p, ee, em) != 0;
+    bad |= er && parse_range(p, er, 0.0f, 1.0f, &rough) != 0;
+    bad |= em_ && parse_range(p, em_, 0.0f, 1.0f, &metal) != 0;
+    bad |= ei && parse_range(p, ei, 1.0f, 10.0f, &ior) != 0;
+    if (ed) {
+        bad |= parse_int(p, ed, 0, 1, &dsided) != 0;
+        have_double = 1;
+    }
+    if (bad)
+        return;
+    int any = 0;
+    for (uint32_t i = 0; i < s->nmaterials; i++)
+        any |= s->materials[i].name && !strcmp(s->materials[i].name, name);
+    if (!any && add_material(s, name) < 0) {
+        diag(p, 0, "out of memory");
         return;
     }
-    for (size_t i = 0; i < p->n; i++) {
-        const Entry *e = &p->e[i];
-        if (strcmp(e->section, section) != 0)
+    for (uint32_t i = 0; i < s->nmaterials; i++) {
+        SceneMaterial *m = &s->materials[i];
+        if (!m->name || strcmp(m->name, name) != 0)
             continue;
-        SceneMaterial *m = &s->materials[mi];
-        float v;
-        if (!strcmp(e->key, "kind")) {
-            if (!strcmp(e->value, "lambert"))
-                m->kind = SCENE_MAT_LAMBERT;
-            else if (!strcmp(e->value, "glossy"))
-                m->kind = SCENE_MAT_GLOSSY;
-            else if (!strcmp(e->value, "dielectric"))
-                m->kind = SCENE_MAT_DIELECTRIC;
-            else
-                diag(p, "%s:%d: key '%s.%s': expected lambert, glossy or dielectric, got '%s'", p->path, e->line,
-                     e->section, e->key, e->value);
-        } else if (!strcmp(e->key, "base_color")) {
-            parse_floats(p, e, m->base_color, 3);
-        } else if (!strcmp(e->key, "emission")) {
-            parse_floats(p, e, m->emission, 3);
-        } else if (!strcmp(e->key, "roughness")) {
-            if (parse_floats(p, e, &v, 1) == 0)
-                m->roughness = v;
-        } else if (!strcmp(e->key, "metallic")) {
-            if (parse_floats(p, e, &v, 1) == 0)
-                m->metallic = v;
-        } else if (!strcmp(e->key, "ior")) {
-            if (parse_floats(p, e, &v, 1) == 0 && positive(p, e, v, 0) == 0)
-                m->ior = v;
-        } else if (!strcmp(e->key, "double_sided")) {
-            int d;
-            if (parse_int(p, e, 0, 1, &d) == 0)
-                m->double_sided = d;
-        } else {
-            unknown_key(p, e);
-        }
+        if (eb)
+            memcpy(m->base_color, base, sizeof base);
+        if (ee)
+            memcpy(m->emission, em, sizeof em);
+        if (er)
+            m->roughness = rough;
+        if (em_)
+            m->metallic = metal;
+        if (ei)
+            m->ior = ior;
+        if (have_double)
+            m->double_sided = dsided;
+        if (kind >= 0)
+            m->kind = (SceneMatKind)kind;
+        else if (m->kind != SCENE_MAT_DIELECTRIC)
+            m->kind = m->metallic > 0.0f || m->roughness < 1.0f ? SCENE_MAT_GLOSSY : SCENE_MAT_LAMBERT;
+        if (m->kind == SCENE_MAT_DIELECTRIC && m->transmission <= 0.0f)
+            m->transmission = 1.0f;
+        if (m->kind != SCENE_MAT_DIELECTRIC)
+            m->transmission = 0.0f;
     }
 }
 
+typedef struct LightKey {
+    const char *key;
+    unsigned types; /* bit per SceneLightKind that takes the key */
+    unsigned required;
+} LightKey;
+
+#define LT(k) (1u << (k))
+static const LightKey light_keys[] = {
+    {"position", LT(SCENE_LIGHT_POINT) | LT(SCENE_LIGHT_SPOT) | LT(SCENE_LIGHT_QUAD),
+     LT(SCENE_LIGHT_POINT) | LT(SCENE_LIGHT_SPOT) | LT(SCENE_LIGHT_QUAD)},
+    {"direction", LT(SCENE_LIGHT_SPOT) | LT(SCENE_LIGHT_DIRECTIONAL),
+     LT(SCENE_LIGHT_SPOT) | LT(SCENE_LIGHT_DIRECTIONAL)},
+    {"edge_u", LT(SCENE_LIGHT_QUAD), LT(SCENE_LIGHT_QUAD)},
+    {"edge_v", LT(SCENE_LIGHT_QUAD), LT(SCENE_LIGHT_QUAD)},
+    {"inner_cone", LT(SCENE_LIGHT_SPOT), 0},
+    {"outer_cone", LT(SCENE_LIGHT_SPOT), 0},
+    {"color", 0xF, 0},
+    {"intensity", 0xF, 0},
+};
+static const char *const light_type_names[] = {"point", "spot", "directional", "quad"};
+
+/* [light.NAME]: type = point | spot | directional | quad and the keys of that type. */
 static void light_section(Parse *p, Scene *s, const char *section, const char *name)
 {
     SceneLight l;
     memset(&l, 0, sizeof l);
-    l.kind = SCENE_LIGHT_POINT;
     l.color[0] = l.color[1] = l.color[2] = 1.0f;
     l.intensity = 1.0f;
-    l.direction[1] = -1.0f;
     float inner = 0.0f, outer = 45.0f;
-    int ok = 1;
-    for (size_t i = 0; i < p->n; i++) {
-        const Entry *e = &p->e[i];
-        if (strcmp(e->section, section) != 0)
+    int bad = 0, kind = -1;
+    const Entry *et = get(p, section, "type");
+    if (!et) {
+        missing(p, section, "type", " (point, spot, directional or quad)");
+        bad = 1;
+    } else {
+        for (int k = 0; k < 4; k++)
+            if (!strcmp(et->value, light_type_names[k]))
+                kind = k;
+        if (kind < 0) {
+            bad_value(p, et, "expected point, spot, directional or quad");
+            bad = 1;
+        }
+    }
+    for (size_t i = 0; i < sizeof light_keys / sizeof light_keys[0]; i++) {
+        const LightKey *lk = &light_keys[i];
+        const Entry *e = get(p, section, lk->key);
+        if (kind < 0)
             continue;
-        int r = 0;
-        if (!strcmp(e->key, "type")) {
-            if (!strcmp(e->value, "point"))
-                l.kind = SCENE_LIGHT_POINT;
-            else if (!strcmp(e->value, "spot"))
-                l.kind = SCENE_LIGHT_SPOT;
-            else if (!strcmp(e->value, "directional"))
-                l.kind = SCENE_LIGHT_DIRECTIONAL;
-            else if (!strcmp(e->value, "quad"))
-                l.kind = SCENE_LIGHT_QUAD;
-            else {
-                diag(p, "%s:%d: key '%s.%s': expected point, spot, directional or quad, got '%s'", p->path, e->line,
-                     e->section, e->key, e->value);
-                r = -1;
+        if (!e) {
+            if (lk->required & LT(kind)) {
+                char why[64];
+                snprintf(why, sizeof why, " for a %s light", light_type_names[kind]);
+                missing(p, section, lk->key, why);
+                bad = 1;
             }
-        } else if (!strcmp(e->key, "position")) {
+            continue;
+        }
+        if (!(lk->types & LT(kind))) {
+            diag(p, e->line, "key '%s.%s': does not apply to a %s light", e->section, e->key,
+                 light_type_names[kind]);
+            bad = 1;
+            continue;
+        }
+        int r = 0;
+        if (!strcmp(lk->key, "position"))
             r = parse_floats(p, e, l.position, 3);
-        } else if (!strcmp(e->key, "direction")) {
+        else if (!strcmp(lk->key, "direction"))
             r = parse_floats(p, e, l.direction, 3);
-        } else if (!strcmp(e->key, "edge_u")) {
+        else if (!strcmp(lk->key, "edge_u"))
             r = parse_floats(p, e, l.edge_u, 3);
-        } else if (!strcmp(e->key, "edge_v")) {
+        else if (!strcmp(lk->key, "edge_v"))
             r = parse_floats(p, e, l.edge_v, 3);
-        } else if (!strcmp(e->key, "color")) {
-            r = parse_floats(p, e, l.color, 3);
-        } else if (!strcmp(e->key, "intensity")) {
-            r = parse_floats(p, e, &l.intensity, 1);
-            if (!r)
-                r = positive(p, e, l.intensity, 1);
-        } else if (!strcmp(e->key, "inner_cone")) {
-            r = parse_floats(p, e, &inner, 1);
-        } else if (!strcmp(e->key, "outer_cone")) {
-            r = parse_floats(p, e, &outer, 1);
-        } else {
-            unknown_key(p, e);
-            r = -1;
-        }
-        ok &= r == 0;
+        else if (!strcmp(lk->key, "inner_cone"))
+            r = parse_range(p, e, 0.0f, 90.0f, &inner);
+        else if (!strcmp(lk->key, "outer_cone"))
+            r = parse_range(p, e, 0.0f, 90.0f, &outer);
+        else if (!strcmp(lk->key, "color"))
+            r = parse_nonneg3(p, e, l.color);
+        else if (!strcmp(lk->key, "intensity"))
+            r = parse_sign(p, e, 0, &l.intensity);
+        bad |= r != 0;
     }
-    if (l.kind == SCENE_LIGHT_QUAD) {
-        float cx = l.edge_u[1] * l.edge_v[2] - l.edge_u[2] * l.edge_v[1];
-        float cy = l.edge_u[2] * l.edge_v[0] - l.edge_u[0] * l.edge_v[2];
-        float cz = l.edge_u[0] * l.edge_v[1] - l.edge_u[1] * l.edge_v[0];
-        if (!(cx * cx + cy * cy + cz * cz > 0.0f)) {
-            diag(p, "%s: [%s]: a quad light needs edge_u and edge_v spanning a non-zero area", p->path, section);
-            ok = 0;
+    if (bad)
+        return;
+    int line = section_line(p, section);
+    l.kind = (SceneLightKind)kind;
+    if (kind == SCENE_LIGHT_SPOT || kind == SCENE_LIGHT_DIRECTIONAL) {
+        double d[3] = {l.direction[0], l.direction[1], l.direction[2]};
+        double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if (!(len > 0.0)) {
+            diag(p, get(p, section, "direction")->line, "key '%s.direction': must not be zero", section);
+            return;
         }
+        for (int k = 0; k < 3; k++)
+            l.direction[k] = (float)(d[k] / len);
     }
-    if (l.kind == SCENE_LIGHT_SPOT || l.kind == SCENE_LIGHT_DIRECTIONAL) {
-        float d2 = l.direction[0] * l.direction[0] + l.direction[1] * l.direction[1] + l.direction[2] * l.direction[2];
-        if (!(d2 > 0.0f)) {
-            diag(p, "%s: [%s]: direction must not be zero", p->path, section);
-            ok = 0;
+    if (kind == SCENE_LIGHT_SPOT && !(inner < outer && outer > 0.0f)) {
+        diag(p, line, "section [%s]: inner_cone (%g) must be smaller than outer_cone (%g)", section,
+             inner, outer);
+        return;
+    }
+    if (kind == SCENE_LIGHT_QUAD) {
+        double u[3] = {l.edge_u[0], l.edge_u[1], l.edge_u[2]}, v[3] = {l.edge_v[0], l.edge_v[1], l.edge_v[2]};
+        double cx = u[1] * v[2] - u[2] * v[1], cy = u[2] * v[0] - u[0] * v[2], cz = u[0] * v[1] - u[1] * v[0];
+        if (!(cx * cx + cy * cy + cz * cz > 0.0)) {
+            diag(p, line, "section [%s]: edge_u and edge_v must span a non-zero area", section);
+            return;
         }
     }
     l.inner_cone = inner * (float)M_PI / 180.0f;
     l.outer_cone = outer * (float)M_PI / 180.0f;
-    if (!ok)
-        return;
-    SceneLight *arr = realloc(s->lights, sizeof *arr * (s->nlights + 1));
-    if (!arr) {
-        diag(p, "%s: out of memory", p->path);
+    SceneLight *arr = realloc(s->lights, sizeof *arr * ((size_t)s->nlights + 1));
+    if (!arr || !(l.name = strdup(name))) {
+        if (arr)
+            s->lights = arr;
+        diag(p, 0, "out of memory");
         return;
     }
-    l.name = strdup(name);
     s->lights = arr;
     s->lights[s->nlights++] = l;
 }
 
-static void sphere_section(Parse *p, Scene *s, const char *section, const char *name)
+/* [sphere.NAME]: center, radius, material. */
+static void sphere_section(Parse *p, Scene *s, const char *section, const char *name, int gltf_failed)
 {
     SceneSphere sp;
     memset(&sp, 0, sizeof sp);
-    sp.radius = 1.0f;
     sp.material = -1;
-    int ok = 1, have_mat = 0;
-    for (size_t i = 0; i < p->n; i++) {
-        const Entry *e = &p->e[i];
-        if (strcmp(e->section, section) != 0)
-            continue;
-        if (!strcmp(e->key, "center")) {
-            ok &= parse_floats(p, e, sp.center, 3) == 0;
-        } else if (!strcmp(e->key, "radius")) {
-            ok &= parse_floats(p, e, &sp.radius, 1) == 0 && positive(p, e, sp.radius, 0) == 0;
-        } else if (!strcmp(e->key, "material")) {
-            have_mat = 1;
-            sp.material = find_material(s, e->value);
-            if (sp.material < 0) {
-                diag(p, "%s:%d: key '%s.%s': no material named '%s'", p->path, e->line, e->section, e->key, e->value);
-                ok = 0;
-            }
-        } else {
-            unknown_key(p, e);
-            ok = 0;
+    int bad = 0;
+    const Entry *ec = get(p, section, "center"), *er = get(p, section, "radius"), *em = get(p, section, "material");
+    if (!ec)
+        missing(p, section, "center", "");
+    if (!er)
+        missing(p, section, "radius", "");
+    if (!em)
+        missing(p, section, "material", "");
+    bad = !ec || !er || !em;
+    bad |= ec && parse_floats(p, ec, sp.center, 3) != 0;
+    bad |= er && parse_sign(p, er, 1, &sp.radius) != 0;
+    if (em) {
+        for (uint32_t i = 0; i < s->nmaterials && sp.material < 0; i++)
+            if (s->materials[i].name && !strcmp(s->materials[i].name, em->value))
+                sp.material = (int)i;
+        if (sp.material < 0) {
+            if (!gltf_failed) /* the name may be in the glTF file that failed to load */
+                diag(p, em->line, "key '%s.material': no [material.%s] section and no glTF material called '%s'",
+                     section, em->value, em->value);
+            bad = 1;
         }
     }
-    if (!have_mat) {
-        diag(p, "%s: [%s]: key 'material' is required", p->path, section);
-        ok = 0;
-    }
-    if (!ok)
+    if (bad)
         return;
-    SceneSphere *arr = realloc(s->spheres, sizeof *arr * (s->nspheres + 1));
-    if (!arr) {
-        diag(p, "%s: out of memory", p->path);
+    SceneSphere *arr = realloc(s->spheres, sizeof *arr * ((size_t)s->nspheres + 1));
+    if (!arr || !(sp.name = strdup(name))) {
+        if (arr)
+            s->spheres = arr;
+        diag(p, 0, "out of memory");
         return;
     }
-    sp.name = strdup(name);
     s->spheres = arr;
     s->spheres[s->nspheres++] = sp;
 }
 
+/* [camera]: position, look_at, up, fov_y, aperture, focus_distance. Overrides the glTF file's
+ * camera key by key; without one, position and look_at are required. */
 static void camera_section(Parse *p, Scene *s)
 {
     SceneCamera c = s->camera;
-    int have_pos = 0, have_at = 0, any = 0;
-    if (c.source == SCENE_CAMERA_DEFAULT) {
+    int from_gltf = c.source == SCENE_CAMERA_GLTF, bad = 0;
+    if (!from_gltf) {
         memset(&c, 0, sizeof c);
         c.up[1] = 1.0f;
         c.fov_y = 45.0f;
     }
-    for (size_t i = 0; i < p->n; i++) {
-        const Entry *e = &p->e[i];
-        if (strcmp(e->section, "camera") != 0)
-            continue;
-        any = 1;
-        if (!strcmp(e->key, "position")) {
-            have_pos = parse_floats(p, e, c.position, 3) == 0;
-        } else if (!strcmp(e->key, "look_at")) {
-            have_at = parse_floats(p, e, c.look_at, 3) == 0;
-        } else if (!strcmp(e->key, "up")) {
-            parse_floats(p, e, c.up, 3);
-        } else if (!strcmp(e->key, "fov_y")) {
-            if (parse_floats(p, e, &c.fov_y, 1) == 0 && !(c.fov_y > 0.0f && c.fov_y < 180.0f))
-                diag(p, "%s:%d: key 'camera.fov_y': must be between 0 and 180 degrees, got '%s'", p->path, e->line, e->value);
-        } else if (!strcmp(e->key, "aperture")) {
-            if (parse_floats(p, e, &c.aperture, 1) == 0)
-                positive(p, e, c.aperture, 1);
-        } else if (!strcmp(e->key, "focus_distance")) {
-            if (parse_floats(p, e, &c.focus_distance, 1) == 0)
-                positive(p, e, c.focus_distance, 1);
+    const Entry *ep = get(p, "camera", "position"), *ea = get(p, "camera", "look_at"), *eu = get(p, "camera", "up"),
+                *ef = get(p, "camera", "fov_y"), *eap = get(p, "camera", "aperture"),
+                *ed = get(p, "camera", "focus_distance");
+    bad |= ep && parse_floats(p, ep, c.position, 3) != 0;
+    bad |= ea && parse_floats(p, ea, c.look_at, 3) != 0;
+    bad |= eu && parse_floats(p, eu, c.up, 3) != 0;
+    if (ef) {
+        float f;
+        if (parse_floats(p, ef, &f, 1) != 0) {
+            bad = 1;
+        } else if (!(f > 0.0f && f < 180.0f)) {
+            bad_value(p, ef, "expected an angle between 0 and 180 degrees (exclusive)");
+            bad = 1;
         } else {
-            unknown_key(p, e);
+            c.fov_y = f;
         }
     }
-    if (!any)
-        return;
-    if (s->camera.source == SCENE_CAMERA_DEFAULT && (!have_pos || !have_at)) {
-        diag(p, "%s: [camera]: position and look_at are required when the glTF file has no camera", p->path);
+    bad |= eap && parse_sign(p, eap, 0, &c.aperture) != 0;
+    bad |= ed && parse_sign(p, ed, 0, &c.focus_distance) != 0;
+    if (!from_gltf && (!ep || !ea)) {
+        if (!ep)
+            missing(p, "camera", "position", " (the glTF files have no camera)");
+        if (!ea)
+            missing(p, "camera", "look_at", " (the glTF files have no camera)");
         return;
     }
-    float d[3] = {c.look_at[0] - c.position[0], c.look_at[1] - c.position[1], c.look_at[2] - c.position[2]};
-    float cr[3] = {d[1] * c.up[2] - d[2] * c.up[1], d[2] * c.up[0] - d[0] * c.up[2], d[0] * c.up[1] - d[1] * c.up[0]};
-    if (!(d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > 0.0f) || !(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2] > 0.0f)) {
-        diag(p, "%s: [camera]: look_at must differ from position and not lie along up", p->path);
+    if (bad)
+        return;
+    double d[3], u[3] = {c.up[0], c.up[1], c.up[2]};
+    for (int k = 0; k < 3; k++)
+        d[k] = (double)c.look_at[k] - c.position[k];
+    double cr[3] = {d[1] * u[2] - d[2] * u[1], d[2] * u[0] - d[0] * u[2], d[0] * u[1] - d[1] * u[0]};
+    int line = section_line(p, "camera");
+    if (!(d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > 0.0)) {
+        diag(p, line, "section [camera]: look_at must differ from position");
+        return;
+    }
+    if (!(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2] > 0.0)) {
+        diag(p, line, "section [camera]: up must not be zero or parallel to the view direction");
         return;
     }
     c.source = SCENE_CAMERA_FILE;
     s->camera = c;
 }
 
+/* [render]: width, height, spp, max_depth, background, ambient. */
 static void render_section(Parse *p, Scene *s)
 {
-    for (size_t i = 0; i < p->n; i++) {
-        const Entry *e = &p->e[i];
-        if (strcmp(e->section, "render") != 0)
-            continue;
-        if (!strcmp(e->key, "width"))
-            parse_int(p, e, 1, 16384, &s->render.width);
-        else if (!strcmp(e->key, "height"))
-            parse_int(p, e, 1, 16384, &s->render.height);
-        else if (!strcmp(e->key, "spp"))
-            parse_int(p, e, 1, 1 << 20, &s->render.spp);
-        else if (!strcmp(e->key, "max_depth"))
-            parse_int(p, e, 0, 63, &s->render.max_depth);
-        else if (!strcmp(e->key, "background"))
-            parse_floats(p, e, s->render.background, 3);
-        else if (!strcmp(e->key, "ambient"))
-            parse_floats(p, e, s->render.ambient, 3);
-        else
-            unknown_key(p, e);
+    const Entry *e;
+    SceneRender r = s->render;
+    int bad = 0;
+    /* The ranges sfsim's --set render.* accepts (sim/main.c). */
+    if ((e = get(p, "render", "width")))
+        bad |= parse_int(p, e, 1, 16384, &r.width);
+    if ((e = get(p, "render", "height")))
+        bad |= parse_int(p, e, 1, 16384, &r.height);
+    if ((e = get(p, "render", "spp")))
+        bad |= parse_int(p, e, 1, 1L << 20, &r.spp);
+    if ((e = get(p, "render", "max_depth")))
+        bad |= parse_int(p, e, 0, 63, &r.max_depth);
+    if ((e = get(p, "render", "background")))
+        bad |= parse_nonneg3(p, e, r.background);
+    if ((e = get(p, "render", "ambient")))
+        bad |= parse_nonneg3(p, e, r.ambient);
+    if (!bad)
+        s->render = r;
+}
+
+static const char *const known_keys[][2] = {
+    {"scene", "gltf"},
+    {"camera", "position look_at up fov_y aperture focus_distance"},
+    {"render", "width height spp max_depth background ambient"},
+    {"gltf", "file translate scale rotate_y"},
+    {"light", "type position direction edge_u edge_v color intensity inner_cone outer_cone"},
+    {"sphere", "center radius material"},
+    {"material", "kind base_color roughness metallic ior emission double_sided"},
+};
+
+/* The kind of a section name ("light" for "light.lamp"), or NULL for an unknown section. */
+static const char *section_kind(const char *name)
+{
+    for (size_t i = 0; i < sizeof known_keys / sizeof known_keys[0]; i++) {
+        const char *k = known_keys[i][0];
+        int is_named = i >= 3;
+        if (is_named ? named(name, k) != NULL : !strcmp(name, k))
+            return k;
     }
+    return NULL;
+}
+
+static const char *keys_of(const char *kind)
+{
+    for (size_t i = 0; i < sizeof known_keys / sizeof known_keys[0]; i++)
+        if (!strcmp(known_keys[i][0], kind))
+            return known_keys[i][1];
+    return "";
 }
 
 int scene_file_load(const char *path, Scene *s, char *err, size_t errlen)
@@ -483,10 +828,11 @@ int scene_file_load(const char *path, Scene *s, char *err, size_t errlen)
     Parse p;
     memset(&p, 0, sizeof p);
     p.path = path;
-    p.err = err;
-    p.errlen = errlen;
-    if (errlen)
-        err[0] = 0;
+    struct stat st;
+    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
+        snprintf(err, errlen, "%s: not a regular file", path);
+        return -1;
+    }
     p.f = fopen(path, "r");
     if (!p.f) {
         snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
@@ -494,78 +840,100 @@ int scene_file_load(const char *path, Scene *s, char *err, size_t errlen)
     }
     int rc = ini_parse_stream(reader, &p, on_entry, &p);
     fclose(p.f);
-    if (rc > 0)
-        diag(&p, "%s:%d: syntax error (expected [section] or key = value)", path, rc);
-    else if (rc < 0)
-        diag(&p, "%s: cannot read (out of memory)", path);
+    if (rc > 0 && p.nerr == 0) /* check_line passes only what inih accepts; a safety net */
+        diag(&p, rc, "syntax error");
+    if (rc < 0 || p.oom) {
+        diag(&p, 0, "out of memory");
+        goto done;
+    }
 
-    /* Sections: check names first, so a typo is reported whatever else happens. */
+    /* Section names: known kinds, each once. */
+    for (size_t i = 0; i < p.nsec; i++) {
+        const char *name = p.sec[i].name;
+        if (!section_kind(name)) {
+            diag(&p, p.sec[i].line,
+                 "unknown section [%s] (expected scene, camera, render, gltf.NAME, light.NAME, sphere.NAME or "
+                 "material.NAME)",
+                 name);
+            continue;
+        }
+        for (size_t j = 0; j < i; j++)
+            if (!strcmp(p.sec[j].name, name)) {
+                diag(&p, p.sec[i].line, "section [%s] appears twice (first at line %d)", name,
+                     p.sec[j].line);
+                break;
+            }
+    }
+    /* Keys: known for their section, each once (except [scene] gltf, which may repeat). */
     for (size_t i = 0; i < p.n; i++) {
         const Entry *e = &p.e[i];
-        const char *sec = e->section;
-        if (!strcmp(sec, "scene")) {
-            if (strcmp(e->key, "gltf") != 0)
-                unknown_key(&p, e);
-        } else if (strcmp(sec, "camera") && strcmp(sec, "render") && !named(sec, "gltf") && !named(sec, "light") &&
-                   !named(sec, "sphere") && !named(sec, "material")) {
-            diag(&p, "%s:%d: key '%s.%s': unknown section [%s]", path, e->line, sec, e->key, sec);
-        }
-    }
-    /* glTF files, in the order they appear. */
-    for (size_t i = 0; p.nerr == 0 && i < p.n; i++) {
-        const Entry *e = &p.e[i];
-        char full[4096], gerr[1024];
-        if (!strcmp(e->section, "scene") && !strcmp(e->key, "gltf")) {
-            resolve(path, e->value, full, sizeof full);
-            if (gltf_append(full, NULL, s, gerr, sizeof gerr) != 0)
-                diag(&p, "%s:%d: key 'scene.gltf': %s", path, e->line, gerr);
-        } else if (named(e->section, "gltf") && (i == 0 || strcmp(p.e[i - 1].section, e->section) != 0)) {
-            int seen = 0;
-            for (size_t j = 0; j < i; j++)
-                seen |= !strcmp(p.e[j].section, e->section);
-            if (seen)
-                continue;
-            double xf[16];
-            const char *file;
-            int line = e->line;
-            placement(&p, e->section, xf, &file, &line);
-            if (!file) {
-                diag(&p, "%s: [%s]: key 'file' is required", path, e->section);
-                continue;
+        const char *kind = section_kind(e->section);
+        if (!kind)
+            continue; /* its section is reported */
+        const char *keys = keys_of(kind);
+        size_t kl = strlen(e->key);
+        const char *hit = keys;
+        int known = 0;
+        while ((hit = strstr(hit, e->key)) != NULL) {
+            if ((hit == keys || hit[-1] == ' ') && (hit[kl] == ' ' || hit[kl] == 0)) {
+                known = 1;
+                break;
             }
-            resolve(path, file, full, sizeof full);
-            if (p.nerr == 0 && gltf_append(full, xf, s, gerr, sizeof gerr) != 0)
-                diag(&p, "%s:%d: key '%s.file': %s", path, line, e->section, gerr);
+            hit += kl;
         }
-    }
-    /* Then everything that refers to what the glTF files brought (materials by name). */
-    for (int pass = 0; pass < 3; pass++) {
-        for (size_t i = 0; i < p.n; i++) {
-            const Entry *e = &p.e[i];
-            int first = 1;
-            for (size_t j = 0; j < i && first; j++)
-                first = strcmp(p.e[j].section, e->section) != 0;
-            if (!first)
-                continue;
-            const char *name;
-            if (pass == 0 && (name = named(e->section, "material")))
-                material_section(&p, s, e->section, name);
-            else if (pass == 1 && (name = named(e->section, "sphere")))
-                sphere_section(&p, s, e->section, name);
-            else if (pass == 2 && (name = named(e->section, "light")))
-                light_section(&p, s, e->section, name);
+        if (!known) {
+            diag(&p, e->line, "key '%s.%s': unknown key (%s takes: %s)", e->section, e->key,
+                 !strcmp(kind, e->section) ? e->section : kind, keys);
+            continue;
         }
+        if (strcmp(e->section, "scene") != 0)
+            for (size_t j = 0; j < i; j++)
+                if (!strcmp(p.e[j].section, e->section) && !strcmp(p.e[j].key, e->key)) {
+                    diag(&p, e->line, "key '%s.%s': given twice (first at line %d)", e->section, e->key,
+                         p.e[j].line);
+                    break;
+                }
     }
-    camera_section(&p, s);
+
+    /* glTF files in the order they appear: [scene] gltf lines, then [gltf.NAME] sections. */
+    int gltf_failed = 0;
+    for (size_t i = 0; i < p.n; i++) {
+        const Entry *e = &p.e[i];
+        if (!strcmp(e->section, "scene") && !strcmp(e->key, "gltf"))
+            gltf_failed |= load_gltf(&p, s, e, NULL) != 0;
+    }
+    for (size_t i = 0; i < p.nsec; i++)
+        if (named(p.sec[i].name, "gltf") && section_line(&p, p.sec[i].name) == p.sec[i].line)
+            gltf_failed |= gltf_section(&p, s, p.sec[i].name) != 0;
+
+    /* Then what refers to the glTF files' materials by name: materials, spheres; then lights. */
+    for (int pass = 0; pass < 3; pass++)
+        for (size_t i = 0; i < p.nsec; i++) {
+            const char *sec = p.sec[i].name, *name;
+            if (section_line(&p, sec) != p.sec[i].line)
+                continue; /* a repeated section, reported above */
+            if (pass == 0 && (name = named(sec, "material")))
+                material_section(&p, s, sec, name);
+            else if (pass == 1 && (name = named(sec, "sphere")))
+                sphere_section(&p, s, sec, name, gltf_failed);
+            else if (pass == 2 && (name = named(sec, "light")))
+                light_section(&p, s, sec, name);
+        }
+    if (section_line(&p, "camera"))
+        camera_section(&p, s);
     render_section(&p, s);
 
+done:
     for (size_t i = 0; i < p.n; i++) {
         free(p.e[i].section);
         free(p.e[i].key);
         free(p.e[i].value);
     }
     free(p.e);
-    if (p.dropped && p.used < errlen)
-        snprintf(err + p.used, errlen - p.used, "\n... and %d more errors", p.dropped);
-    return p.nerr ? -1 : 0;
+    for (size_t i = 0; i < p.nsec; i++)
+        free(p.sec[i].name);
+    free(p.sec);
+    int nerr = p.nerr;
+    write_diags(&p, err, errlen);
+    return nerr ? -1 : 0;
 }
