@@ -140,6 +140,12 @@ int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *
         }
     }
     int rc = bvh_build(bp, lo, hi, nprims, &out->bvh, err, errlen);
+    /* The invariants are checked on every build, not only in tests: O(n), and a broken tree
+     * would silently lose geometry. */
+    if (rc == 0 && bvh_check(&out->bvh, lo, hi, err, errlen) != 0) {
+        bvh_free(&out->bvh);
+        rc = -1;
+    }
     free(lo);
     free(hi);
     if (rc)

@@ -478,6 +478,8 @@ static int cmd_run(int argc, char **argv)
     if (build_config(&ca, &cfg))
         return EXIT_INPUT;
     o.stream_rays = cfg.stream_rays;
+    o.bvh_leaf_size = cfg.bvh_leaf_size;
+    o.bvh_bins = cfg.bvh_bins;
     char err[2048];
     if (render_reference(&o, err, sizeof err) != 0) {
         fprintf(stderr, "sfsim run: %s\n", err);

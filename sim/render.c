@@ -222,6 +222,8 @@ int render_reference(const RenderOptions *o, char *err, size_t errlen)
     cJSON_AddNumberToObject(bvh, "leaves", p.bvh.nleaves);
     cJSON_AddNumberToObject(bvh, "depth", p.bvh.depth);
     cJSON_AddNumberToObject(bvh, "sah_cost", p.bvh.sah_cost);
+    cJSON_AddNumberToObject(bvh, "leaf_size", bp.max_leaf_size);
+    cJSON_AddNumberToObject(bvh, "bins", bp.bins);
     cJSON_AddNumberToObject(sc, "scene_memory_bytes", p.size);
     cJSON *ren = cJSON_AddObjectToObject(root, "render");
     cJSON_AddNumberToObject(ren, "width", s.render.width);
