@@ -128,6 +128,19 @@ Core *core_new(const CoreParams *p, const AsmObject *obj, char *err, size_t errl
     return c;
 }
 
+void core_restart(Core *c)
+{
+    memset(c->r, 0, sizeof c->r);
+    memset(c->v, 0, sizeof c->v);
+    memset(c->m, 0, sizeof c->m);
+    c->m[0] = c->all;
+    c->pc = 0;
+    c->stage = 0;
+    c->cur_rb = 0;
+    c->pq_len = 0;
+    c->trap[0] = 0;
+}
+
 void core_free(Core *c)
 {
     if (!c)

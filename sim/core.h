@@ -66,6 +66,10 @@ typedef struct Core Core;
  * NULL with a message on failure. obj must outlive the core. */
 Core *core_new(const CoreParams *p, const AsmObject *obj, char *err, size_t errlen);
 void core_free(Core *c);
+/* Back to the reset state for another run of the same program: registers 0, m0 all lanes,
+ * pc 0, stage other, RB0 current, partition queue empty. Memories and statistics are kept
+ * (the host rewrites what it needs; statistics keep accumulating). */
+void core_restart(Core *c);
 
 /* Run until halt, trap, or max_instr more instructions (0 = no limit). */
 CoreExit core_run(Core *c, uint64_t max_instr);

@@ -73,13 +73,16 @@ static void usage_config(FILE *out)
 static void usage_run(FILE *out)
 {
     fprintf(out,
-            "usage: sfsim run -s SCENE -o DIR --mode reference [options]\n"
+            "usage: sfsim run -s SCENE -o DIR --mode reference|functional [options]\n"
             "\n"
             "Renders SCENE (a .gltf/.glb file or a scene.ini) and writes DIR/frame.exr (linear),\n"
             "DIR/frame.png (tone-mapped sRGB), DIR/report.json and DIR/report.txt.\n"
             "\n"
             "modes:\n"
             "  reference   the golden model: a plain C path tracer over the packed scene memory\n"
+            "  functional  the path-tracing kernel (kernels/pathtrace.s) executed instruction by\n"
+            "              instruction on the functional core, no timing; the report adds the\n"
+            "              operation mix, SIMD utilization and stream lengths per stage\n"
             "\n"
             "options:\n"
             "  -s, --scene FILE         scene (default: scenes/cornell/scene.ini)\n"
@@ -89,7 +92,11 @@ static void usage_run(FILE *out)
             "                           render.spp, render.max_depth, render.seed\n"
             "  -j, --threads N          host threads (default: all cores; results do not change)\n"
             "  --exposure X             scale before tone mapping frame.png (default 1)\n"
-            "  --no-progress            no progress bar (it is shown only on a terminal anyway)\n");
+            "  --no-progress            no progress bar (it is shown only on a terminal anyway)\n"
+            "  --kernel FILE            functional mode: the kernel source (default: kernels/pathtrace.s\n"
+            "                           beside the executable's folder, or $SFSIM_KERNEL)\n"
+            "\n"
+            "The default mode is reference.\n");
 }
 
 /* Config from -c/--set options, collected by the commands that take them. */
@@ -444,6 +451,8 @@ static int cmd_run(int argc, char **argv)
             }
         } else if (!strcmp(a, "--no-progress")) {
             o.progress = 0;
+        } else if (!strcmp(a, "--kernel") && has_next) {
+            o.kernel_path = argv[++i];
         } else if (!strcmp(a, "--set") && has_next) {
             const char *s = argv[++i];
             static const struct { const char *key; long lo, hi; } render_keys[] = {
@@ -470,18 +479,20 @@ static int cmd_run(int argc, char **argv)
             return EXIT_USAGE;
         }
     }
-    if (strcmp(mode, "reference") != 0) {
-        fprintf(stderr, "sfsim run: --mode %s: this build renders with --mode reference only\n", mode);
+    if (strcmp(mode, "reference") != 0 && strcmp(mode, "functional") != 0) {
+        fprintf(stderr, "sfsim run: --mode %s: expected reference or functional (sfsim help run)\n", mode);
         return EXIT_USAGE;
     }
+    o.mode = mode;
     CfgMachine cfg;
     if (build_config(&ca, &cfg))
         return EXIT_INPUT;
     o.stream_rays = cfg.stream_rays;
     o.bvh_leaf_size = cfg.bvh_leaf_size;
     o.bvh_bins = cfg.bvh_bins;
-    char err[2048];
-    if (render_reference(&o, err, sizeof err) != 0) {
+    o.cfg = &cfg;
+    static char err[65536];
+    if (render_run(&o, err, sizeof err) != 0) {
         fprintf(stderr, "sfsim run: %s\n", err);
         return EXIT_INPUT;
     }

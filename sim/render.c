@@ -20,6 +20,8 @@
 #include "../scenes/pack.h"
 #include "../scenes/scene.h"
 #include "img.h"
+#include "config.h"
+#include "functional.h"
 #include "reference.h"
 
 void render_default_options(RenderOptions *o)
@@ -32,6 +34,7 @@ void render_default_options(RenderOptions *o)
     o->bvh_leaf_size = 4;
     o->bvh_bins = 16;
     o->exposure = 1.0f;
+    o->mode = "reference";
 }
 
 static double now(void)
@@ -131,7 +134,87 @@ static int write_text(const char *path, const char *text, char *err, size_t errl
     return 0;
 }
 
-int render_reference(const RenderOptions *o, char *err, size_t errlen)
+static double ratio(uint64_t a, uint64_t b) { return b ? (double)a / (double)b : 0.0; }
+
+/* Statistics of either mode, in the report's terms. */
+typedef struct RunStats {
+    uint64_t primary, shadow, indirect, dropped;
+    uint64_t per_gen[REF_MAX_GENERATIONS];
+    uint64_t generations;
+    uint64_t nodes_visited, prims_tested;   /* reference only */
+    int functional;
+    FuncStats f;
+} RunStats;
+
+static void add_functional_json(cJSON *root, const RunStats *rs, const CfgMachine *cfg)
+{
+    const FuncStats *f = &rs->f;
+    cJSON *ops = cJSON_AddObjectToObject(root, "ops");
+    for (int c = 0; c < ISA_C_COUNT; c++) {
+        uint64_t n = 0;
+        for (int k = 0; k < ISA_STAGE_COUNT; k++)
+            n += f->core.ops[k][c];
+        cJSON_AddNumberToObject(ops, isa_category_keys[c], (double)n);
+    }
+    cJSON *opst = cJSON_AddObjectToObject(root, "ops_by_stage");
+    for (int k = 0; k < ISA_STAGE_COUNT; k++) {
+        cJSON *o = cJSON_AddObjectToObject(opst, isa_stage_keys[k]);
+        for (int c = 0; c < ISA_C_COUNT; c++)
+            cJSON_AddNumberToObject(o, isa_category_keys[c], (double)f->core.ops[k][c]);
+    }
+    cJSON *ut = cJSON_AddObjectToObject(root, "utilization");
+    int n = cfg->core_simd_width;
+    for (int k = 0; k < ISA_STAGE_COUNT; k++)
+        cJSON_AddNumberToObject(ut, isa_stage_keys[k],
+                                ratio(f->core.active_lanes[k], (uint64_t)n * f->core.vec_instructions[k]));
+    cJSON *sl = cJSON_AddObjectToObject(root, "stream_length");
+    cJSON_AddNumberToObject(sl, "traversal", ratio(f->trav_rays, f->trav_streams));
+    cJSON_AddNumberToObject(sl, "intersection", ratio(f->isect_rays, f->isect_streams));
+    cJSON_AddNumberToObject(sl, "shading", ratio(f->shade_rays, f->shade_streams));
+    cJSON *sc = cJSON_AddObjectToObject(root, "streams");
+    cJSON_AddNumberToObject(sc, "traversal", (double)f->trav_streams);
+    cJSON_AddNumberToObject(sc, "intersection", (double)f->isect_streams);
+    cJSON_AddNumberToObject(sc, "shading", (double)f->shade_streams);
+    cJSON *ins = cJSON_AddObjectToObject(root, "instructions");
+    for (int k = 0; k < ISA_STAGE_COUNT; k++)
+        cJSON_AddNumberToObject(ins, isa_stage_keys[k], (double)f->core.instructions[k]);
+    cJSON *vi = cJSON_AddObjectToObject(root, "vector_instructions");
+    for (int k = 0; k < ISA_STAGE_COUNT; k++)
+        cJSON_AddNumberToObject(vi, isa_stage_keys[k], (double)f->core.vec_instructions[k]);
+    cJSON *byop = cJSON_AddObjectToObject(root, "by_opcode");
+    for (int o = 0; o < ISA_OP_COUNT; o++)
+        if (f->core.by_op[o])
+            cJSON_AddNumberToObject(byop, isa_ops[o].mnemonic, (double)f->core.by_op[o]);
+    cJSON *k = cJSON_AddObjectToObject(root, "kernel");
+    cJSON_AddStringToObject(k, "defines", f->defines);
+    cJSON_AddNumberToObject(k, "instructions", f->kernel_instructions);
+    cJSON *tiles = cJSON_AddArrayToObject(root, "tiles");
+    for (uint32_t t = 0; t < f->ntiles; t++) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddNumberToObject(o, "x", f->tiles[t].x0);
+        cJSON_AddNumberToObject(o, "y", f->tiles[t].y0);
+        cJSON_AddNumberToObject(o, "width", f->tiles[t].w);
+        cJSON_AddNumberToObject(o, "height", f->tiles[t].h);
+        cJSON_AddNumberToObject(o, "instructions", (double)f->tiles[t].instructions);
+        cJSON_AddNumberToObject(o, "rays", (double)f->tiles[t].rays);
+        cJSON_AddItemToArray(tiles, o);
+    }
+    cJSON *cf = cJSON_AddObjectToObject(root, "config");
+    cJSON_AddNumberToObject(cf, "core.simd_width", cfg->core_simd_width);
+    cJSON_AddNumberToObject(cf, "core.clock_mhz", cfg->core_clock_mhz);
+    cJSON_AddNumberToObject(cf, "stream.rays", cfg->stream_rays);
+    cJSON_AddNumberToObject(cf, "raybuf.size_kb", cfg->raybuf_size_kb);
+    cJSON_AddNumberToObject(cf, "raybuf.banks", cfg->raybuf_banks);
+    cJSON_AddNumberToObject(cf, "idm.size_kb", cfg->idm_size_kb);
+    cJSON_AddNumberToObject(cf, "spad.size_kb", cfg->spad_size_kb);
+    cJSON_AddNumberToObject(cf, "scene.size_mb", cfg->scene_size_mb);
+    cJSON_AddNumberToObject(cf, "fb.size_kb", cfg->fb_size_kb);
+    cJSON_AddNumberToObject(cf, "bvh.leaf_size", cfg->bvh_leaf_size);
+    cJSON_AddNumberToObject(cf, "bvh.bins", cfg->bvh_bins);
+    cJSON_AddNumberToObject(cf, "sim.max_instructions", (double)cfg->sim_max_instructions);
+}
+
+int render_run(const RenderOptions *o, char *err, size_t errlen)
 {
     int rc = -1;
     Scene s;
@@ -139,7 +222,17 @@ int render_reference(const RenderOptions *o, char *err, size_t errlen)
     float *rgb = NULL;
     char *json_text = NULL;
     cJSON *root = NULL;
+    RunStats rs;
+    memset(&rs, 0, sizeof rs);
     memset(&p, 0, sizeof p);
+    CfgMachine defcfg;
+    cfg_defaults(&defcfg);
+    const CfgMachine *cfg = o->cfg ? o->cfg : &defcfg;
+    int functional = !strcmp(o->mode, "functional");
+    if (!functional && strcmp(o->mode, "reference") != 0) {
+        snprintf(err, errlen, "--mode %s: this build renders with --mode reference or functional", o->mode);
+        return -1;
+    }
     double t0 = now();
     if (scene_load(o->scene_path, &s, err, errlen) != 0)
         return -1;
@@ -161,10 +254,35 @@ int render_reference(const RenderOptions *o, char *err, size_t errlen)
     }
     int threads = o->threads > 0 ? o->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
     Progress pr = {PTHREAD_MUTEX_INITIALIZER, now(), o->progress};
-    RefParams rp = {(int)lrint(sqrt((double)o->stream_rays)), o->seed, threads, progress_cb, &pr};
-    RefStats st;
-    if (ref_render(&p, &rp, rgb, &st, err, errlen) != 0)
-        goto out;
+    int tile = (int)lrint(sqrt((double)o->stream_rays));
+    if (functional) {
+        char kpath[4200];
+        FuncParams fp = {cfg, o->kernel_path ? o->kernel_path : func_default_kernel(kpath, sizeof kpath),
+                         s.needs, o->seed, threads, progress_cb, &pr};
+        if (func_render(&p, &fp, rgb, &rs.f, err, errlen) != 0)
+            goto out;
+        rs.functional = 1;
+        rs.primary = rs.f.rays_camera;
+        rs.shadow = rs.f.rays_shadow;
+        rs.indirect = rs.f.rays_indirect;
+        rs.dropped = rs.f.dropped;
+        rs.generations = rs.f.generations;
+        for (int g = 0; g < REF_MAX_GENERATIONS && g < FUNC_MAX_GENERATIONS; g++)
+            rs.per_gen[g] = rs.f.rays_per_generation[g];
+    } else {
+        RefParams rp = {tile, o->seed, threads, progress_cb, &pr};
+        RefStats st;
+        if (ref_render(&p, &rp, rgb, &st, err, errlen) != 0)
+            goto out;
+        rs.primary = st.rays[REF_RAY_CAMERA];
+        rs.shadow = st.rays[REF_RAY_SHADOW];
+        rs.indirect = st.rays[REF_RAY_INDIRECT];
+        rs.dropped = st.dropped;
+        rs.generations = st.generations;
+        memcpy(rs.per_gen, st.rays_per_generation, sizeof rs.per_gen);
+        rs.nodes_visited = st.nodes_visited;
+        rs.prims_tested = st.prims_tested;
+    }
     double t_render = now();
 
     char path[4200];
@@ -183,28 +301,32 @@ int render_reference(const RenderOptions *o, char *err, size_t errlen)
         else
             sum += rgb[i];
     }
-    uint64_t total_rays = st.rays[REF_RAY_CAMERA] + st.rays[REF_RAY_SHADOW] + st.rays[REF_RAY_INDIRECT];
+    uint64_t total_rays = rs.primary + rs.shadow + rs.indirect;
     double secs = t_render - t_pack;
 
-    /* report.json: the names of ARCHITECTURE.md Sec. 1; timing fields are null in this mode. */
+    /* report.json: the names of ARCHITECTURE.md Sec. 1; timing fields are null in these modes. */
     root = cJSON_CreateObject();
-    cJSON_AddStringToObject(root, "mode", "reference");
+    cJSON_AddStringToObject(root, "mode", o->mode);
     cJSON_AddNullToObject(root, "cycles");
     cJSON_AddNullToObject(root, "busy_cycles");
     cJSON_AddNullToObject(root, "fps");
     cJSON_AddNullToObject(root, "fps_no_stall");
     cJSON *rays = cJSON_AddObjectToObject(root, "rays");
-    cJSON_AddNumberToObject(rays, "primary", (double)st.rays[REF_RAY_CAMERA]);
-    cJSON_AddNumberToObject(rays, "shadow", (double)st.rays[REF_RAY_SHADOW]);
-    cJSON_AddNumberToObject(rays, "indirect", (double)st.rays[REF_RAY_INDIRECT]);
+    cJSON_AddNumberToObject(rays, "primary", (double)rs.primary);
+    cJSON_AddNumberToObject(rays, "shadow", (double)rs.shadow);
+    cJSON_AddNumberToObject(rays, "indirect", (double)rs.indirect);
     cJSON_AddNumberToObject(rays, "total", (double)total_rays);
-    cJSON_AddNumberToObject(rays, "dropped", (double)st.dropped);
+    cJSON_AddNumberToObject(rays, "dropped", (double)rs.dropped);
     cJSON *gens = cJSON_AddArrayToObject(root, "rays_per_generation");
-    for (uint64_t g = 0; g < st.generations && g < REF_MAX_GENERATIONS; g++)
-        cJSON_AddItemToArray(gens, cJSON_CreateNumber((double)st.rays_per_generation[g]));
-    cJSON *trav = cJSON_AddObjectToObject(root, "traversal");
-    cJSON_AddNumberToObject(trav, "nodes_visited", (double)st.nodes_visited);
-    cJSON_AddNumberToObject(trav, "primitives_tested", (double)st.prims_tested);
+    for (uint64_t g = 0; g < rs.generations && g < REF_MAX_GENERATIONS; g++)
+        cJSON_AddItemToArray(gens, cJSON_CreateNumber((double)rs.per_gen[g]));
+    if (functional) {
+        add_functional_json(root, &rs, cfg);
+    } else {
+        cJSON *trav = cJSON_AddObjectToObject(root, "traversal");
+        cJSON_AddNumberToObject(trav, "nodes_visited", (double)rs.nodes_visited);
+        cJSON_AddNumberToObject(trav, "primitives_tested", (double)rs.prims_tested);
+    }
     cJSON *sc = cJSON_AddObjectToObject(root, "scene");
     cJSON_AddStringToObject(sc, "file", o->scene_path);
     cJSON_AddNumberToObject(sc, "triangles", s.ntris);
@@ -232,7 +354,7 @@ int render_reference(const RenderOptions *o, char *err, size_t errlen)
     cJSON_AddNumberToObject(ren, "max_depth", s.render.max_depth);
     cJSON_AddNumberToObject(ren, "seed", o->seed);
     cJSON_AddNumberToObject(ren, "stream_rays", o->stream_rays);
-    cJSON_AddNumberToObject(ren, "tile", rp.tile);
+    cJSON_AddNumberToObject(ren, "tile", tile);
     cJSON *im = cJSON_AddObjectToObject(root, "image");
     cJSON_AddNumberToObject(im, "mean", npx ? sum / (3.0 * (double)npx) : 0.0);
     cJSON_AddNumberToObject(im, "nonfinite", (double)nonfinite);
@@ -242,30 +364,67 @@ int render_reference(const RenderOptions *o, char *err, size_t errlen)
     cJSON_AddNumberToObject(host, "bvh_pack_seconds", t_pack - t_load);
     cJSON_AddNumberToObject(host, "threads", threads);
     cJSON_AddNumberToObject(host, "rays_per_second", secs > 0 ? (double)total_rays / secs : 0.0);
+    if (functional) {
+        cJSON_AddNumberToObject(host, "sim_instructions", (double)rs.f.instructions);
+        cJSON_AddNumberToObject(host, "instructions_per_second", secs > 0 ? (double)rs.f.instructions / secs : 0.0);
+    }
     json_text = cJSON_Print(root);
     snprintf(path, sizeof path, "%s/report.json", o->out_dir);
     if (!json_text || write_text(path, json_text, err, errlen) != 0)
         goto out;
 
-    char txt[4096];
-    snprintf(txt, sizeof txt,
-             "sfsim report -- mode reference (golden model: no timing)\n"
+    char txt[8192];
+    int len = snprintf(txt, sizeof txt,
+             "sfsim report -- mode %s (%s)\n"
              "scene        %s\n"
              "             %u triangles, %u spheres, %u lights; needs: %s\n"
              "             BVH %u nodes, %u leaves, depth %u, SAH cost %.2f; %u bytes of scene memory\n"
              "image        %d x %d, %d spp, max depth %d, seed %u, tiles %d x %d (M = %d)\n"
              "             mean %.5f, non-finite values %ld\n"
-             "rays         %llu total: %llu primary, %llu shadow, %llu indirect; %llu dropped\n"
-             "traversal    %llu nodes visited, %llu primitive tests\n"
-             "host         %.2f s rendering on %d threads (%.3f M rays/s); load %.2f s, BVH+pack %.2f s\n",
+             "rays         %llu total: %llu primary, %llu shadow, %llu indirect; %llu dropped\n",
+             o->mode, functional ? "the kernel on the functional core: no timing" : "golden model: no timing",
              o->scene_path, s.ntris, s.nspheres, p.nlights, needs[0] ? needs : "-", p.bvh.nnodes,
              p.bvh.nleaves, p.bvh.depth, p.bvh.sah_cost, p.size, s.render.width, s.render.height,
-             s.render.spp, s.render.max_depth, o->seed, rp.tile, rp.tile, o->stream_rays, sum / (3.0 * (double)npx),
-             nonfinite, (unsigned long long)total_rays, (unsigned long long)st.rays[REF_RAY_CAMERA],
-             (unsigned long long)st.rays[REF_RAY_SHADOW], (unsigned long long)st.rays[REF_RAY_INDIRECT],
-             (unsigned long long)st.dropped, (unsigned long long)st.nodes_visited,
-             (unsigned long long)st.prims_tested, secs, threads, secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0,
-             t_load - t0, t_pack - t_load);
+             s.render.spp, s.render.max_depth, o->seed, tile, tile, o->stream_rays, sum / (3.0 * (double)npx),
+             nonfinite, (unsigned long long)total_rays, (unsigned long long)rs.primary,
+             (unsigned long long)rs.shadow, (unsigned long long)rs.indirect, (unsigned long long)rs.dropped);
+    if (functional) {
+        const FuncStats *f = &rs.f;
+        uint64_t opsum[ISA_C_COUNT] = {0}, all = 0;
+        for (int c = 0; c < ISA_C_COUNT; c++) {
+            for (int k = 0; k < ISA_STAGE_COUNT; k++)
+                opsum[c] += f->core.ops[k][c];
+            all += opsum[c];
+        }
+        len += snprintf(txt + len, sizeof txt - (size_t)len,
+                        "machine      N = %d lanes, M = %d rays per stream; kernel %u instructions (%s)\n"
+                        "instructions %llu executed\n"
+                        "ops          ",
+                        cfg->core_simd_width, cfg->stream_rays, f->kernel_instructions, f->defines,
+                        (unsigned long long)f->instructions);
+        for (int c = 0; c < ISA_C_COUNT; c++)
+            len += snprintf(txt + len, sizeof txt - (size_t)len, "%s %.1f%%%s", isa_category_keys[c],
+                            100.0 * ratio(opsum[c], all), c + 1 < ISA_C_COUNT ? ", " : "\n");
+        len += snprintf(txt + len, sizeof txt - (size_t)len, "utilization  ");
+        for (int k = 0; k < ISA_STAGE_COUNT; k++)
+            len += snprintf(txt + len, sizeof txt - (size_t)len, "%s %.1f%%%s", isa_stage_keys[k],
+                            100.0 * ratio(f->core.active_lanes[k],
+                                          (uint64_t)cfg->core_simd_width * f->core.vec_instructions[k]),
+                            k + 1 < ISA_STAGE_COUNT ? ", " : "  (active lanes / (N x vector instructions))\n");
+        len += snprintf(txt + len, sizeof txt - (size_t)len,
+                        "streams      mean length: traversal %.1f, intersection %.1f, shading %.1f rays\n"
+                        "host         %.2f s on %d threads: %.2f M instructions/s, %.3f M rays/s; load %.2f s, BVH+pack %.2f s\n",
+                        ratio(f->trav_rays, f->trav_streams), ratio(f->isect_rays, f->isect_streams),
+                        ratio(f->shade_rays, f->shade_streams), secs, threads,
+                        secs > 0 ? 1e-6 * (double)f->instructions / secs : 0.0,
+                        secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, t_load - t0, t_pack - t_load);
+    } else {
+        len += snprintf(txt + len, sizeof txt - (size_t)len,
+                        "traversal    %llu nodes visited, %llu primitive tests\n"
+                        "host         %.2f s rendering on %d threads (%.3f M rays/s); load %.2f s, BVH+pack %.2f s\n",
+                        (unsigned long long)rs.nodes_visited, (unsigned long long)rs.prims_tested, secs, threads,
+                        secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, t_load - t0, t_pack - t_load);
+    }
     snprintf(path, sizeof path, "%s/report.txt", o->out_dir);
     if (write_text(path, txt, err, errlen) != 0)
         goto out;
@@ -274,6 +433,7 @@ out:
     cJSON_free(json_text);
     cJSON_Delete(root);
     free(rgb);
+    func_stats_free(&rs.f);
     pack_free(&p);
     scene_free(&s);
     return rc;

@@ -20,12 +20,16 @@ typedef struct RenderOptions {
     int bvh_leaf_size, bvh_bins;
     float exposure;            /* for frame.png */
     int progress;              /* 1: progress bar on stderr (the CLI sets it when stderr is a tty) */
+    const char *mode;          /* "reference" or "functional" */
+    const struct CfgMachine *cfg; /* the machine (functional mode; NULL: defaults) */
+    const char *kernel_path;   /* functional mode: the kernel source (NULL: next to the binary) */
 } RenderOptions;
 
 void render_default_options(RenderOptions *o);
 
-/* A run in the golden model (--mode reference). 0, or -1 with a message naming the file or
+/* A run in o->mode: "reference" (the golden model, sim/reference.c) or "functional" (the
+ * kernel on functional cores, sim/functional.c). 0, or -1 with a message naming the file or
  * the setting at fault. */
-int render_reference(const RenderOptions *o, char *err, size_t errlen);
+int render_run(const RenderOptions *o, char *err, size_t errlen);
 
 #endif

@@ -1,0 +1,1668 @@
+; kernels/pathtrace.s -- the stream-filter path tracer (Gribble & Ramani 2008, Sec. 3-4), the
+; program sfsim runs in `--mode functional` (and, later, under the timing model).
+;
+; One run renders one tile of at most RAYS pixels, all samples: for each sample a stream of
+; camera rays, then breadth-first generations -- set-up filter, BVH traversal by stream
+; filtering, intersection, shading filter stacks -- until a generation is empty. Radiance is
+; scatter-added into the tile framebuffer. The algorithm and every float operation follow the
+; golden model (sim/reference.c, docs/golden-model.md) so the images agree bit for bit;
+; docs/kernel.md describes the structure, registers and memories.
+;
+; Assembled by the host with -D RAYS=M and one -D per scene feature (docs/kernel.md):
+;   HAS_GLOSSY, HAS_DIELECTRIC, HAS_LAMBERT, HAS_NORMALS, HAS_BACKGROUND, HAS_AMBIENT.
+
+        .include "abi.inc"
+        .include "layout.inc"
+        .include "vmath.inc"
+
+PI_F      = 3.14159265
+INV_PI_F  = 0.318309886
+INV_2PI_F = 0.159154943
+TWO_PI_F  = 6.28318531
+SHADOW_TMAX = 0.999
+RR_START_DEPTH = 3
+RR_MAX_SURVIVAL = 0.95
+SLAB_FAR_SCALE = 1.00000072
+INF_BITS  = 0x7F800000
+NODE_BYTES_LOG2 = 5
+MAT_LAMBERT = 0
+MAT_GLOSSY = 1
+MAT_DIELECTRIC = 2
+DIM_DIRECT = 0
+DIM_LIGHT = 1
+DIM_LIGHT_U = 2
+DIM_LIGHT_V = 3
+DIM_LOBE = 4
+DIM_DIR_U = 5
+DIM_DIR_V = 6
+DIM_RR = 7
+LIGHT_QUAD = 3
+LIGHT_TRIANGLE = 4
+
+; ---- registers kept for the whole run ---------------------------------------------------------
+; r0 = 0 (never written)          r16 chunk pointer of the running stream loop
+; r17 sample                      r18 generation (= depth of every non-shadow ray in it)
+; r19 current stream begin        r20 current stream end
+; r21 next stream base            r22 next stream append pointer
+; r23 next ray slot counter       r24 traversal stack pointer (scratchpad)
+; r25 N                           r26, r27: scene header values (below)
+; r28 spp   r29 max depth         r30, r31 link registers
+; v31 = 0.0 in every lane, v30 = 0xFFFFFFFE (the shadow-ray mark of F_PRIM)
+.alias  vz, v31
+.alias  vm2, v30
+
+        .text
+start:  vli     vz, 0
+        vli     vm2, -2
+        rdn     r25
+        ld      r28, r0, SM_HDR_SPP
+        ld      r29, r0, SM_HDR_MAX_DEPTH
+        li      r17, 0
+
+; ==== one pass per sample: camera rays of the tile ==============================================
+sample_loop:
+        stage   0
+        li      r19, 0                  ; streams live at IDM 0 and IDM FIELD_BYTES
+        mov     r20, r19
+        spld    r1, r0, L_W
+        spld    r2, r0, L_H
+        spld    r3, r0, L_X0
+        spld    r4, r0, L_Y0
+        spld    r5, r0, L_SEED          ; hash32(seed), scalar
+        shri    r6, r5, 16
+        xor     r5, r5, r6
+        muli    r5, r5, 0x7feb352d
+        shri    r6, r5, 15
+        xor     r5, r5, r6
+        muli    r5, r5, 0x846ca68b
+        shri    r6, r5, 16
+        xor     r5, r5, r6
+        ld      r6, r0, SM_HDR_WIDTH
+        ld      r13, r0, SM_HDR_HEIGHT
+        cvtif   r14, r6                 ; (float) width, height
+        cvtif   r15, r13
+        li      r7, 0                   ; ly
+.alias  vlx, v0
+.alias  vid, v1
+.alias  vkey, v2
+.alias  vt, v3
+.alias  vt2, v4
+.alias  jx, v5
+.alias  jy, v6
+.alias  lr, v7
+.alias  phi, v8
+.alias  lensx, v9
+.alias  lensy, v10
+.alias  dx, v11
+.alias  dy, v12
+.alias  dz, v13
+.alias  ox, v14
+.alias  oy, v15
+.alias  oz, v16
+.alias  w0, v17
+.alias  w1, v18
+.alias  w2, v19
+cam_row:
+        li      r8, 0                   ; lx of the chunk's first lane
+cam_chunk:
+        sub     r9, r1, r8
+        mtail   m1, r9
+        viota   vlx @m1
+        vbcast  vt, r8 @m1
+        vadd    vlx, vlx, vt @m1
+        mul     r10, r7, r1
+        vbcast  vt, r10 @m1
+        vadd    vid, vlx, vt @m1        ; ray ID = ly * w + lx (raster order in the tile)
+        add     r11, r4, r7             ; y
+        mul     r12, r11, r6
+        add     r12, r12, r3
+        vbcast  vt, r12 @m1
+        vadd    vkey, vlx, vt @m1       ; pixel = y * width + x
+        vbcast  vt, r5 @m1
+        vxor    vkey, vkey, vt @m1
+        HASH    vkey, vt
+        vbcast  vt, r17 @m1
+        vadd    vkey, vkey, vt @m1
+        HASH    vkey, vt                ; path key
+        RAND    jx, vkey, 0, vt
+        RAND    jy, vkey, 1, vt
+        RAND    lr, vkey, 2, vt
+        RAND    phi, vkey, 3, vt
+        ; px = ((float) x + jx) / width - 0.5
+        vbcast  vt, r3 @m1
+        vadd    vt, vlx, vt @m1
+        vcvtif  vt, vt @m1
+        vfadd   jx, vt, jx @m1
+        vbcast  vt, r14 @m1
+        vfdiv   jx, jx, vt @m1
+        vli     vt, 0.5 @m1
+        vfsub   jx, jx, vt @m1
+        ; py = 0.5 - ((float) y + jy) / height
+        cvtif   r12, r11
+        vbcast  vt2, r12 @m1
+        vfadd   jy, vt2, jy @m1
+        vbcast  vt2, r15 @m1
+        vfdiv   jy, jy, vt2 @m1
+        vfsub   jy, vt, jy @m1
+        ; lens sample
+        vsqrt   lr, lr @m1
+        vli     vt, TWO_PI_F @m1
+        vfmul   phi, vt, phi @m1
+        vcos    lensx, phi @m1
+        vfmul   lensx, lr, lensx @m1
+        vsin    lensy, phi @m1
+        vfmul   lensy, lr, lensy @m1
+.macro  CAMAXIS d, o, off
+        ldb     w0, r0, SM_HDR_CAM_W + \off @m1
+        ldb     w1, r0, SM_HDR_CAM_U + \off @m1
+        vfmul   w1, jx, w1 @m1
+        vfadd   w0, w0, w1 @m1
+        ldb     w1, r0, SM_HDR_CAM_V + \off @m1
+        vfmul   w1, jy, w1 @m1
+        vfadd   w0, w0, w1 @m1          ; focal point
+        ldb     w1, r0, SM_HDR_LENS_U + \off @m1
+        vfmul   w1, lensx, w1 @m1
+        ldb     w2, r0, SM_HDR_LENS_V + \off @m1
+        vfmul   w2, lensy, w2 @m1
+        vfadd   w1, w1, w2 @m1          ; lens offset
+        ldb     \o, r0, SM_HDR_CAM_POS + \off @m1
+        vfadd   \o, \o, w1 @m1
+        vfsub   \d, w0, w1 @m1
+.endm
+        CAMAXIS dx, ox, 0
+        CAMAXIS dy, oy, 4
+        CAMAXIS dz, oz, 8
+        NORMALIZE3 d, vt, vt2
+        rsct    ox, vid, r0, F_ORGX @m1
+        rsct    oy, vid, r0, F_ORGY @m1
+        rsct    oz, vid, r0, F_ORGZ @m1
+        rsct    dx, vid, r0, F_DIRX @m1
+        rsct    dy, vid, r0, F_DIRY @m1
+        rsct    dz, vid, r0, F_DIRZ @m1
+        vli     vt, INF_BITS @m1
+        rsct    vt, vid, r0, F_TMAX @m1
+        vli     vt, 1.0 @m1
+        rsct    vt, vid, r0, F_THRR @m1
+        rsct    vt, vid, r0, F_THRG @m1
+        rsct    vt, vid, r0, F_THRB @m1
+        vmuli   vt, vid, 12 @m1
+        rsct    vt, vid, r0, F_FBOFF @m1
+        rsct    vkey, vid, r0, F_KEY @m1
+        vli     vt, KIND_CAMERA @m1
+        rsct    vt, vid, r0, F_KIND @m1
+        vli     vt, 0 @m1
+        rsct    vt, vid, r0, F_SPEC @m1
+        sapp    r20, vid @m1
+        add     r8, r8, r25
+        blt     r8, r1, cam_chunk
+        addi    r7, r7, 1
+        blt     r7, r2, cam_row
+        li      r18, 0
+
+; ==== generations ================================================================================
+gen_loop:
+        stage   0
+        li      r1, FIELD_BYTES
+        sub     r21, r1, r19            ; the other stream region
+        mov     r22, r21
+        li      r23, 0
+        li      r1, ST_MAX_GEN
+        bge     r18, r1, err_generations
+        jal     r30, setup
+        ; counters: rays traced in this generation, generations reached
+        sub     r1, r20, r19
+        shri    r1, r1, 2
+        shli    r2, r18, 2
+        spld    r3, r2, ST_PER_GEN
+        add     r3, r3, r1
+        spst    r3, r2, ST_PER_GEN
+        addi    r2, r18, 1
+        spld    r3, r0, ST_GENERATIONS
+        bge     r3, r2, gen_counted
+        spst    r2, r0, ST_GENERATIONS
+gen_counted:
+        beq     r19, r20, gen_shade     ; everything dropped
+        jal     r30, trace
+gen_shade:
+        jal     r30, shade
+        stage   0
+        rswap
+        mov     r19, r21
+        mov     r20, r22
+        addi    r18, r18, 1
+        bne     r19, r20, gen_loop
+        addi    r17, r17, 1
+        blt     r17, r28, sample_loop
+        halt
+
+err_generations:
+        li      r1, ERR_GENERATIONS
+        spst    r1, r0, L_ERROR
+        halt
+err_stack:
+        li      r1, ERR_STACK
+        spst    r1, r0, L_ERROR
+        halt
+
+; ==== set-up filter: drop non-finite rays, precompute the traversal constants ====================
+; Stream [r19, r20) -> [r19, r20') of finite rays; r20 moves down.
+setup:
+        beq     r19, r20, setup_done
+.alias  vid, v0
+.alias  ox, v1
+.alias  oy, v2
+.alias  oz, v3
+.alias  dx, v4
+.alias  dy, v5
+.alias  dz, v6
+.alias  vt, v7
+.alias  vt2, v8
+.alias  ax, v9
+.alias  ay, v10
+.alias  az, v11
+.alias  kx, v12
+.alias  ky, v13
+.alias  kz, v14
+.alias  vone, v15
+.alias  vtwo, v16
+.alias  sel, v17
+.alias  dkz, v18
+        mov     r16, r19
+setup_chunk:
+        sfetch  vid, m1, r16, r20
+        rgat    ox, vid, r0, F_ORGX @m1
+        rgat    oy, vid, r0, F_ORGY @m1
+        rgat    oz, vid, r0, F_ORGZ @m1
+        rgat    dx, vid, r0, F_DIRX @m1
+        rgat    dy, vid, r0, F_DIRY @m1
+        rgat    dz, vid, r0, F_DIRZ @m1
+        ; finite: the sum of x * 0 over the nine values is 0, else NaN
+        vfmul   vt, ox, vz @m1
+        vfmul   vt2, oy, vz @m1
+        vfadd   vt, vt, vt2 @m1
+        vfmul   vt2, oz, vz @m1
+        vfadd   vt, vt, vt2 @m1
+        vfmul   vt2, dx, vz @m1
+        vfadd   vt, vt, vt2 @m1
+        vfmul   vt2, dy, vz @m1
+        vfadd   vt, vt, vt2 @m1
+        vfmul   vt2, dz, vz @m1
+        vfadd   vt, vt, vt2 @m1
+        rgat    ax, vid, r0, F_THRR @m1
+        vfmul   vt2, ax, vz @m1
+        vfadd   vt, vt, vt2 @m1
+        rgat    ax, vid, r0, F_THRG @m1
+        vfmul   vt2, ax, vz @m1
+        vfadd   vt, vt, vt2 @m1
+        rgat    ax, vid, r0, F_THRB @m1
+        vfmul   vt2, ax, vz @m1
+        vfadd   vt, vt, vt2 @m1
+        vfeq    m2, vt, vz @m1
+        pmask   m2
+        ; sanitized direction and its inverse
+        SANITIZE1 dx, vt, vt2, m3
+        SANITIZE1 dy, vt, vt2, m3
+        SANITIZE1 dz, vt, vt2, m3
+        vrcp    vt, dx @m1
+        rsct    vt, vid, r0, F_INVX @m1
+        vrcp    vt, dy @m1
+        rsct    vt, vid, r0, F_INVY @m1
+        vrcp    vt, dz @m1
+        rsct    vt, vid, r0, F_INVZ @m1
+        ; watertight test set-up: kz = axis of the largest |d|, kx, ky the next ones
+        vfabs   ax, dx @m1
+        vfabs   ay, dy @m1
+        vfabs   az, dz @m1
+        vli     vone, 1 @m1
+        vli     vtwo, 2 @m1
+        vflt    m3, ay, ax @m1          ; ax > ay
+        vflt    m4, az, ax @m1          ; ax > az
+        vflt    m5, az, ay @m1          ; ay > az
+        vmov    kz, vtwo @m1
+        vmov    kz, vone @m5
+        mand    m6, m3, m4
+        vli     kz, 0 @m6
+        mandn   m6, m3, m4
+        vmov    kz, vtwo @m6
+        vaddi   kx, kz, 1 @m1
+        vieq    m6, kz, vtwo @m1
+        vli     kx, 0 @m6
+        vaddi   ky, kx, 1 @m1
+        vieq    m6, kx, vtwo @m1
+        vli     ky, 0 @m6
+.macro  PICK d, idx, a                  ; d = a[idx] for idx in 0..2 (lane-wise)
+        vmov    \d, \a\()x @m1
+        vieq    m6, \idx, vone @m1
+        vmov    \d, \a\()y @m6
+        vieq    m6, \idx, vtwo @m1
+        vmov    \d, \a\()z @m6
+.endm
+        PICK    dkz, kz, d
+        vflt    m6, dkz, vz @m1         ; d[kz] < 0: swap kx and ky to keep the winding
+        vmov    vt, kx @m6
+        vmov    kx, ky @m6
+        vmov    ky, vt @m6
+        PICK    vt, kx, d
+        vfdiv   vt, vt, dkz @m1
+        rsct    vt, vid, r0, F_SX @m1
+        PICK    vt, ky, d
+        vfdiv   vt, vt, dkz @m1
+        rsct    vt, vid, r0, F_SY @m1
+        vrcp    vt, dkz @m1
+        rsct    vt, vid, r0, F_SZ @m1
+        PICK    vt, kx, o
+        rsct    vt, vid, r0, F_POX @m1
+        PICK    vt, ky, o
+        rsct    vt, vid, r0, F_POY @m1
+        PICK    vt, kz, o
+        rsct    vt, vid, r0, F_POZ @m1
+        vshli   vt, kx, 2 @m1
+        rsct    vt, vid, r0, F_KX @m1
+        vshli   vt, ky, 2 @m1
+        rsct    vt, vid, r0, F_KY @m1
+        vshli   vt, kz, 2 @m1
+        rsct    vt, vid, r0, F_KZ @m1
+        ; no hit yet; shadow rays are marked -2
+        rgat    vt, vid, r0, F_KIND @m1
+        vieq    m6, vt, vtwo @m1
+        vli     vt2, -1 @m1
+        vmov    vt2, vm2 @m6
+        rsct    vt2, vid, r0, F_PRIM @m1
+        blt     r16, r20, setup_chunk
+        part    r1, r19, r20
+        sub     r2, r20, r1
+        shri    r2, r2, 2
+        spld    r3, r0, ST_DROPPED
+        add     r3, r3, r2
+        spst    r3, r0, ST_DROPPED
+        mov     r20, r1
+setup_done:
+        jr      r30
+
+; ==== traversal: stream filtering down the BVH (Fig. 3), front to back per ray ==================
+; A stack entry is (node address, begin, end) of an ID range in IDM; ranges are partitioned in
+; place, so a child's range is a prefix of its parent's. At an inner node the passing rays are
+; split by the sign of their direction on the split axis, and the four (child, half) entries are
+; pushed so that every ray meets the near child's whole subtree first -- the golden model's
+; visiting order, hence its hit distances and tie breaks, for every ray.
+trace:
+        stage   1
+        ld      r15, r0, SM_HDR_NNODES
+        beq     r15, r0, trace_done
+        ld      r26, r0, SM_HDR_NODES
+        ld      r27, r0, SM_HDR_PRIMS
+        li      r24, STACK_BASE
+        spst    r26, r24, 0
+        spst    r19, r24, 4
+        spst    r20, r24, 8
+        addi    r24, r24, 12
+.alias  vid, v0
+.alias  bminx, v1
+.alias  bminy, v2
+.alias  bminz, v3
+.alias  bmaxx, v4
+.alias  bmaxy, v5
+.alias  bmaxz, v6
+.alias  ox, v7
+.alias  oy, v8
+.alias  oz, v9
+.alias  ix, v10
+.alias  iy, v11
+.alias  iz, v12
+.alias  tn, v13
+.alias  tf, v14
+.alias  t0, v15
+.alias  t1, v16
+.alias  tlo, v17
+.alias  vscale, v18
+trav_pop:
+        li      r1, STACK_BASE
+        beq     r24, r1, trace_done
+        addi    r24, r24, -12
+        spld    r2, r24, 0              ; node address
+        spld    r3, r24, 4              ; range
+        spld    r4, r24, 8
+        ldb     bminx, r2, SM_NODE_BMIN
+        ldb     bminy, r2, SM_NODE_BMIN + 4
+        ldb     bminz, r2, SM_NODE_BMIN + 8
+        ldb     bmaxx, r2, SM_NODE_BMAX
+        ldb     bmaxy, r2, SM_NODE_BMAX + 4
+        ldb     bmaxz, r2, SM_NODE_BMAX + 8
+        vli     vscale, SLAB_FAR_SCALE
+        spld    r5, r0, ST_TRAV_STREAMS
+        addi    r5, r5, 1
+        spst    r5, r0, ST_TRAV_STREAMS
+        sub     r5, r4, r3
+        shri    r5, r5, 2
+        spld    r6, r0, ST_TRAV_RAYS
+        add     r6, r6, r5
+        spst    r6, r0, ST_TRAV_RAYS
+        mov     r16, r3
+box_chunk:
+        sfetch  vid, m1, r16, r4
+        rgat    ox, vid, r0, F_ORGX @m1
+        rgat    oy, vid, r0, F_ORGY @m1
+        rgat    oz, vid, r0, F_ORGZ @m1
+        rgat    ix, vid, r0, F_INVX @m1
+        rgat    iy, vid, r0, F_INVY @m1
+        rgat    iz, vid, r0, F_INVZ @m1
+        rgat    tf, vid, r0, F_TMAX @m1
+        vli     tn, 0 @m1
+.macro  SLAB bmin, bmax, o, inv
+        vfsub   t0, \bmin, \o @m1
+        vfmul   t0, t0, \inv @m1
+        vfsub   t1, \bmax, \o @m1
+        vfmul   t1, t1, \inv @m1
+        vfmin   tlo, t0, t1 @m1
+        vfmax   t1, t0, t1 @m1
+        vfmul   t1, t1, vscale @m1
+        vfmax   tn, tn, tlo @m1
+        vfmin   tf, tf, t1 @m1
+.endm
+        SLAB    bminx, bmaxx, ox, ix
+        SLAB    bminy, bmaxy, oy, iy
+        SLAB    bminz, bmaxz, oz, iz
+        vfle    m2, tn, tf @m1
+        pmask   m2
+        blt     r16, r4, box_chunk
+        part    r5, r3, r4              ; [r3, r5): rays that overlap the box
+        beq     r5, r3, trav_pop        ; empty streams are pruned
+        ld      r6, r2, SM_NODE_INFO
+        ld      r7, r2, SM_NODE_FIRST
+        blt     r6, r0, trav_inner
+        stage   2
+        jal     r31, isect
+        stage   1
+        jmp     trav_pop
+trav_inner:
+        andi    r8, r6, 3               ; split axis: F_INV of that axis
+        muli    r8, r8, FIELD_BYTES
+        addi    r8, r8, F_INVX
+        mov     r16, r3
+split_chunk:
+        sfetch  vid, m1, r16, r5
+        rgat    t0, vid, r8, 0 @m1
+        vflt    m2, t0, vz @m1          ; negative direction: the right child is nearer
+        pmask   m2
+        blt     r16, r5, split_chunk
+        part    r9, r3, r5              ; [r3, r9) negative, [r9, r5) positive
+        shli    r10, r7, NODE_BYTES_LOG2
+        add     r10, r10, r26           ; left child
+        addi    r11, r10, SM_NODE_BYTES ; right child
+        li      r12, STACK_LIMIT        ; room for four entries?
+        addi    r1, r24, 48
+        bltu    r12, r1, err_stack
+.macro  PUSH node, b, e
+        spst    \node, r24, 0
+        spst    \b, r24, 4
+        spst    \e, r24, 8
+        addi    r24, r24, 12
+.endm
+        beq     r9, r5, push_neg_only   ; no positive rays
+        beq     r3, r9, push_pos_only   ; no negative rays
+        PUSH    r11, r9, r5             ; positive rays: right child second
+        PUSH    r10, r3, r9             ; negative rays: left child second
+        PUSH    r10, r9, r5             ; positive rays: left child first
+        PUSH    r11, r3, r9             ; negative rays: right child first
+        jmp     trav_pop
+push_pos_only:
+        PUSH    r11, r9, r5
+        PUSH    r10, r9, r5
+        jmp     trav_pop
+push_neg_only:
+        PUSH    r10, r3, r9
+        PUSH    r11, r3, r9
+        jmp     trav_pop
+trace_done:
+        stage   0
+        jr      r30
+
+; ==== intersection: the leaf's primitives against the stream [r3, r5) ===========================
+; Per ray the primitives are tested in order (the golden model's order); the best hit stays in
+; registers over the leaf and is scattered once per chunk (conditional scatter).
+; In: r7 first primitive, r6 count. Clobbers r1-r15 (not r24, r26, r27).
+isect:
+.alias  vid, v0
+.alias  kx, v1
+.alias  ky, v2
+.alias  kz, v3
+.alias  sx, v4
+.alias  sy, v5
+.alias  sz, v6
+.alias  pox, v7
+.alias  poy, v8
+.alias  poz, v9
+.alias  tm, v10
+.alias  prim, v11
+.alias  bu, v12
+.alias  bv, v13
+.alias  ptm, v14
+.alias  adx, v15
+.alias  ady, v16
+.alias  adz, v17
+.alias  ex, v18
+.alias  ey, v19
+.alias  ez, v20
+.alias  fx, v21
+.alias  fy, v22
+.alias  fz, v23
+.alias  gx, v24
+.alias  gy, v25
+.alias  gz, v26
+.alias  vt, v27
+.alias  vi, v28
+        spld    r8, r0, ST_ISECT_STREAMS
+        addi    r8, r8, 1
+        spst    r8, r0, ST_ISECT_STREAMS
+        sub     r8, r5, r3
+        shri    r8, r8, 2
+        spld    r9, r0, ST_ISECT_RAYS
+        add     r9, r9, r8
+        spst    r9, r0, ST_ISECT_RAYS
+        li      r8, SM_PRIM_BYTES
+        mul     r8, r8, r7
+        add     r8, r8, r27             ; address of the first primitive
+        add     r9, r7, r6              ; one past the last index
+        mov     r16, r3
+isect_chunk:
+        sfetch  vid, m1, r16, r5
+        rgat    kx, vid, r0, F_KX @m1
+        rgat    ky, vid, r0, F_KY @m1
+        rgat    kz, vid, r0, F_KZ @m1
+        rgat    sx, vid, r0, F_SX @m1
+        rgat    sy, vid, r0, F_SY @m1
+        rgat    sz, vid, r0, F_SZ @m1
+        rgat    pox, vid, r0, F_POX @m1
+        rgat    poy, vid, r0, F_POY @m1
+        rgat    poz, vid, r0, F_POZ @m1
+        rgat    tm, vid, r0, F_TMAX @m1
+        rgat    prim, vid, r0, F_PRIM @m1
+        vieq    m2, prim, vm2 @m1       ; shadow rays
+        mclr    m3                      ; lanes whose tmax changed
+        mclr    m4                      ; lanes with a new closest hit
+        mov     r10, r8                 ; primitive address
+        mov     r11, r7                 ; primitive index
+isect_prim:
+        vbcast  vt, r10 @m1
+        vadd    adx, kx, vt @m1
+        vadd    ady, ky, vt @m1
+        vadd    adz, kz, vt @m1
+        ; vertex -> (x, y, z) in the ray's sheared frame; the z value stays unscaled until later
+.macro  SHEAR ox, oy, oz, off
+        ldg     \ox, adx, \off @m1
+        ldg     \oy, ady, \off @m1
+        ldg     \oz, adz, \off @m1
+        vfsub   \ox, \ox, pox @m1
+        vfsub   \oy, \oy, poy @m1
+        vfsub   \oz, \oz, poz @m1        ; A[kz]
+        vfmul   vt, sx, \oz @m1
+        vfsub   \ox, \ox, vt @m1         ; A[kx] - sx A[kz]
+        vfmul   vt, sy, \oz @m1
+        vfsub   \oy, \oy, vt @m1
+.endm
+        SHEAR   ex, ey, ez, SM_PRIM_V0
+        SHEAR   fx, fy, fz, SM_PRIM_V1
+        SHEAR   gx, gy, gz, SM_PRIM_V2
+        ; U = Cx By - Cy Bx, V = Ax Cy - Ay Cx, W = Bx Ay - By Ax  (A = e, B = f, C = g)
+        vfmul   adx, gx, fy @m1
+        vfmul   vt, gy, fx @m1
+        vfsub   adx, adx, vt @m1        ; U
+        vfmul   ady, ex, gy @m1
+        vfmul   vt, ey, gx @m1
+        vfsub   ady, ady, vt @m1        ; V
+        vfmul   adz, fx, ey @m1
+        vfmul   vt, fy, ex @m1
+        vfsub   adz, adz, vt @m1        ; W
+        vflt    m5, adx, vz @m1
+        vflt    m6, ady, vz @m1
+        mor     m5, m5, m6
+        vflt    m6, adz, vz @m1
+        mor     m5, m5, m6              ; some edge function negative
+        vflt    m6, vz, adx @m1
+        vflt    m7, vz, ady @m1
+        mor     m6, m6, m7
+        vflt    m7, vz, adz @m1
+        mor     m6, m6, m7              ; some edge function positive
+        mand    m5, m5, m6
+        mandn   m5, m1, m5              ; inside (or on an edge)
+        bmz     m5, isect_next
+        vfadd   ex, adx, ady @m5
+        vfadd   ex, ex, adz @m5         ; det = U + V + W
+        vfne    m5, ex, vz @m5
+        ; Az, Bz, Cz scaled by sz; T = U Az + V Bz + W Cz
+        vfmul   ez, sz, ez @m5
+        vfmul   fz, sz, fz @m5
+        vfmul   gz, sz, gz @m5
+        vfmul   ey, adx, ez @m5
+        vfmul   vt, ady, fz @m5
+        vfadd   ey, ey, vt @m5
+        vfmul   vt, adz, gz @m5
+        vfadd   ey, ey, vt @m5          ; T
+        vflt    m6, ex, vz @m5          ; seen from behind: flip the signs
+        vfneg   ey, ey @m6
+        vfneg   ex, ex @m6
+        vfneg   ady, ady @m6
+        vfneg   adz, adz @m6
+        ; probe distance: a ray with a hit tests up to nextafter(best), so ties are seen
+        vmov    ptm, tm @m5
+        viltu   m6, prim, vm2 @m5
+        vaddi   ptm, ptm, 1 @m6
+        vflt    m5, vz, ey @m5          ; T > 0
+        vfmul   vt, ptm, ex @m5
+        vflt    m5, ey, vt @m5          ; T < tmax det
+        bmz     m5, isect_next
+        vrcp    ex, ex @m5
+        vfmul   ey, ey, ex @m5          ; t
+        vfmul   ady, ady, ex @m5        ; u
+        vfmul   adz, adz, ex @m5        ; v
+        vflt    m5, vz, ey @m5
+        vflt    m5, ey, ptm @m5
+        ; shadow rays: occluded, done
+        mand    m6, m5, m2
+        vli     tm, -1.0 @m6
+        mor     m3, m3, m6
+        ; closest: t < best, or a tie won by the lower index
+        mandn   m5, m5, m2
+        vbcast  vi, r11 @m5
+        vflt    m6, ey, tm @m5
+        vfeq    m7, ey, tm @m5
+        viltu   m7, vi, prim @m7
+        mor     m6, m6, m7
+        vmov    tm, ey @m6
+        vmov    bu, ady @m6
+        vmov    bv, adz @m6
+        vmov    prim, vi @m6
+        mor     m3, m3, m6
+        mor     m4, m4, m6
+isect_next:
+        addi    r10, r10, SM_PRIM_BYTES
+        addi    r11, r11, 1
+        blt     r11, r9, isect_prim
+        rsct    tm, vid, r0, F_TMAX @m3
+        rsct    prim, vid, r0, F_PRIM @m4
+        rsct    bu, vid, r0, F_U @m4
+        rsct    bv, vid, r0, F_V @m4
+        blt     r16, r5, isect_chunk
+        jr      r31
+
+; ==== shading: the filter stack of Fig. 4 ========================================================
+; Stream [r19, r20) after traversal. Shadow filter, miss filter, surface + hit-light filter, then
+; one filter per material kind; each material shader splits direct and indirect rays with a
+; further filter. New rays go to the next ray buffer (ralloc, rsctn) and their IDs to the next
+; stream (sapp r22).
+
+; count a shading filter's input stream [\b, \e) (scratch r1, r2)
+.macro  SHADE_STREAM b, e
+        spld    r1, r0, ST_SHADE_STREAMS
+        addi    r1, r1, 1
+        spst    r1, r0, ST_SHADE_STREAMS
+        sub     r2, \e, \b
+        shri    r2, r2, 2
+        spld    r1, r0, ST_SHADE_RAYS
+        add     r1, r1, r2
+        spst    r1, r0, ST_SHADE_RAYS
+.endm
+
+; New ray into the next buffer for the lanes of mask k; o, d, th triples; vid the parent.
+.macro  EMIT k, o, d, th, tmaxv, kind, spec, slot, t
+        ralloc  \slot, r23 @\k
+        rsctn   \o\()x, \slot, r0, F_ORGX @\k
+        rsctn   \o\()y, \slot, r0, F_ORGY @\k
+        rsctn   \o\()z, \slot, r0, F_ORGZ @\k
+        rsctn   \d\()x, \slot, r0, F_DIRX @\k
+        rsctn   \d\()y, \slot, r0, F_DIRY @\k
+        rsctn   \d\()z, \slot, r0, F_DIRZ @\k
+        rsctn   \th\()x, \slot, r0, F_THRR @\k
+        rsctn   \th\()y, \slot, r0, F_THRG @\k
+        rsctn   \th\()z, \slot, r0, F_THRB @\k
+        vli     \t, \tmaxv @\k
+        rsctn   \t, \slot, r0, F_TMAX @\k
+        rgat    \t, vid, r0, F_FBOFF @\k
+        rsctn   \t, \slot, r0, F_FBOFF @\k
+        rgat    \t, vid, r0, F_KEY @\k
+        rsctn   \t, \slot, r0, F_KEY @\k
+        vli     \t, \kind @\k
+        rsctn   \t, \slot, r0, F_KIND @\k
+        vli     \t, \spec @\k
+        rsctn   \t, \slot, r0, F_SPEC @\k
+        sapp    r22, \slot @\k
+.endm
+
+; fbadd of a triple at the rays' pixels (vid the rays; t scratch)
+.macro  FBADD3 v, t, k
+        rgat    \t, vid, r0, F_FBOFF @\k
+        fbadd   \v\()x, \t, 0 @\k
+        fbadd   \v\()y, \t, 4 @\k
+        fbadd   \v\()z, \t, 8 @\k
+.endm
+
+; thr triple of the rays
+.macro  GATHER3 v, f0, f1, f2, k=m1
+        rgat    \v\()x, vid, r0, \f0 @\k
+        rgat    \v\()y, vid, r0, \f1 @\k
+        rgat    \v\()z, vid, r0, \f2 @\k
+.endm
+
+; filter: partition [\b, \e) so the rays whose field \field equals \val (integer) come first;
+; \split := end of that part
+.macro  FILTER_EQ b, e, split, field, val
+        mov     \split, \b
+        beq     \b, \e, fd\@
+        mov     r16, \b
+fe\@:
+        sfetch  v0, m1, r16, \e
+        rgat    v1, v0, r0, \field @m1
+        vli     v2, \val @m1
+        vieq    m2, v1, v2 @m1
+        pmask   m2
+        blt     r16, \e, fe\@
+        part    \split, \b, \e
+fd\@:
+.endm
+
+shade:
+        spst    r30, r0, L_LINK         ; the shaders below use r30 and r31 themselves
+        stage   3
+        beq     r19, r20, shade_done
+        ; ---- shadow filter: unoccluded shadow rays add the radiance they carry
+        FILTER_EQ r19, r20, r3, F_KIND, KIND_SHADOW
+        sub     r1, r3, r19
+        shri    r1, r1, 2
+        spld    r2, r0, ST_SHADOW
+        add     r2, r2, r1
+        spst    r2, r0, ST_SHADOW
+        sub     r1, r20, r3
+        shri    r1, r1, 2
+        li      r4, ST_INDIRECT
+        bne     r18, r0, sh_count
+        li      r4, ST_CAMERA
+sh_count:
+        spld    r2, r4, 0
+        add     r2, r2, r1
+        spst    r2, r4, 0
+        beq     r19, r3, sh_shadow_done
+        SHADE_STREAM r19, r3
+.alias  vid, v0
+.alias  tm, v1
+.alias  thx, v2
+.alias  thy, v3
+.alias  thz, v4
+.alias  vt, v5
+        mov     r16, r19
+sh_shadow:
+        sfetch  vid, m1, r16, r3
+        rgat    tm, vid, r0, F_TMAX @m1
+        vfle    m2, vz, tm @m1          ; not occluded (occluded rays have tmax = -1)
+        GATHER3 th, F_THRR, F_THRG, F_THRB, m2
+        FBADD3  th, vt, m2
+        blt     r16, r3, sh_shadow
+sh_shadow_done:
+        ; ---- miss filter
+        FILTER_EQ r3, r20, r4, F_PRIM, -1
+.ifdef HAS_BACKGROUND
+        beq     r3, r4, sh_miss_done
+        SHADE_STREAM r3, r4
+.alias  bgx, v6
+.alias  bgy, v7
+.alias  bgz, v8
+        mov     r16, r3
+sh_miss:
+        sfetch  vid, m1, r16, r4
+        ldb     bgx, r0, SM_HDR_BACKGROUND @m1
+        ldb     bgy, r0, SM_HDR_BACKGROUND + 4 @m1
+        ldb     bgz, r0, SM_HDR_BACKGROUND + 8 @m1
+        GATHER3 th, F_THRR, F_THRG, F_THRB
+        vfmul   thx, thx, bgx @m1
+        vfmul   thy, thy, bgy @m1
+        vfmul   thz, thz, bgz @m1
+        FBADD3  th, vt, m1
+        blt     r16, r4, sh_miss
+sh_miss_done:
+.endif
+        ; ---- surfaces; the hit-light filter
+        beq     r4, r20, sh_return
+        SHADE_STREAM r4, r20
+        mov     r3, r4
+        jal     r31, surface            ; [r3, r20) -> emitters first, r5 = end of them
+        ; ---- one filter per material kind on [r5, r20)
+.ifdef HAS_LAMBERT
+        FILTER_EQ r5, r20, r6, F_MATKIND, MAT_LAMBERT
+        mov     r12, r5
+        mov     r13, r6
+        li      r14, MAT_LAMBERT
+        jal     r31, diffuse
+        mov     r5, r6
+.endif
+.ifdef HAS_GLOSSY
+        FILTER_EQ r5, r20, r6, F_MATKIND, MAT_GLOSSY
+        mov     r12, r5
+        mov     r13, r6
+        li      r14, MAT_GLOSSY
+        jal     r31, diffuse
+        mov     r5, r6
+.endif
+.ifdef HAS_DIELECTRIC
+        FILTER_EQ r5, r20, r6, F_MATKIND, MAT_DIELECTRIC
+        mov     r12, r5
+        mov     r13, r6
+        jal     r31, dielectric
+        mov     r5, r6
+.endif
+sh_return:
+shade_done:
+        spld    r30, r0, L_LINK
+        jr      r30
+
+; ---- surface filter on [r3, r20): hit point, normals, material, base colour into the ray's
+; dead set-up fields; emitters seen from their emitting side go first ([r3, r5)) and add their
+; emission for camera rays and after delta bounces. Clobbers r1, r2, r4, r7-r16.
+surface:
+.alias  vid, v0
+.alias  pa, v1
+.alias  ax, v2
+.alias  ay, v3
+.alias  az, v4
+.alias  ex, v5
+.alias  ey, v6
+.alias  ez, v7
+.alias  fx, v8
+.alias  fy, v9
+.alias  fz, v10
+.alias  gx, v11
+.alias  gy, v12
+.alias  gz, v13
+.alias  vt, v14
+.alias  vt2, v15
+.alias  dn, v16
+.alias  nfx, v17
+.alias  nfy, v18
+.alias  nfz, v19
+.alias  nsx, v20
+.alias  nsy, v21
+.alias  nsz, v22
+.alias  mat, v23
+.alias  bu, v24
+.alias  bv, v25
+.alias  w0, v26
+.alias  vt3, v27
+        ld      r7, r0, SM_HDR_PRIMS
+        ld      r8, r0, SM_HDR_MATS
+        ld      r9, r0, SM_HDR_NORMALS
+        mov     r16, r3
+surf_chunk:
+        sfetch  vid, m1, r16, r20
+        rgat    pa, vid, r0, F_PRIM @m1
+        vmuli   pa, pa, SM_PRIM_BYTES @m1
+        vbcast  vt, r7 @m1
+        vadd    pa, pa, vt @m1
+        ldg     ax, pa, SM_PRIM_V0 @m1
+        ldg     ay, pa, SM_PRIM_V0 + 4 @m1
+        ldg     az, pa, SM_PRIM_V0 + 8 @m1
+        ldg     ex, pa, SM_PRIM_V1 @m1
+        ldg     ey, pa, SM_PRIM_V1 + 4 @m1
+        ldg     ez, pa, SM_PRIM_V1 + 8 @m1
+        ldg     fx, pa, SM_PRIM_V2 @m1
+        ldg     fy, pa, SM_PRIM_V2 + 4 @m1
+        ldg     fz, pa, SM_PRIM_V2 + 8 @m1
+        vfsub   ex, ex, ax @m1          ; e1 = v1 - v0
+        vfsub   ey, ey, ay @m1
+        vfsub   ez, ez, az @m1
+        vfsub   fx, fx, ax @m1          ; e2 = v2 - v0
+        vfsub   fy, fy, ay @m1
+        vfsub   fz, fz, az @m1
+        CROSS3  g, e, f, vt             ; geometric normal (winding)
+        NORMALIZE3 g, vt, vt2
+        rsct    gx, vid, r0, F_NGX @m1
+        rsct    gy, vid, r0, F_NGY @m1
+        rsct    gz, vid, r0, F_NGZ @m1
+        ; hit point p = o + t d
+        GATHER3 e, F_DIRX, F_DIRY, F_DIRZ
+        GATHER3 a, F_ORGX, F_ORGY, F_ORGZ
+        rgat    vt2, vid, r0, F_TMAX @m1
+.macro  HITP a, e, f
+        vfmul   vt, vt2, \e @m1
+        vfadd   vt, \a, vt @m1
+        rsct    vt, vid, r0, \f @m1
+.endm
+        HITP    ax, ex, F_PX
+        HITP    ay, ey, F_PY
+        HITP    az, ez, F_PZ
+        DOT3    dn, g, e, vt            ; ng . d
+        vmov    nfx, gx @m1
+        vmov    nfy, gy @m1
+        vmov    nfz, gz @m1
+        vflt    m2, vz, dn @m1          ; facing away: flip
+        vfneg   nfx, nfx @m2
+        vfneg   nfy, nfy @m2
+        vfneg   nfz, nfz @m2
+        vmov    nsx, nfx @m1
+        vmov    nsy, nfy @m1
+        vmov    nsz, nfz @m1
+.ifdef HAS_NORMALS
+        ; interpolated vertex normals: w0 n0 + u n1 + v n2, normalized, on nf's side
+        ldg     vt, pa, SM_PRIM_SRC @m1
+        vmuli   vt, vt, 36 @m1
+        vbcast  vt2, r9 @m1
+        vadd    vt, vt, vt2 @m1         ; address of the three normals
+        rgat    bu, vid, r0, F_U @m1
+        rgat    bv, vid, r0, F_V @m1
+        vli     w0, 1.0 @m1
+        vfsub   w0, w0, bu @m1
+        vfsub   w0, w0, bv @m1
+.macro  NINTERP d, off
+        ldg     \d, vt, \off @m1
+        vfmul   \d, w0, \d @m1
+        ldg     vt2, vt, \off + 12 @m1
+        vfmul   vt2, bu, vt2 @m1
+        vfadd   \d, \d, vt2 @m1
+        ldg     vt2, vt, \off + 24 @m1
+        vfmul   vt2, bv, vt2 @m1
+        vfadd   \d, \d, vt2 @m1
+.endm
+        NINTERP ax, 0
+        NINTERP ay, 4
+        NINTERP az, 8
+        NORMALIZE3 a, vt, vt2
+        vfmul   vt, ax, vz @m1          ; finite?
+        vfmul   vt2, ay, vz @m1
+        vfadd   vt, vt, vt2 @m1
+        vfmul   vt2, az, vz @m1
+        vfadd   vt, vt, vt2 @m1
+        vfeq    m3, vt, vz @m1
+        DOT3    vt, a, nf, vt2, m3
+        vflt    m4, vt, vz @m3          ; on the other side: flip
+        vfneg   ax, ax @m4
+        vfneg   ay, ay @m4
+        vfneg   az, az @m4
+        vmov    nsx, ax @m3
+        vmov    nsy, ay @m3
+        vmov    nsz, az @m3
+.endif
+        rsct    nsx, vid, r0, F_NSX @m1
+        rsct    nsy, vid, r0, F_NSY @m1
+        rsct    nsz, vid, r0, F_NSZ @m1
+        ; material
+        ldg     mat, pa, SM_PRIM_MAT @m1
+        vmuli   mat, mat, SM_MAT_BYTES @m1
+        vbcast  vt, r8 @m1
+        vadd    mat, mat, vt @m1
+        ldg     vt, mat, SM_MAT_BASE @m1
+        rsct    vt, vid, r0, F_BASER @m1
+        ldg     vt, mat, SM_MAT_BASE + 4 @m1
+        rsct    vt, vid, r0, F_BASEG @m1
+        ldg     vt, mat, SM_MAT_BASE + 8 @m1
+        rsct    vt, vid, r0, F_BASEB @m1
+        ldg     vt, mat, SM_MAT_KIND @m1
+        rsct    mat, vid, r0, F_MAT @m1
+        rsct    vt, vid, r0, F_MATKIND @m1
+        ; hit-light filter: emission > 0 seen from the front (or double-sided)
+        ldg     ax, mat, SM_MAT_EMISSION @m1
+        ldg     ay, mat, SM_MAT_EMISSION + 4 @m1
+        ldg     az, mat, SM_MAT_EMISSION + 8 @m1
+        vfadd   vt, ax, ay @m1
+        vfadd   vt, vt, az @m1
+        vflt    m2, vz, vt @m1          ; emits
+        vflt    m3, dn, vz @m1          ; seen from the front
+        ldg     vt, mat, SM_MAT_DOUBLE_SIDED @m1
+        vli     vt2, 0 @m1
+        vieq    m4, vt, vt2 @m1
+        mandn   m4, m1, m4
+        mor     m3, m3, m4
+        mand    m2, m2, m3
+        pmask   m2
+        ; emission counts for camera rays and after delta bounces
+        beq     r18, r0, surf_add
+        rgat    vt, vid, r0, F_SPEC @m2
+        vli     vt2, 0 @m2
+        vieq    m3, vt, vt2 @m2
+        mandn   m2, m2, m3
+surf_add:
+        GATHER3 e, F_THRR, F_THRG, F_THRB, m2
+        vfmul   ex, ex, ax @m2
+        vfmul   ey, ey, ay @m2
+        vfmul   ez, ez, az @m2
+        FBADD3  e, vt, m2
+        blt     r16, r20, surf_chunk
+        part    r5, r3, r20
+        jr      r31
+
+; ---- Lambertian and coupled glossy shaders on [r12, r13), kind r14 (scalar: the filter above
+; made the stream one kind). Direct/indirect split by a filter, then one pass for each part.
+; Preserves r5, r6, r17-r30.
+diffuse:
+        beq     r12, r13, diff_done
+        SHADE_STREAM r12, r13
+        addi    r7, r18, 1              ; vertex = depth + 1
+        shli    r8, r7, 4               ; 16 * vertex
+        slt     r9, r29, r7             ; can_bounce = depth + 1 <= max_depth
+        xori    r9, r9, 1
+        ld      r10, r0, SM_HDR_NLIGHTS
+        li      r11, 0.5                ; p_direct
+        bne     r9, r0, diff_pd1
+        li      r11, 1.0
+diff_pd1:
+.ifdef HAS_AMBIENT
+        li      r1, MAT_LAMBERT
+        bne     r14, r1, diff_pd2
+        li      r11, 1.0
+diff_pd2:
+.endif
+        bne     r10, r0, diff_pd3
+        li      r11, 0.0
+diff_pd3:
+.alias  vid, v0
+.alias  kb, v1
+.alias  u0, v2
+.alias  vt, v3
+.alias  vpd, v4
+        ; ---- split: direct (u < p_direct) first
+        mov     r16, r12
+diff_split:
+        sfetch  vid, m1, r16, r13
+        rgat    kb, vid, r0, F_KEY @m1
+        vbcast  vt, r8 @m1
+        vadd    kb, kb, vt @m1
+        RAND    u0, kb, DIM_DIRECT, vt
+        vbcast  vpd, r11 @m1
+        vflt    m2, u0, vpd @m1
+        pmask   m2
+.ifdef HAS_AMBIENT
+        li      r1, MAT_LAMBERT
+        bne     r14, r1, diff_noamb
+.alias  thx, v5
+.alias  thy, v6
+.alias  thz, v7
+.alias  bx, v8
+.alias  by, v9
+.alias  bz, v10
+        GATHER3 th, F_THRR, F_THRG, F_THRB
+        GATHER3 b, F_BASER, F_BASEG, F_BASEB
+        vfmul   thx, thx, bx @m1
+        vfmul   thy, thy, by @m1
+        vfmul   thz, thz, bz @m1
+        ldb     bx, r0, SM_HDR_AMBIENT @m1
+        ldb     by, r0, SM_HDR_AMBIENT + 4 @m1
+        ldb     bz, r0, SM_HDR_AMBIENT + 8 @m1
+        vfmul   thx, thx, bx @m1
+        vfmul   thy, thy, by @m1
+        vfmul   thz, thz, bz @m1
+        FBADD3  th, vt, m1
+diff_noamb:
+.endif
+        blt     r16, r13, diff_split
+        part    r15, r12, r13           ; [r12, r15) direct, [r15, r13) indirect
+        beq     r12, r15, diff_indirect
+        SHADE_STREAM r12, r15
+        jal     r30, direct
+diff_indirect:
+        beq     r9, r0, diff_done       ; cannot bounce
+        beq     r15, r13, diff_done
+        SHADE_STREAM r15, r13
+        jal     r30, indirect
+diff_done:
+        jr      r31
+
+; ---- direct lighting on [r12, r15): one shadow ray per path toward a uniformly chosen light.
+; Scalars: r8 = 16 * vertex, r10 = number of lights, r11 = p_direct (float), r14 = kind.
+; Clobbers r1-r4, r7, r16.
+direct:
+.alias  vid, v0
+.alias  kb, v1
+.alias  px, v2
+.alias  py, v3
+.alias  pz, v4
+.alias  nfx, v5
+.alias  nfy, v6
+.alias  nfz, v7
+.alias  ox, v8
+.alias  oy, v9
+.alias  oz, v10
+.alias  la, v11
+.alias  lu, v12
+.alias  lv, v13
+.alias  lk, v14
+.alias  lpx, v15
+.alias  lpy, v16
+.alias  lpz, v17
+.alias  e1x, v18
+.alias  e1y, v19
+.alias  e1z, v20
+.alias  e2x, v21
+.alias  e2y, v22
+.alias  e2z, v23
+.alias  nlx, v24
+.alias  nly, v25
+.alias  nlz, v26
+.alias  vt, v27
+.alias  vt2, v28
+.alias  vt3, v29
+        ld      r1, r0, SM_HDR_LIGHTS
+        cvtif   r2, r10                 ; (float) nlights
+        fdiv    r3, r2, r11             ; weight nlights / p_direct
+        addi    r4, r10, -1
+        mov     r16, r12
+dir_chunk:
+        sfetch  vid, m1, r16, r15
+        rgat    kb, vid, r0, F_KEY @m1
+        vbcast  vt, r8 @m1
+        vadd    kb, kb, vt @m1
+        ; light index l = (int)(u * nlights), at most nlights - 1
+        RAND    la, kb, DIM_LIGHT, vt
+        vbcast  vt, r2 @m1
+        vfmul   la, la, vt @m1
+        vcvtfi  la, la @m1
+        vbcast  vt, r10 @m1
+        viltu   m2, la, vt @m1
+        mandn   m2, m1, m2
+        vbcast  la, r4 @m2
+        vmuli   la, la, SM_LIGHT_BYTES @m1
+        vbcast  vt, r1 @m1
+        vadd    la, la, vt @m1
+        ; origin: the hit point moved off the surface on the incoming side
+        GATHER3 p, F_PX, F_PY, F_PZ
+        GATHER3 nf, F_NGX, F_NGY, F_NGZ
+        GATHER3 o, F_DIRX, F_DIRY, F_DIRZ
+        DOT3    vt, nf, o, vt2
+        vflt    m2, vz, vt @m1
+        vfneg   nfx, nfx @m2
+        vfneg   nfy, nfy @m2
+        vfneg   nfz, nfz @m2
+        OFFSET3 o, p, nf, vt, vt2, vz, m2
+        ; point on the light: P + c1 E1 + c2 E2 (quad: c = (u, v); triangle: sqrt(u) (1 - v), sqrt(u) v)
+        RAND    lu, kb, DIM_LIGHT_U, vt
+        RAND    lv, kb, DIM_LIGHT_V, vt
+        ldg     lk, la, SM_LIGHT_KIND @m1
+        vli     vt, LIGHT_TRIANGLE @m1
+        vieq    m2, lk, vt @m1
+        vsqrt   vt, lu @m2
+        vli     vt2, 1.0 @m2
+        vfsub   vt2, vt2, lv @m2
+        vfmul   vt2, vt, vt2 @m2
+        vfmul   lv, vt, lv @m2
+        vmov    lu, vt2 @m2
+        ldg     lpx, la, SM_LIGHT_P @m1
+        ldg     lpy, la, SM_LIGHT_P + 4 @m1
+        ldg     lpz, la, SM_LIGHT_P + 8 @m1
+        ldg     e1x, la, SM_LIGHT_E1 @m1
+        ldg     e1y, la, SM_LIGHT_E1 + 4 @m1
+        ldg     e1z, la, SM_LIGHT_E1 + 8 @m1
+        ldg     e2x, la, SM_LIGHT_E2 @m1
+        ldg     e2y, la, SM_LIGHT_E2 + 4 @m1
+        ldg     e2z, la, SM_LIGHT_E2 + 8 @m1
+.macro  LPOINT p, e1, e2, o
+        vfmul   vt, lu, \e1 @m1
+        vfadd   \p, \p, vt @m1
+        vfmul   vt, lv, \e2 @m1
+        vfadd   \p, \p, vt @m1
+        vfsub   \p, \p, \o @m1          ; shadow ray direction: light point - origin
+.endm
+        LPOINT  lpx, e1x, e2x, ox
+        LPOINT  lpy, e1y, e2y, oy
+        LPOINT  lpz, e1z, e2z, oz
+        DOT3    vt3, lp, lp, vt         ; d2
+        vflt    m2, vz, vt3 @m1         ; d2 > 0
+        vrsqrt  vt, vt3 @m2
+        vfmul   lu, lpx, vt @m2         ; wi (in lu, lv, lk)
+        vfmul   lv, lpy, vt @m2
+        vfmul   lk, lpz, vt @m2
+.alias  wix, v12
+.alias  wiy, v13
+.alias  wiz, v14
+        ; light normal and the cosine at the light (front side unless two-sided)
+        CROSS3  nl, e1, e2, vt, m2
+        NORMALIZE3 nl, vt, vt2, m2
+        DOT3    vt2, nl, wi, vt, m2
+        vfneg   vt2, vt2 @m2            ; cosl
+        ldg     vt, la, SM_LIGHT_TWO_SIDED @m2
+        vli     nlx, 0 @m2
+        vieq    m3, vt, nlx @m2
+        mandn   m3, m2, m3
+        vfabs   vt2, vt2 @m3
+        vflt    m2, vz, vt2 @m2         ; cosl > 0
+        ldg     vt, la, SM_LIGHT_AREA @m2
+        vfmul   vt2, vt2, vt @m2
+        vfdiv   vt2, vt2, vt3 @m2       ; scale = cosl area / d2
+        ldg     e1x, la, SM_LIGHT_RADIANCE @m2
+        ldg     e1y, la, SM_LIGHT_RADIANCE + 4 @m2
+        ldg     e1z, la, SM_LIGHT_RADIANCE + 8 @m2
+        SCALE3  e1, vt2, m2             ; le
+        vflt    m2, vz, vt2 @m2         ; scale > 0
+        ; both normals must see the light
+        DOT3    vt, wi, nf, vt3, m2
+        vfle    m3, vt, vz @m2
+        mandn   m2, m2, m3
+        GATHER3 e2, F_NSX, F_NSY, F_NSZ, m2
+        DOT3    vt, wi, e2, vt3, m2
+        vfle    m3, vt, vz @m2
+        mandn   m2, m2, m3
+        DOT3    vt3, e2, wi, vt, m2     ; cosi = ns . wi
+        ; brdf x cos into px, py, pz
+        GATHER3 p, F_BASER, F_BASEG, F_BASEB, m2
+.ifdef HAS_GLOSSY
+        li      r7, MAT_GLOSSY
+        beq     r14, r7, dir_glossy
+.endif
+        vli     vt, INV_PI_F @m2
+        vfmul   px, px, vt @m2
+        vfmul   px, px, vt3 @m2
+        vfmul   py, py, vt @m2
+        vfmul   py, py, vt3 @m2
+        vfmul   pz, pz, vt @m2
+        vfmul   pz, pz, vt3 @m2
+.ifdef HAS_GLOSSY
+        jmp     dir_emit
+dir_glossy:
+        ; coupled glossy: (kd / pi + ks (n + 2) / (2 pi) cos^n(refl . wi)) cos
+        ; (wi in v12-14, ns in v21-23 (e2), base in p, cosi vt3; free: v15-17 (shadow dir: keep),
+        ;  v5-7 (nf), v24-26, v27, v28)
+        GATHER3 nf, F_DIRX, F_DIRY, F_DIRZ, m2
+        DOT3    nlx, nf, e2, vt, m2     ; d . ns
+        vfadd   nlx, nlx, nlx @m2       ; 2 dn  (2.0f * dn: exact either way)
+        vfmul   vt, nlx, e2x @m2
+        vfsub   nfx, nfx, vt @m2
+        vfmul   vt, nlx, e2y @m2
+        vfsub   nfy, nfy, vt @m2
+        vfmul   vt, nlx, e2z @m2
+        vfsub   nfz, nfz, vt @m2        ; mirror direction
+        DOT3    nly, nf, wi, vt, m2     ; cos alpha
+        rgat    nlz, vid, r0, F_MAT @m2
+        ldg     vt2, nlz, SM_MAT_ROUGHNESS @m2
+        ldg     nlz, nlz, SM_MAT_METALLIC @m2
+        vfmul   vt2, vt2, vt2 @m2
+        vli     vt, 0.001 @m2
+        vfmax   vt2, vt2, vt @m2
+        vli     vt, 2.0 @m2
+        vfdiv   vt2, vt, vt2 @m2
+        vfsub   vt2, vt2, vt @m2        ; exponent n
+        ; cos^n (0 unless cos > 0)
+        vflt    m3, vz, nly @m2
+        vlog2   nlx, nly @m3
+        vfmul   nlx, vt2, nlx @m3
+        vexp2   nlx, nlx @m3
+        vli     nly, 0 @m2
+        vmov    nly, nlx @m3
+        vfadd   nlx, vt2, vt @m2        ; n + 2
+        vli     vt, INV_2PI_F @m2
+        vfmul   nlx, nlx, vt @m2
+        vfmul   nlx, nlx, nly @m2       ; lobe
+        vli     vt, 1.0 @m2
+        vfsub   nly, vt, nlz @m2        ; 1 - metallic
+.macro  GLOSSYF b
+        vfmul   vt, \b, nly @m2         ; kd
+        vli     vt2, INV_PI_F @m2
+        vfmul   vt, vt, vt2 @m2
+        vli     vt2, 0.04 @m2
+        vfmul   vt2, vt2, nly @m2
+        vfmul   nfx, \b, nlz @m2
+        vfadd   vt2, vt2, nfx @m2       ; ks
+        vfmul   vt2, vt2, nlx @m2
+        vfadd   vt, vt, vt2 @m2
+        vfmul   \b, vt, vt3 @m2
+.endm
+        GLOSSYF px
+        GLOSSYF py
+        GLOSSYF pz
+dir_emit:
+.endif
+        ; throughput x f x le x nlights / p_direct
+        vbcast  vt2, r3 @m2
+.macro  DIRTHR f, le, thr
+        rgat    vt, vid, r0, \thr @m2
+        vfmul   vt, vt, \f @m2
+        vfmul   vt, vt, \le @m2
+        vfmul   \f, vt, vt2 @m2
+.endm
+        DIRTHR  px, e1x, F_THRR
+        DIRTHR  py, e1y, F_THRG
+        DIRTHR  pz, e1z, F_THRB
+        EMIT    m2, o, lp, p, SHADOW_TMAX, KIND_SHADOW, 0, vt, vt2
+        blt     r16, r15, dir_chunk
+        jr      r30
+
+; Russian roulette on new rays of depth >= RR_START_DEPTH (scalar r7 = new depth): survive with
+; q = min(max(thr), 0.95), thr / q. Mask k keeps the survivors; kb = key + 16 vertex.
+; u, q, t scratch.
+.macro  ROULETTE k, th, u, q, t
+        li      r1, RR_START_DEPTH
+        blt     r7, r1, rr\@
+        vfmax   \q, \th\()x, \th\()y @\k
+        vfmax   \q, \q, \th\()z @\k
+        vli     \u, RR_MAX_SURVIVAL @\k
+        vfmin   \q, \q, \u @\k
+        RAND    \u, kb, DIM_RR, \t, \k
+        vflt    \k, \u, \q @\k
+        vfdiv   \th\()x, \th\()x, \q @\k
+        vfdiv   \th\()y, \th\()y, \q @\k
+        vfdiv   \th\()z, \th\()z, \q @\k
+rr\@:
+.endm
+
+; ---- indirect bounce on [r15, r13): cosine-weighted (Lambert) or lobe-sampled (glossy).
+; Scalars: r8 = 16 * vertex, r11 = p_direct, r14 = kind. Clobbers r1-r4, r7, r16.
+indirect:
+.alias  vid, v0
+.alias  kb, v1
+.alias  u5, v2
+.alias  phi, v3
+.alias  nsx, v4
+.alias  nsy, v5
+.alias  nsz, v6
+.alias  dx, v7
+.alias  dy, v8
+.alias  dz, v9
+.alias  nfx, v10
+.alias  nfy, v11
+.alias  nfz, v12
+.alias  thx, v13
+.alias  thy, v14
+.alias  thz, v15
+.alias  bx, v16
+.alias  by, v17
+.alias  bz, v18
+.alias  cx, v19
+.alias  cy, v20
+.alias  cz, v21
+.alias  vt, v22
+.alias  vt2, v23
+.alias  vt3, v24
+.alias  vt4, v25
+.alias  vt5, v26
+.alias  vt6, v27
+.alias  vt7, v28
+.alias  vt8, v29
+        addi    r7, r18, 1              ; depth of the new rays
+        li      r1, 1.0
+        fsub    r2, r1, r11
+        fdiv    r2, r1, r2              ; weight 1 / (1 - p_direct)
+        mov     r16, r15
+ind_chunk:
+        sfetch  vid, m1, r16, r13
+        mmov    m2, m1
+        rgat    kb, vid, r0, F_KEY @m1
+        vbcast  vt, r8 @m1
+        vadd    kb, kb, vt @m1
+        RAND    u5, kb, DIM_DIR_U, vt
+        RAND    phi, kb, DIM_DIR_V, vt
+        vli     vt, TWO_PI_F @m1
+        vfmul   phi, vt, phi @m1
+        GATHER3 ns, F_NSX, F_NSY, F_NSZ
+        GATHER3 th, F_THRR, F_THRG, F_THRB
+        GATHER3 b, F_BASER, F_BASEG, F_BASEB
+.ifdef HAS_GLOSSY
+        li      r3, MAT_GLOSSY
+        beq     r14, r3, ind_glossy
+.endif
+        ; Lambert: cosine-weighted hemisphere around ns; thr x base x weight
+        vsqrt   vt, u5 @m1
+        vcos    cx, phi @m1
+        vfmul   cx, vt, cx @m1
+        vsin    cy, phi @m1
+        vfmul   cy, vt, cy @m1
+        vli     vt, 1.0 @m1
+        vfsub   vt, vt, u5 @m1
+        vfmax   vt, vz, vt @m1
+        vsqrt   cz, vt @m1
+        TO_WORLD d, ns, cx, cy, cz, vt, vt2, vt3, vt4, vt5
+        vbcast  vt, r2 @m1
+        vfmul   thx, thx, bx @m1
+        vfmul   thx, thx, vt @m1
+        vfmul   thy, thy, by @m1
+        vfmul   thy, thy, vt @m1
+        vfmul   thz, thz, bz @m1
+        vfmul   thz, thz, vt @m1
+.ifdef HAS_GLOSSY
+        jmp     ind_spawn
+ind_glossy:
+        ; kd = base (1 - metallic), ks = 0.04 (1 - metallic) + base metallic, n, ps
+        rgat    vt, vid, r0, F_MAT @m1
+        ldg     vt2, vt, SM_MAT_ROUGHNESS @m1
+        ldg     vt, vt, SM_MAT_METALLIC @m1
+        vfmul   vt2, vt2, vt2 @m1
+        vli     vt3, 0.001 @m1
+        vfmax   vt2, vt2, vt3 @m1
+        vli     vt3, 2.0 @m1
+        vfdiv   vt2, vt3, vt2 @m1
+        vfsub   vt2, vt2, vt3 @m1       ; n
+        vli     vt3, 1.0 @m1
+        vfsub   vt3, vt3, vt @m1        ; 1 - metallic
+.macro  KDKS b, kd, t
+        vli     \t, 0.04 @m1
+        vfmul   \t, \t, vt3 @m1
+        vfmul   \kd, \b, vt @m1
+        vfadd   \t, \t, \kd @m1         ; ks (into t)
+        vfmul   \kd, \b, vt3 @m1        ; kd
+.endm
+        KDKS    bx, cx, vt4
+        vmov    bx, vt4 @m1             ; b := ks, c := kd
+        KDKS    by, cy, vt4
+        vmov    by, vt4 @m1
+        KDKS    bz, cz, vt4
+        vmov    bz, vt4 @m1
+        vfadd   vt4, bx, by @m1
+        vfadd   vt4, vt4, bz @m1        ; ls
+        vfadd   vt5, cx, cy @m1
+        vfadd   vt5, vt5, cz @m1        ; ld
+        vfadd   vt5, vt4, vt5 @m1
+        vfdiv   vt4, vt4, vt5 @m1       ; ps = ls / (ls + ld)
+        RAND    vt5, kb, DIM_LOBE, vt
+        vflt    m3, vt5, vt4 @m1        ; specular lobe
+        mandn   m4, m1, m3              ; diffuse lobe
+        ; throughput: diffuse lanes thr kd (weight / (1 - ps)); specular lanes thr ks (x lobe below)
+        vbcast  vt, r2 @m4
+        vli     vt5, 1.0 @m4
+        vfsub   vt5, vt5, vt4 @m4
+        vfdiv   vt5, vt, vt5 @m4
+        vmov    dx, bx @m3
+        vmov    dy, by @m3
+        vmov    dz, bz @m3
+        vmov    dx, cx @m4
+        vmov    dy, cy @m4
+        vmov    dz, cz @m4
+        vfmul   thx, thx, dx @m1
+        vfmul   thy, thy, dy @m1
+        vfmul   thz, thz, dz @m1
+        vfmul   thx, thx, vt5 @m4
+        vfmul   thy, thy, vt5 @m4
+        vfmul   thz, thz, vt5 @m4
+        ; -- diffuse lanes: cosine-weighted around ns
+        vsqrt   vt, u5 @m4
+        vcos    cx, phi @m4
+        vfmul   cx, vt, cx @m4
+        vsin    cy, phi @m4
+        vfmul   cy, vt, cy @m4
+        vli     vt, 1.0 @m4
+        vfsub   vt, vt, u5 @m4
+        vfmax   vt, vz, vt @m4
+        vsqrt   cz, vt @m4
+        TO_WORLD d, ns, cx, cy, cz, vt, vt3, vt5, vt6, vt7, m4
+        ; -- specular lanes: around the mirror direction, cos a = exp2(log2(u5) / (n + 1))
+        GATHER3 b, F_DIRX, F_DIRY, F_DIRZ, m3
+        DOT3    vt, b, ns, vt3, m3
+        vfadd   vt, vt, vt @m3          ; 2 dn
+        vfmul   vt3, vt, nsx @m3
+        vfsub   nfx, bx, vt3 @m3
+        vfmul   vt3, vt, nsy @m3
+        vfsub   nfy, by, vt3 @m3
+        vfmul   vt3, vt, nsz @m3
+        vfsub   nfz, bz, vt3 @m3        ; refl (in nf)
+        vli     vt, 1.0 @m3
+        vfadd   vt6, vt2, vt @m3        ; n + 1
+        vlog2   cz, u5 @m3
+        vfdiv   cz, cz, vt6 @m3
+        vexp2   cz, cz @m3              ; cos a
+        vfmul   vt3, cz, cz @m3
+        vfsub   vt3, vt, vt3 @m3
+        vfmax   vt3, vz, vt3 @m3
+        vsqrt   vt3, vt3 @m3            ; sin a
+        vcos    cx, phi @m3
+        vfmul   cx, vt3, cx @m3
+        vsin    cy, phi @m3
+        vfmul   cy, vt3, cy @m3
+        TO_WORLD d, nf, cx, cy, cz, vt, vt3, vt5, vt7, vt8, m3
+        DOT3    vt, ns, d, vt3, m3      ; cos at the shading normal
+        vflt    m5, vz, vt @m3
+        mandn   m6, m3, m5
+        mandn   m2, m2, m6              ; below the surface: absorbed
+        mand    m3, m3, m5
+        ; lobe = (n + 2) / (n + 1) x cos / ps x weight
+        vli     vt3, 2.0 @m3
+        vfadd   vt3, vt2, vt3 @m3
+        vfdiv   vt3, vt3, vt6 @m3
+        vfmul   vt3, vt3, vt @m3
+        vfdiv   vt3, vt3, vt4 @m3
+        vbcast  vt5, r2 @m3
+        vfmul   vt3, vt3, vt5 @m3
+        vfmul   thx, thx, vt3 @m3
+        vfmul   thy, thy, vt3 @m3
+        vfmul   thz, thz, vt3 @m3
+ind_spawn:
+.endif
+        ; keep directions above the geometric surface
+        GATHER3 nf, F_NGX, F_NGY, F_NGZ
+        GATHER3 b, F_DIRX, F_DIRY, F_DIRZ
+        DOT3    vt, nf, b, vt2
+        vflt    m3, vz, vt @m1
+        vfneg   nfx, nfx @m3
+        vfneg   nfy, nfy @m3
+        vfneg   nfz, nfz @m3
+        DOT3    vt, d, nf, vt2, m2
+        vflt    m2, vz, vt @m2
+        ROULETTE m2, th, vt, vt2, vt3
+        GATHER3 b, F_PX, F_PY, F_PZ, m2
+        OFFSET3 c, b, nf, vt, vt2, vz, m3, m2
+        EMIT    m2, c, d, th, INF_BITS, KIND_INDIRECT, 0, vt, vt2
+        blt     r16, r13, ind_chunk
+        jr      r30
+
+.ifdef HAS_DIELECTRIC
+; ---- dielectric shader on [r12, r13): Fresnel-weighted choice of reflection or refraction.
+; Preserves r5, r6, r17-r30.
+dielectric:
+        beq     r12, r13, diel_done
+        SHADE_STREAM r12, r13
+        addi    r7, r18, 1
+        blt     r29, r7, diel_done      ; cannot bounce
+        shli    r8, r7, 4
+.alias  vid, v0
+.alias  kb, v1
+.alias  dx, v2
+.alias  dy, v3
+.alias  dz, v4
+.alias  ngx, v5
+.alias  ngy, v6
+.alias  ngz, v7
+.alias  nnx, v8
+.alias  nny, v9
+.alias  nnz, v10
+.alias  eta, v11
+.alias  cc, v12
+.alias  ct, v13
+.alias  fr, v14
+.alias  ox, v15
+.alias  oy, v16
+.alias  oz, v17
+.alias  thx, v18
+.alias  thy, v19
+.alias  thz, v20
+.alias  vt, v21
+.alias  vt2, v22
+.alias  vt3, v23
+.alias  cosi, v24
+.alias  px, v25
+.alias  py, v26
+.alias  pz, v27
+        mov     r16, r12
+diel_chunk:
+        sfetch  vid, m1, r16, r13
+        rgat    kb, vid, r0, F_KEY @m1
+        vbcast  vt, r8 @m1
+        vadd    kb, kb, vt @m1
+        GATHER3 d, F_DIRX, F_DIRY, F_DIRZ
+        GATHER3 ng, F_NGX, F_NGY, F_NGZ
+        rgat    vt, vid, r0, F_MAT @m1
+        ldg     eta, vt, SM_MAT_IOR @m1
+        DOT3    cosi, d, ng, vt
+        vflt    m2, cosi, vz @m1        ; entering
+        mandn   m3, m1, m2
+        vrcp    eta, eta @m2            ; eta = 1 / ior entering, ior leaving
+        vmov    nnx, ngx @m1
+        vmov    nny, ngy @m1
+        vmov    nnz, ngz @m1
+        vfneg   nnx, nnx @m3
+        vfneg   nny, nny @m3
+        vfneg   nnz, nnz @m3
+        DOT3    cc, d, nn, vt
+        vfneg   cc, cc @m1
+        ; k2 = 1 - eta^2 (1 - cc^2); F = 1 (total internal reflection) unless k2 > 0
+        vfmul   vt, eta, eta @m1
+        vfmul   vt2, cc, cc @m1
+        vli     vt3, 1.0 @m1
+        vfsub   vt2, vt3, vt2 @m1
+        vfmul   vt, vt, vt2 @m1
+        vfsub   vt, vt3, vt @m1
+        vli     fr, 1.0 @m1
+        vli     ct, 0 @m1
+        vflt    m2, vz, vt @m1
+        vsqrt   ct, vt @m2
+        vfmul   vt, eta, cc @m2
+        vfsub   vt2, vt, ct @m2
+        vfadd   vt, vt, ct @m2
+        vfdiv   vt2, vt2, vt @m2        ; rs
+        vfmul   vt, eta, ct @m2
+        vfsub   vt3, vt, cc @m2
+        vfadd   vt, vt, cc @m2
+        vfdiv   vt3, vt3, vt @m2        ; rp
+        vfmul   vt2, vt2, vt2 @m2
+        vfmul   vt3, vt3, vt3 @m2
+        vfadd   vt2, vt2, vt3 @m2
+        vli     vt, 0.5 @m2
+        vfmul   fr, vt, vt2 @m2
+        GATHER3 th, F_THRR, F_THRG, F_THRB
+        RAND    vt, kb, DIM_LOBE, vt2
+        vflt    m2, vt, fr @m1          ; reflect
+        mandn   m3, m1, m2              ; refract
+        ; reflection: d - 2 (d . nn) nn
+        DOT3    vt, d, nn, vt2, m2
+        vfadd   vt, vt, vt @m2
+        vfmul   vt2, vt, nnx @m2
+        vfsub   ox, dx, vt2 @m2
+        vfmul   vt2, vt, nny @m2
+        vfsub   oy, dy, vt2 @m2
+        vfmul   vt2, vt, nnz @m2
+        vfsub   oz, dz, vt2 @m2
+        ; refraction: eta d + (eta cc - ct) nn, normalized; tinted by the base colour
+        vfmul   vt, eta, cc @m3
+        vfsub   vt, vt, ct @m3
+.macro  REFR o, d, n, th, base
+        vfmul   \o, eta, \d @m3
+        vfmul   vt2, vt, \n @m3
+        vfadd   \o, \o, vt2 @m3
+        rgat    vt2, vid, r0, \base @m3
+        vfmul   \th, \th, vt2 @m3
+.endm
+        REFR    ox, dx, nnx, thx, F_BASER
+        REFR    oy, dy, nny, thy, F_BASEG
+        REFR    oz, dz, nnz, thz, F_BASEB
+        NORMALIZE3 o, vt, vt2, m3
+        mmov    m2, m1
+        ROULETTE m2, th, vt, vt2, vt3
+        ; origin on the side the new ray leaves: sign of d' . nf
+        vmov    nnx, ngx @m2
+        vmov    nny, ngy @m2
+        vmov    nnz, ngz @m2
+        vflt    m3, vz, cosi @m2        ; nf = -ng when ng . d > 0
+        vfneg   nnx, nnx @m3
+        vfneg   nny, nny @m3
+        vfneg   nnz, nnz @m3
+        DOT3    vt, o, nn, vt2, m2
+        vflt    m3, vt, vz @m2          ; d' . nf < 0: below
+        vfneg   nnx, nnx @m3
+        vfneg   nny, nny @m3
+        vfneg   nnz, nnz @m3
+        GATHER3 p, F_PX, F_PY, F_PZ, m2
+        OFFSET3 d, p, nn, vt, vt2, vz, m3, m2
+        EMIT    m2, d, o, th, INF_BITS, KIND_INDIRECT, 1, vt, vt2
+        blt     r16, r13, diel_chunk
+diel_done:
+        jr      r31
+.endif

@@ -1,0 +1,433 @@
+/* sim/functional.c -- the functional mode: kernels/pathtrace.s on functional cores, one tile per
+ * run, host threads over tiles.
+ *
+ * Owns: the kernel's build symbols, its launch block and counters (by name from the object's
+ * symbol table: kernels/lib/abi.inc is their only definition), copying tiles out of the
+ * framebuffer. Must not: compute radiance, or make results depend on the thread count (each
+ * tile's pixels come from its own run only).
+ */
+#include "functional.h"
+
+#include <limits.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "../asm/asm.h"
+
+const char *func_default_kernel(char *buf, size_t len)
+{
+    const char *env = getenv("SFSIM_KERNEL");
+    if (env && *env) {
+        snprintf(buf, len, "%s", env);
+        return buf;
+    }
+    char exe[PATH_MAX];
+    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (n <= 0) {
+        snprintf(buf, len, "kernels/pathtrace.s");
+        return buf;
+    }
+    exe[n] = 0;
+    char *slash = strrchr(exe, '/');
+    if (slash)
+        *slash = 0;
+    snprintf(buf, len, "%s/../kernels/pathtrace.s", exe);
+    return buf;
+}
+
+/* The ABI constants the host needs, looked up by name. */
+typedef struct Abi {
+    uint32_t l_x0, l_y0, l_w, l_h, l_seed, l_error;
+    uint32_t st_dropped, st_camera, st_indirect, st_shadow, st_generations, st_per_gen, st_max_gen;
+    uint32_t st_trav_streams, st_trav_rays, st_isect_streams, st_isect_rays, st_shade_streams, st_shade_rays;
+    uint32_t stack_base, ray_fields, err_stack, err_generations;
+} Abi;
+
+static int abi_lookup(const AsmObject *obj, Abi *abi, char *err, size_t errlen)
+{
+    static const struct { const char *name; size_t off; } names[] = {
+#define A(field, name) {name, offsetof(Abi, field)}
+        A(l_x0, "L_X0"), A(l_y0, "L_Y0"), A(l_w, "L_W"), A(l_h, "L_H"), A(l_seed, "L_SEED"),
+        A(l_error, "L_ERROR"), A(st_dropped, "ST_DROPPED"), A(st_camera, "ST_CAMERA"),
+        A(st_indirect, "ST_INDIRECT"), A(st_shadow, "ST_SHADOW"), A(st_generations, "ST_GENERATIONS"),
+        A(st_per_gen, "ST_PER_GEN"), A(st_max_gen, "ST_MAX_GEN"), A(st_trav_streams, "ST_TRAV_STREAMS"),
+        A(st_trav_rays, "ST_TRAV_RAYS"), A(st_isect_streams, "ST_ISECT_STREAMS"),
+        A(st_isect_rays, "ST_ISECT_RAYS"), A(st_shade_streams, "ST_SHADE_STREAMS"),
+        A(st_shade_rays, "ST_SHADE_RAYS"), A(stack_base, "STACK_BASE"), A(ray_fields, "RAY_FIELDS"),
+        A(err_stack, "ERR_STACK"), A(err_generations, "ERR_GENERATIONS"),
+#undef A
+    };
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+        const AsmSymbol *found = NULL;
+        for (uint32_t s = 0; s < obj->nsyms; s++)
+            if (!strcmp(obj->syms[s].name, names[i].name))
+                found = &obj->syms[s];
+        if (!found) {
+            snprintf(err, errlen, "kernel: symbol %s missing (kernels/lib/abi.inc defines the host interface)",
+                     names[i].name);
+            return -1;
+        }
+        *(uint32_t *)((char *)abi + names[i].off) = found->value;
+    }
+    if (abi->st_max_gen > FUNC_MAX_GENERATIONS) {
+        snprintf(err, errlen, "kernel: ST_MAX_GEN %u exceeds the host's %d", abi->st_max_gen, FUNC_MAX_GENERATIONS);
+        return -1;
+    }
+    return 0;
+}
+
+typedef struct Job {
+    const PackedScene *p;
+    const FuncParams *fp;
+    const AsmObject *obj;
+    const Abi *abi;
+    CoreParams cp;
+    float *rgb;
+    uint32_t width, height, tile, tiles_x, ntiles;
+    FuncTile *tiles;
+    atomic_uint next_tile, done_tiles;
+    atomic_int failed;
+    pthread_mutex_t lock;
+    char err[1024];
+} Job;
+
+typedef struct Worker {
+    Job *job;
+    FuncStats st;
+} Worker;
+
+static uint32_t spad_u32(Core *c, uint32_t addr)
+{
+    uint32_t v, size;
+    uint8_t *m = core_mem(c, CORE_MEM_SPAD, &size);
+    memcpy(&v, m + addr, 4);
+    return v;
+}
+
+static void spad_set(Core *c, uint32_t addr, uint32_t v)
+{
+    uint32_t size;
+    uint8_t *m = core_mem(c, CORE_MEM_SPAD, &size);
+    memcpy(m + addr, &v, 4);
+}
+
+static void fail(Job *j, const char *msg)
+{
+    pthread_mutex_lock(&j->lock);
+    if (!atomic_load(&j->failed))
+        snprintf(j->err, sizeof j->err, "%s", msg);
+    atomic_store(&j->failed, 1);
+    pthread_mutex_unlock(&j->lock);
+}
+
+static int run_tile(Job *j, Core *c, uint32_t t, FuncStats *st)
+{
+    const Abi *a = j->abi;
+    FuncTile *ft = &j->tiles[t];
+    ft->x0 = (t % j->tiles_x) * j->tile;
+    ft->y0 = (t / j->tiles_x) * j->tile;
+    ft->w = j->width - ft->x0 < j->tile ? j->width - ft->x0 : j->tile;
+    ft->h = j->height - ft->y0 < j->tile ? j->height - ft->y0 : j->tile;
+    core_restart(c);
+    uint32_t size;
+    uint8_t *sp = core_mem(c, CORE_MEM_SPAD, &size);
+    memset(sp, 0, a->stack_base);
+    spad_set(c, a->l_x0, ft->x0);
+    spad_set(c, a->l_y0, ft->y0);
+    spad_set(c, a->l_w, ft->w);
+    spad_set(c, a->l_h, ft->h);
+    spad_set(c, a->l_seed, j->fp->seed);
+    uint8_t *fb = core_mem(c, CORE_MEM_FB, &size);
+    memset(fb, 0, (size_t)ft->w * ft->h * 12);
+    uint64_t before = core_instructions(c);
+    CoreExit ex = core_run(c, (uint64_t)j->fp->cfg->sim_max_instructions);
+    char msg[1400];
+    if (ex != CORE_EXIT_HALT) {
+        snprintf(msg, sizeof msg, "kernel, tile at (%u, %u): %s%s", ft->x0, ft->y0, core_trap_message(c),
+                 ex == CORE_EXIT_LIMIT ? " (sim.max_instructions)" : "");
+        fail(j, msg);
+        return -1;
+    }
+    uint32_t kerr = spad_u32(c, a->l_error);
+    if (kerr) {
+        snprintf(msg, sizeof msg, "kernel, tile at (%u, %u): %s", ft->x0, ft->y0,
+                 kerr == a->err_stack ? "traversal stack overflow (raise spad.size_kb)"
+                 : kerr == a->err_generations ? "more generations than the kernel counts (64)"
+                                             : "error code set");
+        fail(j, msg);
+        return -1;
+    }
+    for (uint32_t y = 0; y < ft->h; y++)
+        memcpy(&j->rgb[3 * ((size_t)(ft->y0 + y) * j->width + ft->x0)], fb + (size_t)12 * y * ft->w,
+               (size_t)12 * ft->w);
+    ft->instructions = core_instructions(c) - before;
+    st->dropped += spad_u32(c, a->st_dropped);
+    st->rays_camera += spad_u32(c, a->st_camera);
+    st->rays_indirect += spad_u32(c, a->st_indirect);
+    st->rays_shadow += spad_u32(c, a->st_shadow);
+    ft->rays = (uint64_t)spad_u32(c, a->st_camera) + spad_u32(c, a->st_indirect) + spad_u32(c, a->st_shadow);
+    uint32_t g = spad_u32(c, a->st_generations);
+    if (g > st->generations)
+        st->generations = g;
+    for (uint32_t k = 0; k < a->st_max_gen; k++)
+        st->rays_per_generation[k] += spad_u32(c, a->st_per_gen + 4 * k);
+    st->trav_streams += spad_u32(c, a->st_trav_streams);
+    st->trav_rays += spad_u32(c, a->st_trav_rays);
+    st->isect_streams += spad_u32(c, a->st_isect_streams);
+    st->isect_rays += spad_u32(c, a->st_isect_rays);
+    st->shade_streams += spad_u32(c, a->st_shade_streams);
+    st->shade_rays += spad_u32(c, a->st_shade_rays);
+    return 0;
+}
+
+static void *worker_main(void *arg)
+{
+    Worker *w = arg;
+    Job *j = w->job;
+    char err[512];
+    Core *c = core_new(&j->cp, j->obj, err, sizeof err);
+    if (!c) {
+        char msg[600];
+        snprintf(msg, sizeof msg, "kernel: %s", err);
+        fail(j, msg);
+        return NULL;
+    }
+    uint32_t size;
+    uint8_t *sm = core_mem(c, CORE_MEM_SCENE, &size);
+    memcpy(sm, j->p->mem, j->p->size);
+    while (!atomic_load(&j->failed)) {
+        uint32_t t = atomic_fetch_add(&j->next_tile, 1u);
+        if (t >= j->ntiles)
+            break;
+        if (run_tile(j, c, t, &w->st) != 0)
+            break;
+        uint32_t done = atomic_fetch_add(&j->done_tiles, 1u) + 1u;
+        if (j->fp->progress)
+            j->fp->progress(j->fp->progress_ctx, done, j->ntiles);
+    }
+    w->st.core = *core_stats(c);
+    w->st.instructions = core_instructions(c);
+    core_free(c);
+    return NULL;
+}
+
+static void add_define(AsmDefine *defs, int *n, char *list, size_t len, const char *name, long long v)
+{
+    defs[*n].name = name;
+    defs[*n].value = v;
+    (*n)++;
+    size_t used = strlen(list);
+    snprintf(list + used, len - used, "%s%s=%lld", used ? " " : "", name, v);
+}
+
+int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStats *st, char *err,
+                size_t errlen)
+{
+    memset(st, 0, sizeof *st);
+    const CfgMachine *cfg = fp->cfg;
+    uint32_t unsupported = fp->needs & (SCENE_NEED_SPHERES | SCENE_NEED_PUNCTUAL | SCENE_NEED_TEXTURES);
+    if (unsupported) {
+        char names[256];
+        scene_needs_string(unsupported, names, sizeof names);
+        snprintf(err, errlen,
+                 "the path-tracing kernel does not render %s yet (docs/kernel.md lists what it models); "
+                 "--mode reference renders this scene",
+                 names);
+        return -1;
+    }
+    /* Build symbols from the packed scene itself (docs/kernel.md). */
+    AsmDefine defs[16];
+    int nd = 0;
+    uint32_t rays = (uint32_t)cfg->stream_rays;
+    add_define(defs, &nd, st->defines, sizeof st->defines, "RAYS", rays);
+    uint32_t spad_bytes = (uint32_t)cfg->spad_size_kb * 1024u;
+    add_define(defs, &nd, st->defines, sizeof st->defines, "SPAD_BYTES", spad_bytes);
+    uint32_t nmats = sm_u32(p, sm_hdr(p, SM_HDR_NMATS)), mats = sm_u32(p, sm_hdr(p, SM_HDR_MATS));
+    int kinds = 0;
+    for (uint32_t m = 0; m < nmats; m++) {
+        uint32_t k = sm_u32(p, sm_rec(mats, SM_MAT_WORDS, m, SM_MAT_KIND));
+        if (k < 3)
+            kinds |= 1 << k;
+    }
+    if (kinds & (1 << SCENE_MAT_LAMBERT))
+        add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_LAMBERT", 1);
+    if (kinds & (1 << SCENE_MAT_GLOSSY))
+        add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_GLOSSY", 1);
+    if (kinds & (1 << SCENE_MAT_DIELECTRIC))
+        add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_DIELECTRIC", 1);
+    if (sm_u32(p, sm_hdr(p, SM_HDR_NORMALS)))
+        add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_NORMALS", 1);
+    float bg = 0.0f, amb = 0.0f;
+    for (int k = 0; k < 3; k++) {
+        bg += sm_f32(p, sm_hdr(p, SM_HDR_BACKGROUND + k));
+        amb += sm_f32(p, sm_hdr(p, SM_HDR_AMBIENT + k));
+    }
+    if (bg != 0.0f)
+        add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_BACKGROUND", 1);
+    if (amb > 0.0f)
+        add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_AMBIENT", 1);
+
+    char libdir[PATH_MAX + 8];
+    snprintf(libdir, sizeof libdir, "%s", fp->kernel_path);
+    char *slash = strrchr(libdir, '/');
+    if (slash)
+        snprintf(slash, sizeof libdir - (size_t)(slash - libdir), "/lib");
+    else
+        snprintf(libdir, sizeof libdir, "lib");
+    const char *incs[1] = {libdir};
+    char *diag = NULL;
+    size_t diaglen = 0;
+    FILE *dm = open_memstream(&diag, &diaglen);
+    AsmOptions ao = {defs, nd, incs, 1, dm};
+    AsmObject obj;
+    memset(&obj, 0, sizeof obj);
+    int nerr = asm_assemble_file(fp->kernel_path, &ao, &obj);
+    if (dm)
+        fclose(dm);
+    if (nerr) {
+        snprintf(err, errlen, "kernel %s does not assemble (%d errors):\n%s", fp->kernel_path, nerr,
+                 diag ? diag : "");
+        free(diag);
+        return -1;
+    }
+    free(diag);
+    int rc = -1;
+    Worker *ws = NULL;
+    pthread_t *th = NULL;
+    Abi abi;
+    Job *job = calloc(1, sizeof *job);
+    if (!job) {
+        snprintf(err, errlen, "out of memory");
+        goto out;
+    }
+    pthread_mutex_init(&job->lock, NULL);
+    if (abi_lookup(&obj, &abi, err, errlen) != 0)
+        goto out;
+    st->kernel_instructions = obj.ntext;
+
+    /* The machine's memories must hold what the kernel keeps in them. */
+    CoreParams cp;
+    cfg_core_params(cfg, &cp);
+    uint64_t rb_need = (uint64_t)abi.ray_fields * rays * 4u;
+    if (cp.mem_bytes[CORE_MEM_RB0] < rb_need) {
+        snprintf(err, errlen,
+                 "raybuf.size_kb = %d: the kernel's %u-word ray records for %u rays need %llu KiB per ray buffer",
+                 cfg->raybuf_size_kb, abi.ray_fields, rays, (unsigned long long)((rb_need + 1023) / 1024));
+        goto out;
+    }
+    if (cp.mem_bytes[CORE_MEM_IDM] < 8u * rays) {
+        snprintf(err, errlen, "idm.size_kb = %d: two streams of %u ray IDs need %u KiB", cfg->idm_size_kb, rays,
+                 8u * rays / 1024u);
+        goto out;
+    }
+    if (cp.mem_bytes[CORE_MEM_FB] < 12u * rays) {
+        snprintf(err, errlen, "fb.size_kb = %d: a tile of %u RGB pixels needs %u KiB", cfg->fb_size_kb, rays,
+                 (12u * rays + 1023u) / 1024u);
+        goto out;
+    }
+    uint64_t stack_need = abi.stack_base + 12ull * (3ull * p->bvh.depth + 8);
+    if (cp.mem_bytes[CORE_MEM_SPAD] < stack_need) {
+        snprintf(err, errlen, "spad.size_kb = %d: the traversal stack of a BVH of depth %u needs %llu KiB",
+                 cfg->spad_size_kb, p->bvh.depth, (unsigned long long)((stack_need + 1023) / 1024));
+        goto out;
+    }
+    if (cp.mem_bytes[CORE_MEM_SCENE] < p->size) {
+        snprintf(err, errlen, "scene.size_mb = %d: the packed scene needs %u bytes", cfg->scene_size_mb, p->size);
+        goto out;
+    }
+
+    job->p = p;
+    job->fp = fp;
+    job->obj = &obj;
+    job->abi = &abi;
+    job->cp = cp;
+    job->rgb = rgb;
+    job->width = sm_u32(p, sm_hdr(p, SM_HDR_WIDTH));
+    job->height = sm_u32(p, sm_hdr(p, SM_HDR_HEIGHT));
+    uint32_t spp = sm_u32(p, sm_hdr(p, SM_HDR_SPP));
+    job->tile = 1;
+    while (job->tile * job->tile < rays)
+        job->tile++;
+    job->tiles_x = (job->width + job->tile - 1) / job->tile;
+    job->ntiles = job->tiles_x * ((job->height + job->tile - 1) / job->tile);
+    job->tiles = calloc(job->ntiles ? job->ntiles : 1, sizeof(FuncTile));
+    atomic_init(&job->next_tile, 0u);
+    atomic_init(&job->done_tiles, 0u);
+    atomic_init(&job->failed, 0);
+    int nthreads = fp->threads < 1 ? 1 : fp->threads;
+    if ((uint32_t)nthreads > job->ntiles)
+        nthreads = (int)job->ntiles;
+    ws = calloc((size_t)nthreads, sizeof *ws);
+    th = calloc((size_t)nthreads, sizeof *th);
+    if (!job->tiles || !ws || !th) {
+        snprintf(err, errlen, "out of memory");
+        goto out;
+    }
+    int started = 0;
+    for (int i = 0; i < nthreads; i++)
+        ws[i].job = job;
+    for (int i = 1; i < nthreads; i++, started++)
+        if (pthread_create(&th[i], NULL, worker_main, &ws[i]) != 0)
+            break;
+    worker_main(&ws[0]);
+    for (int i = 1; i <= started; i++)
+        pthread_join(th[i], NULL);
+    if (atomic_load(&job->failed)) {
+        snprintf(err, errlen, "%s", job->err);
+        goto out;
+    }
+    float inv = 1.0f / (float)spp;
+    for (size_t i = 0; i < 3 * (size_t)job->width * job->height; i++)
+        rgb[i] = rgb[i] * inv;
+    for (int i = 0; i < nthreads; i++) {
+        const FuncStats *s = &ws[i].st;
+        for (int k = 0; k < ISA_STAGE_COUNT; k++) {
+            st->core.instructions[k] += s->core.instructions[k];
+            st->core.vec_instructions[k] += s->core.vec_instructions[k];
+            st->core.active_lanes[k] += s->core.active_lanes[k];
+            for (int c = 0; c < ISA_C_COUNT; c++)
+                st->core.ops[k][c] += s->core.ops[k][c];
+        }
+        for (int o = 0; o < ISA_OP_COUNT; o++)
+            st->core.by_op[o] += s->core.by_op[o];
+        st->instructions += s->instructions;
+        st->rays_camera += s->rays_camera;
+        st->rays_indirect += s->rays_indirect;
+        st->rays_shadow += s->rays_shadow;
+        st->dropped += s->dropped;
+        for (int g = 0; g < FUNC_MAX_GENERATIONS; g++)
+            st->rays_per_generation[g] += s->rays_per_generation[g];
+        if (s->generations > st->generations)
+            st->generations = s->generations;
+        st->trav_streams += s->trav_streams;
+        st->trav_rays += s->trav_rays;
+        st->isect_streams += s->isect_streams;
+        st->isect_rays += s->isect_rays;
+        st->shade_streams += s->shade_streams;
+        st->shade_rays += s->shade_rays;
+    }
+    st->tiles = job->tiles;
+    st->ntiles = job->ntiles;
+    job->tiles = NULL;
+    rc = 0;
+out:
+    if (job) {
+        free(job->tiles);
+        pthread_mutex_destroy(&job->lock);
+    }
+    free(job);
+    free(ws);
+    free(th);
+    asm_object_free(&obj);
+    return rc;
+}
+
+void func_stats_free(FuncStats *st)
+{
+    free(st->tiles);
+    st->tiles = NULL;
+}

@@ -1,0 +1,60 @@
+/* sim/functional.h -- the functional mode: the path-tracing kernel (kernels/pathtrace.s)
+ * assembled for the scene and the machine, run tile by tile on functional cores.
+ *
+ * Owns: choosing the kernel's -D symbols from the scene's needs, the kernel's launch ABI
+ * (kernels/lib/abi.inc, read back from the object's symbols), host threads over tiles, and
+ * the statistics that need no timing. Must not: compute any pixel itself or model time.
+ */
+#ifndef SFSIM_FUNCTIONAL_H
+#define SFSIM_FUNCTIONAL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../scenes/pack.h"
+#include "config.h"
+#include "core.h"
+
+#define FUNC_MAX_GENERATIONS 64
+
+typedef struct FuncParams {
+    const CfgMachine *cfg;     /* SIMD width, stream size, memories, instruction limit */
+    const char *kernel_path;   /* kernels/pathtrace.s */
+    uint32_t needs;            /* SCENE_NEED_* of the scene */
+    uint32_t seed;
+    int threads;
+    void (*progress)(void *ctx, uint32_t tiles_done, uint32_t tiles_total);
+    void *progress_ctx;
+} FuncParams;
+
+typedef struct FuncTile {
+    uint32_t x0, y0, w, h;
+    uint64_t instructions;
+    uint64_t rays;             /* traced, all kinds */
+} FuncTile;
+
+typedef struct FuncStats {
+    CoreStats core;                                 /* summed over all tiles */
+    uint64_t instructions;
+    uint64_t rays_camera, rays_indirect, rays_shadow, dropped;
+    uint64_t rays_per_generation[FUNC_MAX_GENERATIONS];
+    uint64_t generations;
+    /* stream filters run per stage and the rays entering them (average stream length) */
+    uint64_t trav_streams, trav_rays, isect_streams, isect_rays, shade_streams, shade_rays;
+    FuncTile *tiles;                                /* ntiles entries, raster order */
+    uint32_t ntiles;
+    uint32_t kernel_instructions;                   /* program size */
+    char defines[512];                              /* the -D symbols the kernel was built with */
+} FuncStats;
+
+/* Render the whole image through the kernel: rgb (width * height * 3 floats, zeroed by the
+ * caller) receives the mean radiance. 0, or -1 with a message (assembly errors, a scene the
+ * kernel cannot render, memories too small, a trap in a tile). Free st with func_stats_free. */
+int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStats *st, char *err,
+                size_t errlen);
+void func_stats_free(FuncStats *st);
+
+/* The kernel next to the executable: <dir of exe>/../kernels/pathtrace.s, or SFSIM_KERNEL. */
+const char *func_default_kernel(char *buf, size_t len);
+
+#endif
