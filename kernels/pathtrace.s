@@ -36,6 +36,9 @@ DIM_LOBE = 4
 DIM_DIR_U = 5
 DIM_DIR_V = 6
 DIM_RR = 7
+LIGHT_POINT = 0
+LIGHT_SPOT = 1
+LIGHT_DIRECTIONAL = 2
 LIGHT_QUAD = 3
 LIGHT_TRIANGLE = 4
 
@@ -888,6 +891,9 @@ surface:
         ld      r7, r0, SM_HDR_PRIMS
         ld      r8, r0, SM_HDR_MATS
         ld      r9, r0, SM_HDR_NORMALS
+        ld      r10, r0, SM_HDR_TEXS
+        ld      r11, r0, SM_HDR_UVS
+        ld      r12, r0, SM_HDR_SRGB_LUT
         mov     r16, r3
 surf_chunk:
         sfetch  vid, m1, r16, r20
@@ -986,12 +992,80 @@ surf_chunk:
         vmuli   mat, mat, SM_MAT_BYTES @m1
         vbcast  vt, r8 @m1
         vadd    mat, mat, vt @m1
-        ldg     vt, mat, SM_MAT_BASE @m1
-        rsct    vt, vid, r0, F_BASER @m1
-        ldg     vt, mat, SM_MAT_BASE + 4 @m1
-        rsct    vt, vid, r0, F_BASEG @m1
-        ldg     vt, mat, SM_MAT_BASE + 8 @m1
-        rsct    vt, vid, r0, F_BASEB @m1
+        ldg     ex, mat, SM_MAT_BASE @m1
+        ldg     ey, mat, SM_MAT_BASE + 4 @m1
+        ldg     ez, mat, SM_MAT_BASE + 8 @m1
+.ifdef HAS_TEXTURES
+        ; base colour texture: nearest texel, repeat wrapping, sRGB decoded through the table
+        ldg     vt, mat, SM_MAT_TEX @m1
+        vilt    m3, vt, vz @m1
+        mandn   m3, m1, m3              ; textured (index >= 0)
+        bmz     m3, surf_notex
+        vshli   vt, vt, 4 @m3           ; SM_TEX_BYTES = 16
+        vbcast  vt2, r10 @m3
+        vadd    vt, vt, vt2 @m3         ; texture record
+        ldg     fx, pa, SM_PRIM_SRC @m3
+        vmuli   fx, fx, 24 @m3
+        vbcast  vt2, r11 @m3
+        vadd    fx, fx, vt2 @m3         ; the three uv pairs
+.ifndef HAS_NORMALS
+        rgat    bu, vid, r0, F_U @m3
+        rgat    bv, vid, r0, F_V @m3
+        vli     w0, 1.0 @m3
+        vfsub   w0, w0, bu @m3
+        vfsub   w0, w0, bv @m3
+.endif
+.macro  UVINTERP d, off
+        ldg     \d, fx, \off @m3
+        vfmul   \d, w0, \d @m3
+        ldg     vt2, fx, \off + 8 @m3
+        vfmul   vt2, bu, vt2 @m3
+        vfadd   \d, \d, vt2 @m3
+        ldg     vt2, fx, \off + 16 @m3
+        vfmul   vt2, bv, vt2 @m3
+        vfadd   \d, \d, vt2 @m3
+.endm
+        UVINTERP fy, 0                  ; tu
+        UVINTERP fz, 4                  ; tv
+.macro  TEXCOORD d, t, size
+        vffloor vt2, \t @m3
+        vfsub   \t, \t, vt2 @m3        ; fractional part
+        vcvtif  vt2, \size @m3
+        vfmul   \t, \t, vt2 @m3
+        vcvtfi  \d, \t @m3
+        vilt    m4, \d, vz @m3          ; (integer compare with 0)
+        vli     \d, 0 @m4
+        vilt    m4, \d, \size @m3
+        mandn   m4, m3, m4
+        vaddi   \d, \size, -1 @m4
+.endm
+        ldg     gx, vt, SM_TEX_WIDTH @m3
+        ldg     gy, vt, SM_TEX_HEIGHT @m3
+        TEXCOORD gz, fy, gx             ; ix
+        TEXCOORD fy, fz, gy             ; iy
+        vmul    fy, fy, gx @m3
+        vadd    fy, fy, gz @m3
+        vshli   fy, fy, 2 @m3
+        ldg     vt, vt, SM_TEX_TEXELS @m3
+        vadd    fy, fy, vt @m3
+        ldg     fy, fy, 0 @m3           ; RGBA8 texel
+        vbcast  vt2, r12 @m3
+.macro  TEXMUL b, shift
+        vshri   vt, fy, \shift @m3
+        vandi   vt, vt, 255 @m3
+        vshli   vt, vt, 2 @m3
+        vadd    vt, vt, vt2 @m3
+        ldg     vt, vt, 0 @m3
+        vfmul   \b, \b, vt @m3
+.endm
+        TEXMUL  ex, 0
+        TEXMUL  ey, 8
+        TEXMUL  ez, 16
+surf_notex:
+.endif
+        rsct    ex, vid, r0, F_BASER @m1
+        rsct    ey, vid, r0, F_BASEG @m1
+        rsct    ez, vid, r0, F_BASEB @m1
         ldg     vt, mat, SM_MAT_KIND @m1
         rsct    mat, vid, r0, F_MAT @m1
         rsct    vt, vid, r0, F_MATKIND @m1
@@ -1172,6 +1246,20 @@ dir_chunk:
         RAND    lu, kb, DIM_LIGHT_U, vt
         RAND    lv, kb, DIM_LIGHT_V, vt
         ldg     lk, la, SM_LIGHT_KIND @m1
+        ; light kinds: m4 area (quad, triangle), m5 spot, m6 directional, m7 point
+.ifdef HAS_PUNCTUAL
+        vli     vt, LIGHT_QUAD @m1
+        vilt    m4, lk, vt @m1
+        mandn   m4, m1, m4
+        vli     vt, LIGHT_SPOT @m1
+        vieq    m5, lk, vt @m1
+        vli     vt, LIGHT_DIRECTIONAL @m1
+        vieq    m6, lk, vt @m1
+        vli     vt, LIGHT_POINT @m1
+        vieq    m7, lk, vt @m1
+.else
+        mmov    m4, m1
+.endif
         vli     vt, LIGHT_TRIANGLE @m1
         vieq    m2, lk, vt @m1
         vsqrt   vt, lu @m2
@@ -1186,15 +1274,15 @@ dir_chunk:
         ldg     e1x, la, SM_LIGHT_E1 @m1
         ldg     e1y, la, SM_LIGHT_E1 + 4 @m1
         ldg     e1z, la, SM_LIGHT_E1 + 8 @m1
-        ldg     e2x, la, SM_LIGHT_E2 @m1
-        ldg     e2y, la, SM_LIGHT_E2 + 4 @m1
-        ldg     e2z, la, SM_LIGHT_E2 + 8 @m1
+        ldg     e2x, la, SM_LIGHT_E2 @m4
+        ldg     e2y, la, SM_LIGHT_E2 + 4 @m4
+        ldg     e2z, la, SM_LIGHT_E2 + 8 @m4
 .macro  LPOINT p, e1, e2, o
-        vfmul   vt, lu, \e1 @m1
-        vfadd   \p, \p, vt @m1
-        vfmul   vt, lv, \e2 @m1
-        vfadd   \p, \p, vt @m1
-        vfsub   \p, \p, \o @m1          ; shadow ray direction: light point - origin
+        vfmul   vt, lu, \e1 @m4
+        vfadd   \p, \p, vt @m4
+        vfmul   vt, lv, \e2 @m4
+        vfadd   \p, \p, vt @m4
+        vfsub   \p, \p, \o @m1         ; shadow ray direction: light point - origin
 .endm
         LPOINT  lpx, e1x, e2x, ox
         LPOINT  lpy, e1y, e2y, oy
@@ -1208,20 +1296,66 @@ dir_chunk:
 .alias  wix, v12
 .alias  wiy, v13
 .alias  wiz, v14
-        ; light normal and the cosine at the light (front side unless two-sided)
-        CROSS3  nl, e1, e2, vt, m2
-        NORMALIZE3 nl, vt, vt2, m2
-        DOT3    vt2, nl, wi, vt, m2
-        vfneg   vt2, vt2 @m2            ; cosl
-        ldg     vt, la, SM_LIGHT_TWO_SIDED @m2
-        vli     nlx, 0 @m2
-        vieq    m3, vt, nlx @m2
-        mandn   m3, m2, m3
-        vfabs   vt2, vt2 @m3
-        vflt    m2, vz, vt2 @m2         ; cosl > 0
-        ldg     vt, la, SM_LIGHT_AREA @m2
-        vfmul   vt2, vt2, vt @m2
-        vfdiv   vt2, vt2, vt3 @m2       ; scale = cosl area / d2
+        ; area lights: the cosine at the light (front side unless two-sided); scale in vt2
+        mand    m3, m2, m4
+        CROSS3  nl, e1, e2, vt, m3
+        NORMALIZE3 nl, vt, vt2, m3
+        DOT3    vt2, nl, wi, vt, m3
+        vfneg   vt2, vt2 @m3            ; cosl
+        ldg     vt, la, SM_LIGHT_TWO_SIDED @m3
+        vsub    nlx, vz, vt @m3
+        vor     vt, vt, nlx @m3
+        vshri   vt, vt, 31 @m3
+        vshli   vt, vt, 31 @m3
+        vxori   vt, vt, -1 @m3
+        vand    vt2, vt2, vt @m3        ; two-sided: |cosl|
+        vflt    m3, vz, vt2 @m3         ; cosl > 0
+        mandn   m4, m4, m3
+        mandn   m2, m2, m4              ; area lanes failing it are out
+        ldg     vt, la, SM_LIGHT_AREA @m3
+        vfmul   vt2, vt2, vt @m3
+        vfdiv   vt2, vt2, vt3 @m3       ; scale = cosl area / d2
+.ifdef HAS_PUNCTUAL
+        ; spot: falloff between the cone angles / d2
+        mand    m3, m2, m5
+        NORMALIZE3 e1, vt, nlx, m3
+        DOT3    nlx, e1, wi, vt, m3
+        vfneg   nlx, nlx @m3            ; cd
+        ldg     nly, la, SM_LIGHT_COS_INNER @m3
+        ldg     nlz, la, SM_LIGHT_COS_OUTER @m3
+        vfsub   nlx, nlx, nlz @m3
+        vfsub   nly, nly, nlz @m3
+        vli     vt, 0.000001 @m3
+        vfmax   nly, nly, vt @m3
+        vfdiv   nlx, nlx, nly @m3
+        vfmax   nlx, nlx, vz @m3
+        vli     vt, 1.0 @m3
+        vfmin   nlx, nlx, vt @m3
+        vfdiv   vt2, nlx, vt3 @m3
+        ; point: 1 / d2
+        mand    m3, m2, m7
+        vrcp    vt2, vt3 @m3
+        ; directional: wi = normalize(-P), direction wi x 4 scene scale, scale 1
+        bmz     m6, dir_nodirectional
+        ldg     lu, la, SM_LIGHT_P @m6
+        ldg     lv, la, SM_LIGHT_P + 4 @m6
+        ldg     lk, la, SM_LIGHT_P + 8 @m6
+        vfneg   lu, lu @m6
+        vfneg   lv, lv @m6
+        vfneg   lk, lk @m6
+        NORMALIZE3 wi, vt, nlx, m6
+        ld      r7, r0, SM_HDR_EPSILON
+        li      r1, 4.0
+        fmul    r7, r1, r7
+        vbcast  vt, r7 @m6
+        vfmul   lpx, wix, vt @m6
+        vfmul   lpy, wiy, vt @m6
+        vfmul   lpz, wiz, vt @m6
+        vli     vt2, 1.0 @m6
+        mor     m2, m2, m6
+        ld      r1, r0, SM_HDR_LIGHTS   ; (r1: light array, clobbered above)
+dir_nodirectional:
+.endif
         ldg     e1x, la, SM_LIGHT_RADIANCE @m2
         ldg     e1y, la, SM_LIGHT_RADIANCE + 4 @m2
         ldg     e1z, la, SM_LIGHT_RADIANCE + 8 @m2

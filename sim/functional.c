@@ -229,7 +229,7 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
 {
     memset(st, 0, sizeof *st);
     const CfgMachine *cfg = fp->cfg;
-    uint32_t unsupported = fp->needs & (SCENE_NEED_SPHERES | SCENE_NEED_PUNCTUAL | SCENE_NEED_TEXTURES);
+    uint32_t unsupported = fp->needs & SCENE_NEED_SPHERES;
     if (unsupported) {
         char names[256];
         scene_needs_string(unsupported, names, sizeof names);
@@ -261,6 +261,15 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
         add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_DIELECTRIC", 1);
     if (sm_u32(p, sm_hdr(p, SM_HDR_NORMALS)))
         add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_NORMALS", 1);
+    if ((fp->needs & SCENE_NEED_TEXTURES) && sm_u32(p, sm_hdr(p, SM_HDR_UVS)))
+        add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_TEXTURES", 1);
+    uint32_t nlights = sm_u32(p, sm_hdr(p, SM_HDR_NLIGHTS)), lights = sm_u32(p, sm_hdr(p, SM_HDR_LIGHTS));
+    int punctual = 0;
+    for (uint32_t l = 0; l < nlights; l++)
+        if (sm_u32(p, sm_rec(lights, SM_LIGHT_WORDS, l, SM_LIGHT_KIND)) <= SM_LIGHT_DIRECTIONAL)
+            punctual = 1;
+    if (punctual)
+        add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_PUNCTUAL", 1);
     float bg = 0.0f, amb = 0.0f;
     for (int k = 0; k < 3; k++) {
         bg += sm_f32(p, sm_hdr(p, SM_HDR_BACKGROUND + k));
