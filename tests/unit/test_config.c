@@ -79,7 +79,7 @@ Test(config_defaults, values_from_config_def)
     cr_expect_eq(c.raybuf_banks, 32);
     cr_expect_eq(c.idm_size_kb, 32);
     cr_expect_eq(c.spad_size_kb, 64);
-    cr_expect_eq(c.scene_size_mb, 64);
+    cr_expect_eq(c.scene_size_mb, 256);
     cr_expect_eq(c.fb_size_kb, 256);
     cr_expect_eq(c.sim_max_instructions, INT64_C(10000000000));
 }
@@ -499,7 +499,7 @@ Test(config_params, dump_lists_every_key_with_its_value)
     fclose(f);
     const char *must[] = {"[core]\n", "simd_width = 12\n", "clock_mhz = 500\n", "[stream]\n", "rays = 4096\n",
                           "[raybuf]\n", "size_kb = 512\n", "banks = 32\n", "[idm]\n", "[spad]\n", "[scene]\n",
-                          "size_mb = 64\n", "[fb]\n", "size_kb = 256\n", "[sim]\n", "max_instructions = 777\n"};
+                          "size_mb = 256\n", "[fb]\n", "size_kb = 256\n", "[sim]\n", "max_instructions = 777\n"};
     for (size_t i = 0; i < sizeof must / sizeof must[0]; i++)
         cr_expect(strstr(buf, must[i]) != NULL, "dump lacks '%s':\n%s", must[i], buf);
     free(buf);
