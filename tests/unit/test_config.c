@@ -466,7 +466,7 @@ Test(config_params, core_params_from_keys)
     cr_expect_eq(p.mem_bytes[CORE_MEM_RB1], 512u * 1024);
     cr_expect_eq(p.mem_bytes[CORE_MEM_IDM], 32u * 1024);
     cr_expect_eq(p.mem_bytes[CORE_MEM_SPAD], 64u * 1024);
-    cr_expect_eq(p.mem_bytes[CORE_MEM_SCENE], 64u * 1024 * 1024);
+    cr_expect_eq(p.mem_bytes[CORE_MEM_SCENE], 256u * 1024 * 1024);
     cr_expect_eq(p.mem_bytes[CORE_MEM_FB], 256u * 1024);
 
     CfgErrors e = {0};
