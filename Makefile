@@ -183,11 +183,10 @@ bench: deps
 
 # ---- the example `make run` executes --------------------------------------------------------
 run-built: all
-	@echo "== sfsim: assembling kernels/examples/filter_demo.s and running it on the functional core"
-	bin/sfasm kernels/examples/filter_demo.s -o $(BUILD)/filter_demo.sfo
-	bin/sfsim exec $(BUILD)/filter_demo.sfo -c configs/streamray.ini
-	@echo "== r10 = rays the partition unit kept, r11 = rays that passed the test (equal), r12 = kept rays"
-	@echo "   that fail the test (0, so not listed); utilization per stage is in the counters above."
+	@echo "== sfsim: the path-tracing kernel renders the Cornell box on the functional core (configs/streamray.ini)"
+	bin/sfsim run --mode functional -s scenes/cornell/scene.ini -c configs/streamray.ini -o out
+	@cat out/report.txt
+	@echo "== images: out/frame.png (tone-mapped), out/frame.exr (linear); the full report: out/report.json"
 
 clean:
 	rm -rf $(BUILD) bin

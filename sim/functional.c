@@ -91,6 +91,7 @@ typedef struct Job {
     FuncTile *tiles;
     atomic_uint next_tile, done_tiles;
     atomic_int failed;
+    int trapped;               /* the failure was the kernel's (trap, limit, error code) */
     pthread_mutex_t lock;
     char err[1024];
 } Job;
@@ -115,11 +116,13 @@ static void spad_set(Core *c, uint32_t addr, uint32_t v)
     memcpy(m + addr, &v, 4);
 }
 
-static void fail(Job *j, const char *msg)
+static void fail(Job *j, const char *msg, int trapped)
 {
     pthread_mutex_lock(&j->lock);
-    if (!atomic_load(&j->failed))
+    if (!atomic_load(&j->failed)) {
         snprintf(j->err, sizeof j->err, "%s", msg);
+        j->trapped = trapped;
+    }
     atomic_store(&j->failed, 1);
     pthread_mutex_unlock(&j->lock);
 }
@@ -149,7 +152,7 @@ static int run_tile(Job *j, Core *c, uint32_t t, FuncStats *st)
     if (ex != CORE_EXIT_HALT) {
         snprintf(msg, sizeof msg, "kernel, tile at (%u, %u): %s%s", ft->x0, ft->y0, core_trap_message(c),
                  ex == CORE_EXIT_LIMIT ? " (sim.max_instructions)" : "");
-        fail(j, msg);
+        fail(j, msg, 1);
         return -1;
     }
     uint32_t kerr = spad_u32(c, a->l_error);
@@ -158,7 +161,7 @@ static int run_tile(Job *j, Core *c, uint32_t t, FuncStats *st)
                  kerr == a->err_stack ? "traversal stack overflow (raise spad.size_kb)"
                  : kerr == a->err_generations ? "more generations than the kernel counts (64)"
                                              : "error code set");
-        fail(j, msg);
+        fail(j, msg, 1);
         return -1;
     }
     for (uint32_t y = 0; y < ft->h; y++)
@@ -193,7 +196,7 @@ static void *worker_main(void *arg)
     if (!c) {
         char msg[600];
         snprintf(msg, sizeof msg, "kernel: %s", err);
-        fail(j, msg);
+        fail(j, msg, 0);
         return NULL;
     }
     uint32_t size;
@@ -387,6 +390,7 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
         pthread_join(th[i], NULL);
     if (atomic_load(&job->failed)) {
         snprintf(err, errlen, "%s", job->err);
+        rc = job->trapped ? -2 : -1;
         goto out;
     }
     float inv = 1.0f / (float)spp;

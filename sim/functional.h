@@ -48,8 +48,9 @@ typedef struct FuncStats {
 } FuncStats;
 
 /* Render the whole image through the kernel: rgb (width * height * 3 floats, zeroed by the
- * caller) receives the mean radiance. 0, or -1 with a message (assembly errors, a scene the
- * kernel cannot render, memories too small, a trap in a tile). Free st with func_stats_free. */
+ * caller) receives the mean radiance. 0; -1 with a message for bad input (assembly errors, a
+ * scene the kernel cannot render, memories too small); -2 when the kernel itself failed in a
+ * tile (a trap, the instruction limit, an error code it set). Free st with func_stats_free. */
 int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStats *st, char *err,
                 size_t errlen);
 void func_stats_free(FuncStats *st);

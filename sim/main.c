@@ -492,9 +492,10 @@ static int cmd_run(int argc, char **argv)
     o.bvh_bins = cfg.bvh_bins;
     o.cfg = &cfg;
     static char err[65536];
-    if (render_run(&o, err, sizeof err) != 0) {
+    int rrc = render_run(&o, err, sizeof err);
+    if (rrc != 0) {
         fprintf(stderr, "sfsim run: %s\n", err);
-        return EXIT_INPUT;
+        return rrc == -2 ? EXIT_TRAP : EXIT_INPUT;
     }
     printf("sfsim run: wrote %s/frame.png, frame.exr, report.txt, report.json\n", o.out_dir);
     return EXIT_OK;

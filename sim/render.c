@@ -259,8 +259,11 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         char kpath[4200];
         FuncParams fp = {cfg, o->kernel_path ? o->kernel_path : func_default_kernel(kpath, sizeof kpath),
                          s.needs, o->seed, threads, progress_cb, &pr};
-        if (func_render(&p, &fp, rgb, &rs.f, err, errlen) != 0)
+        int frc = func_render(&p, &fp, rgb, &rs.f, err, errlen);
+        if (frc != 0) {
+            rc = frc;
             goto out;
+        }
         rs.functional = 1;
         rs.primary = rs.f.rays_camera;
         rs.shadow = rs.f.rays_shadow;

@@ -29,7 +29,7 @@ void render_default_options(RenderOptions *o);
 
 /* A run in o->mode: "reference" (the golden model, sim/reference.c) or "functional" (the
  * kernel on functional cores, sim/functional.c). 0, or -1 with a message naming the file or
- * the setting at fault. */
+ * the setting at fault; -2 when the simulated program failed (trap, instruction limit). */
 int render_run(const RenderOptions *o, char *err, size_t errlen);
 
 #endif

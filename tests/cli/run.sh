@@ -289,5 +289,41 @@ run "$SFSIM" run --mode nonsense -o "$T/ref5"
 want_rc 2; want_err "nonsense"
 end
 
+# ---- sfsim run --mode functional: the kernel on the functional core ------------------------------
+begin "sfsim run --mode functional renders the Cornell box like the golden model (compare: RMSE 0)"
+run "$SFSIM" run --mode functional -s scenes/cornell/scene.ini -o "$T/fun1" --set render.width=48 \
+    --set render.height=32 --set render.spp=2 -j 2 --no-progress
+want_rc 0
+for f in frame.png frame.exr report.txt report.json; do [ -s "$T/fun1/$f" ] || no "missing $f"; done
+grep -qE '"mode":[[:space:]]+"functional"' "$T/fun1/report.json" 2>/dev/null || no "report.json has no mode"
+for k in utilization stream_length ops tiles rays_per_generation sim_instructions; do
+    grep -q "\"$k\"" "$T/fun1/report.json" 2>/dev/null || no "report.json lacks $k"
+done
+grep -q "utilization" "$T/fun1/report.txt" 2>/dev/null || no "report.txt lacks utilization"
+run "$SFSIM" compare "$T/ref1/frame.exr" "$T/fun1/frame.exr"
+want_rc 0; want_out "max diff +0$"
+end
+
+begin "sfsim run --mode functional on a too small ray buffer names the key (exit 1)"
+run "$SFSIM" run --mode functional -s scenes/cornell/scene.ini -o "$T/fun2" --set raybuf.size_kb=64 \
+    --set render.width=16 --set render.height=16 --set render.spp=1 --no-progress
+want_rc 1; want_err "raybuf.size_kb"
+end
+
+begin "sfsim run --mode functional with a kernel that does not assemble shows file:line (exit 1)"
+printf 'start: vfadd v1, r2, v3\n' > "$T/bad_kernel.s"
+run "$SFSIM" run --mode functional --kernel "$T/bad_kernel.s" -s scenes/cornell/scene.ini -o "$T/fun3" \
+    --set render.width=16 --set render.height=16 --set render.spp=1 --no-progress
+want_rc 1; want_err "bad_kernel.s:1:"
+end
+
+begin "sfsim run --mode functional: a kernel that traps names pc and tile (exit 3)"
+printf '.include "abi.inc"\nstart: li r1, 0x7FFFFFF0\n ld r2, r1, 0\n halt\n' > "$T/trap_kernel.s"
+mkdir -p "$T/lib" && cp kernels/lib/abi.inc "$T/lib/"
+run "$SFSIM" run --mode functional --kernel "$T/trap_kernel.s" -s scenes/cornell/scene.ini -o "$T/fun4" \
+    --set render.width=16 --set render.height=16 --set render.spp=1 --no-progress
+want_rc 3; want_err "tile at \(0, 0\).*trap"
+end
+
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
