@@ -586,6 +586,10 @@ isect_chunk:
         mov     r10, r8                 ; primitive address
         mov     r11, r7                 ; primitive index
 isect_prim:
+.ifdef HAS_SPHERES
+        ld      r12, r10, SM_PRIM_KIND
+        bne     r12, r0, isect_sphere
+.endif
         vbcast  vt, r10 @m1
         vadd    adx, kx, vt @m1
         vadd    ady, ky, vt @m1
@@ -660,6 +664,7 @@ isect_prim:
         vfmul   adz, adz, ex @m5        ; v
         vflt    m5, vz, ey @m5
         vflt    m5, ey, ptm @m5
+isect_update:
         ; shadow rays: occluded, done
         mand    m6, m5, m2
         vli     tm, -1.0 @m6
@@ -677,6 +682,69 @@ isect_prim:
         vmov    prim, vi @m6
         mor     m3, m3, m6
         mor     m4, m4, m6
+.ifdef HAS_SPHERES
+        jmp     isect_next
+        ; ray/sphere (Haines et al. 2019): discriminant from the closest-approach vector; the
+        ; hit distance goes to the shared update with u = v = 0
+isect_sphere:
+.macro  SPH_OC o, f, off
+        rgat    \o, vid, r0, \f @m1
+        ldb     vt, r10, SM_PRIM_V0 + \off @m1
+        vfsub   \o, \o, vt @m1
+.endm
+        SPH_OC  ex, F_ORGX, 0           ; oc = o - center
+        SPH_OC  ey, F_ORGY, 4
+        SPH_OC  ez, F_ORGZ, 8
+        rgat    fx, vid, r0, F_DIRX @m1
+        rgat    fy, vid, r0, F_DIRY @m1
+        rgat    fz, vid, r0, F_DIRZ @m1
+        SANITIZE1 fx, vt, vi, m6
+        SANITIZE1 fy, vt, vi, m6
+        SANITIZE1 fz, vt, vi, m6
+        DOT3    gx, f, f, vt            ; a
+        vflt    m5, vz, gx @m1
+        DOT3    gy, e, f, vt, m5
+        vfneg   gy, gy @m5              ; b = -(oc . d)
+        vfdiv   gz, gy, gx @m5          ; s = b / a
+        vfmul   vt, gz, fx @m5
+        vfadd   fx, ex, vt @m5          ; l = oc + s d
+        vfmul   vt, gz, fy @m5
+        vfadd   fy, ey, vt @m5
+        vfmul   vt, gz, fz @m5
+        vfadd   fz, ez, vt @m5
+        ldb     vt, r10, SM_PRIM_V1 @m5 ; radius
+        vfmul   adx, vt, vt @m5         ; r2
+        DOT3    gz, f, f, vt, m5
+        vfsub   gz, adx, gz @m5
+        vfmul   gz, gx, gz @m5          ; disc = a (r2 - l . l)
+        vflt    m6, gz, vz @m5
+        mandn   m5, m5, m6
+        DOT3    fx, e, e, vt, m5
+        vfsub   fx, fx, adx @m5         ; c = oc . oc - r2
+        vsqrt   fy, gz @m5
+        vandi   vt, fy, 0x7FFFFFFF @m5
+        vandi   vi, gy, 0x80000000 @m5
+        vor     vt, vt, vi @m5
+        vfadd   fy, gy, vt @m5          ; q = b + copysign(sqrt(disc), b)
+        vfne    m5, fy, vz @m5
+        vfdiv   fz, fx, fy @m5          ; t0 = c / q
+        vfdiv   ex, fy, gx @m5          ; t1 = q / a
+        vfmin   adx, fz, ex @m5         ; lo
+        vfmax   ady, fz, ex @m5         ; hi
+        vmov    ptm, tm @m5
+        viltu   m6, prim, vm2 @m5
+        vaddi   ptm, ptm, 1 @m6
+        vflt    m6, vz, adx @m5
+        vflt    m6, adx, ptm @m6        ; lo in (0, tmax)
+        vflt    m7, vz, ady @m5
+        vflt    m7, ady, ptm @m7        ; hi in (0, tmax)
+        vmov    ey, ady @m7
+        vmov    ey, adx @m6
+        mor     m5, m6, m7
+        vli     ady, 0 @m5
+        vli     adz, 0 @m5
+        jmp     isect_update
+.endif
 isect_next:
         addi    r10, r10, SM_PRIM_BYTES
         addi    r11, r11, 1
@@ -933,6 +1001,27 @@ surf_chunk:
         HITP    ax, ex, F_PX
         HITP    ay, ey, F_PY
         HITP    az, ez, F_PZ
+.ifdef HAS_SPHERES
+        ; spheres: the outward normal p - center (m5: sphere lanes, kept for the blocks below)
+        ldg     vt, pa, SM_PRIM_KIND @m1
+        vli     vt2, 0 @m1
+        vieq    m5, vt, vt2 @m1
+        mandn   m5, m1, m5
+        bmz     m5, surf_nosphere
+.macro  SPHN g, f, off
+        rgat    \g, vid, r0, \f @m5
+        ldg     vt, pa, SM_PRIM_V0 + \off @m5
+        vfsub   \g, \g, vt @m5
+.endm
+        SPHN    gx, F_PX, 0
+        SPHN    gy, F_PY, 4
+        SPHN    gz, F_PZ, 8
+        NORMALIZE3 g, vt, vt2, m5
+        rsct    gx, vid, r0, F_NGX @m5
+        rsct    gy, vid, r0, F_NGY @m5
+        rsct    gz, vid, r0, F_NGZ @m5
+surf_nosphere:
+.endif
         DOT3    dn, g, e, vt            ; ng . d
         vmov    nfx, gx @m1
         vmov    nfy, gy @m1
@@ -946,35 +1035,39 @@ surf_chunk:
         vmov    nsz, nfz @m1
 .ifdef HAS_NORMALS
         ; interpolated vertex normals: w0 n0 + u n1 + v n2, normalized, on nf's side
-        ldg     vt, pa, SM_PRIM_SRC @m1
-        vmuli   vt, vt, 36 @m1
-        vbcast  vt2, r9 @m1
-        vadd    vt, vt, vt2 @m1         ; address of the three normals
-        rgat    bu, vid, r0, F_U @m1
-        rgat    bv, vid, r0, F_V @m1
-        vli     w0, 1.0 @m1
-        vfsub   w0, w0, bu @m1
-        vfsub   w0, w0, bv @m1
+        mmov    m6, m1
+.ifdef HAS_SPHERES
+        mandn   m6, m1, m5              ; (not on spheres)
+.endif
+        ldg     vt, pa, SM_PRIM_SRC @m6
+        vmuli   vt, vt, 36 @m6
+        vbcast  vt2, r9 @m6
+        vadd    vt, vt, vt2 @m6         ; address of the three normals
+        rgat    bu, vid, r0, F_U @m6
+        rgat    bv, vid, r0, F_V @m6
+        vli     w0, 1.0 @m6
+        vfsub   w0, w0, bu @m6
+        vfsub   w0, w0, bv @m6
 .macro  NINTERP d, off
-        ldg     \d, vt, \off @m1
-        vfmul   \d, w0, \d @m1
-        ldg     vt2, vt, \off + 12 @m1
-        vfmul   vt2, bu, vt2 @m1
-        vfadd   \d, \d, vt2 @m1
-        ldg     vt2, vt, \off + 24 @m1
-        vfmul   vt2, bv, vt2 @m1
-        vfadd   \d, \d, vt2 @m1
+        ldg     \d, vt, \off @m6
+        vfmul   \d, w0, \d @m6
+        ldg     vt2, vt, \off + 12 @m6
+        vfmul   vt2, bu, vt2 @m6
+        vfadd   \d, \d, vt2 @m6
+        ldg     vt2, vt, \off + 24 @m6
+        vfmul   vt2, bv, vt2 @m6
+        vfadd   \d, \d, vt2 @m6
 .endm
         NINTERP ax, 0
         NINTERP ay, 4
         NINTERP az, 8
-        NORMALIZE3 a, vt, vt2
-        vfmul   vt, ax, vz @m1          ; finite?
-        vfmul   vt2, ay, vz @m1
-        vfadd   vt, vt, vt2 @m1
-        vfmul   vt2, az, vz @m1
-        vfadd   vt, vt, vt2 @m1
-        vfeq    m3, vt, vz @m1
+        NORMALIZE3 a, vt, vt2, m6
+        vfmul   vt, ax, vz @m6          ; finite?
+        vfmul   vt2, ay, vz @m6
+        vfadd   vt, vt, vt2 @m6
+        vfmul   vt2, az, vz @m6
+        vfadd   vt, vt, vt2 @m6
+        vfeq    m3, vt, vz @m6
         DOT3    vt, a, nf, vt2, m3
         vflt    m4, vt, vz @m3          ; on the other side: flip
         vfneg   ax, ax @m4
@@ -1000,6 +1093,9 @@ surf_chunk:
         ldg     vt, mat, SM_MAT_TEX @m1
         vilt    m3, vt, vz @m1
         mandn   m3, m1, m3              ; textured (index >= 0)
+.ifdef HAS_SPHERES
+        mandn   m3, m3, m5              ; (spheres have no texture coordinates)
+.endif
         bmz     m3, surf_notex
         vshli   vt, vt, 4 @m3           ; SM_TEX_BYTES = 16
         vbcast  vt2, r10 @m3

@@ -232,16 +232,6 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
 {
     memset(st, 0, sizeof *st);
     const CfgMachine *cfg = fp->cfg;
-    uint32_t unsupported = fp->needs & SCENE_NEED_SPHERES;
-    if (unsupported) {
-        char names[256];
-        scene_needs_string(unsupported, names, sizeof names);
-        snprintf(err, errlen,
-                 "the path-tracing kernel does not render %s yet (docs/kernel.md lists what it models); "
-                 "--mode reference renders this scene",
-                 names);
-        return -1;
-    }
     /* Build symbols from the packed scene itself (docs/kernel.md). */
     AsmDefine defs[16];
     int nd = 0;
@@ -262,6 +252,12 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
         add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_GLOSSY", 1);
     if (kinds & (1 << SCENE_MAT_DIELECTRIC))
         add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_DIELECTRIC", 1);
+    uint32_t prims = sm_u32(p, sm_hdr(p, SM_HDR_PRIMS));
+    int spheres = 0;
+    for (uint32_t i = 0; i < p->nprims && !spheres; i++)
+        spheres = sm_u32(p, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_KIND)) == 1;
+    if (spheres)
+        add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_SPHERES", 1);
     if (sm_u32(p, sm_hdr(p, SM_HDR_NORMALS)))
         add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_NORMALS", 1);
     if ((fp->needs & SCENE_NEED_TEXTURES) && sm_u32(p, sm_hdr(p, SM_HDR_UVS)))

@@ -118,6 +118,11 @@ Test(functional, cornell_spheres_glass_matches_the_golden_model, .timeout = 120)
     matches_golden("scenes/cornell/spheres.ini", 80, 64, 4);
 }
 
+Test(functional, cornell_analytic_spheres_match_the_golden_model, .timeout = 120)
+{
+    matches_golden("scenes/cornell/analytic.ini", 80, 64, 4);
+}
+
 Test(functional, conference_room_matches_the_golden_model, .timeout = 300)
 {
     matches_golden("scenes/conference/scene.ini", 64, 48, 1);
