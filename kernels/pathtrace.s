@@ -54,6 +54,19 @@ LIGHT_TRIANGLE = 4
 .alias  vz, v31
 .alias  vm2, v30
 
+; Per-generation stream counters: one more stream of [\b, \e) for stage offset \off.
+.macro  COUNT_STREAM off, b, e, t1, t2, t3
+        muli    \t1, r18, ST_GEN_BYTES
+        spld    \t2, \t1, ST_GEN_BASE + \off
+        addi    \t2, \t2, 1
+        spst    \t2, \t1, ST_GEN_BASE + \off
+        sub     \t3, \e, \b
+        shri    \t3, \t3, 2
+        spld    \t2, \t1, ST_GEN_BASE + \off + 4
+        add     \t2, \t2, \t3
+        spst    \t2, \t1, ST_GEN_BASE + \off + 4
+.endm
+
         .text
 start:  vli     vz, 0
         vli     vm2, -2
@@ -65,6 +78,7 @@ start:  vli     vz, 0
 ; ==== one pass per sample: camera rays of the tile ==============================================
 sample_loop:
         stage   0
+        sgen    r0                      ; counters of generation 0 (camera rays)
         li      r19, 0                  ; streams live at IDM 0 and IDM FIELD_BYTES
         mov     r20, r19
         spld    r1, r0, L_W
@@ -205,6 +219,7 @@ cam_chunk:
 ; ==== generations ================================================================================
 gen_loop:
         stage   0
+        sgen    r18                     ; per-generation counters
         li      r1, FIELD_BYTES
         sub     r21, r1, r19            ; the other stream region
         mov     r22, r21
@@ -432,14 +447,7 @@ trav_pop:
         ldb     bmaxy, r2, SM_NODE_BMAX + 4
         ldb     bmaxz, r2, SM_NODE_BMAX + 8
         vli     vscale, SLAB_FAR_SCALE
-        spld    r5, r0, ST_TRAV_STREAMS
-        addi    r5, r5, 1
-        spst    r5, r0, ST_TRAV_STREAMS
-        sub     r5, r4, r3
-        shri    r5, r5, 2
-        spld    r6, r0, ST_TRAV_RAYS
-        add     r6, r6, r5
-        spst    r6, r0, ST_TRAV_RAYS
+        COUNT_STREAM ST_G_TRAV, r3, r4, r5, r6, r7
         mov     r16, r3
 box_chunk:
         sfetch  vid, m1, r16, r4
@@ -554,14 +562,7 @@ isect:
 .alias  gz, v26
 .alias  vt, v27
 .alias  vi, v28
-        spld    r8, r0, ST_ISECT_STREAMS
-        addi    r8, r8, 1
-        spst    r8, r0, ST_ISECT_STREAMS
-        sub     r8, r5, r3
-        shri    r8, r8, 2
-        spld    r9, r0, ST_ISECT_RAYS
-        add     r9, r9, r8
-        spst    r9, r0, ST_ISECT_RAYS
+        COUNT_STREAM ST_G_ISECT, r3, r5, r8, r9, r10
         li      r8, SM_PRIM_BYTES
         mul     r8, r8, r7
         add     r8, r8, r27             ; address of the first primitive
@@ -762,16 +763,11 @@ isect_next:
 ; further filter. New rays go to the next ray buffer (ralloc, rsctn) and their IDs to the next
 ; stream (sapp r22).
 
-; count a shading filter's input stream [\b, \e) (scratch r1, r2)
+; count a shading filter's input stream [\b, \e) (scratch r1, r2, r4 saved around it)
 .macro  SHADE_STREAM b, e
-        spld    r1, r0, ST_SHADE_STREAMS
-        addi    r1, r1, 1
-        spst    r1, r0, ST_SHADE_STREAMS
-        sub     r2, \e, \b
-        shri    r2, r2, 2
-        spld    r1, r0, ST_SHADE_RAYS
-        add     r1, r1, r2
-        spst    r1, r0, ST_SHADE_RAYS
+        spst    r4, r0, L_SCRATCH
+        COUNT_STREAM ST_G_SHADE, \b, \e, r1, r2, r4
+        spld    r4, r0, L_SCRATCH
 .endm
 
 ; New ray into the next buffer for the lanes of mask k; o, d, th triples; vid the parent.

@@ -41,6 +41,7 @@ struct Core {
     uint64_t m[ISA_NUM_MREGS];
     uint32_t pc;
     uint8_t stage;
+    uint8_t gen;                  /* statistics generation (sgen) */
     int cur_rb;                   /* physical buffer (0/1) that is RBc */
     uint8_t *mem[CORE_MEM_COUNT];
     uint32_t size[CORE_MEM_COUNT];
@@ -136,6 +137,7 @@ void core_restart(Core *c)
     c->m[0] = c->all;
     c->pc = 0;
     c->stage = 0;
+    c->gen = 0;
     c->cur_rb = 0;
     c->pq_len = 0;
     c->trap[0] = 0;
@@ -336,7 +338,7 @@ static int step(Core *c)
     uint32_t active = dc->vec ? (uint32_t)popcount64(E) : 0;
     if (c->hook)
         record_reset(&c->rec, c->pc, in, c->stage, E);
-    const uint8_t stage = c->stage;
+    const uint8_t stage = c->stage, gen = c->gen;
 
 #define BRANCH_TO(cond)                                                                         \
     do {                                                                                        \
@@ -358,6 +360,9 @@ static int step(Core *c)
     /* control */
     case ISA_OP_NOP: break;
     case ISA_OP_HALT: halt = 1; break;
+    case ISA_OP_SGEN:
+        c->gen = (uint8_t)(SR(in->a) < CORE_GENERATIONS ? SR(in->a) : CORE_GENERATIONS - 1);
+        break;
     case ISA_OP_STAGE:
         if (IMM >= ISA_STAGE_COUNT)
             return -trap(c, "bad stage %u (0..%d)", IMM, ISA_STAGE_COUNT - 1);
@@ -735,9 +740,12 @@ static int step(Core *c)
     c->st.instructions[stage]++;
     c->st.ops[stage][dc->cat]++;
     c->st.by_op[in->op]++;
+    c->st.gen_instructions[gen][stage]++;
     if (dc->vec) {
         c->st.vec_instructions[stage]++;
         c->st.active_lanes[stage] += active;
+        c->st.gen_vec_instructions[gen][stage]++;
+        c->st.gen_active_lanes[gen][stage] += active;
     }
     c->total++;
     if (c->hook) {

@@ -32,6 +32,8 @@ typedef struct CoreParams {
 
 typedef enum CoreExit { CORE_EXIT_HALT = 0, CORE_EXIT_TRAP = 1, CORE_EXIT_LIMIT = 2 } CoreExit;
 
+#define CORE_GENERATIONS 64   /* statistics generations kept apart (sgen) */
+
 /* Counters, per statistics stage (IsaStage). */
 typedef struct CoreStats {
     uint64_t instructions[ISA_STAGE_COUNT];
@@ -40,6 +42,11 @@ typedef struct CoreStats {
     uint64_t active_lanes[ISA_STAGE_COUNT];       /* sum of their active lanes: exec-mask lanes, and
                                                      for sfetch the n lanes that received an ID */
     uint64_t by_op[ISA_OP_COUNT];                 /* executions per opcode */
+    /* The same per statistics generation (set by sgen; 0 at reset), for utilization per ray
+     * generation: instructions, vector instructions and their active lanes. */
+    uint64_t gen_instructions[CORE_GENERATIONS][ISA_STAGE_COUNT];
+    uint64_t gen_vec_instructions[CORE_GENERATIONS][ISA_STAGE_COUNT];
+    uint64_t gen_active_lanes[CORE_GENERATIONS][ISA_STAGE_COUNT];
 } CoreStats;
 
 /* Per-instruction record for the timing model (produced only when a hook is set). */

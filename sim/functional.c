@@ -43,7 +43,7 @@ const char *func_default_kernel(char *buf, size_t len)
 typedef struct Abi {
     uint32_t l_x0, l_y0, l_w, l_h, l_seed, l_error;
     uint32_t st_dropped, st_camera, st_indirect, st_shadow, st_generations, st_per_gen, st_max_gen;
-    uint32_t st_trav_streams, st_trav_rays, st_isect_streams, st_isect_rays, st_shade_streams, st_shade_rays;
+    uint32_t st_gen_base, st_gen_bytes, st_g_trav, st_g_isect, st_g_shade;
     uint32_t stack_base, ray_fields, err_stack, err_generations;
 } Abi;
 
@@ -54,10 +54,9 @@ static int abi_lookup(const AsmObject *obj, Abi *abi, char *err, size_t errlen)
         A(l_x0, "L_X0"), A(l_y0, "L_Y0"), A(l_w, "L_W"), A(l_h, "L_H"), A(l_seed, "L_SEED"),
         A(l_error, "L_ERROR"), A(st_dropped, "ST_DROPPED"), A(st_camera, "ST_CAMERA"),
         A(st_indirect, "ST_INDIRECT"), A(st_shadow, "ST_SHADOW"), A(st_generations, "ST_GENERATIONS"),
-        A(st_per_gen, "ST_PER_GEN"), A(st_max_gen, "ST_MAX_GEN"), A(st_trav_streams, "ST_TRAV_STREAMS"),
-        A(st_trav_rays, "ST_TRAV_RAYS"), A(st_isect_streams, "ST_ISECT_STREAMS"),
-        A(st_isect_rays, "ST_ISECT_RAYS"), A(st_shade_streams, "ST_SHADE_STREAMS"),
-        A(st_shade_rays, "ST_SHADE_RAYS"), A(stack_base, "STACK_BASE"), A(ray_fields, "RAY_FIELDS"),
+        A(st_per_gen, "ST_PER_GEN"), A(st_max_gen, "ST_MAX_GEN"), A(st_gen_base, "ST_GEN_BASE"),
+        A(st_gen_bytes, "ST_GEN_BYTES"), A(st_g_trav, "ST_G_TRAV"), A(st_g_isect, "ST_G_ISECT"),
+        A(st_g_shade, "ST_G_SHADE"), A(stack_base, "STACK_BASE"), A(ray_fields, "RAY_FIELDS"),
         A(err_stack, "ERR_STACK"), A(err_generations, "ERR_GENERATIONS"),
 #undef A
     };
@@ -178,12 +177,13 @@ static int run_tile(Job *j, Core *c, uint32_t t, FuncStats *st)
         st->generations = g;
     for (uint32_t k = 0; k < a->st_max_gen; k++)
         st->rays_per_generation[k] += spad_u32(c, a->st_per_gen + 4 * k);
-    st->trav_streams += spad_u32(c, a->st_trav_streams);
-    st->trav_rays += spad_u32(c, a->st_trav_rays);
-    st->isect_streams += spad_u32(c, a->st_isect_streams);
-    st->isect_rays += spad_u32(c, a->st_isect_rays);
-    st->shade_streams += spad_u32(c, a->st_shade_streams);
-    st->shade_rays += spad_u32(c, a->st_shade_rays);
+    const uint32_t off[FUNC_STAGES] = {a->st_g_trav, a->st_g_isect, a->st_g_shade};
+    for (uint32_t k = 0; k < a->st_max_gen; k++)
+        for (int s = 0; s < FUNC_STAGES; s++) {
+            uint32_t at = a->st_gen_base + k * a->st_gen_bytes + off[s];
+            st->gen_streams[k][s] += spad_u32(c, at);
+            st->gen_rays[k][s] += spad_u32(c, at + 4);
+        }
     return 0;
 }
 
@@ -400,6 +400,11 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
             st->core.active_lanes[k] += s->core.active_lanes[k];
             for (int c = 0; c < ISA_C_COUNT; c++)
                 st->core.ops[k][c] += s->core.ops[k][c];
+            for (int g = 0; g < CORE_GENERATIONS; g++) {
+                st->core.gen_instructions[g][k] += s->core.gen_instructions[g][k];
+                st->core.gen_vec_instructions[g][k] += s->core.gen_vec_instructions[g][k];
+                st->core.gen_active_lanes[g][k] += s->core.gen_active_lanes[g][k];
+            }
         }
         for (int o = 0; o < ISA_OP_COUNT; o++)
             st->core.by_op[o] += s->core.by_op[o];
@@ -412,12 +417,19 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
             st->rays_per_generation[g] += s->rays_per_generation[g];
         if (s->generations > st->generations)
             st->generations = s->generations;
-        st->trav_streams += s->trav_streams;
-        st->trav_rays += s->trav_rays;
-        st->isect_streams += s->isect_streams;
-        st->isect_rays += s->isect_rays;
-        st->shade_streams += s->shade_streams;
-        st->shade_rays += s->shade_rays;
+        for (int g = 0; g < FUNC_MAX_GENERATIONS; g++)
+            for (int k = 0; k < FUNC_STAGES; k++) {
+                st->gen_streams[g][k] += s->gen_streams[g][k];
+                st->gen_rays[g][k] += s->gen_rays[g][k];
+            }
+    }
+    for (int g = 0; g < FUNC_MAX_GENERATIONS; g++) {
+        st->trav_streams += st->gen_streams[g][0];
+        st->trav_rays += st->gen_rays[g][0];
+        st->isect_streams += st->gen_streams[g][1];
+        st->isect_rays += st->gen_rays[g][1];
+        st->shade_streams += st->gen_streams[g][2];
+        st->shade_rays += st->gen_rays[g][2];
     }
     st->tiles = job->tiles;
     st->ntiles = job->ntiles;

@@ -16,6 +16,7 @@
 #include "core.h"
 
 #define FUNC_MAX_GENERATIONS 64
+#define FUNC_STAGES 3          /* stream counters: traversal, intersection, shading */
 
 typedef struct FuncParams {
     const CfgMachine *cfg;     /* SIMD width, stream size, memories, instruction limit */
@@ -39,7 +40,9 @@ typedef struct FuncStats {
     uint64_t rays_camera, rays_indirect, rays_shadow, dropped;
     uint64_t rays_per_generation[FUNC_MAX_GENERATIONS];
     uint64_t generations;
-    /* stream filters run per stage and the rays entering them (average stream length) */
+    /* stream filters run per stage and the rays entering them (average stream length): per
+     * generation, and summed */
+    uint64_t gen_streams[FUNC_MAX_GENERATIONS][FUNC_STAGES], gen_rays[FUNC_MAX_GENERATIONS][FUNC_STAGES];
     uint64_t trav_streams, trav_rays, isect_streams, isect_rays, shade_streams, shade_rays;
     FuncTile *tiles;                                /* ntiles entries, raster order */
     uint32_t ntiles;

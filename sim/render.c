@@ -167,10 +167,49 @@ static void add_functional_json(cJSON *root, const RunStats *rs, const CfgMachin
     for (int k = 0; k < ISA_STAGE_COUNT; k++)
         cJSON_AddNumberToObject(ut, isa_stage_keys[k],
                                 ratio(f->core.active_lanes[k], (uint64_t)n * f->core.vec_instructions[k]));
+    /* Primary rays are generation 0 (camera rays only); the rest are secondary (Tables 2, 3). */
+    cJSON *ug = cJSON_AddArrayToObject(root, "utilization_by_generation");
+    uint64_t sec_act[ISA_STAGE_COUNT] = {0}, sec_vec[ISA_STAGE_COUNT] = {0};
+    for (uint64_t g = 0; g < f->generations && g < CORE_GENERATIONS; g++) {
+        cJSON *o = cJSON_CreateObject();
+        for (int k = 0; k < ISA_STAGE_COUNT; k++) {
+            cJSON_AddNumberToObject(o, isa_stage_keys[k],
+                                    ratio(f->core.gen_active_lanes[g][k], (uint64_t)n * f->core.gen_vec_instructions[g][k]));
+            if (g > 0) {
+                sec_act[k] += f->core.gen_active_lanes[g][k];
+                sec_vec[k] += f->core.gen_vec_instructions[g][k];
+            }
+        }
+        cJSON_AddItemToArray(ug, o);
+    }
+    cJSON *up = cJSON_AddObjectToObject(root, "utilization_primary");
+    cJSON *us = cJSON_AddObjectToObject(root, "utilization_secondary");
+    for (int k = 0; k < ISA_STAGE_COUNT; k++) {
+        cJSON_AddNumberToObject(up, isa_stage_keys[k],
+                                ratio(f->core.gen_active_lanes[0][k], (uint64_t)n * f->core.gen_vec_instructions[0][k]));
+        cJSON_AddNumberToObject(us, isa_stage_keys[k], ratio(sec_act[k], (uint64_t)n * sec_vec[k]));
+    }
     cJSON *sl = cJSON_AddObjectToObject(root, "stream_length");
     cJSON_AddNumberToObject(sl, "traversal", ratio(f->trav_rays, f->trav_streams));
     cJSON_AddNumberToObject(sl, "intersection", ratio(f->isect_rays, f->isect_streams));
     cJSON_AddNumberToObject(sl, "shading", ratio(f->shade_rays, f->shade_streams));
+    static const char *const stage3[FUNC_STAGES] = {"traversal", "intersection", "shading"};
+    uint64_t ss[FUNC_STAGES] = {0}, sr[FUNC_STAGES] = {0};
+    cJSON *slg = cJSON_AddArrayToObject(root, "stream_length_by_generation");
+    for (uint64_t g = 0; g < f->generations && g < FUNC_MAX_GENERATIONS; g++) {
+        cJSON *o = cJSON_CreateObject();
+        for (int k = 0; k < FUNC_STAGES; k++) {
+            cJSON_AddNumberToObject(o, stage3[k], ratio(f->gen_rays[g][k], f->gen_streams[g][k]));
+            if (g > 0) {
+                ss[k] += f->gen_streams[g][k];
+                sr[k] += f->gen_rays[g][k];
+            }
+        }
+        cJSON_AddItemToArray(slg, o);
+    }
+    cJSON *sls = cJSON_AddObjectToObject(root, "stream_length_secondary");
+    for (int k = 0; k < FUNC_STAGES; k++)
+        cJSON_AddNumberToObject(sls, stage3[k], ratio(sr[k], ss[k]));
     cJSON *sc = cJSON_AddObjectToObject(root, "streams");
     cJSON_AddNumberToObject(sc, "traversal", (double)f->trav_streams);
     cJSON_AddNumberToObject(sc, "intersection", (double)f->isect_streams);

@@ -23,7 +23,8 @@
  *     mem M[ADDR] OP EXPR    32-bit little-endian word at byte ADDR of memory M: rb0 rb1 idm spad
  *                            scene fb, or rbc / rbn for the current / next ray buffer
  *     stat KEY OP EXPR       a core counter: total, instr.STAGE, vec.STAGE, lanes.STAGE,
- *                            op.MNEMONIC, cat.STAGE.CATEGORY (stage keys: other traversal ...)
+ *                            op.MNEMONIC, cat.STAGE.CATEGORY (stage keys: other traversal ...),
+ *                            genG.instr.STAGE, genG.vec.STAGE, genG.lanes.STAGE (generation G)
  *     pc OP EXPR             the pc after the run
  *     trap "TEXT" ...        the run must trap, and the message contain every TEXT
  *     limit                  the run must stop at the instruction limit
@@ -818,10 +819,33 @@ static int stat_value(Core *c, const char *key, uint64_t *out)
         *out = core_instructions(c);
         return 0;
     }
+    int gen = -1;
+    if (!strncmp(key, "gen", 3) && key[3] >= '0' && key[3] <= '9') {
+        char *end;
+        long g = strtol(key + 3, &end, 10);
+        if (*end != '.' || g < 0 || g >= CORE_GENERATIONS)
+            return -1;
+        gen = (int)g;
+        key = end + 1;
+    }
     const char *dot = strchr(key, '.');
     if (!dot)
         return -1;
     size_t head = (size_t)(dot - key);
+    if (gen >= 0) {
+        int gs = stage_from_key(dot + 1, strlen(dot + 1));
+        if (gs < 0)
+            return -1;
+        if (head == 5 && !strncmp(key, "instr", 5))
+            *out = st->gen_instructions[gen][gs];
+        else if (head == 3 && !strncmp(key, "vec", 3))
+            *out = st->gen_vec_instructions[gen][gs];
+        else if (head == 5 && !strncmp(key, "lanes", 5))
+            *out = st->gen_active_lanes[gen][gs];
+        else
+            return -1;
+        return 0;
+    }
     const char *rest = dot + 1;
     if (head == 2 && !strncmp(key, "op", 2)) {
         int op = isa_op_from_mnemonic(rest);
