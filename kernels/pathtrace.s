@@ -36,6 +36,15 @@ DIM_LOBE = 4
 DIM_DIR_U = 5
 DIM_DIR_V = 6
 DIM_RR = 7
+WL_PATH = 0                     ; WORKLOAD: the path tracer, or a utilization workload
+WL_SPECULAR = 1
+WL_DIFFUSE = 2
+.ifndef WORKLOAD
+WORKLOAD = WL_PATH
+.endif
+.if WORKLOAD == WL_SPECULAR && !defined(BOUNCES)
+        .error "the specular workload needs -D BOUNCES=n"
+.endif
 LIGHT_POINT = 0
 LIGHT_SPOT = 1
 LIGHT_DIRECTIONAL = 2
@@ -891,6 +900,17 @@ sh_miss_done:
         SHADE_STREAM r4, r20
         mov     r3, r4
         jal     r31, surface            ; [r3, r20) -> emitters first, r5 = end of them
+.if WORKLOAD == WL_SPECULAR
+        mov     r12, r5
+        mov     r13, r20
+        jal     r31, forced_specular
+        jmp     sh_return
+.elif WORKLOAD == WL_DIFFUSE
+        mov     r12, r5
+        mov     r13, r20
+        jal     r31, one_bounce_diffuse
+        jmp     sh_return
+.else
         ; ---- one filter per material kind on [r5, r20)
 .ifdef HAS_LAMBERT
         FILTER_EQ r5, r20, r6, F_MATKIND, MAT_LAMBERT
@@ -914,6 +934,7 @@ sh_miss_done:
         mov     r13, r6
         jal     r31, dielectric
         mov     r5, r6
+.endif
 .endif
 sh_return:
 shade_done:
@@ -1175,6 +1196,9 @@ surf_notex:
         mandn   m4, m1, m4
         mor     m3, m3, m4
         mand    m2, m2, m3
+.if WORKLOAD != WL_PATH
+        mclr    m2                      ; (the utilization workloads treat emitters as surfaces)
+.endif
         pmask   m2
         ; emission counts for camera rays and after delta bounces
         beq     r18, r0, surf_add
@@ -1192,6 +1216,7 @@ surf_add:
         part    r5, r3, r20
         jr      r31
 
+.if WORKLOAD == WL_PATH
 ; ---- Lambertian and coupled glossy shaders on [r12, r13), kind r14 (scalar: the filter above
 ; made the stream one kind). Direct/indirect split by a filter, then one pass for each part.
 ; Preserves r5, r6, r17-r30.
@@ -1890,5 +1915,154 @@ diel_chunk:
         EMIT    m2, d, o, th, INF_BITS, KIND_INDIRECT, 1, vt, vt2
         blt     r16, r13, diel_chunk
 diel_done:
+        jr      r31
+.endif
+.endif ; WORKLOAD == WL_PATH
+
+.if WORKLOAD == WL_SPECULAR
+; ---- forced specular workload (seed 000 Sec. 5.3) on [r12, r13): every hit is a mirror for
+; BOUNCES bounces, whatever its material; a path's last hit adds throughput x base colour.
+forced_specular:
+        beq     r12, r13, fs_done
+        SHADE_STREAM r12, r13
+        addi    r7, r18, 1
+        li      r1, BOUNCES
+        slt     r9, r1, r7
+        xori    r9, r9, 1               ; another bounce?
+.alias  vid, v0
+.alias  dx, v1
+.alias  dy, v2
+.alias  dz, v3
+.alias  nfx, v4
+.alias  nfy, v5
+.alias  nfz, v6
+.alias  px, v7
+.alias  py, v8
+.alias  pz, v9
+.alias  ox, v10
+.alias  oy, v11
+.alias  oz, v12
+.alias  thx, v13
+.alias  thy, v14
+.alias  thz, v15
+.alias  vt, v16
+.alias  vt2, v17
+        mov     r16, r12
+fs_chunk:
+        sfetch  vid, m1, r16, r13
+        GATHER3 th, F_THRR, F_THRG, F_THRB
+        bne     r9, r0, fs_bounce
+        GATHER3 p, F_BASER, F_BASEG, F_BASEB
+        vfmul   thx, thx, px @m1
+        vfmul   thy, thy, py @m1
+        vfmul   thz, thz, pz @m1
+        FBADD3  th, vt, m1
+        jmp     fs_next
+fs_bounce:
+        GATHER3 d, F_DIRX, F_DIRY, F_DIRZ
+        GATHER3 nf, F_NGX, F_NGY, F_NGZ
+        DOT3    vt, nf, d, vt2
+        vflt    m2, vz, vt @m1
+        vfneg   nfx, nfx @m2
+        vfneg   nfy, nfy @m2
+        vfneg   nfz, nfz @m2
+        DOT3    vt, d, nf, vt2
+        vfadd   vt, vt, vt @m1
+        vfmul   vt2, vt, nfx @m1
+        vfsub   dx, dx, vt2 @m1
+        vfmul   vt2, vt, nfy @m1
+        vfsub   dy, dy, vt2 @m1
+        vfmul   vt2, vt, nfz @m1
+        vfsub   dz, dz, vt2 @m1         ; mirror direction
+        GATHER3 p, F_PX, F_PY, F_PZ
+        OFFSET3 o, p, nf, vt, vt2, vz, m2
+        EMIT    m1, o, d, th, INF_BITS, KIND_INDIRECT, 1, vt, vt2
+fs_next:
+        blt     r16, r13, fs_chunk
+fs_done:
+        jr      r31
+.endif
+
+.if WORKLOAD == WL_DIFFUSE
+; ---- one-bounce diffuse workload (seed 000 Sec. 5.4) on [r12, r13): camera-ray hits send one
+; cosine-weighted ray around the shading normal (throughput x base colour); its hit adds
+; throughput x base colour.
+one_bounce_diffuse:
+        beq     r12, r13, od_done
+        SHADE_STREAM r12, r13
+        addi    r7, r18, 1
+        shli    r8, r7, 4
+.alias  vid, v0
+.alias  kb, v1
+.alias  u5, v2
+.alias  phi, v3
+.alias  nsx, v4
+.alias  nsy, v5
+.alias  nsz, v6
+.alias  dx, v7
+.alias  dy, v8
+.alias  dz, v9
+.alias  nfx, v10
+.alias  nfy, v11
+.alias  nfz, v12
+.alias  thx, v13
+.alias  thy, v14
+.alias  thz, v15
+.alias  bx, v16
+.alias  by, v17
+.alias  bz, v18
+.alias  cx, v19
+.alias  cy, v20
+.alias  cz, v21
+.alias  vt, v22
+.alias  vt2, v23
+.alias  vt3, v24
+.alias  vt4, v25
+.alias  vt5, v26
+        mov     r16, r12
+od_chunk:
+        sfetch  vid, m1, r16, r13
+        GATHER3 th, F_THRR, F_THRG, F_THRB
+        GATHER3 b, F_BASER, F_BASEG, F_BASEB
+        vfmul   thx, thx, bx @m1
+        vfmul   thy, thy, by @m1
+        vfmul   thz, thz, bz @m1
+        beq     r18, r0, od_bounce
+        FBADD3  th, vt, m1
+        jmp     od_next
+od_bounce:
+        rgat    kb, vid, r0, F_KEY @m1
+        vbcast  vt, r8 @m1
+        vadd    kb, kb, vt @m1
+        RAND    u5, kb, DIM_DIR_U, vt
+        RAND    phi, kb, DIM_DIR_V, vt
+        vli     vt, TWO_PI_F @m1
+        vfmul   phi, vt, phi @m1
+        GATHER3 ns, F_NSX, F_NSY, F_NSZ
+        vsqrt   vt, u5 @m1
+        vcos    cx, phi @m1
+        vfmul   cx, vt, cx @m1
+        vsin    cy, phi @m1
+        vfmul   cy, vt, cy @m1
+        vli     vt, 1.0 @m1
+        vfsub   vt, vt, u5 @m1
+        vfmax   vt, vz, vt @m1
+        vsqrt   cz, vt @m1
+        TO_WORLD d, ns, cx, cy, cz, vt, vt2, vt3, vt4, vt5
+        GATHER3 nf, F_NGX, F_NGY, F_NGZ
+        GATHER3 b, F_DIRX, F_DIRY, F_DIRZ
+        DOT3    vt, nf, b, vt2
+        vflt    m2, vz, vt @m1
+        vfneg   nfx, nfx @m2
+        vfneg   nfy, nfy @m2
+        vfneg   nfz, nfz @m2
+        DOT3    vt, d, nf, vt2
+        vflt    m2, vz, vt @m1          ; above the geometric surface
+        GATHER3 b, F_PX, F_PY, F_PZ, m2
+        OFFSET3 c, b, nf, vt, vt2, vz, m3, m2
+        EMIT    m2, c, d, th, INF_BITS, KIND_INDIRECT, 0, vt, vt2
+od_next:
+        blt     r16, r13, od_chunk
+od_done:
         jr      r31
 .endif

@@ -13,7 +13,29 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef enum CfgType { CFG_INT, CFG_I64, CFG_FLOAT } CfgType;
+typedef enum CfgType { CFG_INT, CFG_I64, CFG_FLOAT, CFG_ENUM } CfgType;
+
+/* The names of ENUM keys' values, in index order (sim/config.h has the index constants). */
+static const struct { const char *section, *key; const char *names[4]; } enum_names[] = {
+    {"stream", "mode", {"stream", "packet"}},
+    {"workload", "kind", {"path", "specular", "diffuse"}},
+};
+
+static const char *const *enum_of(const char *section, const char *key)
+{
+    for (size_t i = 0; i < sizeof enum_names / sizeof enum_names[0]; i++)
+        if (!strcmp(enum_names[i].section, section) && !strcmp(enum_names[i].key, key))
+            return enum_names[i].names;
+    return NULL;
+}
+
+const char *cfg_enum_name(const char *section, const char *key, int value)
+{
+    const char *const *n = enum_of(section, key);
+    if (!n || value < 0 || value >= 4)
+        return NULL;
+    return n[value];
+}
 
 typedef struct CfgKeyInfo {
     const char *section, *key;
@@ -67,7 +89,7 @@ typedef struct CfgValue { double f; long long i; } CfgValue;
 static void store(CfgMachine *cfg, const CfgKeyInfo *k, CfgValue v)
 {
     char *p = (char *)cfg + k->offset;
-    if (k->type == CFG_INT) {
+    if (k->type == CFG_INT || k->type == CFG_ENUM) {
         int32_t x = (int32_t)v.i;
         memcpy(p, &x, sizeof x);
     } else if (k->type == CFG_I64) {
@@ -81,7 +103,7 @@ static void store(CfgMachine *cfg, const CfgKeyInfo *k, CfgValue v)
 static double load(const CfgMachine *cfg, const CfgKeyInfo *k)
 {
     const char *p = (const char *)cfg + k->offset;
-    if (k->type == CFG_INT) {
+    if (k->type == CFG_INT || k->type == CFG_ENUM) {
         int32_t x;
         memcpy(&x, p, sizeof x);
         return x;
@@ -126,6 +148,25 @@ static const char *parse_value(const CfgKeyInfo *k, const char *text, CfgValue *
         text++;
     if (!*text)
         return "missing value";
+    if (k->type == CFG_ENUM) {
+        const char *const *names = enum_of(k->section, k->key);
+        size_t len = strlen(text);
+        while (len && (text[len - 1] == ' ' || text[len - 1] == '\t'))
+            len--;
+        size_t used = (size_t)snprintf(buf, buflen, "expected one of");
+        for (long long i = k->ilo; names && i <= k->ihi; i++) {
+            if (strlen(names[i]) == len && !strncmp(names[i], text, len)) {
+                out->i = i;
+                out->f = (double)i;
+                return NULL;
+            }
+            if (used < buflen)
+                used += (size_t)snprintf(buf + used, buflen - used, "%s %s", i > k->ilo ? "," : "", names[i]);
+        }
+        if (used < buflen)
+            snprintf(buf + used, buflen - used, ", got '%.*s'", (int)len, text);
+        return buf;
+    }
     char *end;
     errno = 0;
     int bad_range;
@@ -316,14 +357,31 @@ void cfg_core_params(const CfgMachine *cfg, CoreParams *p)
     p->mem_bytes[CORE_MEM_FB] = (uint32_t)cfg->fb_size_kb * 1024u;
 }
 
-static const char *type_name(CfgType t) { return t == CFG_INT ? "int" : t == CFG_I64 ? "int64" : "float"; }
+static const char *type_name(CfgType t)
+{
+    return t == CFG_INT ? "int" : t == CFG_I64 ? "int64" : t == CFG_ENUM ? "enum" : "float";
+}
 
 static void fmt_value(const CfgKeyInfo *k, double v, char *buf, size_t len)
 {
-    if (k->type == CFG_FLOAT)
+    if (k->type == CFG_ENUM) {
+        const char *n = cfg_enum_name(k->section, k->key, (int)v);
+        snprintf(buf, len, "%s", n ? n : "?");
+    } else if (k->type == CFG_FLOAT)
         snprintf(buf, len, "%g", v);
     else
         snprintf(buf, len, "%.0f", v);
+}
+
+/* "a, b, c": the names of an ENUM key. */
+static const char *enum_list(const CfgKeyInfo *k, char *buf, size_t len)
+{
+    const char *const *names = enum_of(k->section, k->key);
+    size_t used = 0;
+    buf[0] = 0;
+    for (long long i = k->ilo; names && i <= k->ihi && used < len; i++)
+        used += (size_t)snprintf(buf + used, len - used, "%s%s", i > k->ilo ? ", " : "", names[i]);
+    return buf;
 }
 
 void cfg_dump(const CfgMachine *cfg, FILE *out)
@@ -340,8 +398,12 @@ void cfg_dump(const CfgMachine *cfg, FILE *out)
         fmt_value(k, k->def, def, sizeof def);
         fmt_value(k, k->lo, lo, sizeof lo);
         fmt_value(k, k->hi, hi, sizeof hi);
-        fprintf(out, "%s = %s\n    ; %s, default %s, range %s..%s: %s\n", k->key, val, type_name(k->type), def, lo, hi,
-                k->help);
+        if (k->type == CFG_ENUM)
+            fprintf(out, "%s = %s\n    ; %s, default %s, one of %s: %s\n", k->key, val, type_name(k->type), def,
+                     enum_list(k, lo, sizeof lo), k->help);
+        else
+            fprintf(out, "%s = %s\n    ; %s, default %s, range %s..%s: %s\n", k->key, val, type_name(k->type), def,
+                    lo, hi, k->help);
     }
 }
 
@@ -363,7 +425,11 @@ void cfg_markdown(FILE *out)
         fmt_value(k, k->def, def, sizeof def);
         fmt_value(k, k->lo, lo, sizeof lo);
         fmt_value(k, k->hi, hi, sizeof hi);
-        fprintf(out, "| `%s.%s` | %s | %s | %s..%s | %s |\n", k->section, k->key, type_name(k->type), def, lo, hi,
-                k->help);
+        if (k->type == CFG_ENUM)
+            fprintf(out, "| `%s.%s` | %s | %s | %s | %s |\n", k->section, k->key, type_name(k->type), def,
+                    enum_list(k, lo, sizeof lo), k->help);
+        else
+            fprintf(out, "| `%s.%s` | %s | %s | %s..%s | %s |\n", k->section, k->key, type_name(k->type), def, lo,
+                    hi, k->help);
     }
 }

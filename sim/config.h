@@ -17,6 +17,7 @@ typedef struct CfgMachine {
 #define CFG_T_INT int32_t
 #define CFG_T_I64 int64_t
 #define CFG_T_FLOAT double
+#define CFG_T_ENUM int32_t
 #define CFG_KEY(sec, key, type, def, lo, hi, help) CFG_T_##type sec##_##key;
 #include "config.def"
 #undef CFG_KEY
@@ -41,6 +42,12 @@ void cfg_errors_free(CfgErrors *errs);
 
 /* Memory sizes and width for the functional core. */
 void cfg_core_params(const CfgMachine *cfg, CoreParams *p);
+
+/* Values of the ENUM keys (index = stored value). */
+enum { CFG_STREAM_MODE_STREAM = 0, CFG_STREAM_MODE_PACKET = 1 };
+enum { CFG_WORKLOAD_PATH = 0, CFG_WORKLOAD_SPECULAR = 1, CFG_WORKLOAD_DIFFUSE = 2 };
+/* The name of an ENUM key's value ("packet"), or NULL for other keys. */
+const char *cfg_enum_name(const char *section, const char *key, int value);
 
 /* Every key with type, default, range, help and the value in cfg. */
 void cfg_dump(const CfgMachine *cfg, FILE *out);

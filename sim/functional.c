@@ -86,7 +86,7 @@ typedef struct Job {
     const Abi *abi;
     CoreParams cp;
     float *rgb;
-    uint32_t width, height, tile, tiles_x, ntiles;
+    uint32_t width, height, tile_w, tile_h, tiles_x, ntiles;
     FuncTile *tiles;
     atomic_uint next_tile, done_tiles;
     atomic_int failed;
@@ -130,10 +130,10 @@ static int run_tile(Job *j, Core *c, uint32_t t, FuncStats *st)
 {
     const Abi *a = j->abi;
     FuncTile *ft = &j->tiles[t];
-    ft->x0 = (t % j->tiles_x) * j->tile;
-    ft->y0 = (t / j->tiles_x) * j->tile;
-    ft->w = j->width - ft->x0 < j->tile ? j->width - ft->x0 : j->tile;
-    ft->h = j->height - ft->y0 < j->tile ? j->height - ft->y0 : j->tile;
+    ft->x0 = (t % j->tiles_x) * j->tile_w;
+    ft->y0 = (t / j->tiles_x) * j->tile_h;
+    ft->w = j->width - ft->x0 < j->tile_w ? j->width - ft->x0 : j->tile_w;
+    ft->h = j->height - ft->y0 < j->tile_h ? j->height - ft->y0 : j->tile_h;
     core_restart(c);
     uint32_t size;
     uint8_t *sp = core_mem(c, CORE_MEM_SPAD, &size);
@@ -235,8 +235,33 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
     /* Build symbols from the packed scene itself (docs/kernel.md). */
     AsmDefine defs[16];
     int nd = 0;
-    uint32_t rays = (uint32_t)cfg->stream_rays;
+    /* Stream mode: tiles of sqrt(M) x sqrt(M) rays; packet mode: packets of N rays, as square as
+     * N allows (2 x 2, 4 x 2, 4 x 3, 4 x 4, 8 x 8). */
+    uint32_t tile_w, tile_h;
+    if (cfg->stream_mode == CFG_STREAM_MODE_PACKET) {
+        uint32_t n = (uint32_t)cfg->core_simd_width;
+        tile_w = 1;
+        while (tile_w * tile_w < n)
+            tile_w++;
+        while (n % tile_w)
+            tile_w++;
+        tile_h = n / tile_w;
+    } else {
+        tile_w = 1;
+        while (tile_w * tile_w < (uint32_t)cfg->stream_rays)
+            tile_w++;
+        tile_h = tile_w;
+    }
+    uint32_t rays = tile_w * tile_h;
+    st->tile_w = tile_w;
+    st->tile_h = tile_h;
     add_define(defs, &nd, st->defines, sizeof st->defines, "RAYS", rays);
+    if (cfg->workload_kind == CFG_WORKLOAD_SPECULAR) {
+        add_define(defs, &nd, st->defines, sizeof st->defines, "WORKLOAD", 1);
+        add_define(defs, &nd, st->defines, sizeof st->defines, "BOUNCES", cfg->workload_bounces);
+    } else if (cfg->workload_kind == CFG_WORKLOAD_DIFFUSE) {
+        add_define(defs, &nd, st->defines, sizeof st->defines, "WORKLOAD", 2);
+    }
     uint32_t spad_bytes = (uint32_t)cfg->spad_size_kb * 1024u;
     add_define(defs, &nd, st->defines, sizeof st->defines, "SPAD_BYTES", spad_bytes);
     uint32_t nmats = sm_u32(p, sm_hdr(p, SM_HDR_NMATS)), mats = sm_u32(p, sm_hdr(p, SM_HDR_MATS));
@@ -357,11 +382,10 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
     job->width = sm_u32(p, sm_hdr(p, SM_HDR_WIDTH));
     job->height = sm_u32(p, sm_hdr(p, SM_HDR_HEIGHT));
     uint32_t spp = sm_u32(p, sm_hdr(p, SM_HDR_SPP));
-    job->tile = 1;
-    while (job->tile * job->tile < rays)
-        job->tile++;
-    job->tiles_x = (job->width + job->tile - 1) / job->tile;
-    job->ntiles = job->tiles_x * ((job->height + job->tile - 1) / job->tile);
+    job->tile_w = tile_w;
+    job->tile_h = tile_h;
+    job->tiles_x = (job->width + tile_w - 1) / tile_w;
+    job->ntiles = job->tiles_x * ((job->height + tile_h - 1) / tile_h);
     job->tiles = calloc(job->ntiles ? job->ntiles : 1, sizeof(FuncTile));
     atomic_init(&job->next_tile, 0u);
     atomic_init(&job->done_tiles, 0u);

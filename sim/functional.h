@@ -47,6 +47,7 @@ typedef struct FuncStats {
     FuncTile *tiles;                                /* ntiles entries, raster order */
     uint32_t ntiles;
     uint32_t kernel_instructions;                   /* program size */
+    uint32_t tile_w, tile_h;                        /* pixels (= rays) of a stream's tile */
     char defines[512];                              /* the -D symbols the kernel was built with */
 } FuncStats;
 

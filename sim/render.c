@@ -225,6 +225,12 @@ static void add_functional_json(cJSON *root, const RunStats *rs, const CfgMachin
         if (f->core.by_op[o])
             cJSON_AddNumberToObject(byop, isa_ops[o].mnemonic, (double)f->core.by_op[o]);
     cJSON *k = cJSON_AddObjectToObject(root, "kernel");
+    cJSON_AddStringToObject(k, "stream_mode", cfg_enum_name("stream", "mode", cfg->stream_mode));
+    cJSON_AddStringToObject(k, "workload", cfg_enum_name("workload", "kind", cfg->workload_kind));
+    if (cfg->workload_kind == CFG_WORKLOAD_SPECULAR)
+        cJSON_AddNumberToObject(k, "bounces", cfg->workload_bounces);
+    cJSON_AddNumberToObject(k, "tile_width", f->tile_w);
+    cJSON_AddNumberToObject(k, "tile_height", f->tile_h);
     cJSON_AddStringToObject(k, "defines", f->defines);
     cJSON_AddNumberToObject(k, "instructions", f->kernel_instructions);
     cJSON *tiles = cJSON_AddArrayToObject(root, "tiles");
@@ -241,7 +247,10 @@ static void add_functional_json(cJSON *root, const RunStats *rs, const CfgMachin
     cJSON *cf = cJSON_AddObjectToObject(root, "config");
     cJSON_AddNumberToObject(cf, "core.simd_width", cfg->core_simd_width);
     cJSON_AddNumberToObject(cf, "core.clock_mhz", cfg->core_clock_mhz);
+    cJSON_AddStringToObject(cf, "stream.mode", cfg_enum_name("stream", "mode", cfg->stream_mode));
     cJSON_AddNumberToObject(cf, "stream.rays", cfg->stream_rays);
+    cJSON_AddStringToObject(cf, "workload.kind", cfg_enum_name("workload", "kind", cfg->workload_kind));
+    cJSON_AddNumberToObject(cf, "workload.bounces", cfg->workload_bounces);
     cJSON_AddNumberToObject(cf, "raybuf.size_kb", cfg->raybuf_size_kb);
     cJSON_AddNumberToObject(cf, "raybuf.banks", cfg->raybuf_banks);
     cJSON_AddNumberToObject(cf, "idm.size_kb", cfg->idm_size_kb);
@@ -439,10 +448,12 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
             all += opsum[c];
         }
         len += snprintf(txt + len, sizeof txt - (size_t)len,
-                        "machine      N = %d lanes, M = %d rays per stream; kernel %u instructions (%s)\n"
+                        "machine      N = %d lanes, %s of %u x %u rays, workload %s; kernel %u instructions (%s)\n"
                         "instructions %llu executed\n"
                         "ops          ",
-                        cfg->core_simd_width, cfg->stream_rays, f->kernel_instructions, f->defines,
+                        cfg->core_simd_width, cfg->stream_mode == CFG_STREAM_MODE_PACKET ? "packets" : "streams",
+                        f->tile_w, f->tile_h, cfg_enum_name("workload", "kind", cfg->workload_kind),
+                        f->kernel_instructions, f->defines,
                         (unsigned long long)f->instructions);
         for (int c = 0; c < ISA_C_COUNT; c++)
             len += snprintf(txt + len, sizeof txt - (size_t)len, "%s %.1f%%%s", isa_category_keys[c],

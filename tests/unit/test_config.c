@@ -588,3 +588,24 @@ Test(config_files, streamray_ini_is_the_default_machine)
     cr_expect_eq(c.fb_size_kb, def.fb_size_kb);
     cr_expect_eq(c.sim_max_instructions, def.sim_max_instructions);
 }
+
+Test(config_params, enum_keys_take_names_and_reject_others)
+{
+    CfgMachine c;
+    cfg_defaults(&c);
+    cr_expect_eq(c.stream_mode, CFG_STREAM_MODE_STREAM);
+    cr_expect_eq(c.workload_kind, CFG_WORKLOAD_PATH);
+    CfgErrors e = {0};
+    cr_expect_eq(cfg_set(&c, "stream.mode=packet", &e), 0);
+    cr_expect_eq(c.stream_mode, CFG_STREAM_MODE_PACKET);
+    cr_expect_eq(cfg_set(&c, "workload.kind=diffuse", &e), 0);
+    cr_expect_eq(c.workload_kind, CFG_WORKLOAD_DIFFUSE);
+    cr_expect_eq(cfg_set(&c, "workload.kind=2", &e), 1);
+    cr_expect_eq(cfg_set(&c, "workload.kind=specularity", &e), 1);
+    cr_expect(e.text && strstr(e.text, "expected one of path, specular, diffuse, got 'specularity'"), "%s",
+              e.text ? e.text : "");
+    cr_expect_eq(c.workload_kind, CFG_WORKLOAD_DIFFUSE);
+    cr_expect_str_eq(cfg_enum_name("stream", "mode", 1), "packet");
+    cr_expect_null(cfg_enum_name("core", "simd_width", 0));
+    cfg_errors_free(&e);
+}

@@ -41,6 +41,16 @@ static Img golden(const PackedScene *p, int w, int h, int tile)
     return im;
 }
 
+static Img kernel_cfg(const PackedScene *p, uint32_t needs, int w, int h, const CfgMachine *cfg, int threads,
+                      FuncStats *st)
+{
+    Img im = {calloc(3 * (size_t)w * h, sizeof(float)), w, h};
+    static char err[65536];
+    FuncParams fp = {cfg, "kernels/pathtrace.s", needs, 1, threads, NULL, NULL};
+    cr_assert_eq(func_render(p, &fp, im.rgb, st, err, sizeof err), 0, "%s", err);
+    return im;
+}
+
 static Img kernel(const PackedScene *p, uint32_t needs, int w, int h, int lanes, int rays, int threads,
                   FuncStats *st)
 {
@@ -48,11 +58,17 @@ static Img kernel(const PackedScene *p, uint32_t needs, int w, int h, int lanes,
     cfg_defaults(&cfg);
     cfg.core_simd_width = lanes;
     cfg.stream_rays = rays;
-    Img im = {calloc(3 * (size_t)w * h, sizeof(float)), w, h};
-    static char err[65536];
-    FuncParams fp = {&cfg, "kernels/pathtrace.s", needs, 1, threads, NULL, NULL};
-    cr_assert_eq(func_render(p, &fp, im.rgb, st, err, sizeof err), 0, "%s", err);
-    return im;
+    return kernel_cfg(p, needs, w, h, &cfg, threads, st);
+}
+
+static double util(const FuncStats *st, int lanes, int gen_from, int stage)
+{
+    uint64_t act = 0, vec = 0;
+    for (int g = gen_from; g < CORE_GENERATIONS; g++) {
+        act += st->core.gen_active_lanes[g][stage];
+        vec += st->core.gen_vec_instructions[g][stage];
+    }
+    return vec ? (double)act / ((double)lanes * (double)vec) : 0.0;
 }
 
 /* Max |a - b| over all values, the mean of b, and non-finite values in a. */
@@ -258,6 +274,96 @@ Test(functional, a_missing_kernel_is_an_error_naming_it)
     cr_expect_neq(func_render(&p, &fp, rgb, &st, err, sizeof err), 0);
     cr_expect(strstr(err, "no_such_kernel.s") != NULL, "%s", err);
     free(rgb);
+    pack_free(&p);
+    scene_free(&s);
+}
+
+/* Packet tracing (stream size = N, 001 Table 7) renders the same image -- it is the same
+ * algorithm on smaller streams -- and uses the SIMD unit less than streams of M rays. */
+Test(functional, packet_tracing_same_image_lower_utilization, .timeout = 300)
+{
+    Scene s;
+    PackedScene p;
+    int w = 64, h = 48;
+    load_packed("scenes/cornell/glossy.ini", w, h, 2, &s, &p);
+    Img g = golden(&p, w, h, 64);
+    static const int lanes[] = {4, 8, 12, 16};
+    for (size_t i = 0; i < sizeof lanes / sizeof lanes[0]; i++) {
+        CfgMachine cfg;
+        cfg_defaults(&cfg);
+        cfg.core_simd_width = lanes[i];
+        cfg.stream_mode = CFG_STREAM_MODE_PACKET;
+        FuncStats pk, sm;
+        Img a = kernel_cfg(&p, s.needs, w, h, &cfg, 2, &pk);
+        cr_expect_eq(pk.tile_w * pk.tile_h, (uint32_t)lanes[i], "N = %d: packet of %u x %u", lanes[i], pk.tile_w,
+                     pk.tile_h);
+        cr_expect(memcmp(a.rgb, g.rgb, sizeof(float) * 3 * (size_t)w * h) == 0, "N = %d: packet image differs",
+                  lanes[i]);
+        cfg.stream_mode = CFG_STREAM_MODE_STREAM;
+        Img b = kernel_cfg(&p, s.needs, w, h, &cfg, 2, &sm);
+        for (int stage = ISA_STAGE_TRAVERSAL; stage <= ISA_STAGE_SHADING; stage++)
+            cr_expect(util(&pk, lanes[i], 1, stage) < util(&sm, lanes[i], 1, stage),
+                      "N = %d stage %d: packet utilization %g not below stream %g", lanes[i], stage,
+                      util(&pk, lanes[i], 1, stage), util(&sm, lanes[i], 1, stage));
+        free(a.rgb);
+        free(b.rgb);
+        func_stats_free(&pk);
+        func_stats_free(&sm);
+    }
+    free(g.rgb);
+    pack_free(&p);
+    scene_free(&s);
+}
+
+/* Forced specular workload: every camera ray that hits bounces BOUNCES times (a closed box
+ * keeps every ray), so each generation has as many rays as the first. */
+Test(functional, forced_specular_workload_bounces_every_ray, .timeout = 300)
+{
+    Scene s;
+    PackedScene p;
+    int w = 48, h = 40;
+    load_packed("scenes/cornell/scene.ini", w, h, 1, &s, &p);
+    CfgMachine cfg;
+    cfg_defaults(&cfg);
+    cfg.workload_kind = CFG_WORKLOAD_SPECULAR;
+    cfg.workload_bounces = 3;
+    FuncStats st;
+    Img k = kernel_cfg(&p, s.needs, w, h, &cfg, 2, &st);
+    cr_expect_eq(st.generations, 4);
+    cr_expect_eq(st.rays_shadow, 0);
+    cr_expect_eq(st.rays_camera, (uint64_t)w * h);
+    for (int g = 1; g < 4; g++)
+        cr_expect(st.rays_per_generation[g] <= st.rays_per_generation[g - 1] && st.rays_per_generation[g] > 0,
+                  "generation %d: %llu rays", g, (unsigned long long)st.rays_per_generation[g]);
+    double maxd, mean;
+    long bad;
+    diff(&k, &k, &maxd, &mean, &bad);
+    cr_expect_eq(bad, 0);
+    cr_expect(mean > 0.0);
+    free(k.rgb);
+    func_stats_free(&st);
+    pack_free(&p);
+    scene_free(&s);
+}
+
+/* One-bounce diffuse workload: two generations, one bounce per camera hit, no shadow rays. */
+Test(functional, one_bounce_diffuse_workload_has_two_generations, .timeout = 300)
+{
+    Scene s;
+    PackedScene p;
+    int w = 48, h = 40;
+    load_packed("scenes/cornell/scene.ini", w, h, 4, &s, &p);
+    CfgMachine cfg;
+    cfg_defaults(&cfg);
+    cfg.workload_kind = CFG_WORKLOAD_DIFFUSE;
+    FuncStats st;
+    Img k = kernel_cfg(&p, s.needs, w, h, &cfg, 2, &st);
+    cr_expect_eq(st.generations, 2);
+    cr_expect_eq(st.rays_shadow, 0);
+    cr_expect(st.rays_per_generation[1] > 0 && st.rays_per_generation[1] <= st.rays_per_generation[0]);
+    cr_expect_eq(st.rays_indirect, st.rays_per_generation[1]);
+    free(k.rgb);
+    func_stats_free(&st);
     pack_free(&p);
     scene_free(&s);
 }
