@@ -176,10 +176,15 @@ $(BUILD)/bench/embree_xcheck: bench/embree_xcheck.c tests/support/xcheck.c $(BUI
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $^ -o $@ $(EMBREE) $(INIH) $(LDLIBS)
 
+$(BUILD)/bench/functional_speed: bench/functional_speed.c $(BUILD)/libsfsim.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
+
 bench: deps
-	@$(MAKE) --no-print-directory $(BUILD)/bench/core_speed $(BUILD)/bench/embree_xcheck
+	@$(MAKE) --no-print-directory $(BUILD)/bench/core_speed $(BUILD)/bench/embree_xcheck $(BUILD)/bench/functional_speed
 	$(BUILD)/bench/core_speed
 	$(BUILD)/bench/embree_xcheck
+	$(BUILD)/bench/functional_speed
 
 # ---- the example `make run` executes --------------------------------------------------------
 run-built: all
