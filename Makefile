@@ -180,6 +180,15 @@ $(BUILD)/bench/functional_speed: bench/functional_speed.c $(BUILD)/libsfsim.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
 
+$(BUILD)/validation: tools/validation.c $(BUILD)/libsfsim.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
+
+# The utilization experiments of docs/validation.md (several minutes on 2 cores).
+validation: deps
+	@$(MAKE) --no-print-directory $(BUILD)/validation
+	$(BUILD)/validation > docs/validation-data.md
+
 bench: deps
 	@$(MAKE) --no-print-directory $(BUILD)/bench/core_speed $(BUILD)/bench/embree_xcheck $(BUILD)/bench/functional_speed
 	$(BUILD)/bench/core_speed

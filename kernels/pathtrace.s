@@ -643,37 +643,44 @@ isect_prim:
         mand    m5, m5, m6
         mandn   m5, m1, m5              ; inside (or on an edge)
         bmz     m5, isect_next
-        vfadd   ex, adx, ady @m5
-        vfadd   ex, ex, adz @m5         ; det = U + V + W
-        vfne    m5, ex, vz @m5
+        ; the rest of the test runs on every lane of the chunk (the paper's N-wide SIMD test
+        ; makes its hit mask at the end); m5 collects the lanes still hitting
+        vfadd   ex, adx, ady @m1
+        vfadd   ex, ex, adz @m1         ; det = U + V + W
+        vfne    m6, ex, vz @m1
+        mand    m5, m5, m6
         ; Az, Bz, Cz scaled by sz; T = U Az + V Bz + W Cz
-        vfmul   ez, sz, ez @m5
-        vfmul   fz, sz, fz @m5
-        vfmul   gz, sz, gz @m5
-        vfmul   ey, adx, ez @m5
-        vfmul   vt, ady, fz @m5
-        vfadd   ey, ey, vt @m5
-        vfmul   vt, adz, gz @m5
-        vfadd   ey, ey, vt @m5          ; T
-        vflt    m6, ex, vz @m5          ; seen from behind: flip the signs
+        vfmul   ez, sz, ez @m1
+        vfmul   fz, sz, fz @m1
+        vfmul   gz, sz, gz @m1
+        vfmul   ey, adx, ez @m1
+        vfmul   vt, ady, fz @m1
+        vfadd   ey, ey, vt @m1
+        vfmul   vt, adz, gz @m1
+        vfadd   ey, ey, vt @m1          ; T
+        vflt    m6, ex, vz @m1          ; seen from behind: flip the signs
         vfneg   ey, ey @m6
         vfneg   ex, ex @m6
         vfneg   ady, ady @m6
         vfneg   adz, adz @m6
         ; probe distance: a ray with a hit tests up to nextafter(best), so ties are seen
-        vmov    ptm, tm @m5
-        viltu   m6, prim, vm2 @m5
+        vmov    ptm, tm @m1
+        viltu   m6, prim, vm2 @m1
         vaddi   ptm, ptm, 1 @m6
-        vflt    m5, vz, ey @m5          ; T > 0
-        vfmul   vt, ptm, ex @m5
-        vflt    m5, ey, vt @m5          ; T < tmax det
+        vflt    m6, vz, ey @m1          ; T > 0
+        mand    m5, m5, m6
+        vfmul   vt, ptm, ex @m1
+        vflt    m6, ey, vt @m1          ; T < tmax det
+        mand    m5, m5, m6
         bmz     m5, isect_next
-        vrcp    ex, ex @m5
-        vfmul   ey, ey, ex @m5          ; t
-        vfmul   ady, ady, ex @m5        ; u
-        vfmul   adz, adz, ex @m5        ; v
-        vflt    m5, vz, ey @m5
-        vflt    m5, ey, ptm @m5
+        vrcp    ex, ex @m1
+        vfmul   ey, ey, ex @m1          ; t
+        vfmul   ady, ady, ex @m1        ; u
+        vfmul   adz, adz, ex @m1        ; v
+        vflt    m6, vz, ey @m1
+        mand    m5, m5, m6
+        vflt    m6, ey, ptm @m1
+        mand    m5, m5, m6
 isect_update:
         ; shadow rays: occluded, done
         mand    m6, m5, m2
