@@ -63,6 +63,13 @@ LIGHT_TRIANGLE = 4
 .alias  vz, v31
 .alias  vm2, v30
 
+.macro  PUSH node, b, e
+        spst    \node, r24, 0
+        spst    \b, r24, 4
+        spst    \e, r24, 8
+        addi    r24, r24, 12
+.endm
+
 ; Per-generation stream counters: one more stream of [\b, \e) for stage offset \off.
 .macro  COUNT_STREAM off, b, e, t1, t2, t3
         muli    \t1, r18, ST_GEN_BYTES
@@ -498,6 +505,28 @@ trav_inner:
         andi    r8, r6, 3               ; split axis: F_INV of that axis
         muli    r8, r8, FIELD_BYTES
         addi    r8, r8, F_INVX
+.ifdef ORDER_FIRST
+        ; stream.order = first: the whole stream visits the near child of its first ray first
+        ; (Fig. 3's front_child; images may differ from the golden model's in exact ties)
+        mov     r16, r3
+        sfetch  vid, m1, r16, r5
+        rgat    t0, vid, r8, 0 @m1
+        vext    r9, t0, 0
+        shli    r10, r7, NODE_BYTES_LOG2
+        add     r10, r10, r26           ; left child
+        addi    r11, r10, SM_NODE_BYTES ; right child
+        li      r12, STACK_LIMIT
+        addi    r1, r24, 24
+        bltu    r12, r1, err_stack
+        blt     r9, r0, first_neg       ; (the sign bit of 1 / d)
+        PUSH    r11, r3, r5
+        PUSH    r10, r3, r5
+        jmp     trav_pop
+first_neg:
+        PUSH    r10, r3, r5
+        PUSH    r11, r3, r5
+        jmp     trav_pop
+.endif
         mov     r16, r3
 split_chunk:
         sfetch  vid, m1, r16, r5
@@ -512,12 +541,6 @@ split_chunk:
         li      r12, STACK_LIMIT        ; room for four entries?
         addi    r1, r24, 48
         bltu    r12, r1, err_stack
-.macro  PUSH node, b, e
-        spst    \node, r24, 0
-        spst    \b, r24, 4
-        spst    \e, r24, 8
-        addi    r24, r24, 12
-.endm
         beq     r9, r5, push_neg_only   ; no positive rays
         beq     r3, r9, push_pos_only   ; no negative rays
         PUSH    r11, r9, r5             ; positive rays: right child second

@@ -18,6 +18,7 @@ typedef enum CfgType { CFG_INT, CFG_I64, CFG_FLOAT, CFG_ENUM } CfgType;
 /* The names of ENUM keys' values, in index order (sim/config.h has the index constants). */
 static const struct { const char *section, *key; const char *names[4]; } enum_names[] = {
     {"stream", "mode", {"stream", "packet"}},
+    {"stream", "order", {"ray", "first"}},
     {"workload", "kind", {"path", "specular", "diffuse"}},
 };
 

@@ -45,6 +45,7 @@ void cfg_core_params(const CfgMachine *cfg, CoreParams *p);
 
 /* Values of the ENUM keys (index = stored value). */
 enum { CFG_STREAM_MODE_STREAM = 0, CFG_STREAM_MODE_PACKET = 1 };
+enum { CFG_STREAM_ORDER_RAY = 0, CFG_STREAM_ORDER_FIRST = 1 };
 enum { CFG_WORKLOAD_PATH = 0, CFG_WORKLOAD_SPECULAR = 1, CFG_WORKLOAD_DIFFUSE = 2 };
 /* The name of an ENUM key's value ("packet"), or NULL for other keys. */
 const char *cfg_enum_name(const char *section, const char *key, int value);

@@ -256,6 +256,8 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
     st->tile_w = tile_w;
     st->tile_h = tile_h;
     add_define(defs, &nd, st->defines, sizeof st->defines, "RAYS", rays);
+    if (cfg->stream_order == CFG_STREAM_ORDER_FIRST)
+        add_define(defs, &nd, st->defines, sizeof st->defines, "ORDER_FIRST", 1);
     if (cfg->workload_kind == CFG_WORKLOAD_SPECULAR) {
         add_define(defs, &nd, st->defines, sizeof st->defines, "WORKLOAD", 1);
         add_define(defs, &nd, st->defines, sizeof st->defines, "BOUNCES", cfg->workload_bounces);

@@ -248,6 +248,7 @@ static void add_functional_json(cJSON *root, const RunStats *rs, const CfgMachin
     cJSON_AddNumberToObject(cf, "core.simd_width", cfg->core_simd_width);
     cJSON_AddNumberToObject(cf, "core.clock_mhz", cfg->core_clock_mhz);
     cJSON_AddStringToObject(cf, "stream.mode", cfg_enum_name("stream", "mode", cfg->stream_mode));
+    cJSON_AddStringToObject(cf, "stream.order", cfg_enum_name("stream", "order", cfg->stream_order));
     cJSON_AddNumberToObject(cf, "stream.rays", cfg->stream_rays);
     cJSON_AddStringToObject(cf, "workload.kind", cfg_enum_name("workload", "kind", cfg->workload_kind));
     cJSON_AddNumberToObject(cf, "workload.bounces", cfg->workload_bounces);
