@@ -410,12 +410,17 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
     worker_main(&ws[0]);
     for (int i = 1; i <= started; i++)
         pthread_join(th[i], NULL);
+    float inv = 1.0f / (float)spp;
     if (atomic_load(&job->failed)) {
         snprintf(err, errlen, "%s", job->err);
         rc = job->trapped ? -2 : -1;
+        /* The tiles that finished are kept (the caller may write them as a partial image). */
+        for (size_t i = 0; i < 3 * (size_t)job->width * job->height; i++)
+            rgb[i] = rgb[i] * inv;
+        st->tiles_done = atomic_load(&job->done_tiles);
+        st->ntiles = job->ntiles;
         goto out;
     }
-    float inv = 1.0f / (float)spp;
     for (size_t i = 0; i < 3 * (size_t)job->width * job->height; i++)
         rgb[i] = rgb[i] * inv;
     for (int i = 0; i < nthreads; i++) {
@@ -459,6 +464,7 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
     }
     st->tiles = job->tiles;
     st->ntiles = job->ntiles;
+    st->tiles_done = job->ntiles;
     job->tiles = NULL;
     rc = 0;
 out:

@@ -45,7 +45,7 @@ typedef struct FuncStats {
     uint64_t gen_streams[FUNC_MAX_GENERATIONS][FUNC_STAGES], gen_rays[FUNC_MAX_GENERATIONS][FUNC_STAGES];
     uint64_t trav_streams, trav_rays, isect_streams, isect_rays, shade_streams, shade_rays;
     FuncTile *tiles;                                /* ntiles entries, raster order */
-    uint32_t ntiles;
+    uint32_t ntiles, tiles_done;                    /* after a failure: the tiles that finished */
     uint32_t kernel_instructions;                   /* program size */
     uint32_t tile_w, tile_h;                        /* pixels (= rays) of a stream's tile */
     char defines[512];                              /* the -D symbols the kernel was built with */

@@ -309,6 +309,34 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         FuncParams fp = {cfg, o->kernel_path ? o->kernel_path : func_default_kernel(kpath, sizeof kpath),
                          s.needs, o->seed, threads, progress_cb, &pr};
         int frc = func_render(&p, &fp, rgb, &rs.f, err, errlen);
+        if (frc == -2) {
+            /* The kernel failed in a tile: keep what the finished tiles rendered, marked partial;
+             * a previous run's complete outputs in this folder would now mislead, so they go. */
+            char path[4200], perr[512], text[8192];
+            static const char *const stale[] = {"frame.exr", "frame.png", "report.txt"};
+            for (size_t k = 0; k < sizeof stale / sizeof stale[0]; k++) {
+                snprintf(path, sizeof path, "%s/%s", o->out_dir, stale[k]);
+                unlink(path);
+            }
+            snprintf(path, sizeof path, "%s/frame.partial.exr", o->out_dir);
+            img_write_linear(path, rgb, s.render.width, s.render.height, perr, sizeof perr);
+            snprintf(path, sizeof path, "%s/report.json", o->out_dir);
+            cJSON *fr = cJSON_CreateObject();
+            cJSON_AddStringToObject(fr, "mode", o->mode);
+            cJSON_AddStringToObject(fr, "status", "failed");
+            cJSON_AddStringToObject(fr, "error", err);
+            cJSON_AddNumberToObject(fr, "tiles_done", rs.f.tiles_done);
+            cJSON_AddNumberToObject(fr, "tiles", rs.f.ntiles);
+            cJSON_AddStringToObject(fr, "partial_image", "frame.partial.exr");
+            char *ft = cJSON_Print(fr);
+            if (ft)
+                write_text(path, ft, perr, sizeof perr);
+            cJSON_free(ft);
+            cJSON_Delete(fr);
+            snprintf(text, sizeof text, "%s\n(%u of %u tiles finished: %s/frame.partial.exr; unfinished tiles are black)",
+                     err, rs.f.tiles_done, rs.f.ntiles, o->out_dir);
+            snprintf(err, errlen, "%s", text);
+        }
         if (frc != 0) {
             rc = frc;
             goto out;

@@ -317,12 +317,16 @@ run "$SFSIM" run --mode functional --kernel "$T/bad_kernel.s" -s scenes/cornell/
 want_rc 1; want_err "bad_kernel.s:1:"
 end
 
-begin "sfsim run --mode functional: a kernel that traps names pc and tile (exit 3)"
-printf '.include "abi.inc"\nstart: li r1, 0x7FFFFFF0\n ld r2, r1, 0\n halt\n' > "$T/trap_kernel.s"
+begin "sfsim run --mode functional: a kernel that traps names pc and tile, keeps finished tiles (exit 3)"
+printf '.include "abi.inc"\nstart: spld r1, r0, L_X0\n li r2, 16\n bne r1, r2, ok\n li r1, 0x7FFFFFF0\n ld r2, r1, 0\nok: halt\n' > "$T/trap_kernel.s"
 mkdir -p "$T/lib" && cp kernels/lib/abi.inc "$T/lib/"
 run "$SFSIM" run --mode functional --kernel "$T/trap_kernel.s" -s scenes/cornell/scene.ini -o "$T/fun4" \
-    --set render.width=16 --set render.height=16 --set render.spp=1 --no-progress
-want_rc 3; want_err "tile at \(0, 0\).*trap"
+    --set render.width=32 --set render.height=16 --set stream.rays=1024 --set core.simd_width=4 \
+    --set stream.mode=packet --set render.spp=1 -j 1 --no-progress
+want_rc 3; want_err "tile at \(16, 0\).*trap.*trap_kernel.s:6"; want_err "tiles finished"
+[ -s "$T/fun4/frame.partial.exr" ] || no "no frame.partial.exr"
+grep -qE '"status":[[:space:]]+"failed"' "$T/fun4/report.json" 2>/dev/null || no "report.json not marked failed"
+[ ! -e "$T/fun4/frame.exr" ] || no "a complete-looking frame.exr"
 end
 
 echo "cli: $pass passed, $fail failed"
