@@ -139,6 +139,13 @@ Test(functional, cornell_analytic_spheres_match_the_golden_model, .timeout = 120
     matches_golden("scenes/cornell/analytic.ini", 80, 64, 4);
 }
 
+/* Every kind of light (point, spot, directional, quad), ambient term, background, an analytic
+ * glass sphere: every optional path of the kernel at once. */
+Test(functional, every_light_kind_ambient_and_background_match_the_golden_model, .timeout = 120)
+{
+    matches_golden("tests/scenes/ok_every_section.ini", 64, 48, 4);
+}
+
 Test(functional, conference_room_matches_the_golden_model, .timeout = 300)
 {
     matches_golden("scenes/conference/scene.ini", 64, 48, 1);
