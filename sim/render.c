@@ -434,7 +434,9 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     cJSON_AddNumberToObject(ren, "max_depth", s.render.max_depth);
     cJSON_AddNumberToObject(ren, "seed", o->seed);
     cJSON_AddNumberToObject(ren, "stream_rays", o->stream_rays);
-    cJSON_AddNumberToObject(ren, "tile", tile);
+    int tile_w = functional ? (int)rs.f.tile_w : tile, tile_h = functional ? (int)rs.f.tile_h : tile;
+    cJSON_AddNumberToObject(ren, "tile", tile_w);
+    cJSON_AddNumberToObject(ren, "tile_height", tile_h);
     cJSON *im = cJSON_AddObjectToObject(root, "image");
     cJSON_AddNumberToObject(im, "mean", npx ? sum / (3.0 * (double)npx) : 0.0);
     cJSON_AddNumberToObject(im, "nonfinite", (double)nonfinite);
@@ -459,13 +461,13 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
              "scene        %s\n"
              "             %u triangles, %u spheres, %u lights; needs: %s\n"
              "             BVH %u nodes, %u leaves, depth %u, SAH cost %.2f; %u bytes of scene memory\n"
-             "image        %d x %d, %d spp, max depth %d, seed %u, tiles %d x %d (M = %d)\n"
+             "image        %d x %d, %d spp, max depth %d, seed %u, tiles of %d x %d pixels\n"
              "             mean %.5f, non-finite values %ld\n"
              "rays         %llu total: %llu primary, %llu shadow, %llu indirect; %llu dropped\n",
              o->mode, functional ? "the kernel on the functional core: no timing" : "golden model: no timing",
              o->scene_path, s.ntris, s.nspheres, p.nlights, needs[0] ? needs : "-", p.bvh.nnodes,
              p.bvh.nleaves, p.bvh.depth, p.bvh.sah_cost, p.size, s.render.width, s.render.height,
-             s.render.spp, s.render.max_depth, o->seed, tile, tile, o->stream_rays, sum / (3.0 * (double)npx),
+             s.render.spp, s.render.max_depth, o->seed, tile_w, tile_h, sum / (3.0 * (double)npx),
              nonfinite, (unsigned long long)total_rays, (unsigned long long)rs.primary,
              (unsigned long long)rs.shadow, (unsigned long long)rs.indirect, (unsigned long long)rs.dropped);
     if (functional) {
