@@ -160,12 +160,18 @@ $(BUILD)/fuzz/fuzz_scene: tests/fuzz/fuzz_scene.c scenes/scene.c scenes/scene_fi
 	$(CLANG)++ -x c -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined \
 	    $(filter %.c,$^) -x none $(filter %.o,$^) -o $@ -linih -lm
 
-fuzz: $(BUILD)/fuzz/fuzz_asm $(BUILD)/fuzz/fuzz_scene
+$(BUILD)/fuzz/fuzz_rays: tests/fuzz/fuzz_rays.c sim/raybatch.c
+	@mkdir -p $(dir $@)
+	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ -lm
+
+fuzz: $(BUILD)/fuzz/fuzz_asm $(BUILD)/fuzz/fuzz_scene $(BUILD)/fuzz/fuzz_rays
 
 fuzz-run: fuzz
 	@mkdir -p $(BUILD)/fuzz/corpus $(BUILD)/fuzz/scene_corpus
 	$(BUILD)/fuzz/fuzz_asm -max_total_time=$(FUZZ_SECONDS) -max_len=4096 $(BUILD)/fuzz/corpus tests/fuzz/seeds
 	$(BUILD)/fuzz/fuzz_scene -max_total_time=$(FUZZ_SECONDS) -max_len=65536 -timeout=30 $(BUILD)/fuzz/scene_corpus tests/scenes
+	@mkdir -p $(BUILD)/fuzz/ray_corpus
+	$(BUILD)/fuzz/fuzz_rays -max_total_time=$(FUZZ_SECONDS) -max_len=8192 $(BUILD)/fuzz/ray_corpus tests/fuzz/ray_seeds
 
 # ---- benchmarks -----------------------------------------------------------------------------
 $(BUILD)/bench/core_speed: bench/core_speed.c $(BUILD)/libsfsim.a

@@ -90,6 +90,31 @@ start:  vli     vz, 0
         ld      r28, r0, SM_HDR_SPP
         ld      r29, r0, SM_HDR_MAX_DEPTH
         li      r17, 0
+.ifdef TRACE_ONLY
+; ==== `sfsim trace`: the host put L_W rays (origin, direction, tmax, kind) in the current ray
+; buffer; the stream is their IDs 0..L_W-1. Set-up filter and traversal only; the host reads
+; F_PRIM, F_TMAX, F_U, F_V back (docs/trace.md).
+        li      r18, 0
+        sgen    r0
+        li      r19, 0
+        mov     r20, r19
+        spld    r1, r0, L_W
+        li      r2, 0
+trace_ids:
+        sub     r3, r1, r2
+        mtail   m1, r3
+        viota   v0 @m1
+        vbcast  v1, r2 @m1
+        vadd    v0, v0, v1 @m1
+        sapp    r20, v0 @m1
+        add     r2, r2, r25
+        blt     r2, r1, trace_ids
+        jal     r30, setup
+        beq     r19, r20, trace_only_done
+        jal     r30, trace
+trace_only_done:
+        halt
+.endif
 
 ; ==== one pass per sample: camera rays of the tile ==============================================
 sample_loop:

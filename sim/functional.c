@@ -9,6 +9,7 @@
 #include "functional.h"
 
 #include <limits.h>
+#include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -45,6 +46,7 @@ typedef struct Abi {
     uint32_t st_dropped, st_camera, st_indirect, st_shadow, st_generations, st_per_gen, st_max_gen;
     uint32_t st_gen_base, st_gen_bytes, st_g_trav, st_g_isect, st_g_shade;
     uint32_t stack_base, ray_fields, err_stack, err_generations;
+    uint32_t f_org[3], f_dir[3], f_tmax, f_kind, f_prim, f_u, f_v;
 } Abi;
 
 static int abi_lookup(const AsmObject *obj, Abi *abi, char *err, size_t errlen)
@@ -57,7 +59,10 @@ static int abi_lookup(const AsmObject *obj, Abi *abi, char *err, size_t errlen)
         A(st_per_gen, "ST_PER_GEN"), A(st_max_gen, "ST_MAX_GEN"), A(st_gen_base, "ST_GEN_BASE"),
         A(st_gen_bytes, "ST_GEN_BYTES"), A(st_g_trav, "ST_G_TRAV"), A(st_g_isect, "ST_G_ISECT"),
         A(st_g_shade, "ST_G_SHADE"), A(stack_base, "STACK_BASE"), A(ray_fields, "RAY_FIELDS"),
-        A(err_stack, "ERR_STACK"), A(err_generations, "ERR_GENERATIONS"),
+        A(err_stack, "ERR_STACK"), A(err_generations, "ERR_GENERATIONS"), A(f_org[0], "F_ORGX"),
+        A(f_org[1], "F_ORGY"), A(f_org[2], "F_ORGZ"), A(f_dir[0], "F_DIRX"), A(f_dir[1], "F_DIRY"),
+        A(f_dir[2], "F_DIRZ"), A(f_tmax, "F_TMAX"), A(f_kind, "F_KIND"), A(f_prim, "F_PRIM"), A(f_u, "F_U"),
+        A(f_v, "F_V"),
 #undef A
     };
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
@@ -86,7 +91,7 @@ typedef struct Job {
     const Abi *abi;
     CoreParams cp;
     float *rgb;
-    uint32_t width, height, tile_w, tile_h, tiles_x, ntiles;
+    uint32_t width, height, tile_w, tile_h, tiles_x, ntiles, rays;
     FuncTile *tiles;
     atomic_uint next_tile, done_tiles;
     atomic_int failed;
@@ -126,9 +131,87 @@ static void fail(Job *j, const char *msg, int trapped)
     pthread_mutex_unlock(&j->lock);
 }
 
+static void rb_set(uint8_t *rb, uint32_t addr, uint32_t v) { memcpy(rb + addr, &v, 4); }
+static uint32_t rb_get(const uint8_t *rb, uint32_t addr)
+{
+    uint32_t v;
+    memcpy(&v, rb + addr, 4);
+    return v;
+}
+
+/* One batch of `sfsim trace`: rays [t * M, ...) into RB0, run, hits out. */
+static int trace_batch(Job *j, Core *c, uint32_t t, FuncStats *st)
+{
+    const Abi *a = j->abi;
+    const RayBatch *b = j->fp->batch;
+    uint32_t first = t * j->rays, n = b->count - first < j->rays ? b->count - first : j->rays;
+    core_restart(c);
+    uint32_t size;
+    uint8_t *sp = core_mem(c, CORE_MEM_SPAD, &size);
+    memset(sp, 0, a->stack_base);
+    spad_set(c, a->l_w, n);
+    uint8_t *rb = core_mem(c, CORE_MEM_RB0, &size);
+    const float nan = NAN;
+    uint32_t nanbits;
+    memcpy(&nanbits, &nan, 4);
+    for (uint32_t i = 0; i < n; i++) {
+        const BatchRay *r = &b->rays[first + i];
+        int invalid = raybatch_ray_invalid(r);
+        for (int k = 0; k < 3; k++) {
+            uint32_t o, d;
+            memcpy(&o, &r->org[k], 4);
+            memcpy(&d, &r->dir[k], 4);
+            rb_set(rb, a->f_org[k] + 4 * i, invalid ? nanbits : o); /* NaN: the set-up filter drops it */
+            rb_set(rb, a->f_dir[k] + 4 * i, d);
+        }
+        uint32_t tm;
+        memcpy(&tm, &r->tmax, 4);
+        rb_set(rb, a->f_tmax + 4 * i, tm);
+        rb_set(rb, a->f_kind + 4 * i, r->query == RAY_ANY ? 2u : 0u);
+        rb_set(rb, a->f_prim + 4 * i, UINT32_MAX);
+    }
+    CoreExit ex = core_run(c, (uint64_t)j->fp->cfg->sim_max_instructions);
+    char msg[1400];
+    if (ex != CORE_EXIT_HALT) {
+        snprintf(msg, sizeof msg, "kernel, rays %u..%u: %s%s", first, first + n - 1, core_trap_message(c),
+                 ex == CORE_EXIT_LIMIT ? " (sim.max_instructions)" : "");
+        fail(j, msg, 1);
+        return -1;
+    }
+    if (spad_u32(c, a->l_error)) {
+        snprintf(msg, sizeof msg, "kernel, rays %u..%u: traversal stack overflow (raise spad.size_kb)", first,
+                 first + n - 1);
+        fail(j, msg, 1);
+        return -1;
+    }
+    for (uint32_t i = 0; i < n; i++) {
+        const BatchRay *r = &b->rays[first + i];
+        BatchHit *h = &j->fp->hits[first + i];
+        memset(h, 0, sizeof *h);
+        h->invalid = (uint32_t)raybatch_ray_invalid(r);
+        uint32_t tm = rb_get(rb, a->f_tmax + 4 * i), u = rb_get(rb, a->f_u + 4 * i), v = rb_get(rb, a->f_v + 4 * i);
+        if (r->query == RAY_ANY) {
+            float tf;
+            memcpy(&tf, &tm, 4);
+            h->prim = !h->invalid && tf < 0.0f;
+            continue;
+        }
+        h->prim = h->invalid ? UINT32_MAX : rb_get(rb, a->f_prim + 4 * i);
+        if (h->prim != UINT32_MAX) {
+            memcpy(&h->t, &tm, 4);
+            memcpy(&h->u, &u, 4);
+            memcpy(&h->v, &v, 4);
+        }
+    }
+    st->rays_camera += n;
+    return 0;
+}
+
 static int run_tile(Job *j, Core *c, uint32_t t, FuncStats *st)
 {
     const Abi *a = j->abi;
+    if (j->fp->batch)
+        return trace_batch(j, c, t, st);
     FuncTile *ft = &j->tiles[t];
     ft->x0 = (t % j->tiles_x) * j->tile_w;
     ft->y0 = (t / j->tiles_x) * j->tile_h;
@@ -256,6 +339,8 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
     st->tile_w = tile_w;
     st->tile_h = tile_h;
     add_define(defs, &nd, st->defines, sizeof st->defines, "RAYS", rays);
+    if (fp->batch)
+        add_define(defs, &nd, st->defines, sizeof st->defines, "TRACE_ONLY", 1);
     if (cfg->stream_order == CFG_STREAM_ORDER_FIRST)
         add_define(defs, &nd, st->defines, sizeof st->defines, "ORDER_FIRST", 1);
     if (cfg->workload_kind == CFG_WORKLOAD_SPECULAR) {
@@ -386,8 +471,11 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
     uint32_t spp = sm_u32(p, sm_hdr(p, SM_HDR_SPP));
     job->tile_w = tile_w;
     job->tile_h = tile_h;
+    job->rays = rays;
     job->tiles_x = (job->width + tile_w - 1) / tile_w;
     job->ntiles = job->tiles_x * ((job->height + tile_h - 1) / tile_h);
+    if (fp->batch)
+        job->ntiles = (fp->batch->count + rays - 1) / rays;
     job->tiles = calloc(job->ntiles ? job->ntiles : 1, sizeof(FuncTile));
     atomic_init(&job->next_tile, 0u);
     atomic_init(&job->done_tiles, 0u);
@@ -415,13 +503,13 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
         snprintf(err, errlen, "%s", job->err);
         rc = job->trapped ? -2 : -1;
         /* The tiles that finished are kept (the caller may write them as a partial image). */
-        for (size_t i = 0; i < 3 * (size_t)job->width * job->height; i++)
+        for (size_t i = 0; rgb && i < 3 * (size_t)job->width * job->height; i++)
             rgb[i] = rgb[i] * inv;
         st->tiles_done = atomic_load(&job->done_tiles);
         st->ntiles = job->ntiles;
         goto out;
     }
-    for (size_t i = 0; i < 3 * (size_t)job->width * job->height; i++)
+    for (size_t i = 0; rgb && i < 3 * (size_t)job->width * job->height; i++)
         rgb[i] = rgb[i] * inv;
     for (int i = 0; i < nthreads; i++) {
         const FuncStats *s = &ws[i].st;
@@ -477,6 +565,15 @@ out:
     free(th);
     asm_object_free(&obj);
     return rc;
+}
+
+int func_trace(const PackedScene *p, const FuncParams *fp, FuncStats *st, char *err, size_t errlen)
+{
+    if (!fp->batch || !fp->hits) {
+        snprintf(err, errlen, "trace: no ray batch");
+        return -1;
+    }
+    return func_render(p, fp, NULL, st, err, errlen);
 }
 
 void func_stats_free(FuncStats *st)

@@ -14,6 +14,7 @@
 #include "../scenes/pack.h"
 #include "config.h"
 #include "core.h"
+#include "raybatch.h"
 
 #define FUNC_MAX_GENERATIONS 64
 #define FUNC_STAGES 3          /* stream counters: traversal, intersection, shading */
@@ -26,6 +27,11 @@ typedef struct FuncParams {
     int threads;
     void (*progress)(void *ctx, uint32_t tiles_done, uint32_t tiles_total);
     void *progress_ctx;
+    /* Trace mode (`sfsim trace`): when batch is set, the kernel is built with TRACE_ONLY and runs
+     * traversal and intersection on the batch, M rays per run; hits[i] receives ray i's result
+     * and rgb is not touched (may be NULL). */
+    const RayBatch *batch;
+    BatchHit *hits;
 } FuncParams;
 
 typedef struct FuncTile {
@@ -58,6 +64,9 @@ typedef struct FuncStats {
 int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStats *st, char *err,
                 size_t errlen);
 void func_stats_free(FuncStats *st);
+
+/* `sfsim trace` through the kernel: fp->batch and fp->hits must be set. Same returns. */
+int func_trace(const PackedScene *p, const FuncParams *fp, FuncStats *st, char *err, size_t errlen);
 
 /* The kernel next to the executable: <dir of exe>/../kernels/pathtrace.s, or SFSIM_KERNEL. */
 const char *func_default_kernel(char *buf, size_t len);

@@ -16,6 +16,7 @@
 #include "core.h"
 #include "img.h"
 #include "render.h"
+#include "trace.h"
 
 #define SFSIM_VERSION "0.1"
 
@@ -29,11 +30,13 @@ static void usage(FILE *out)
             "sfsim simulates a stream-filtering ray tracing processor (Gribble & Ramani 2008).\n"
             "\n"
             "commands:\n"
-            "  run      render a scene (--mode reference: the golden model)\n"
+            "  run      render a scene: --mode functional (the kernel on the simulated machine) or\n"
+            "           --mode reference (the golden model)\n"
             "  exec     run an assembled program (.sfo) on the functional core; print registers\n"
             "           and counters\n"
             "  config   list the machine-config keys (--dump) or write their reference (--markdown)\n"
             "  compare  compare two images: RMSE, PSNR, largest difference, NaN/Inf counts\n"
+            "  trace    closest-hit / any-hit queries for a file of rays, through the kernel or the golden model\n"
             "  help     help on a command: sfsim help exec\n"
             "\n"
             "options everywhere: --help, --version\n"
@@ -501,6 +504,91 @@ static int cmd_run(int argc, char **argv)
     return EXIT_OK;
 }
 
+static void usage_trace(FILE *out)
+{
+    fprintf(out,
+            "usage: sfsim trace -s SCENE --rays FILE -o HITS [options]\n"
+            "\n"
+            "Traces each ray of FILE (text or binary, docs/trace.md) against SCENE and writes its closest hit\n"
+            "(distance, primitive, barycentrics) or miss, or for any-hit rays whether it is occluded, to HITS.\n"
+            "\n"
+            "options:\n"
+            "  --mode functional|reference  the kernel's traversal and intersection on the functional core\n"
+            "                           (default), or the golden model's\n"
+            "  -c, --config FILE        machine config; --set SECTION.KEY=VALUE overrides a key\n"
+            "  --binary                 write HITS in the binary format (default: text)\n"
+            "  -j, --threads N          host threads (default: all cores; results do not change)\n"
+            "  --kernel FILE            the kernel source (default: kernels/pathtrace.s beside the binary)\n");
+}
+
+static int cmd_trace(int argc, char **argv)
+{
+    ConfigArgs ca = {0};
+    TraceOptions o;
+    memset(&o, 0, sizeof o);
+    o.mode = "functional";
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        int has_next = i + 1 < argc;
+        long v;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            usage_trace(stdout);
+            return EXIT_OK;
+        } else if ((!strcmp(a, "-s") || !strcmp(a, "--scene")) && has_next) {
+            o.scene_path = argv[++i];
+        } else if (!strcmp(a, "--rays") && has_next) {
+            o.rays_path = argv[++i];
+        } else if ((!strcmp(a, "-o") || !strcmp(a, "--out")) && has_next) {
+            o.out_path = argv[++i];
+        } else if (!strcmp(a, "--mode") && has_next) {
+            o.mode = argv[++i];
+        } else if ((!strcmp(a, "-c") || !strcmp(a, "--config")) && has_next) {
+            ca.path = argv[++i];
+        } else if (!strcmp(a, "--set") && has_next) {
+            if (add_set(&ca, argv[++i]))
+                return EXIT_USAGE;
+        } else if (!strcmp(a, "--binary")) {
+            o.binary = 1;
+        } else if ((!strcmp(a, "-j") || !strcmp(a, "--threads")) && has_next) {
+            if (parse_int(a, argv[++i], 1, 1024, &v))
+                return EXIT_USAGE;
+            o.threads = (int)v;
+        } else if (!strcmp(a, "--kernel") && has_next) {
+            o.kernel_path = argv[++i];
+        } else {
+            fprintf(stderr, "sfsim trace: unknown option or missing value: %s (sfsim help trace)\n", a);
+            return EXIT_USAGE;
+        }
+    }
+    if (!o.scene_path || !o.rays_path || !o.out_path) {
+        fprintf(stderr, "sfsim trace: -s SCENE, --rays FILE and -o HITS are required (sfsim help trace)\n");
+        return EXIT_USAGE;
+    }
+    if (strcmp(o.mode, "functional") != 0 && strcmp(o.mode, "reference") != 0) {
+        fprintf(stderr, "sfsim trace: --mode %s: expected functional or reference\n", o.mode);
+        return EXIT_USAGE;
+    }
+    if (o.threads == 0)
+        o.threads = (int)sysconf(_SC_NPROCESSORS_ONLN);
+    CfgMachine cfg;
+    if (build_config(&ca, &cfg))
+        return EXIT_INPUT;
+    o.cfg = &cfg;
+    static char err[65536];
+    TraceSummary sum;
+    int rc = trace_run(&o, &sum, err, sizeof err);
+    if (rc != 0) {
+        fprintf(stderr, "sfsim trace: %s\n", err);
+        return rc == -2 ? EXIT_TRAP : EXIT_INPUT;
+    }
+    printf("sfsim trace: %u rays (%s): %u hits, %u misses, %u occluded, %u clear, %u invalid; %.3f s",
+           sum.rays, o.mode, sum.hits, sum.misses, sum.occluded, sum.clear, sum.invalid, sum.seconds);
+    if (sum.sim_instructions)
+        printf(", %llu simulated instructions", (unsigned long long)sum.sim_instructions);
+    printf("; wrote %s\n", o.out_path);
+    return EXIT_OK;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -527,6 +615,8 @@ int main(int argc, char **argv)
             usage_run(stdout);
         else if (!strcmp(argv[2], "compare"))
             usage_compare(stdout);
+        else if (!strcmp(argv[2], "trace"))
+            usage_trace(stdout);
         else {
             fprintf(stderr, "sfsim help: unknown command '%s'\n", argv[2]);
             return EXIT_USAGE;
@@ -541,6 +631,8 @@ int main(int argc, char **argv)
         return cmd_run(argc - 2, argv + 2);
     if (!strcmp(cmd, "compare"))
         return cmd_compare(argc - 2, argv + 2);
+    if (!strcmp(cmd, "trace"))
+        return cmd_trace(argc - 2, argv + 2);
     fprintf(stderr, "sfsim: unknown command '%s'\n\n", cmd);
     usage(stderr);
     return EXIT_USAGE;

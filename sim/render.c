@@ -307,7 +307,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     if (functional) {
         char kpath[4200];
         FuncParams fp = {cfg, o->kernel_path ? o->kernel_path : func_default_kernel(kpath, sizeof kpath),
-                         s.needs, o->seed, threads, progress_cb, &pr};
+                         s.needs, o->seed, threads, progress_cb, &pr, NULL, NULL};
         int frc = func_render(&p, &fp, rgb, &rs.f, err, errlen);
         if (frc == -2) {
             /* The kernel failed in a tile: keep what the finished tiles rendered, marked partial;

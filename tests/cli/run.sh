@@ -329,5 +329,45 @@ grep -qE '"status":[[:space:]]+"failed"' "$T/fun4/report.json" 2>/dev/null || no
 [ ! -e "$T/fun4/frame.exr" ] || no "a complete-looking frame.exr"
 end
 
+# ---- sfsim trace ---------------------------------------------------------------------------------
+begin "sfsim trace: kernel and golden model give the same hits, text and binary (docs/trace.md)"
+cp tests/fuzz/ray_seeds/cornell.txt "$T/rays.txt"
+run "$SFSIM" trace -s scenes/cornell/scene.ini --rays "$T/rays.txt" -o "$T/hits_f.txt" -j 2
+want_rc 0; want_out "7 rays \(functional\): 2 hits, 1 misses, 1 occluded, 1 clear, 2 invalid"
+run "$SFSIM" trace --mode reference -s scenes/cornell/scene.ini --rays "$T/rays.txt" -o "$T/hits_r.txt"
+want_rc 0
+cmp -s "$T/hits_f.txt" "$T/hits_r.txt" || no "text hits differ between the kernel and the golden model"
+grep -q "^4 invalid$" "$T/hits_f.txt" || no "the NaN ray is not reported invalid"
+run "$SFSIM" trace -s scenes/cornell/scene.ini --rays tests/fuzz/ray_seeds/two.bin -o "$T/hits_f.bin" --binary
+want_rc 0
+run "$SFSIM" trace --mode reference -s scenes/cornell/scene.ini --rays tests/fuzz/ray_seeds/two.bin -o "$T/hits_r.bin" --binary
+want_rc 0
+cmp -s "$T/hits_f.bin" "$T/hits_r.bin" || no "binary hits differ"
+[ "$(stat -c %s "$T/hits_f.bin")" -eq 56 ] || no "binary hit file is not 16 + 2 x 20 bytes"
+end
+
+begin "sfsim trace: a malformed text ray file names file and line (exit 1)"
+printf '0 0 0 1 0 0\n0 0 0 1 x 0\n' > "$T/bad1.txt"
+run "$SFSIM" trace -s scenes/cornell/scene.ini --rays "$T/bad1.txt" -o "$T/h.txt"
+want_rc 1; want_err "bad1.txt:2: field 5: 'x' is not a number"
+printf '0 0 0 1 0\n' > "$T/bad2.txt"
+run "$SFSIM" trace -s scenes/cornell/scene.ini --rays "$T/bad2.txt" -o "$T/h.txt"
+want_rc 1; want_err "bad2.txt:1: 5 fields"
+printf '0 0 0 1 0 0 -1\n' > "$T/bad3.txt"
+run "$SFSIM" trace -s scenes/cornell/scene.ini --rays "$T/bad3.txt" -o "$T/h.txt"
+want_rc 1; want_err "bad3.txt:1: tmax must be > 0"
+end
+
+begin "sfsim trace: a truncated binary ray file names the byte count (exit 1)"
+head -c 60 tests/fuzz/ray_seeds/two.bin > "$T/short.bin"
+run "$SFSIM" trace -s scenes/cornell/scene.ini --rays "$T/short.bin" -o "$T/h.bin"
+want_rc 1; want_err "short.bin: 60 bytes, but a header claiming 2 rays needs exactly 80"
+end
+
+begin "sfsim trace without its required options is a usage error (exit 2)"
+run "$SFSIM" trace -s scenes/cornell/scene.ini
+want_rc 2; want_err "required"
+end
+
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

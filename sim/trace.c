@@ -1,0 +1,120 @@
+/* sim/trace.c -- `sfsim trace`: a batch of rays through the kernel's traversal and intersection
+ * (sim/functional.c, TRACE_ONLY) or the golden model (sim/ref_trace.c); hits to a file.
+ *
+ * Owns: choosing the engine and summarising. Must not: trace rays itself.
+ */
+#include "trace.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "../scenes/scene.h"
+#include "functional.h"
+#include "ref_trace.h"
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+int trace_batch_run(const PackedScene *p, uint32_t needs, const RayBatch *b, BatchHit *hits, const char *mode,
+                    const CfgMachine *cfg, const char *kernel_path, int threads, uint64_t *sim_instructions,
+                    char *err, size_t errlen)
+{
+    if (sim_instructions)
+        *sim_instructions = 0;
+    if (!strcmp(mode, "reference")) {
+        for (uint32_t i = 0; i < b->count; i++) {
+            const BatchRay *r = &b->rays[i];
+            BatchHit *h = &hits[i];
+            memset(h, 0, sizeof *h);
+            h->invalid = (uint32_t)raybatch_ray_invalid(r);
+            if (h->invalid) {
+                h->prim = r->query == RAY_ANY ? 0 : UINT32_MAX;
+                continue;
+            }
+            RefRay q = {{r->org[0], r->org[1], r->org[2]}, {r->dir[0], r->dir[1], r->dir[2]}, r->tmax};
+            if (r->query == RAY_ANY) {
+                h->prim = (uint32_t)ref_any_hit(p, &q, NULL);
+            } else {
+                RefHit rh;
+                ref_closest_hit(p, &q, &rh, NULL);
+                h->prim = rh.prim;
+                if (rh.prim != REF_NO_HIT) {
+                    h->t = rh.t;
+                    h->u = rh.u;
+                    h->v = rh.v;
+                }
+            }
+        }
+        return 0;
+    }
+    if (strcmp(mode, "functional") != 0) {
+        snprintf(err, errlen, "--mode %s: expected functional or reference", mode);
+        return -1;
+    }
+    char kpath[4200];
+    FuncParams fp = {cfg, kernel_path ? kernel_path : func_default_kernel(kpath, sizeof kpath), needs, 1, threads,
+                     NULL, NULL, b, hits};
+    FuncStats st;
+    int rc = func_trace(p, &fp, &st, err, errlen);
+    if (rc == 0 && sim_instructions)
+        *sim_instructions = st.instructions;
+    func_stats_free(&st);
+    return rc;
+}
+
+int trace_run(const TraceOptions *o, TraceSummary *sum, char *err, size_t errlen)
+{
+    memset(sum, 0, sizeof *sum);
+    Scene s;
+    PackedScene p;
+    RayBatch b;
+    BatchHit *hits = NULL;
+    memset(&p, 0, sizeof p);
+    memset(&b, 0, sizeof b);
+    if (scene_load(o->scene_path, &s, err, errlen) != 0)
+        return -1;
+    int rc = -1;
+    BvhParams bp;
+    bvh_default_params(&bp);
+    bp.max_leaf_size = o->cfg->bvh_leaf_size;
+    bp.bins = o->cfg->bvh_bins;
+    if (pack_scene(&s, &bp, 0, &p, err, errlen) != 0)
+        goto out;
+    if (raybatch_load(o->rays_path, &b, err, errlen) != 0)
+        goto out;
+    hits = calloc(b.count ? b.count : 1, sizeof *hits);
+    if (!hits) {
+        snprintf(err, errlen, "out of memory for %u hits", b.count);
+        goto out;
+    }
+    double t0 = now();
+    rc = trace_batch_run(&p, s.needs, &b, hits, o->mode, o->cfg, o->kernel_path, o->threads, &sum->sim_instructions,
+                         err, errlen);
+    sum->seconds = now() - t0;
+    if (rc != 0)
+        goto out;
+    rc = -1;
+    if (raybatch_write_hits(o->out_path, &b, hits, o->binary, err, errlen) != 0)
+        goto out;
+    sum->rays = b.count;
+    for (uint32_t i = 0; i < b.count; i++) {
+        if (hits[i].invalid)
+            sum->invalid++;
+        else if (b.rays[i].query == RAY_ANY)
+            hits[i].prim ? sum->occluded++ : sum->clear++;
+        else
+            hits[i].prim == UINT32_MAX ? sum->misses++ : sum->hits++;
+    }
+    rc = 0;
+out:
+    free(hits);
+    raybatch_free(&b);
+    pack_free(&p);
+    scene_free(&s);
+    return rc;
+}

@@ -1,0 +1,41 @@
+/* sim/trace.h -- `sfsim trace`: closest-hit and any-hit queries for a batch of rays, through the
+ * kernel's traversal and intersection on the functional core, or through the golden model.
+ *
+ * Owns: the orchestration of a trace run (scene, rays, engine, hit file, summary).
+ * Must not: parse the command line or implement a ray query.
+ */
+#ifndef SFSIM_TRACE_H
+#define SFSIM_TRACE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../scenes/pack.h"
+#include "config.h"
+#include "raybatch.h"
+
+typedef struct TraceOptions {
+    const char *scene_path, *rays_path, *out_path;
+    const char *mode;             /* "functional" (default) or "reference" */
+    const char *kernel_path;      /* NULL: next to the executable */
+    const CfgMachine *cfg;
+    int threads;
+    int binary;                   /* hits in binary */
+} TraceOptions;
+
+typedef struct TraceSummary {
+    uint32_t rays, hits, misses, occluded, clear, invalid;
+    uint64_t sim_instructions;
+    double seconds;
+} TraceSummary;
+
+/* Trace a batch with either engine (no files): hits[i] for batch ray i. 0, -1 (input) or -2
+ * (the kernel failed). */
+int trace_batch_run(const PackedScene *p, uint32_t needs, const RayBatch *b, BatchHit *hits, const char *mode,
+                    const CfgMachine *cfg, const char *kernel_path, int threads, uint64_t *sim_instructions,
+                    char *err, size_t errlen);
+
+/* The whole command: 0, -1 with a message naming the file or key, -2 when the kernel failed. */
+int trace_run(const TraceOptions *o, TraceSummary *sum, char *err, size_t errlen);
+
+#endif
