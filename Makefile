@@ -39,7 +39,7 @@ ASMLIB_OBJ = $(patsubst %.c,$(BUILD)/obj/%.o,$(ISA_SRC) $(ASM_SRC))
 LIB_OBJ  = $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/obj/%.o,$(CXX_SRC))
 ASAN_OBJ = $(patsubst %.c,$(BUILD)/asan/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/asan/%.o,$(CXX_SRC))
 
-.PHONY: all deps run test test-asan test-unit fuzz fuzz-run bench docs check-docs clean run-built test-built help
+.PHONY: all deps run test test-asan test-unit test-hard fuzz fuzz-run bench validation docs check-docs clean run-built test-built help
 
 all: bin/sfasm bin/sfsim
 
@@ -126,6 +126,17 @@ $(BUILD)/tests/unit-asan: $(TEST_SRC) $(BUILD)/libsfsim-asan.a $(BUILD)/gen_isad
 $(BUILD)/tests/io-asan: $(IO_TEST_SRC) $(BUILD)/libsfsim-asan.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(SAN) $(LDAS) $(IO_TEST_SRC) $(BUILD)/libsfsim-asan.a -o $@ $(CRIT) $(EMBREE) $(INIH) $(LDLIBS)
+
+HARD_TEST_SRC := $(wildcard tests/hard/*.c) tests/support/numerics.c
+
+$(BUILD)/tests/hard: $(HARD_TEST_SRC) tests/support/numerics.h $(BUILD)/libsfsim.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(LDAS) $(HARD_TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
+
+# The slow hard numerics cases (docs/numerics.md gives the run time).
+test-hard: deps
+	@$(MAKE) --no-print-directory all $(BUILD)/tests/hard
+	@$(TEST_ENV) $(BUILD)/tests/hard --jobs 2
 
 # CLI tests first, Criterion last: its synthesis line closes the run.
 TEST_ENV = SFSIM_BUILD=$(BUILD) SFSIM_GEN_ISADOC=$(BUILD)/gen_isadoc

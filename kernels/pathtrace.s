@@ -1050,6 +1050,24 @@ surf_chunk:
         ldg     fx, pa, SM_PRIM_V2 @m1
         ldg     fy, pa, SM_PRIM_V2 + 4 @m1
         ldg     fz, pa, SM_PRIM_V2 + 8 @m1
+        ; triangles: the hit point interpolated from the vertices, w0 v0 + u v1 + v v2 (spheres
+        ; overwrite it below with o + t d)
+        rgat    bu, vid, r0, F_U @m1
+        rgat    bv, vid, r0, F_V @m1
+        vli     w0, 1.0 @m1
+        vfsub   w0, w0, bu @m1
+        vfsub   w0, w0, bv @m1
+.macro  BARYP a, e, f, fld
+        vfmul   vt, w0, \a @m1
+        vfmul   vt2, bu, \e @m1
+        vfadd   vt, vt, vt2 @m1
+        vfmul   vt2, bv, \f @m1
+        vfadd   vt, vt, vt2 @m1
+        rsct    vt, vid, r0, \fld @m1
+.endm
+        BARYP   ax, ex, fx, F_PX
+        BARYP   ay, ey, fy, F_PY
+        BARYP   az, ez, fz, F_PZ
         vfsub   ex, ex, ax @m1          ; e1 = v1 - v0
         vfsub   ey, ey, ay @m1
         vfsub   ez, ez, az @m1
@@ -1061,25 +1079,25 @@ surf_chunk:
         rsct    gx, vid, r0, F_NGX @m1
         rsct    gy, vid, r0, F_NGY @m1
         rsct    gz, vid, r0, F_NGZ @m1
-        ; hit point p = o + t d
         GATHER3 e, F_DIRX, F_DIRY, F_DIRZ
-        GATHER3 a, F_ORGX, F_ORGY, F_ORGZ
-        rgat    vt2, vid, r0, F_TMAX @m1
-.macro  HITP a, e, f
-        vfmul   vt, vt2, \e @m1
-        vfadd   vt, \a, vt @m1
-        rsct    vt, vid, r0, \f @m1
-.endm
-        HITP    ax, ex, F_PX
-        HITP    ay, ey, F_PY
-        HITP    az, ez, F_PZ
 .ifdef HAS_SPHERES
-        ; spheres: the outward normal p - center (m5: sphere lanes, kept for the blocks below)
+        ; spheres: the hit point o + t d, the outward normal p - center (m5: sphere lanes, kept
+        ; for the blocks below)
         ldg     vt, pa, SM_PRIM_KIND @m1
         vli     vt2, 0 @m1
         vieq    m5, vt, vt2 @m1
         mandn   m5, m1, m5
         bmz     m5, surf_nosphere
+        GATHER3 a, F_ORGX, F_ORGY, F_ORGZ, m5
+        rgat    vt2, vid, r0, F_TMAX @m5
+.macro  HITP a, e, f
+        vfmul   vt, vt2, \e @m5
+        vfadd   vt, \a, vt @m5
+        rsct    vt, vid, r0, \f @m5
+.endm
+        HITP    ax, ex, F_PX
+        HITP    ay, ey, F_PY
+        HITP    az, ez, F_PZ
 .macro  SPHN g, f, off
         rgat    \g, vid, r0, \f @m5
         ldg     vt, pa, SM_PRIM_V0 + \off @m5
@@ -1115,11 +1133,6 @@ surf_nosphere:
         vmuli   vt, vt, 36 @m6
         vbcast  vt2, r9 @m6
         vadd    vt, vt, vt2 @m6         ; address of the three normals
-        rgat    bu, vid, r0, F_U @m6
-        rgat    bv, vid, r0, F_V @m6
-        vli     w0, 1.0 @m6
-        vfsub   w0, w0, bu @m6
-        vfsub   w0, w0, bv @m6
 .macro  NINTERP d, off
         ldg     \d, vt, \off @m6
         vfmul   \d, w0, \d @m6
@@ -1176,13 +1189,6 @@ surf_nosphere:
         vmuli   fx, fx, 24 @m3
         vbcast  vt2, r11 @m3
         vadd    fx, fx, vt2 @m3         ; the three uv pairs
-.ifndef HAS_NORMALS
-        rgat    bu, vid, r0, F_U @m3
-        rgat    bv, vid, r0, F_V @m3
-        vli     w0, 1.0 @m3
-        vfsub   w0, w0, bu @m3
-        vfsub   w0, w0, bv @m3
-.endif
 .macro  UVINTERP d, off
         ldg     \d, fx, \off @m3
         vfmul   \d, w0, \d @m3

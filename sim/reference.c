@@ -101,6 +101,8 @@ static void offset_point(const float *p, const float *n, float *out)
     }
 }
 
+void ref_offset_point(const float *p, const float *n, float *out) { offset_point(p, n, out); }
+
 /* Orthonormal basis around n (Duff et al., "Building an Orthonormal Basis, Revisited", JCGT
  * 2017); returns x * t + y * b + z * n. */
 static void to_world(const float *n, float x, float y, float z, float *out)
@@ -204,9 +206,14 @@ static void surface(const Ctx *c, const Ray *r, Surface *s)
     float g[9];
     for (int k = 0; k < 9; k++)
         g[k] = sm_f32(p, a + 4u * (uint32_t)k);
-    for (int k = 0; k < 3; k++)
-        s->p[k] = r->org[k] + r->hit.t * r->dir[k];
     uint32_t is_sphere = sm_u32(p, sm_rec(c->prims, SM_PRIM_WORDS, i, SM_PRIM_KIND)) == 1;
+    /* The hit point: a triangle's interpolated from its vertices (error relative to the vertices'
+     * coordinates, so a floor at y = 0 gets y = 0 even in a scene far from the origin, as the
+     * offsets of offset_point assume); a sphere's along the ray. */
+    float w0 = 1.0f - r->hit.u - r->hit.v;
+    for (int k = 0; k < 3; k++)
+        s->p[k] = is_sphere ? r->org[k] + r->hit.t * r->dir[k]
+                            : w0 * g[k] + r->hit.u * g[3 + k] + r->hit.v * g[6 + k];
     uint32_t src = sm_u32(p, sm_rec(c->prims, SM_PRIM_WORDS, i, SM_PRIM_SRC));
     if (is_sphere) {
         for (int k = 0; k < 3; k++)
@@ -219,7 +226,6 @@ static void surface(const Ctx *c, const Ray *r, Surface *s)
     float side = dot3(s->ng, r->dir) > 0.0f ? -1.0f : 1.0f;
     for (int k = 0; k < 3; k++)
         s->nf[k] = side * s->ng[k];
-    float w0 = 1.0f - r->hit.u - r->hit.v;
     if (!is_sphere && c->normals) {
         uint32_t na = c->normals + 36u * src;
         for (int k = 0; k < 3; k++)

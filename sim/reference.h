@@ -42,6 +42,10 @@ uint32_t ref_hash32(uint32_t x);
 uint32_t ref_path_key(uint32_t seed, uint32_t pixel, uint32_t sample);
 float ref_rand(uint32_t path_key, uint32_t vertex, uint32_t dim);
 
+/* The origin of a ray leaving the surface point p on the side of the unit normal n (Waechter and
+ * Binder 2019, docs/golden-model.md), as the renderer computes it. */
+void ref_offset_point(const float *p, const float *n, float *out);
+
 /* Render the whole image: rgb (width * height * 3 floats, zeroed by the caller) receives the
  * mean radiance per pixel. 0, or -1 with a message. stats may be NULL. */
 int ref_render(const PackedScene *p, const RefParams *rp, float *rgb, RefStats *stats, char *err,
