@@ -175,7 +175,11 @@ $(BUILD)/fuzz/fuzz_rays: tests/fuzz/fuzz_rays.c sim/raybatch.c
 	@mkdir -p $(dir $@)
 	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ -lm
 
-fuzz: $(BUILD)/fuzz/fuzz_asm $(BUILD)/fuzz/fuzz_scene $(BUILD)/fuzz/fuzz_rays
+$(BUILD)/fuzz/fuzz_config: tests/fuzz/fuzz_config.c sim/config.c
+	@mkdir -p $(dir $@)
+	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ $(INIH) -lm
+
+fuzz: $(BUILD)/fuzz/fuzz_asm $(BUILD)/fuzz/fuzz_scene $(BUILD)/fuzz/fuzz_rays $(BUILD)/fuzz/fuzz_config
 
 fuzz-run: fuzz
 	@mkdir -p $(BUILD)/fuzz/corpus $(BUILD)/fuzz/scene_corpus
@@ -183,6 +187,8 @@ fuzz-run: fuzz
 	$(BUILD)/fuzz/fuzz_scene -max_total_time=$(FUZZ_SECONDS) -max_len=65536 -timeout=30 $(BUILD)/fuzz/scene_corpus tests/scenes
 	@mkdir -p $(BUILD)/fuzz/ray_corpus
 	$(BUILD)/fuzz/fuzz_rays -max_total_time=$(FUZZ_SECONDS) -max_len=8192 $(BUILD)/fuzz/ray_corpus tests/fuzz/ray_seeds
+	@mkdir -p $(BUILD)/fuzz/config_corpus
+	$(BUILD)/fuzz/fuzz_config -max_total_time=$(FUZZ_SECONDS) -max_len=4096 $(BUILD)/fuzz/config_corpus tests/fuzz/config_seeds
 
 # ---- benchmarks -----------------------------------------------------------------------------
 $(BUILD)/bench/core_speed: bench/core_speed.c $(BUILD)/libsfsim.a

@@ -277,6 +277,18 @@ static int handler(void *user, const char *section, const char *name, const char
     return 1;
 }
 
+int cfg_load_stream(CfgMachine *cfg, FILE *f, const char *name, CfgErrors *errs)
+{
+    int before = errs->count;
+    Reader r = {f, name, 0, 0, cfg, errs};
+    int rc = ini_parse_stream(reader, &r, handler, &r);
+    if (rc > 0 && rc != r.last_syntax_error)
+        add_error(errs, "%s:%d: syntax error (expected [section] or key = value)", name, rc);
+    else if (rc < 0)
+        add_error(errs, "%s: cannot read", name);
+    return errs->count - before;
+}
+
 int cfg_load(CfgMachine *cfg, const char *path, CfgErrors *errs)
 {
     int before = errs->count;
@@ -285,13 +297,8 @@ int cfg_load(CfgMachine *cfg, const char *path, CfgErrors *errs)
         add_error(errs, "%s: cannot open: %s", path, strerror(errno));
         return errs->count - before;
     }
-    Reader r = {f, path, 0, 0, cfg, errs};
-    int rc = ini_parse_stream(reader, &r, handler, &r);
+    cfg_load_stream(cfg, f, path, errs);
     fclose(f);
-    if (rc > 0 && rc != r.last_syntax_error)
-        add_error(errs, "%s:%d: syntax error (expected [section] or key = value)", path, rc);
-    else if (rc < 0)
-        add_error(errs, "%s: cannot read", path);
     return errs->count - before;
 }
 

@@ -34,6 +34,8 @@ void cfg_defaults(CfgMachine *cfg);
 /* Read an INI file over cfg. Every problem is reported as "FILE:LINE: key 'sec.key': message"
  * (or "FILE:LINE: message" for syntax), all of them. */
 int cfg_load(CfgMachine *cfg, const char *path, CfgErrors *errs);
+/* The same from an open stream; name is used in the messages. */
+int cfg_load_stream(CfgMachine *cfg, FILE *f, const char *name, CfgErrors *errs);
 /* Apply "section.key=value"; errors name the option: "--set core.simd_width=999: ...". */
 int cfg_set(CfgMachine *cfg, const char *assignment, CfgErrors *errs);
 /* Cross-key consistency (e.g. a 4096-ray stream of 128-byte records must fit a ray buffer). */
