@@ -859,6 +859,33 @@ isect_next:
         sapp    r22, \slot @\k
 .endm
 
+; n := the unit geometric normal turned to face the incoming ray (nf), d := the ray direction;
+; m := lanes where it was turned. t, t2 scratch.
+.macro  FACING_NORMAL n, d, t, t2, m, k=m1
+        GATHER3 \n, F_NGX, F_NGY, F_NGZ, \k
+        GATHER3 \d, F_DIRX, F_DIRY, F_DIRZ, \k
+        DOT3    \t, \n, \d, \t2, \k
+        vflt    \m, vz, \t @\k
+        vfneg   \n\()x, \n\()x @\m
+        vfneg   \n\()y, \n\()y @\m
+        vfneg   \n\()z, \n\()z @\m
+.endm
+
+; c := a cosine-weighted direction's local coordinates (sqrt(u) cos phi, sqrt(u) sin phi,
+; sqrt(max(0, 1 - u))), d := it around the unit vector n. t1..t5 scratch.
+.macro  COSINE_DIR d, n, u, phi, c, t1, t2, t3, t4, t5, k=m1
+        vsqrt   \t1, \u @\k
+        vcos    \c\()x, \phi @\k
+        vfmul   \c\()x, \t1, \c\()x @\k
+        vsin    \c\()y, \phi @\k
+        vfmul   \c\()y, \t1, \c\()y @\k
+        vli     \t1, 1.0 @\k
+        vfsub   \t1, \t1, \u @\k
+        vfmax   \t1, vz, \t1 @\k
+        vsqrt   \c\()z, \t1 @\k
+        TO_WORLD \d, \n, \c\()x, \c\()y, \c\()z, \t1, \t2, \t3, \t4, \t5, \k
+.endm
+
 ; fbadd of a triple at the rays' pixels (vid the rays; t scratch)
 .macro  FBADD3 v, t, k
         rgat    \t, vid, r0, F_FBOFF @\k
@@ -1412,13 +1439,7 @@ dir_chunk:
         vadd    la, la, vt @m1
         ; origin: the hit point moved off the surface on the incoming side
         GATHER3 p, F_PX, F_PY, F_PZ
-        GATHER3 nf, F_NGX, F_NGY, F_NGZ
-        GATHER3 o, F_DIRX, F_DIRY, F_DIRZ
-        DOT3    vt, nf, o, vt2
-        vflt    m2, vz, vt @m1
-        vfneg   nfx, nfx @m2
-        vfneg   nfy, nfy @m2
-        vfneg   nfz, nfz @m2
+        FACING_NORMAL nf, o, vt, vt2, m2
         OFFSET3 o, p, nf, vt, vt2, vz, m2
         ; point on the light: P + c1 E1 + c2 E2 (quad: c = (u, v); triangle: sqrt(u) (1 - v), sqrt(u) v)
         RAND    lu, kb, DIM_LIGHT_U, vt
@@ -1705,16 +1726,7 @@ ind_chunk:
         beq     r14, r3, ind_glossy
 .endif
         ; Lambert: cosine-weighted hemisphere around ns; thr x base x weight
-        vsqrt   vt, u5 @m1
-        vcos    cx, phi @m1
-        vfmul   cx, vt, cx @m1
-        vsin    cy, phi @m1
-        vfmul   cy, vt, cy @m1
-        vli     vt, 1.0 @m1
-        vfsub   vt, vt, u5 @m1
-        vfmax   vt, vz, vt @m1
-        vsqrt   cz, vt @m1
-        TO_WORLD d, ns, cx, cy, cz, vt, vt2, vt3, vt4, vt5
+        COSINE_DIR d, ns, u5, phi, c, vt, vt2, vt3, vt4, vt5
         vbcast  vt, r2 @m1
         vfmul   thx, thx, bx @m1
         vfmul   thx, thx, vt @m1
@@ -1777,16 +1789,7 @@ ind_glossy:
         vfmul   thy, thy, vt5 @m4
         vfmul   thz, thz, vt5 @m4
         ; -- diffuse lanes: cosine-weighted around ns
-        vsqrt   vt, u5 @m4
-        vcos    cx, phi @m4
-        vfmul   cx, vt, cx @m4
-        vsin    cy, phi @m4
-        vfmul   cy, vt, cy @m4
-        vli     vt, 1.0 @m4
-        vfsub   vt, vt, u5 @m4
-        vfmax   vt, vz, vt @m4
-        vsqrt   cz, vt @m4
-        TO_WORLD d, ns, cx, cy, cz, vt, vt3, vt5, vt6, vt7, m4
+        COSINE_DIR d, ns, u5, phi, c, vt, vt3, vt5, vt6, vt7, m4
         ; -- specular lanes: around the mirror direction, cos a = exp2(log2(u5) / (n + 1))
         GATHER3 b, F_DIRX, F_DIRY, F_DIRZ, m3
         DOT3    vt, b, ns, vt3, m3
@@ -1830,13 +1833,7 @@ ind_glossy:
 ind_spawn:
 .endif
         ; keep directions above the geometric surface
-        GATHER3 nf, F_NGX, F_NGY, F_NGZ
-        GATHER3 b, F_DIRX, F_DIRY, F_DIRZ
-        DOT3    vt, nf, b, vt2
-        vflt    m3, vz, vt @m1
-        vfneg   nfx, nfx @m3
-        vfneg   nfy, nfy @m3
-        vfneg   nfz, nfz @m3
+        FACING_NORMAL nf, b, vt, vt2, m3
         DOT3    vt, d, nf, vt2, m2
         vflt    m2, vz, vt @m2
         ROULETTE m2, th, vt, vt2, vt3
@@ -2020,13 +2017,7 @@ fs_chunk:
         FBADD3  th, vt, m1
         jmp     fs_next
 fs_bounce:
-        GATHER3 d, F_DIRX, F_DIRY, F_DIRZ
-        GATHER3 nf, F_NGX, F_NGY, F_NGZ
-        DOT3    vt, nf, d, vt2
-        vflt    m2, vz, vt @m1
-        vfneg   nfx, nfx @m2
-        vfneg   nfy, nfy @m2
-        vfneg   nfz, nfz @m2
+        FACING_NORMAL nf, d, vt, vt2, m2
         DOT3    vt, d, nf, vt2
         vfadd   vt, vt, vt @m1
         vfmul   vt2, vt, nfx @m1
@@ -2100,23 +2091,8 @@ od_bounce:
         vli     vt, TWO_PI_F @m1
         vfmul   phi, vt, phi @m1
         GATHER3 ns, F_NSX, F_NSY, F_NSZ
-        vsqrt   vt, u5 @m1
-        vcos    cx, phi @m1
-        vfmul   cx, vt, cx @m1
-        vsin    cy, phi @m1
-        vfmul   cy, vt, cy @m1
-        vli     vt, 1.0 @m1
-        vfsub   vt, vt, u5 @m1
-        vfmax   vt, vz, vt @m1
-        vsqrt   cz, vt @m1
-        TO_WORLD d, ns, cx, cy, cz, vt, vt2, vt3, vt4, vt5
-        GATHER3 nf, F_NGX, F_NGY, F_NGZ
-        GATHER3 b, F_DIRX, F_DIRY, F_DIRZ
-        DOT3    vt, nf, b, vt2
-        vflt    m2, vz, vt @m1
-        vfneg   nfx, nfx @m2
-        vfneg   nfy, nfy @m2
-        vfneg   nfz, nfz @m2
+        COSINE_DIR d, ns, u5, phi, c, vt, vt2, vt3, vt4, vt5
+        FACING_NORMAL nf, b, vt, vt2, m2
         DOT3    vt, d, nf, vt2
         vflt    m2, vz, vt @m1          ; above the geometric surface
         GATHER3 b, F_PX, F_PY, F_PZ, m2
