@@ -405,6 +405,29 @@ Test(numerics, white_furnace_lambert, .timeout = 300) { furnace(3, "Lambert albe
 
 Test(numerics, white_furnace_dielectric, .timeout = 300) { furnace(2, "white glass, ior 1.5"); }
 
+/* Render s with the kernel (2 host threads) and the golden model: *k and *g receive the images
+ * (free them), st the kernel's statistics (func_stats_free), rs the golden model's. */
+static size_t render_both(const Scene *s, float **k, float **g, FuncStats *st, RefStats *rs)
+{
+    PackedScene p;
+    BvhParams bp;
+    bvh_default_params(&bp);
+    static char err[65536];
+    cr_assert_eq(pack_scene(s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
+    size_t n = 3 * (size_t)s->render.width * s->render.height;
+    *k = calloc(n, sizeof(float));
+    *g = calloc(n, sizeof(float));
+    cr_assert(*k && *g);
+    CfgMachine cfg;
+    cfg_defaults(&cfg);
+    FuncParams fp = {&cfg, "kernels/pathtrace.s", s->needs, 1, 2, NULL, NULL, NULL, NULL};
+    cr_assert_eq(func_render(&p, &fp, *k, st, err, sizeof err), 0, "%s", err);
+    RefParams rp = {64, 1, 2, NULL, NULL};
+    cr_assert_eq(ref_render(&p, &rp, *g, rs, err, sizeof err), 0, "%s", err);
+    pack_free(&p);
+    return n;
+}
+
 /* Rays starting inside glass, nested glass, total internal reflection and grazing Fresnel: a
  * glass sphere inside a glass sphere with the camera inside the outer one; every pixel finite and
  * the same in both engines. */
@@ -426,21 +449,9 @@ Test(numerics, nested_glass_total_internal_reflection_camera_inside, .timeout = 
     s.render = (SceneRender){32, 24, 4, 12, {0.2f, 0.3f, 0.4f}, {0, 0, 0}};
     s.needs |= SCENE_NEED_BACKGROUND;
     s.camera = (SceneCamera){{0, 0, 1.5f}, {0, 0, -1}, {0, 1, 0}, 70.0f, 0, 0, SCENE_CAMERA_FILE};
-    PackedScene p;
-    BvhParams bp;
-    bvh_default_params(&bp);
-    char err[512];
-    cr_assert_eq(pack_scene(&s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
-    size_t n = 3 * 32 * 24;
-    float *k = calloc(n, sizeof(float)), *g = calloc(n, sizeof(float));
-    CfgMachine cfg;
-    cfg_defaults(&cfg);
-    FuncParams fp = {&cfg, "kernels/pathtrace.s", s.needs, 1, 2, NULL, NULL, NULL, NULL};
+    float *k, *g;
     FuncStats st;
-    static char ferr[65536];
-    cr_assert_eq(func_render(&p, &fp, k, &st, ferr, sizeof ferr), 0, "%s", ferr);
-    RefParams rp = {64, 1, 2, NULL, NULL};
-    cr_assert_eq(ref_render(&p, &rp, g, NULL, ferr, sizeof ferr), 0, "%s", ferr);
+    size_t n = render_both(&s, &k, &g, &st, NULL);
     long bad = 0;
     for (size_t i = 0; i < n; i++)
         bad += !isfinite(k[i]);
@@ -453,7 +464,6 @@ Test(numerics, nested_glass_total_internal_reflection_camera_inside, .timeout = 
     free(k);
     free(g);
     func_stats_free(&st);
-    pack_free(&p);
     mesh_free(&m);
 }
 
@@ -473,22 +483,10 @@ Test(numerics, rays_made_invalid_by_input_data_are_dropped_and_counted, .timeout
     m.mats[0].base_color[0] = m.mats[0].base_color[1] = m.mats[0].base_color[2] = 3e38f;
     s.render = (SceneRender){16, 16, 2, 6, {0, 0, 0}, {0, 0, 0}};
     s.camera = (SceneCamera){{0, 0, 1}, {0, 0, -1}, {0, 1, 0}, 60.0f, 0, 0, SCENE_CAMERA_FILE};
-    PackedScene p;
-    BvhParams bp;
-    bvh_default_params(&bp);
-    char err[512];
-    cr_assert_eq(pack_scene(&s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
-    size_t n = 3 * 16 * 16;
-    float *k = calloc(n, sizeof(float)), *g = calloc(n, sizeof(float));
-    CfgMachine cfg;
-    cfg_defaults(&cfg);
-    FuncParams fp = {&cfg, "kernels/pathtrace.s", s.needs, 1, 1, NULL, NULL, NULL, NULL};
+    float *k, *g;
     FuncStats st;
-    static char ferr[65536];
-    cr_assert_eq(func_render(&p, &fp, k, &st, ferr, sizeof ferr), 0, "%s", ferr);
-    RefParams rp = {64, 1, 1, NULL, NULL};
     RefStats rs;
-    cr_assert_eq(ref_render(&p, &rp, g, &rs, ferr, sizeof ferr), 0, "%s", ferr);
+    size_t n = render_both(&s, &k, &g, &st, &rs);
     printf("overflowing throughput: kernel dropped %llu rays, golden model %llu\n", (unsigned long long)st.dropped,
            (unsigned long long)rs.dropped);
     cr_expect(st.dropped > 0, "no ray was dropped: the case does not overflow");
@@ -497,6 +495,5 @@ Test(numerics, rays_made_invalid_by_input_data_are_dropped_and_counted, .timeout
     free(k);
     free(g);
     func_stats_free(&st);
-    pack_free(&p);
     mesh_free(&m);
 }
