@@ -15,7 +15,6 @@
         .include "layout.inc"
         .include "vmath.inc"
 
-PI_F      = 3.14159265
 INV_PI_F  = 0.318309886
 INV_2PI_F = 0.159154943
 TWO_PI_F  = 6.28318531
