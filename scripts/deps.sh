@@ -7,6 +7,7 @@ PKGS=(
   build-essential pkg-config clang libclang-rt-14-dev
   libtinygltf-dev nlohmann-json3-dev libstb-dev
   libopenimageio-dev openimageio-tools
+  fonts-dejavu-core
   libinih-dev libcjson-dev libcriterion-dev
   libembree-dev gnuplot-nox parallel
 )

@@ -351,6 +351,19 @@ int cfg_check(const CfgMachine *cfg, CfgErrors *errs)
     if ((int64_t)cfg->stream_rays * 8 > (int64_t)cfg->idm_size_kb * 1024)
         add_error(errs, "config: stream.rays = %d needs %d KiB of ID-stream memory (two streams), idm.size_kb = %d",
                   cfg->stream_rays, cfg->stream_rays * 8 / 1024, cfg->idm_size_kb);
+    /* Timing model: line sizes are powers of two; the scene cache divides into whole sets. */
+    const struct { const char *key; int v; } pow2[] = {
+        {"raybuf.line_bytes", cfg->raybuf_line_bytes}, {"spad.line_bytes", cfg->spad_line_bytes},
+        {"scene.line_bytes", cfg->scene_line_bytes}};
+    for (size_t i = 0; i < sizeof pow2 / sizeof pow2[0]; i++)
+        if (pow2[i].v & (pow2[i].v - 1))
+            add_error(errs, "config: %s = %d is not a power of two", pow2[i].key, pow2[i].v);
+    if (cfg->scene_cache_kb > 0) {
+        int64_t set_bytes = (int64_t)cfg->scene_line_bytes * cfg->scene_cache_ways;
+        if (((int64_t)cfg->scene_cache_kb * 1024) % set_bytes != 0)
+            add_error(errs, "config: scene.cache_kb = %d is not a whole number of sets of scene.cache_ways = %d x "
+                      "scene.line_bytes = %d", cfg->scene_cache_kb, cfg->scene_cache_ways, cfg->scene_line_bytes);
+    }
     return errs->count - before;
 }
 

@@ -265,11 +265,14 @@ static inline int popcount64(uint64_t x) { return __builtin_popcountll(x); }
 #define SETF(i, x) (c->r[i] = u_of(x))
 #define IMM (in->imm)
 
-static void record_reset(CoreRecord *rec, uint32_t pc, const IsaInstr *in, uint8_t stage, uint64_t exec)
+static void record_reset(CoreRecord *rec, uint32_t pc, const IsaInstr *in, uint8_t stage, uint8_t gen,
+                         uint64_t exec)
 {
     rec->pc = pc;
     rec->in = in;
     rec->stage = stage;
+    rec->gen = gen;
+    rec->base = 0;
     rec->taken = 0;
     rec->mem = CORE_MEM_COUNT;
     rec->naddr = 0;
@@ -314,6 +317,7 @@ static int do_part(Core *c, const IsaInstr *in)
     if (c->hook) {
         c->rec.mem = CORE_MEM_IDM;
         c->rec.count = len;
+        c->rec.base = b;
     }
     return 0;
 }
@@ -337,7 +341,7 @@ static int step(Core *c)
     int halt = 0;
     uint32_t active = dc->vec ? (uint32_t)popcount64(E) : 0;
     if (c->hook)
-        record_reset(&c->rec, c->pc, in, c->stage, E);
+        record_reset(&c->rec, c->pc, in, c->stage, c->gen, E);
     const uint8_t stage = c->stage, gen = c->gen;
 
 #define BRANCH_TO(cond)                                                                         \
@@ -555,8 +559,12 @@ static int step(Core *c)
         /* Utilization counts the lanes that carry a ray: a stream's last, partial vector is the
          * paper's first source of under-utilization (Gribble & Ramani 2008, Sec. 4.1). */
         active = k;
-        if (c->hook)
+        if (c->hook) {
             c->rec.exec = c->m[in->b];
+            c->rec.mem = CORE_MEM_IDM;
+            c->rec.count = avail;
+            c->rec.base = b;
+        }
         break;
     }
     case ISA_OP_SLD: {
@@ -575,6 +583,8 @@ static int step(Core *c)
     }
     case ISA_OP_SAPP: {
         uint32_t p = SR(in->a);
+        if (c->hook)
+            c->rec.base = p;
         const VReg *B = &c->v[in->b];
         for (int l = 0; l < n; l++) {
             if (!((E >> l) & 1u))

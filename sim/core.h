@@ -57,7 +57,10 @@ typedef struct CoreRecord {
     uint8_t taken;          /* branch taken */
     uint8_t mem;            /* CoreMem touched (physical buffer for ray buffers), or CORE_MEM_COUNT */
     uint8_t naddr;          /* number of valid entries in addr (lanes that accessed memory) */
-    uint32_t count;         /* part: stream length in IDs; pmask: bits queued after it; else 0 */
+    uint8_t gen;            /* statistics generation (sgen) at execution */
+    uint32_t count;         /* part: stream length in IDs; pmask: bits queued after it; sfetch: IDs
+                               left in the stream before it (rd - rc) / 4; else 0 */
+    uint32_t base;          /* sfetch: stream pointer rc before it; sapp: ra before it; part: rb */
     uint64_t exec;          /* exec mask as applied (all N lanes for unmasked ops; sfetch: the
                                lanes that received an ID) */
     uint32_t addr[ISA_MAX_LANES]; /* byte addresses, lane order (sfetch/vspld: the N words) */

@@ -103,7 +103,9 @@ typedef struct Job {
 typedef struct Worker {
     Job *job;
     FuncStats st;
+    Timing *tm;                /* detailed mode */
 } Worker;
+
 
 static uint32_t spad_u32(Core *c, uint32_t addr)
 {
@@ -131,6 +133,35 @@ static void fail(Job *j, const char *msg, int trapped)
     pthread_mutex_unlock(&j->lock);
 }
 
+/* Detailed mode: start a cold machine for one tile or batch. */
+static void timing_begin(Worker *w, TimingStats *before)
+{
+    if (w->tm) {
+        timing_reset(w->tm);
+        *before = *timing_stats(w->tm);
+    }
+}
+
+/* Detailed mode: close the run and give its figures to the tile; -1 if the model failed. */
+static int timing_close(Worker *w, const TimingStats *before, FuncTile *ft)
+{
+    if (!w->tm)
+        return 0;
+    timing_end(w->tm);
+    const TimingStats *s = timing_stats(w->tm);
+    if (ft) {
+        ft->cycles = s->cycles - before->cycles;
+        ft->busy = s->busy - before->busy;
+        for (int c = 0; c < TM_CAUSE_COUNT; c++)
+            ft->stalls[c] = s->stalls[c] - before->stalls[c];
+    }
+    if (timing_error(w->tm)) {
+        fail(w->job, timing_error(w->tm), 0);
+        return -1;
+    }
+    return 0;
+}
+
 static void rb_set(uint8_t *rb, uint32_t addr, uint32_t v) { memcpy(rb + addr, &v, 4); }
 static uint32_t rb_get(const uint8_t *rb, uint32_t addr)
 {
@@ -140,8 +171,9 @@ static uint32_t rb_get(const uint8_t *rb, uint32_t addr)
 }
 
 /* One batch of `sfsim trace`: rays [t * M, ...) into RB0, run, hits out. */
-static int trace_batch(Job *j, Core *c, uint32_t t, FuncStats *st)
+static int trace_batch(Worker *w, Core *c, uint32_t t, FuncStats *st)
 {
+    Job *j = w->job;
     const Abi *a = j->abi;
     const RayBatch *b = j->fp->batch;
     uint32_t first = t * j->rays, n = b->count - first < j->rays ? b->count - first : j->rays;
@@ -170,7 +202,15 @@ static int trace_batch(Job *j, Core *c, uint32_t t, FuncStats *st)
         rb_set(rb, a->f_kind + 4 * i, r->query == RAY_ANY ? 2u : 0u);
         rb_set(rb, a->f_prim + 4 * i, UINT32_MAX);
     }
+    TimingStats before;
+    timing_begin(w, &before);
     CoreExit ex = core_run(c, (uint64_t)j->fp->cfg->sim_max_instructions);
+    FuncTile *ft = &j->tiles[t];
+    ft->x0 = first;
+    ft->w = n;
+    ft->h = 1;
+    if (timing_close(w, &before, ft))
+        return -1;
     char msg[1400];
     if (ex != CORE_EXIT_HALT) {
         snprintf(msg, sizeof msg, "kernel, rays %u..%u: %s%s", first, first + n - 1, core_trap_message(c),
@@ -207,11 +247,12 @@ static int trace_batch(Job *j, Core *c, uint32_t t, FuncStats *st)
     return 0;
 }
 
-static int run_tile(Job *j, Core *c, uint32_t t, FuncStats *st)
+static int run_tile(Worker *w, Core *c, uint32_t t, FuncStats *st)
 {
+    Job *j = w->job;
     const Abi *a = j->abi;
     if (j->fp->batch)
-        return trace_batch(j, c, t, st);
+        return trace_batch(w, c, t, st);
     FuncTile *ft = &j->tiles[t];
     ft->x0 = (t % j->tiles_x) * j->tile_w;
     ft->y0 = (t / j->tiles_x) * j->tile_h;
@@ -229,7 +270,11 @@ static int run_tile(Job *j, Core *c, uint32_t t, FuncStats *st)
     uint8_t *fb = core_mem(c, CORE_MEM_FB, &size);
     memset(fb, 0, (size_t)ft->w * ft->h * 12);
     uint64_t before = core_instructions(c);
+    TimingStats tbefore;
+    timing_begin(w, &tbefore);
     CoreExit ex = core_run(c, (uint64_t)j->fp->cfg->sim_max_instructions);
+    if (timing_close(w, &tbefore, ft))
+        return -1;
     char msg[1400];
     if (ex != CORE_EXIT_HALT) {
         snprintf(msg, sizeof msg, "kernel, tile at (%u, %u): %s%s", ft->x0, ft->y0, core_trap_message(c),
@@ -282,6 +327,19 @@ static void *worker_main(void *arg)
         fail(j, msg, 0);
         return NULL;
     }
+    if (j->fp->timed) {
+        TimingParams tp;
+        timing_params(j->fp->cfg, &tp);
+        w->tm = timing_new(&tp, err, sizeof err);
+        if (!w->tm) {
+            char msg[600];
+            snprintf(msg, sizeof msg, "timing model: %s", err);
+            fail(j, msg, 0);
+            core_free(c);
+            return NULL;
+        }
+        core_set_hook(c, timing_hook, w->tm);
+    }
     uint32_t size;
     uint8_t *sm = core_mem(c, CORE_MEM_SCENE, &size);
     memcpy(sm, j->p->mem, j->p->size);
@@ -289,7 +347,7 @@ static void *worker_main(void *arg)
         uint32_t t = atomic_fetch_add(&j->next_tile, 1u);
         if (t >= j->ntiles)
             break;
-        if (run_tile(j, c, t, &w->st) != 0)
+        if (run_tile(w, c, t, &w->st) != 0)
             break;
         uint32_t done = atomic_fetch_add(&j->done_tiles, 1u) + 1u;
         if (j->fp->progress)
@@ -297,6 +355,11 @@ static void *worker_main(void *arg)
     }
     w->st.core = *core_stats(c);
     w->st.instructions = core_instructions(c);
+    if (w->tm) {
+        w->st.timing = *timing_stats(w->tm);
+        timing_free(w->tm);
+        w->tm = NULL;
+    }
     core_free(c);
     return NULL;
 }
@@ -528,6 +591,7 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
         for (int o = 0; o < ISA_OP_COUNT; o++)
             st->core.by_op[o] += s->core.by_op[o];
         st->instructions += s->instructions;
+        timing_stats_add(&st->timing, &s->timing);
         st->rays_camera += s->rays_camera;
         st->rays_indirect += s->rays_indirect;
         st->rays_shadow += s->rays_shadow;
@@ -549,6 +613,11 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
         st->isect_rays += st->gen_rays[g][1];
         st->shade_streams += st->gen_streams[g][2];
         st->shade_rays += st->gen_rays[g][2];
+    }
+    if (fp->timed) {
+        st->timed = 1;
+        if (timing_check(&st->timing, err, errlen) != 0)
+            goto out;
     }
     st->tiles = job->tiles;
     st->ntiles = job->ntiles;

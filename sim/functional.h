@@ -3,7 +3,8 @@
  *
  * Owns: choosing the kernel's -D symbols from the scene's needs, the kernel's launch ABI
  * (kernels/lib/abi.inc, read back from the object's symbols), host threads over tiles, and
- * the statistics that need no timing. Must not: compute any pixel itself or model time.
+ * the statistics that need no timing, and (detailed mode) attaching a timing model to each
+ * core. Must not: compute any pixel itself or model time (sim/timing.c does).
  */
 #ifndef SFSIM_FUNCTIONAL_H
 #define SFSIM_FUNCTIONAL_H
@@ -15,6 +16,7 @@
 #include "config.h"
 #include "core.h"
 #include "raybatch.h"
+#include "timing.h"
 
 #define FUNC_MAX_GENERATIONS 64
 #define FUNC_STAGES 3          /* stream counters: traversal, intersection, shading */
@@ -32,12 +34,17 @@ typedef struct FuncParams {
      * and rgb is not touched (may be NULL). */
     const RayBatch *batch;
     BatchHit *hits;
+    /* Detailed mode: time every instruction on the machine of cfg (sim/timing.h). Each tile (or
+     * trace batch) starts on a cold machine, so the cycles do not depend on the host threads. */
+    int timed;
 } FuncParams;
 
 typedef struct FuncTile {
     uint32_t x0, y0, w, h;
     uint64_t instructions;
     uint64_t rays;             /* traced, all kinds */
+    uint64_t cycles, busy;     /* detailed mode */
+    uint64_t stalls[TM_CAUSE_COUNT];
 } FuncTile;
 
 typedef struct FuncStats {
@@ -55,6 +62,8 @@ typedef struct FuncStats {
     uint32_t kernel_instructions;                   /* program size */
     uint32_t tile_w, tile_h;                        /* pixels (= rays) of a stream's tile */
     char defines[512];                              /* the -D symbols the kernel was built with */
+    int timed;                                      /* detailed mode: timing holds the sums */
+    TimingStats timing;
 } FuncStats;
 
 /* Render the whole image through the kernel: rgb (width * height * 3 floats, zeroed by the

@@ -16,6 +16,7 @@
 #include "core.h"
 #include "img.h"
 #include "render.h"
+#include "timing.h"
 #include "trace.h"
 
 #define SFSIM_VERSION "0.1"
@@ -30,8 +31,8 @@ static void usage(FILE *out)
             "sfsim simulates a stream-filtering ray tracing processor (Gribble & Ramani 2008).\n"
             "\n"
             "commands:\n"
-            "  run      render a scene: --mode functional (the kernel on the simulated machine) or\n"
-            "           --mode reference (the golden model)\n"
+            "  run      render a scene: --mode detailed (default: the kernel on the timed machine),\n"
+            "           functional (the kernel, no timing) or reference (the golden model)\n"
             "  exec     run an assembled program (.sfo) on the functional core; print registers\n"
             "           and counters\n"
             "  config   list the machine-config keys (--dump) or write their reference (--markdown)\n"
@@ -49,10 +50,12 @@ static void usage_exec(FILE *out)
     fprintf(out,
             "usage: sfsim exec PROG.sfo [options]\n"
             "\n"
-            "Runs an object produced by sfasm on the functional core (no timing) until halt, a trap,\n"
-            "or the instruction limit, then prints the scalar registers, the non-zero vector lanes,\n"
-            "the masks and the counters per stage (instructions, operations by category, SIMD\n"
-            "utilization = active lanes / (N x vector instructions)).\n"
+            "Runs an object produced by sfasm on the functional core until halt, a trap, or the\n"
+            "instruction limit, then prints the scalar registers, the non-zero vector lanes, the\n"
+            "masks and the counters per stage (instructions, operations by category, SIMD\n"
+            "utilization = active lanes / (N x vector instructions)). With --timing the timing model\n"
+            "runs beside it and the cycles are printed too: total, busy, stalls by cause, per stage,\n"
+            "and the units' counters (docs/model.md).\n"
             "\n"
             "options:\n"
             "  -c, --config FILE        machine config (default: the built-in streamray machine)\n"
@@ -61,7 +64,8 @@ static void usage_exec(FILE *out)
             "  --max-instructions N     instruction limit, same as --set sim.max_instructions=N\n"
             "  --dump-mem MEM:ADDR:WORDS  print WORDS words of MEM (rb0 rb1 idm spad scene fb) from\n"
             "                           byte address ADDR after the run (repeatable)\n"
-            "  -q, --quiet              print only the summary line\n");
+            "  -t, --timing             time the run on the machine of the config (detailed mode)\n"
+            "  -q, --quiet              print only the summary line (and the timing, with --timing)\n");
 }
 
 static void usage_config(FILE *out)
@@ -76,16 +80,20 @@ static void usage_config(FILE *out)
 static void usage_run(FILE *out)
 {
     fprintf(out,
-            "usage: sfsim run -s SCENE -o DIR --mode reference|functional [options]\n"
+            "usage: sfsim run [-s SCENE] [-o DIR] [-c CONFIG] [--mode detailed|functional|reference] [options]\n"
             "\n"
             "Renders SCENE (a .gltf/.glb file or a scene.ini) and writes DIR/frame.exr (linear),\n"
-            "DIR/frame.png (tone-mapped sRGB), DIR/report.json and DIR/report.txt.\n"
+            "DIR/frame.png (tone-mapped sRGB), DIR/report.json and DIR/report.txt, and in detailed\n"
+            "mode DIR/cost.png (simulated cycles per pixel, per tile). docs/report.md lists the fields.\n"
             "\n"
             "modes:\n"
+            "  detailed    (default) the path-tracing kernel (kernels/pathtrace.s) on the functional core\n"
+            "              with the cycle-accurate timing model of the machine in CONFIG: cycles, fps,\n"
+            "              stalls by cause, per stage, generation and tile, the units' counters\n"
+            "              (docs/model.md); the same image bits as functional mode\n"
+            "  functional  the kernel executed instruction by instruction, no timing (fastest\n"
+            "              simulation): operation mix, SIMD utilization and stream lengths per stage\n"
             "  reference   the golden model: a plain C path tracer over the packed scene memory\n"
-            "  functional  the path-tracing kernel (kernels/pathtrace.s) executed instruction by\n"
-            "              instruction on the functional core, no timing; the report adds the\n"
-            "              operation mix, SIMD utilization and stream lengths per stage\n"
             "\n"
             "options:\n"
             "  -s, --scene FILE         scene (default: scenes/cornell/scene.ini)\n"
@@ -96,10 +104,8 @@ static void usage_run(FILE *out)
             "  -j, --threads N          host threads (default: all cores; results do not change)\n"
             "  --exposure X             scale before tone mapping frame.png (default 1)\n"
             "  --no-progress            no progress bar (it is shown only on a terminal anyway)\n"
-            "  --kernel FILE            functional mode: the kernel source (default: kernels/pathtrace.s\n"
-            "                           beside the executable's folder, or $SFSIM_KERNEL)\n"
-            "\n"
-            "The default mode is reference.\n");
+            "  --kernel FILE            detailed and functional modes: the kernel source (default:\n"
+            "                           kernels/pathtrace.s beside the executable's folder, or $SFSIM_KERNEL)\n");
 }
 
 /* Config from -c/--set options, collected by the commands that take them. */
@@ -238,11 +244,45 @@ static void print_state(Core *c)
     }
 }
 
+/* The timing of one `exec --timing` run; non-zero when the model failed its own check. */
+static int print_timing(const TimingStats *s, const char *model_err)
+{
+    uint64_t stalls = s->cycles - s->busy;
+    printf("timing: %llu cycles = %llu busy + %llu stall\n", (unsigned long long)s->cycles,
+           (unsigned long long)s->busy, (unsigned long long)stalls);
+    for (int c = 0; c < TM_CAUSE_COUNT; c++)
+        if (s->stalls[c])
+            printf("  stall %-16s %llu\n", tm_cause_keys[c], (unsigned long long)s->stalls[c]);
+    for (int g = 0; g < ISA_STAGE_COUNT; g++)
+        if (s->stage_cycles[g])
+            printf("  stage %-16s %llu cycles, %llu busy\n", isa_stage_keys[g], (unsigned long long)s->stage_cycles[g],
+                   (unsigned long long)s->stage_busy[g]);
+    printf("  raybuf accesses %llu, lines %llu, with a bank conflict %llu\n", (unsigned long long)s->rb_accesses,
+           (unsigned long long)s->rb_lines, (unsigned long long)s->rb_conflicted);
+    printf("  agu fetches %llu (%llu ahead); interconnect transfers %llu, unit waits %llu cycles\n",
+           (unsigned long long)s->agu_fetches, (unsigned long long)s->agu_ahead, (unsigned long long)s->icn_transfers,
+           (unsigned long long)s->icn_unit_delay);
+    printf("  partitions %llu (%llu IDs, %llu cycles); scratchpad accesses %llu (%llu lines)\n",
+           (unsigned long long)s->partitions, (unsigned long long)s->partition_ids,
+           (unsigned long long)s->partition_cycles, (unsigned long long)s->spad_accesses,
+           (unsigned long long)s->spad_lines);
+    printf("  scene lines %llu: %llu hits, %llu misses, %llu write-backs, %llu bus bytes\n",
+           (unsigned long long)s->scene.accesses, (unsigned long long)s->scene.hits,
+           (unsigned long long)s->scene.misses, (unsigned long long)s->scene.writebacks,
+           (unsigned long long)s->scene.bus_bytes);
+    char err[256];
+    if (model_err || timing_check(s, err, sizeof err)) {
+        fprintf(stderr, "sfsim exec: %s\n", model_err ? model_err : err);
+        return -1;
+    }
+    return 0;
+}
+
 static int cmd_exec(int argc, char **argv)
 {
     ConfigArgs ca = {0};
     const char *prog = NULL, *dumps[64];
-    int ndumps = 0, quiet = 0;
+    int ndumps = 0, quiet = 0, timed = 0;
     char setbuf[2][64];
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
@@ -271,6 +311,8 @@ static int cmd_exec(int argc, char **argv)
             dumps[ndumps++] = argv[++i];
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
             quiet = 1;
+        } else if (!strcmp(a, "-t") || !strcmp(a, "--timing")) {
+            timed = 1;
         } else if (a[0] == '-') {
             fprintf(stderr, "sfsim exec: unknown option or missing value: %s (sfsim help exec)\n", a);
             return EXIT_USAGE;
@@ -302,9 +344,24 @@ static int cmd_exec(int argc, char **argv)
         asm_object_free(&obj);
         return EXIT_INPUT;
     }
+    Timing *tm = NULL;
+    if (timed) {
+        TimingParams tp;
+        timing_params(&cfg, &tp);
+        tm = timing_new(&tp, err, sizeof err);
+        if (!tm) {
+            fprintf(stderr, "sfsim exec: %s\n", err);
+            core_free(c);
+            asm_object_free(&obj);
+            return EXIT_INPUT;
+        }
+        core_set_hook(c, timing_hook, tm);
+    }
     double t0 = now();
     CoreExit ex = core_run(c, (uint64_t)cfg.sim_max_instructions);
     double secs = now() - t0;
+    if (tm)
+        timing_end(tm);
     uint64_t ni = core_instructions(c);
     printf("sfsim exec: %s on N = %d lanes: %s after %llu instructions (%.3f s, %.1f M instructions/s)\n", prog,
            core_lanes(c), ex == CORE_EXIT_HALT ? "halted" : ex == CORE_EXIT_TRAP ? "trapped" : "stopped at the limit",
@@ -315,6 +372,11 @@ static int cmd_exec(int argc, char **argv)
     for (int i = 0; i < ndumps; i++)
         if (dump_mem(c, dumps[i]))
             rc = EXIT_USAGE;
+    if (tm) {
+        if (print_timing(timing_stats(tm), timing_error(tm)))
+            rc = EXIT_TRAP;
+        timing_free(tm);
+    }
     if (ex != CORE_EXIT_HALT) {
         fprintf(stderr, "sfsim exec: %s\n", core_trap_message(c));
         rc = EXIT_TRAP;
@@ -425,7 +487,7 @@ static int cmd_run(int argc, char **argv)
     o.scene_path = "scenes/cornell/scene.ini";
     o.out_dir = "out";
     o.progress = isatty(2);
-    const char *mode = "reference";
+    const char *mode = "detailed";
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         int has_next = i + 1 < argc;
@@ -482,8 +544,8 @@ static int cmd_run(int argc, char **argv)
             return EXIT_USAGE;
         }
     }
-    if (strcmp(mode, "reference") != 0 && strcmp(mode, "functional") != 0) {
-        fprintf(stderr, "sfsim run: --mode %s: expected reference or functional (sfsim help run)\n", mode);
+    if (strcmp(mode, "reference") != 0 && strcmp(mode, "functional") != 0 && strcmp(mode, "detailed") != 0) {
+        fprintf(stderr, "sfsim run: --mode %s: expected detailed, functional or reference (sfsim help run)\n", mode);
         return EXIT_USAGE;
     }
     o.mode = mode;
@@ -500,7 +562,8 @@ static int cmd_run(int argc, char **argv)
         fprintf(stderr, "sfsim run: %s\n", err);
         return rrc == -2 ? EXIT_TRAP : EXIT_INPUT;
     }
-    printf("sfsim run: wrote %s/frame.png, frame.exr, report.txt, report.json\n", o.out_dir);
+    printf("sfsim run: wrote %s/frame.png, frame.exr, report.txt, report.json%s\n", o.out_dir,
+           !strcmp(mode, "detailed") ? ", cost.png" : "");
     return EXIT_OK;
 }
 
@@ -513,8 +576,9 @@ static void usage_trace(FILE *out)
             "(distance, primitive, barycentrics) or miss, or for any-hit rays whether it is occluded, to HITS.\n"
             "\n"
             "options:\n"
-            "  --mode functional|reference  the kernel's traversal and intersection on the functional core\n"
-            "                           (default), or the golden model's\n"
+            "  --mode functional|detailed|reference  the kernel's traversal and intersection on the\n"
+            "                           functional core (default), the same timed on the machine of the\n"
+            "                           config (prints cycles and stalls by cause), or the golden model's\n"
             "  -c, --config FILE        machine config; --set SECTION.KEY=VALUE overrides a key\n"
             "  --binary                 write HITS in the binary format (default: text)\n"
             "  -j, --threads N          host threads (default: all cores; results do not change)\n"
@@ -564,8 +628,8 @@ static int cmd_trace(int argc, char **argv)
         fprintf(stderr, "sfsim trace: -s SCENE, --rays FILE and -o HITS are required (sfsim help trace)\n");
         return EXIT_USAGE;
     }
-    if (strcmp(o.mode, "functional") != 0 && strcmp(o.mode, "reference") != 0) {
-        fprintf(stderr, "sfsim trace: --mode %s: expected functional or reference\n", o.mode);
+    if (strcmp(o.mode, "functional") != 0 && strcmp(o.mode, "reference") != 0 && strcmp(o.mode, "detailed") != 0) {
+        fprintf(stderr, "sfsim trace: --mode %s: expected functional, detailed or reference\n", o.mode);
         return EXIT_USAGE;
     }
     if (o.threads == 0)
@@ -586,6 +650,8 @@ static int cmd_trace(int argc, char **argv)
     if (sum.sim_instructions)
         printf(", %llu simulated instructions", (unsigned long long)sum.sim_instructions);
     printf("; wrote %s\n", o.out_path);
+    if (sum.timed && print_timing(&sum.timing, NULL))
+        return EXIT_TRAP;
     return EXIT_OK;
 }
 

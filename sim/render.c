@@ -22,7 +22,9 @@
 #include "img.h"
 #include "config.h"
 #include "functional.h"
+#include "heatmap.h"
 #include "reference.h"
+#include "timing.h"
 
 void render_default_options(RenderOptions *o)
 {
@@ -263,6 +265,175 @@ static void add_functional_json(cJSON *root, const RunStats *rs, const CfgMachin
     cJSON_AddNumberToObject(cf, "sim.max_instructions", (double)cfg->sim_max_instructions);
 }
 
+/* Detailed mode: the timing fields of report.json (names: ARCHITECTURE.md Sec. 1; docs/report.md). */
+static void add_timing_json(cJSON *root, const FuncStats *f, const CfgMachine *cfg)
+{
+    const TimingStats *t = &f->timing;
+    double hz = cfg->core_clock_mhz * 1e6;
+    cJSON_ReplaceItemInObject(root, "cycles", cJSON_CreateNumber((double)t->cycles));
+    cJSON_ReplaceItemInObject(root, "busy_cycles", cJSON_CreateNumber((double)t->busy));
+    cJSON_ReplaceItemInObject(root, "fps", cJSON_CreateNumber(t->cycles ? hz / (double)t->cycles : 0.0));
+    cJSON_ReplaceItemInObject(root, "fps_no_stall", cJSON_CreateNumber(t->busy ? hz / (double)t->busy : 0.0));
+    cJSON_AddNumberToObject(root, "clock_mhz", cfg->core_clock_mhz);
+    cJSON *st = cJSON_AddObjectToObject(root, "stalls");
+    cJSON *sh = cJSON_AddObjectToObject(root, "stall_shares");
+    for (int c = 0; c < TM_CAUSE_COUNT; c++) {
+        cJSON_AddNumberToObject(st, tm_cause_keys[c], (double)t->stalls[c]);
+        cJSON_AddNumberToObject(sh, tm_cause_keys[c], ratio(t->stalls[c], t->cycles));
+    }
+    cJSON *cs = cJSON_AddObjectToObject(root, "cycles_by_stage");
+    cJSON *ss = cJSON_AddObjectToObject(root, "stalls_by_stage");
+    cJSON *ut = cJSON_AddObjectToObject(root, "utilization_timed");
+    int n = cfg->core_simd_width;
+    for (int k = 0; k < ISA_STAGE_COUNT; k++) {
+        cJSON *o = cJSON_AddObjectToObject(cs, isa_stage_keys[k]);
+        cJSON_AddNumberToObject(o, "cycles", (double)t->stage_cycles[k]);
+        cJSON_AddNumberToObject(o, "busy", (double)t->stage_busy[k]);
+        cJSON *so = cJSON_AddObjectToObject(ss, isa_stage_keys[k]);
+        uint64_t stalls = 0;
+        for (int c = 0; c < TM_CAUSE_COUNT; c++) {
+            cJSON_AddNumberToObject(so, tm_cause_keys[c], (double)t->stage_stalls[k][c]);
+            stalls += t->stage_stalls[k][c];
+        }
+        /* Lanes doing work over the lane-cycles of the stage's vector issue and stall cycles:
+         * the paper's utilization with the overheads of address fetch, alignment, partition. */
+        cJSON_AddNumberToObject(ut, isa_stage_keys[k],
+                                ratio(f->core.active_lanes[k], (uint64_t)n * (t->stage_vec_busy[k] + stalls)));
+    }
+    cJSON *cg = cJSON_AddArrayToObject(root, "cycles_by_generation");
+    for (uint64_t g = 0; g < f->generations && g < CORE_GENERATIONS; g++)
+        cJSON_AddItemToArray(cg, cJSON_CreateNumber((double)t->gen_cycles[g]));
+    cJSON *u = cJSON_AddObjectToObject(root, "units");
+    cJSON *rb = cJSON_AddObjectToObject(u, "ray_buffers");
+    cJSON_AddNumberToObject(rb, "accesses", (double)t->rb_accesses);
+    cJSON_AddNumberToObject(rb, "lines", (double)t->rb_lines);
+    cJSON_AddNumberToObject(rb, "accesses_with_bank_conflict", (double)t->rb_conflicted);
+    cJSON_AddNumberToObject(rb, "bank_conflict_cycles", (double)t->stalls[TM_BANK_CONFLICT]);
+    cJSON *ag = cJSON_AddObjectToObject(u, "agu");
+    cJSON_AddNumberToObject(ag, "id_vectors", (double)t->agu_fetches);
+    cJSON_AddNumberToObject(ag, "fetched_ahead", (double)t->agu_ahead);
+    cJSON *ic = cJSON_AddObjectToObject(u, "interconnect");
+    cJSON_AddNumberToObject(ic, "data_path_transfers", (double)t->icn_transfers);
+    cJSON_AddNumberToObject(ic, "contention_stall_cycles", (double)t->stalls[TM_INTERCONNECT]);
+    cJSON_AddNumberToObject(ic, "unit_wait_cycles", (double)t->icn_unit_delay);
+    cJSON *pa = cJSON_AddObjectToObject(u, "partition");
+    cJSON_AddNumberToObject(pa, "partitions", (double)t->partitions);
+    cJSON_AddNumberToObject(pa, "ids", (double)t->partition_ids);
+    cJSON_AddNumberToObject(pa, "busy_cycles", (double)t->partition_cycles);
+    cJSON *sp = cJSON_AddObjectToObject(u, "scratchpad");
+    cJSON_AddNumberToObject(sp, "accesses", (double)t->spad_accesses);
+    cJSON_AddNumberToObject(sp, "lines", (double)t->spad_lines);
+    cJSON *sm = cJSON_AddObjectToObject(u, "scene_memory");
+    cJSON_AddBoolToObject(sm, "cache", cfg->scene_cache_kb > 0);
+    cJSON_AddNumberToObject(sm, "instructions", (double)t->scene_instr);
+    cJSON_AddNumberToObject(sm, "line_accesses", (double)t->scene.accesses);
+    cJSON_AddNumberToObject(sm, "hits", (double)t->scene.hits);
+    cJSON_AddNumberToObject(sm, "misses", (double)t->scene.misses);
+    cJSON_AddNumberToObject(sm, "hit_rate", ratio(t->scene.hits, t->scene.accesses));
+    cJSON_AddNumberToObject(sm, "writebacks", (double)t->scene.writebacks);
+    cJSON_AddNumberToObject(sm, "bus_bytes", (double)t->scene.bus_bytes);
+    /* What the kernel exercised: a unit no instruction used was never stepped (docs/model.md). */
+    cJSON *mod = cJSON_AddArrayToObject(root, "units_exercised");
+    cJSON *nmod = cJSON_AddArrayToObject(root, "units_not_exercised");
+    for (int k = 0; k < ISA_U_COUNT; k++)
+        cJSON_AddItemToArray(t->unit_uses[k] ? mod : nmod, cJSON_CreateString(isa_unit_names[k]));
+    cJSON *tiles = cJSON_GetObjectItem(root, "tiles");
+    for (uint32_t i = 0; tiles && i < f->ntiles; i++) {
+        cJSON *o = cJSON_GetArrayItem(tiles, (int)i);
+        cJSON_AddNumberToObject(o, "cycles", (double)f->tiles[i].cycles);
+        cJSON_AddNumberToObject(o, "busy_cycles", (double)f->tiles[i].busy);
+        cJSON *tsl = cJSON_AddObjectToObject(o, "stalls");
+        for (int c = 0; c < TM_CAUSE_COUNT; c++)
+            cJSON_AddNumberToObject(tsl, tm_cause_keys[c], (double)f->tiles[i].stalls[c]);
+    }
+}
+
+/* Detailed mode: report.txt lines for the timing. */
+static int timing_text(char *txt, size_t cap, const FuncStats *f, const CfgMachine *cfg)
+{
+    const TimingStats *t = &f->timing;
+    double hz = cfg->core_clock_mhz * 1e6;
+    int len = snprintf(txt, cap,
+                       "cycles       %llu = %llu busy + %llu stalled; %.2f fps at %g MHz (%.2f fps with no stalls)\n"
+                       "stalls      ",
+                       (unsigned long long)t->cycles, (unsigned long long)t->busy,
+                       (unsigned long long)(t->cycles - t->busy), t->cycles ? hz / (double)t->cycles : 0.0,
+                       cfg->core_clock_mhz, t->busy ? hz / (double)t->busy : 0.0);
+    for (int c = 0; c < TM_CAUSE_COUNT; c++)
+        len += snprintf(txt + len, cap - (size_t)len, " %s %.1f%%%s", tm_cause_keys[c],
+                        100.0 * ratio(t->stalls[c], t->cycles), c + 1 < TM_CAUSE_COUNT ? "," : "  (of all cycles)\n");
+    len += snprintf(txt + len, cap - (size_t)len, "cycles by   ");
+    for (int k = 0; k < ISA_STAGE_COUNT; k++)
+        len += snprintf(txt + len, cap - (size_t)len, " %s %.1f%%%s", isa_stage_keys[k],
+                        100.0 * ratio(t->stage_cycles[k], t->cycles), k + 1 < ISA_STAGE_COUNT ? "," : " (stage)\n");
+    len += snprintf(txt + len, cap - (size_t)len, "utilization ");
+    for (int k = 0; k < ISA_STAGE_COUNT; k++) {
+        uint64_t stalls = 0;
+        for (int c = 0; c < TM_CAUSE_COUNT; c++)
+            stalls += t->stage_stalls[k][c];
+        len += snprintf(txt + len, cap - (size_t)len, " %s %.1f%%%s", isa_stage_keys[k],
+                        100.0 * ratio(f->core.active_lanes[k],
+                                      (uint64_t)cfg->core_simd_width * (t->stage_vec_busy[k] + stalls)),
+                        k + 1 < ISA_STAGE_COUNT ? "," : "  (timed: stall cycles count as idle lanes)\n");
+    }
+    len += snprintf(txt + len, cap - (size_t)len,
+                    "ray buffers  %llu gathers/scatters over %llu lines; %llu with a bank conflict (%llu cycles)\n"
+                    "AGUs         %llu ID vectors, %llu of them fetched ahead of the data path\n"
+                    "interconnect %llu data-path transfers; contention: %llu stall cycles, units waited %llu cycles\n"
+                    "partition    %llu partitions of %llu IDs, %llu unit cycles\n"
+                    "scene memory %llu line accesses, hit rate %.1f%% (%s), %llu bytes over the bus\n",
+                    (unsigned long long)t->rb_accesses, (unsigned long long)t->rb_lines,
+                    (unsigned long long)t->rb_conflicted, (unsigned long long)t->stalls[TM_BANK_CONFLICT],
+                    (unsigned long long)t->agu_fetches, (unsigned long long)t->agu_ahead,
+                    (unsigned long long)t->icn_transfers, (unsigned long long)t->stalls[TM_INTERCONNECT],
+                    (unsigned long long)t->icn_unit_delay, (unsigned long long)t->partitions,
+                    (unsigned long long)t->partition_ids, (unsigned long long)t->partition_cycles,
+                    (unsigned long long)t->scene.accesses, 100.0 * ratio(t->scene.hits, t->scene.accesses),
+                    cfg->scene_cache_kb > 0 ? "cached" : "no cache", (unsigned long long)t->scene.bus_bytes);
+    len += snprintf(txt + len, cap - (size_t)len, "not used    ");
+    int any = 0;
+    for (int k = 0; k < ISA_U_COUNT; k++)
+        if (!t->unit_uses[k]) {
+            len += snprintf(txt + len, cap - (size_t)len, " %s", isa_unit_names[k]);
+            any = 1;
+        }
+    len += snprintf(txt + len, cap - (size_t)len, "%s\n", any ? " (no instruction of the kernel used them)" : " -");
+    return len;
+}
+
+/* Detailed mode: cost.png, simulated cycles per pixel of each tile. */
+static int write_cost_map(const char *dir, const FuncStats *f, int width, int height, char *err, size_t errlen)
+{
+    /* One value per pixel; an image wider or taller than the heat map takes (8192) is drawn one
+     * value per tile instead (the values are per tile either way). */
+    int scale_x = 1, scale_y = 1;
+    if (width > 8192 || height > 8192) {
+        scale_x = (int)f->tile_w;
+        scale_y = (int)f->tile_h;
+    }
+    int mw = (width + scale_x - 1) / scale_x, mh = (height + scale_y - 1) / scale_y;
+    double *v = calloc((size_t)mw * (size_t)mh, sizeof *v);
+    if (!v) {
+        snprintf(err, errlen, "out of memory for cost.png");
+        return -1;
+    }
+    for (uint32_t i = 0; i < f->ntiles; i++) {
+        const FuncTile *t = &f->tiles[i];
+        double per = t->w && t->h ? (double)t->cycles / ((double)t->w * t->h) : 0.0;
+        for (uint32_t y = t->y0; y < t->y0 + t->h && y < (uint32_t)height; y += (uint32_t)scale_y)
+            for (uint32_t x = t->x0; x < t->x0 + t->w && x < (uint32_t)width; x += (uint32_t)scale_x)
+                v[(size_t)(y / (uint32_t)scale_y) * (size_t)mw + x / (uint32_t)scale_x] = per;
+    }
+    width = mw;
+    height = mh;
+    char path[4200], title[128];
+    snprintf(path, sizeof path, "%s/cost.png", dir);
+    snprintf(title, sizeof title, "simulated cycles per pixel (tiles of %u x %u)", f->tile_w, f->tile_h);
+    int rc = heatmap_write(path, v, width, height, title, "cycles", err, errlen);
+    free(v);
+    return rc;
+}
+
 int render_run(const RenderOptions *o, char *err, size_t errlen)
 {
     int rc = -1;
@@ -277,9 +448,10 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     CfgMachine defcfg;
     cfg_defaults(&defcfg);
     const CfgMachine *cfg = o->cfg ? o->cfg : &defcfg;
-    int functional = !strcmp(o->mode, "functional");
+    int detailed = !strcmp(o->mode, "detailed");
+    int functional = detailed || !strcmp(o->mode, "functional");
     if (!functional && strcmp(o->mode, "reference") != 0) {
-        snprintf(err, errlen, "--mode %s: this build renders with --mode reference or functional", o->mode);
+        snprintf(err, errlen, "--mode %s: this build renders with --mode detailed, functional or reference", o->mode);
         return -1;
     }
     double t0 = now();
@@ -307,13 +479,13 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     if (functional) {
         char kpath[4200];
         FuncParams fp = {cfg, o->kernel_path ? o->kernel_path : func_default_kernel(kpath, sizeof kpath),
-                         s.needs, o->seed, threads, progress_cb, &pr, NULL, NULL};
+                         s.needs, o->seed, threads, progress_cb, &pr, NULL, NULL, detailed};
         int frc = func_render(&p, &fp, rgb, &rs.f, err, errlen);
         if (frc == -2) {
             /* The kernel failed in a tile: keep what the finished tiles rendered, marked partial;
              * a previous run's complete outputs in this folder would now mislead, so they go. */
             char path[4200], perr[512], text[8192];
-            static const char *const stale[] = {"frame.exr", "frame.png", "report.txt"};
+            static const char *const stale[] = {"frame.exr", "frame.png", "report.txt", "cost.png"};
             for (size_t k = 0; k < sizeof stale / sizeof stale[0]; k++) {
                 snprintf(path, sizeof path, "%s/%s", o->out_dir, stale[k]);
                 unlink(path);
@@ -384,7 +556,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     uint64_t total_rays = rs.primary + rs.shadow + rs.indirect;
     double secs = t_render - t_pack;
 
-    /* report.json: the names of ARCHITECTURE.md Sec. 1; timing fields are null in these modes. */
+    /* report.json: the names of ARCHITECTURE.md Sec. 1; the timing fields stay null unless detailed. */
     root = cJSON_CreateObject();
     cJSON_AddStringToObject(root, "mode", o->mode);
     cJSON_AddNullToObject(root, "cycles");
@@ -402,6 +574,8 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         cJSON_AddItemToArray(gens, cJSON_CreateNumber((double)rs.per_gen[g]));
     if (functional) {
         add_functional_json(root, &rs, cfg);
+        if (detailed)
+            add_timing_json(root, &rs.f, cfg);
     } else {
         cJSON *trav = cJSON_AddObjectToObject(root, "traversal");
         cJSON_AddNumberToObject(trav, "nodes_visited", (double)rs.nodes_visited);
@@ -455,7 +629,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     if (!json_text || write_text(path, json_text, err, errlen) != 0)
         goto out;
 
-    char txt[8192];
+    char txt[16384];
     int len = snprintf(txt, sizeof txt,
              "sfsim report -- mode %s (%s)\n"
              "scene        %s\n"
@@ -464,7 +638,10 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
              "image        %d x %d, %d spp, max depth %d, seed %u, tiles of %d x %d pixels\n"
              "             mean %.5f, non-finite values %ld\n"
              "rays         %llu total: %llu primary, %llu shadow, %llu indirect; %llu dropped\n",
-             o->mode, functional ? "the kernel on the functional core: no timing" : "golden model: no timing",
+             o->mode,
+             detailed     ? "the kernel on the timing model of the machine"
+             : functional ? "the kernel on the functional core: no timing"
+                          : "golden model: no timing",
              o->scene_path, s.ntris, s.nspheres, p.nlights, needs[0] ? needs : "-", p.bvh.nnodes,
              p.bvh.nleaves, p.bvh.depth, p.bvh.sah_cost, p.size, s.render.width, s.render.height,
              s.render.spp, s.render.max_depth, o->seed, tile_w, tile_h, sum / (3.0 * (double)npx),
@@ -495,6 +672,8 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
                             100.0 * ratio(f->core.active_lanes[k],
                                           (uint64_t)cfg->core_simd_width * f->core.vec_instructions[k]),
                             k + 1 < ISA_STAGE_COUNT ? ", " : "  (active lanes / (N x vector instructions))\n");
+        if (detailed)
+            len += timing_text(txt + len, sizeof txt - (size_t)len, f, cfg);
         len += snprintf(txt + len, sizeof txt - (size_t)len,
                         "streams      mean length: traversal %.1f, intersection %.1f, shading %.1f rays\n"
                         "host         %.2f s on %d threads: %.2f M instructions/s, %.3f M rays/s; load %.2f s, BVH+pack %.2f s\n",
@@ -511,6 +690,8 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     }
     snprintf(path, sizeof path, "%s/report.txt", o->out_dir);
     if (write_text(path, txt, err, errlen) != 0)
+        goto out;
+    if (detailed && write_cost_map(o->out_dir, &rs.f, s.render.width, s.render.height, err, errlen) != 0)
         goto out;
     rc = 0;
 out:

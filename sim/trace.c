@@ -22,7 +22,7 @@ static double now(void)
 
 int trace_batch_run(const PackedScene *p, uint32_t needs, const RayBatch *b, BatchHit *hits, const char *mode,
                     const CfgMachine *cfg, const char *kernel_path, int threads, uint64_t *sim_instructions,
-                    char *err, size_t errlen)
+                    TimingStats *timing, char *err, size_t errlen)
 {
     if (sim_instructions)
         *sim_instructions = 0;
@@ -52,17 +52,20 @@ int trace_batch_run(const PackedScene *p, uint32_t needs, const RayBatch *b, Bat
         }
         return 0;
     }
-    if (strcmp(mode, "functional") != 0) {
-        snprintf(err, errlen, "--mode %s: expected functional or reference", mode);
+    int detailed = !strcmp(mode, "detailed");
+    if (!detailed && strcmp(mode, "functional") != 0) {
+        snprintf(err, errlen, "--mode %s: expected functional, detailed or reference", mode);
         return -1;
     }
     char kpath[4200];
     FuncParams fp = {cfg, kernel_path ? kernel_path : func_default_kernel(kpath, sizeof kpath), needs, 1, threads,
-                     NULL, NULL, b, hits};
+                     NULL, NULL, b, hits, detailed};
     FuncStats st;
     int rc = func_trace(p, &fp, &st, err, errlen);
     if (rc == 0 && sim_instructions)
         *sim_instructions = st.instructions;
+    if (rc == 0 && timing)
+        *timing = st.timing;
     func_stats_free(&st);
     return rc;
 }
@@ -94,7 +97,8 @@ int trace_run(const TraceOptions *o, TraceSummary *sum, char *err, size_t errlen
     }
     double t0 = now();
     rc = trace_batch_run(&p, s.needs, &b, hits, o->mode, o->cfg, o->kernel_path, o->threads, &sum->sim_instructions,
-                         err, errlen);
+                         &sum->timing, err, errlen);
+    sum->timed = !strcmp(o->mode, "detailed");
     sum->seconds = now() - t0;
     if (rc != 0)
         goto out;

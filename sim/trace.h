@@ -1,5 +1,6 @@
 /* sim/trace.h -- `sfsim trace`: closest-hit and any-hit queries for a batch of rays, through the
- * kernel's traversal and intersection on the functional core, or through the golden model.
+ * kernel's traversal and intersection on the functional core (timed in detailed mode), or
+ * through the golden model.
  *
  * Owns: the orchestration of a trace run (scene, rays, engine, hit file, summary).
  * Must not: parse the command line or implement a ray query.
@@ -13,10 +14,11 @@
 #include "../scenes/pack.h"
 #include "config.h"
 #include "raybatch.h"
+#include "timing.h"
 
 typedef struct TraceOptions {
     const char *scene_path, *rays_path, *out_path;
-    const char *mode;             /* "functional" (default) or "reference" */
+    const char *mode;             /* "functional" (default), "detailed" (the kernel, timed) or "reference" */
     const char *kernel_path;      /* NULL: next to the executable */
     const CfgMachine *cfg;
     int threads;
@@ -27,13 +29,16 @@ typedef struct TraceSummary {
     uint32_t rays, hits, misses, occluded, clear, invalid;
     uint64_t sim_instructions;
     double seconds;
+    int timed;                    /* detailed mode: timing holds the cycles of all batches */
+    TimingStats timing;
 } TraceSummary;
 
-/* Trace a batch with either engine (no files): hits[i] for batch ray i. 0, -1 (input) or -2
- * (the kernel failed). */
+/* Trace a batch with either engine (no files): hits[i] for batch ray i. In detailed mode the
+ * kernel is timed and *timing (if not NULL) receives the cycles. 0, -1 (input) or -2 (the kernel
+ * failed). */
 int trace_batch_run(const PackedScene *p, uint32_t needs, const RayBatch *b, BatchHit *hits, const char *mode,
                     const CfgMachine *cfg, const char *kernel_path, int threads, uint64_t *sim_instructions,
-                    char *err, size_t errlen);
+                    TimingStats *timing, char *err, size_t errlen);
 
 /* The whole command: 0, -1 with a message naming the file or key, -2 when the kernel failed. */
 int trace_run(const TraceOptions *o, TraceSummary *sum, char *err, size_t errlen);

@@ -329,6 +329,49 @@ grep -qE '"status":[[:space:]]+"failed"' "$T/fun4/report.json" 2>/dev/null || no
 [ ! -e "$T/fun4/frame.exr" ] || no "a complete-looking frame.exr"
 end
 
+# ---- sfsim run (detailed mode, the default): the timing model --------------------------------------
+begin "sfsim run (detailed, the default) renders the functional image bits and reports cycles, stalls, cost.png"
+run "$SFSIM" run -s scenes/cornell/scene.ini -o "$T/det1" --set render.width=48 --set render.height=32 \
+    --set render.spp=2 -j 2 --no-progress
+want_rc 0; want_out "cost.png"
+for f in frame.png frame.exr report.txt report.json cost.png; do [ -s "$T/det1/$f" ] || no "missing $f"; done
+grep -qE '"mode":[[:space:]]+"detailed"' "$T/det1/report.json" 2>/dev/null || no "report.json: mode is not detailed"
+for k in cycles busy_cycles fps fps_no_stall clock_mhz stalls stall_shares cycles_by_stage stalls_by_stage \
+         cycles_by_generation utilization_timed units units_not_exercised bank_conflict_cycles hit_rate; do
+    grep -q "\"$k\"" "$T/det1/report.json" 2>/dev/null || no "report.json lacks $k"
+done
+grep -qE '"cycles":[[:space:]]+null' "$T/det1/report.json" && no "cycles is null in detailed mode"
+grep -qE '^cycles +[0-9]+ = [0-9]+ busy \+ [0-9]+ stalled; [0-9.]+ fps at 500 MHz' "$T/det1/report.txt" 2>/dev/null \
+    || no "report.txt has no cycles line"
+run "$SFSIM" compare "$T/fun1/frame.exr" "$T/det1/frame.exr"
+want_rc 0; want_out "max diff +0$"
+end
+
+begin "sfsim run (detailed): identical cycles and image on 1 and 2 threads"
+run "$SFSIM" run -s scenes/cornell/scene.ini -o "$T/det2" --set render.width=48 --set render.height=32 \
+    --set render.spp=2 -j 1 --no-progress
+want_rc 0
+c1=$(grep -E '^cycles ' "$T/det1/report.txt" 2>/dev/null | sed 's/fps.*//')
+c2=$(grep -E '^cycles ' "$T/det2/report.txt" 2>/dev/null | sed 's/fps.*//')
+[ -n "$c1" ] && [ "$c1" = "$c2" ] || no "cycles differ: '$c1' vs '$c2'"
+run "$SFSIM" compare "$T/det1/frame.exr" "$T/det2/frame.exr"
+want_rc 0; want_out "max diff +0$"
+end
+
+begin "sfsim run with an impossible timing config names the key (exit 1)"
+run "$SFSIM" run -s scenes/cornell/scene.ini -o "$T/det3" --set raybuf.line_bytes=48 --no-progress
+want_rc 1; want_err "raybuf.line_bytes"
+run "$SFSIM" run -s scenes/cornell/scene.ini -o "$T/det3" --set scene.cache_kb=1 --set scene.cache_ways=64 --no-progress
+want_rc 1; want_err "scene.cache_kb"
+end
+
+begin "sfsim exec --timing prints the cycles of a micro-benchmark (kernels/bench/branch.s: 10 cycles)"
+run "$SFASM" kernels/bench/branch.s -o "$T/branch.sfo"
+want_rc 0
+run "$SFSIM" exec "$T/branch.sfo" --timing -q
+want_rc 0; want_out "^timing: 10 cycles = 8 busy \+ 2 stall"; want_out "stall control +2"
+end
+
 # ---- sfsim trace ---------------------------------------------------------------------------------
 begin "sfsim trace: kernel and golden model give the same hits, text and binary (docs/trace.md)"
 cp tests/fuzz/ray_seeds/cornell.txt "$T/rays.txt"
@@ -344,6 +387,12 @@ run "$SFSIM" trace --mode reference -s scenes/cornell/scene.ini --rays tests/fuz
 want_rc 0
 cmp -s "$T/hits_f.bin" "$T/hits_r.bin" || no "binary hits differ"
 [ "$(stat -c %s "$T/hits_f.bin")" -eq 56 ] || no "binary hit file is not 16 + 2 x 20 bytes"
+end
+
+begin "sfsim trace --mode detailed: the same hits, and the cycles with their breakdown"
+run "$SFSIM" trace --mode detailed -s scenes/cornell/scene.ini --rays "$T/rays.txt" -o "$T/hits_d.txt" -j 2
+want_rc 0; want_out "7 rays \(detailed\)"; want_out "^timing: [0-9]+ cycles = [0-9]+ busy"; want_out "stage +traversal"
+cmp -s "$T/hits_f.txt" "$T/hits_d.txt" || no "detailed hits differ from functional"
 end
 
 begin "sfsim trace: a malformed text ray file names file and line (exit 1)"

@@ -277,9 +277,9 @@ uint32_t trace_both(const PackedScene *p, uint32_t needs, const RayBatch *b, int
     *rh = calloc(b->count ? b->count : 1, sizeof(BatchHit));
     cr_assert(*kh && *rh);
     static char err[65536];
-    cr_assert_eq(trace_batch_run(p, needs, b, *kh, "functional", &cfg, "kernels/pathtrace.s", 2, NULL, err, sizeof err),
+    cr_assert_eq(trace_batch_run(p, needs, b, *kh, "functional", &cfg, "kernels/pathtrace.s", 2, NULL, NULL, err, sizeof err),
                  0, "%s", err);
-    cr_assert_eq(trace_batch_run(p, needs, b, *rh, "reference", &cfg, NULL, 1, NULL, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(trace_batch_run(p, needs, b, *rh, "reference", &cfg, NULL, 1, NULL, NULL, err, sizeof err), 0, "%s", err);
     uint32_t differ = 0;
     for (uint32_t i = 0; i < b->count; i++)
         if (memcmp(&(*kh)[i], &(*rh)[i], sizeof(BatchHit)) != 0)

@@ -1204,7 +1204,7 @@ Test(core_hook, records)
         {14, 15, 0, NO_MEM, 0, {0}, 0, ANY},
         {15, 18, 1, NO_MEM, 0, {0}, 0, ANY},
         {18, 19, 0, CORE_MEM_SPAD, 3, {8, 12, 16}, 0, 0x7},
-        {19, 20, 0, CORE_MEM_IDM, 4, {64, 68, 72, 76}, 0, 0xF},
+        {19, 20, 0, CORE_MEM_IDM, 4, {64, 68, 72, 76}, 6, 0xF}, /* count: IDs left, (88 - 64) / 4 */
         {20, 21, 0, NO_MEM, 0, {0}, 0, 0x0},
         {21, 22, 0, NO_MEM, 0, {0}, 0, 0xF},
         {22, 23, 0, NO_MEM, 0, {0}, 0, 0xF},
@@ -1255,6 +1255,10 @@ Test(core_hook, records)
             cr_expect_eq(r->exec, (uint64_t)w->exec, "record %d (pc %u): exec %#llx, expected %#llx", i, w->pc,
                          (unsigned long long)r->exec, (unsigned long long)w->exec);
     }
+    /* base: the stream pointer before sfetch and sapp, the begin of a partition */
+    cr_expect_eq(log.rec[11].base, 64u, "part: base %u", log.rec[11].base);
+    cr_expect_eq(log.rec[16].base, 64u, "sfetch: base %u", log.rec[16].base);
+    cr_expect_eq(log.rec[22].base, 80u, "sapp: base %u", log.rec[22].base);
     t_free(&t);
 }
 

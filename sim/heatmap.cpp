@@ -1,0 +1,220 @@
+// sim/heatmap.cpp -- heat-map images (cost.png) drawn with OpenImageIO's ImageBufAlgo.
+//
+// Owns: the colormap table, the layout documented in heatmap.h, the font search. Must not: open
+// image files itself (img_write_rgb8 in img.cpp does, so errors read the same everywhere) or
+// know what the values measure.
+#include <OpenImageIO/imagebufalgo.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <optional>
+#include <string>
+#include <vector>
+
+extern "C" {
+#include "heatmap.h"
+#include "img.h"
+}
+
+namespace {
+
+using OIIO::ImageBuf;
+using OIIO::ImageSpec;
+using OIIO::TypeDesc;
+namespace IBA = OIIO::ImageBufAlgo;
+
+// Layout of heatmap.h, in output pixels.
+constexpr int MARGIN = 16, TITLE_H = 36, GAP = 24, BAR_W = 24, LABEL_W = 136, TICK = 6;
+constexpr int MIN_MAP_W = 512, MAX_MAP_H = 2048, MIN_BAR_H = 256, MAX_SIDE = 8192;
+constexpr int TITLE_PX = 18, LABEL_PX = 14, NTICKS = 5;
+
+// Ten evenly spaced stops of a viridis-like ramp, 8-bit sRGB. Rec. 709 luma of the stops rises
+// 21, 53, 76, 95, 111, 130, 151, 176, 200, 222, and linear interpolation keeps it monotone.
+constexpr unsigned char RAMP[][3] = {
+    {0x44, 0x01, 0x54}, {0x48, 0x28, 0x78}, {0x3e, 0x4a, 0x89}, {0x31, 0x68, 0x8e},
+    {0x26, 0x82, 0x8e}, {0x1f, 0x9e, 0x89}, {0x35, 0xb7, 0x79}, {0x6d, 0xcd, 0x59},
+    {0xb4, 0xde, 0x2c}, {0xfd, 0xe7, 0x25},
+};
+constexpr int NRAMP = sizeof RAMP / sizeof RAMP[0];
+
+const float BACKGROUND[3] = {1.0f, 1.0f, 1.0f};
+const float INK[3] = {0.1f, 0.1f, 0.1f};
+const float FRAME[3] = {0.35f, 0.35f, 0.35f};
+
+const char *const DEJAVU = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+bool font_overridden = false;
+std::string font_override;
+
+int fail(char *err, size_t errlen, const char *path, const std::string &why)
+{
+    std::snprintf(err, errlen, "%s: %s", path, why.c_str());
+    return -1;
+}
+
+// The font to draw with ("" is OpenImageIO's own default), or none: then no text is drawn.
+std::optional<std::string> pick_font()
+{
+    std::vector<std::string> candidates;
+    if (font_overridden)
+        candidates = {font_override};
+    else
+        candidates = {DEJAVU, "DejaVuSans", ""};
+    for (const std::string &f : candidates)
+        if (IBA::text_size("0", LABEL_PX, f).defined())
+            return f;
+    return std::nullopt;
+}
+
+// A label: the value to `digits` significant digits with an SI prefix, then the unit.
+std::string format_value(double v, int digits, const char *unit)
+{
+    static const char *const PREFIX[] = {"", "k", "M", "G", "T", "P"};
+    int p = 0;
+    while (std::fabs(v) >= 999.5 && p < 5) {
+        v /= 1000.0;
+        p++;
+    }
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "%.*g%s%s%s", digits, v, PREFIX[p], unit && *unit ? " " : "",
+                  unit ? unit : "");
+    return buf;
+}
+
+// Tick labels for values[]: three significant digits, more while neighbours would read alike.
+std::vector<std::string> tick_labels(const std::vector<double> &values, const char *unit)
+{
+    std::vector<std::string> labels;
+    for (int digits = 3; digits <= 8; digits++) {
+        labels.clear();
+        for (double v : values)
+            labels.push_back(format_value(v, digits, unit));
+        if (std::adjacent_find(labels.begin(), labels.end()) == labels.end())
+            break;
+    }
+    return labels;
+}
+
+bool draw_text(ImageBuf &img, const std::optional<std::string> &font, int x, int y,
+               const std::string &text, int px, IBA::TextAlignY aligny)
+{
+    if (!font || text.empty())
+        return true;
+    return IBA::render_text(img, x, y, text, px, *font, INK, IBA::TextAlignX::Left, aligny);
+}
+
+// The body of heatmap_write once the arguments are checked; OpenImageIO reports failures
+// through the ImageBuf, which is what `why` carries back.
+bool render(ImageBuf &canvas, const std::vector<float> &t, int w, int h, double lo, double hi,
+            const char *title, const char *unit, std::string &why)
+{
+    int s = w >= MIN_MAP_W ? 1 : (MIN_MAP_W + w - 1) / w;
+    s = std::max(1, std::min(s, MAX_MAP_H / h));
+    const int map_w = w * s, map_h = h * s, bar_h = std::max(map_h, MIN_BAR_H);
+    const int map_x = MARGIN, top = MARGIN + TITLE_H, bar_x = map_x + map_w + GAP;
+    const int cw = bar_x + BAR_W + LABEL_W + MARGIN, ch = top + bar_h + MARGIN;
+
+    float knots[NRAMP * 3];
+    for (int i = 0; i < NRAMP * 3; i++)
+        knots[i] = RAMP[i / 3][i % 3] / 255.0f;
+
+    ImageBuf norm(ImageSpec(w, h, 1, TypeDesc::FLOAT)), rgb;
+    ImageBuf map(ImageSpec(map_w, map_h, 3, TypeDesc::FLOAT));
+    if (!norm.set_pixels(OIIO::ROI::All(), TypeDesc::FLOAT, t.data()) ||
+        !IBA::color_map(rgb, norm, 0, NRAMP, 3, knots) || !IBA::resample(map, rgb, false)) {
+        why = norm.has_error() ? norm.geterror() : rgb.has_error() ? rgb.geterror() : map.geterror();
+        return false;
+    }
+
+    // The bar runs from 1 (top) to 0 (bottom); a constant map is the middle colour throughout.
+    ImageBuf ramp(ImageSpec(BAR_W, bar_h, 1, TypeDesc::FLOAT)), bar;
+    const bool flat = !(hi > lo);
+    const float one = flat ? 0.5f : 1.0f, zero = flat ? 0.5f : 0.0f;
+    if (!IBA::fill(ramp, {&one, 1}, {&zero, 1}) ||
+        !IBA::color_map(bar, ramp, 0, NRAMP, 3, knots)) {
+        why = ramp.has_error() ? ramp.geterror() : bar.geterror();
+        return false;
+    }
+
+    canvas.reset(ImageSpec(cw, ch, 3, TypeDesc::FLOAT));
+    bool ok = IBA::fill(canvas, BACKGROUND) && IBA::paste(canvas, map_x, top, 0, 0, map) &&
+              IBA::paste(canvas, bar_x, top, 0, 0, bar) &&
+              IBA::render_box(canvas, map_x - 1, top - 1, map_x + map_w, top + map_h, FRAME) &&
+              IBA::render_box(canvas, bar_x - 1, top - 1, bar_x + BAR_W, top + bar_h, FRAME);
+
+    std::vector<double> tick_t, tick_v;
+    if (flat) {
+        tick_t = {0.5};
+        tick_v = {lo};
+    } else {
+        for (int i = 0; i < NTICKS; i++) {
+            tick_t.push_back((double)i / (NTICKS - 1));
+            tick_v.push_back(i == NTICKS - 1 ? hi : lo + (hi - lo) * i / (NTICKS - 1));
+        }
+    }
+    std::vector<std::string> labels = tick_labels(tick_v, unit);
+    const std::optional<std::string> font = pick_font();
+    for (size_t i = 0; ok && i < tick_t.size(); i++) {
+        int y = top + (int)std::lround((1.0 - tick_t[i]) * (bar_h - 1));
+        int x = bar_x + BAR_W;
+        ok = IBA::render_line(canvas, x, y, x + TICK - 1, y, FRAME) &&
+             draw_text(canvas, font, x + TICK + 4, y, labels[i], LABEL_PX,
+                       IBA::TextAlignY::Center);
+    }
+    ok = ok && draw_text(canvas, font, MARGIN, MARGIN + TITLE_H / 2, title ? title : "",
+                         TITLE_PX, IBA::TextAlignY::Center);
+    if (!ok)
+        why = canvas.geterror();
+    return ok;
+}
+
+} // namespace
+
+extern "C" void heatmap_set_font(const char *font_path)
+{
+    font_overridden = font_path != nullptr;
+    font_override = font_path ? font_path : "";
+}
+
+extern "C" int heatmap_write(const char *path, const double *values, int width, int height,
+                             const char *title, const char *unit, char *err, size_t errlen)
+{
+    if (width <= 0 || height <= 0 || width > MAX_SIDE || height > MAX_SIDE)
+        return fail(err, errlen, path, "heat map size " + std::to_string(width) + " x " +
+                                           std::to_string(height) + " is outside 1..8192");
+    if (!values)
+        return fail(err, errlen, path, "no values");
+    size_t n = (size_t)width * height;
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < n; i++) {
+        double v = values[i];
+        if (std::isfinite(v) && v >= 0.0) {
+            lo = std::min(lo, v);
+            hi = std::max(hi, v);
+            continue;
+        }
+        char why[160];
+        std::snprintf(why, sizeof why, "pixel (%zu, %zu) is %s (%g); values must be finite and >= 0",
+                      i % width, i / width,
+                      std::isnan(v) ? "NaN" : std::isinf(v) ? "infinite" : "negative", v);
+        return fail(err, errlen, path, why);
+    }
+    try {
+        std::vector<float> t(n);
+        for (size_t i = 0; i < n; i++)
+            t[i] = hi > lo ? (float)((values[i] - lo) / (hi - lo)) : 0.5f;
+        ImageBuf canvas;
+        std::string why;
+        if (!render(canvas, t, width, height, lo, hi, title, unit, why))
+            return fail(err, errlen, path, "drawing the heat map: " + why);
+        const ImageSpec &spec = canvas.spec();
+        std::vector<float> px((size_t)spec.width * spec.height * 3);
+        if (!canvas.get_pixels(OIIO::ROI::All(), TypeDesc::FLOAT, px.data()))
+            return fail(err, errlen, path, "drawing the heat map: " + canvas.geterror());
+        return img_write_rgb8(path, px.data(), spec.width, spec.height, err, errlen);
+    } catch (const std::exception &e) {
+        return fail(err, errlen, path, std::string("drawing the heat map: ") + e.what());
+    }
+}

@@ -1,0 +1,106 @@
+/* sim/timing.h -- the cycle-accurate timing model of the stream-filtering machine (detailed mode).
+ *
+ * Owns: time. It consumes the functional core's CoreRecord stream (core_set_hook(core,
+ * timing_hook, t)) and schedules each instruction's issue and completion, and each unit's work,
+ * as events on a time-ordered queue (sim/event.h); time jumps from event to event. Units: the
+ * in-order single-issue SIMD execution unit with per-class latency and issue interval and a
+ * register scoreboard; the banked ray buffers (lines, bank conflicts); the decoupled address-
+ * generation units that fetch ID vectors ahead of the data path; the multiplexer interconnect
+ * (latency, ports shared by data path, AGUs and partition unit); the partition unit; the
+ * scratchpad ports; scene memory with an optional cache (sim/scenemem.h).
+ * Must not: compute any architectural value or change what the program does (the functional
+ * core does); results are identical with and without timing.
+ *
+ * Accounting: every cycle of a run is either busy (an instruction issues in it) or a stall
+ * charged to exactly one TmCause, to the stage and the statistics generation of the instruction
+ * that waits. cycles = busy + sum of stalls, per stage too (timing_check). The model and the
+ * source of each choice: docs/model.md.
+ */
+#ifndef SFSIM_TIMING_H
+#define SFSIM_TIMING_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "config.h"
+#include "core.h"
+#include "scenemem.h"
+
+/* Stall causes (ARCHITECTURE.md Sec. 3), in the order reports list them. */
+#define TM_CAUSES(X) \
+    X(ADDRESS_FETCH,   "address_fetch",   "the data path waits for an ID vector the AGUs have not fetched yet") \
+    X(BANK_CONFLICT,   "bank_conflict",   "lanes of one gather/scatter hit different lines of one ray-buffer bank") \
+    X(ALIGNMENT,       "alignment",       "an ID vector read or appended off a line boundary is rotated into place") \
+    X(INTERCONNECT,    "interconnect",    "no interconnect port is free (data path, AGUs and partition unit share them)") \
+    X(FU_BUSY,         "fu_busy",         "the functional unit cannot accept another instruction yet (issue interval)") \
+    X(DATA_DEPENDENCY, "data_dependency", "an operand (or the destination) waits for an arithmetic or ray-buffer result") \
+    X(PARTITION,       "partition",       "the partition unit is busy, or its result or the IDs it moves are needed") \
+    X(SCRATCHPAD,      "scratchpad",      "a vector scratchpad access needs more lines than there are ports") \
+    X(SCENE_MEMORY,    "scene_memory",    "scene-memory or framebuffer lines: cache port cycles and waits for loaded data") \
+    X(CONTROL,         "control",         "the bubble after a taken branch, jump, call or return")
+
+typedef enum TmCause {
+#define TM_CAUSE_ENUM(name, key, desc) TM_##name,
+    TM_CAUSES(TM_CAUSE_ENUM)
+#undef TM_CAUSE_ENUM
+    TM_CAUSE_COUNT
+} TmCause;
+
+extern const char *const tm_cause_keys[TM_CAUSE_COUNT];
+extern const char *const tm_cause_descs[TM_CAUSE_COUNT];
+
+typedef struct TimingParams {
+    int lanes;
+    int lat[ISA_U_COUNT];     /* result latency per unit class (compute classes, AGU, branch) */
+    int issue[ISA_U_COUNT];   /* cycles between issues per unit class */
+    int taken_penalty;
+    int rb_banks, rb_line, rb_access, align_cycles;
+    int agu_ids_per_cycle, agu_depth;
+    int icn_latency, icn_ports;
+    int part_setup, part_ids_per_cycle;
+    int spad_ports, spad_latency, spad_line;
+    int scene_ports;
+    SceneMemParams scene;
+} TimingParams;
+
+void timing_params(const CfgMachine *cfg, TimingParams *p);
+
+typedef struct TimingStats {
+    uint64_t cycles, busy;
+    uint64_t stalls[TM_CAUSE_COUNT];
+    uint64_t stage_cycles[ISA_STAGE_COUNT], stage_busy[ISA_STAGE_COUNT];
+    uint64_t stage_vec_busy[ISA_STAGE_COUNT];               /* issue cycles of vector instructions */
+    uint64_t stage_stalls[ISA_STAGE_COUNT][TM_CAUSE_COUNT];
+    uint64_t gen_cycles[CORE_GENERATIONS];
+    uint64_t runs;                                          /* programs timed (tiles) */
+    /* units */
+    uint64_t rb_accesses, rb_lines, rb_conflicted;          /* gathers/scatters, lines, those with a conflict */
+    uint64_t agu_fetches, agu_ahead;                        /* ID vectors fetched; of them fetched ahead */
+    uint64_t icn_transfers, icn_unit_delay;                 /* data-path transfers; cycles AGU/partition work waited for a port */
+    uint64_t partitions, partition_ids, partition_cycles;
+    uint64_t spad_accesses, spad_lines;
+    uint64_t scene_instr;                                   /* scene-memory and framebuffer instructions */
+    SceneMemStats scene;
+    uint64_t unit_uses[ISA_U_COUNT];                        /* instructions per unit class */
+} TimingStats;
+
+typedef struct Timing Timing;
+
+Timing *timing_new(const TimingParams *p, char *err, size_t errlen);
+void timing_free(Timing *t);
+/* A cold machine for the next program run (empty queues, idle units, empty cache, time 0);
+ * statistics keep accumulating. */
+void timing_reset(Timing *t);
+/* The CoreHook: one executed instruction. */
+void timing_hook(void *ctx, const CoreRecord *rec);
+/* After core_run: a run that stopped without halt (trap, limit) counts the cycles so far. */
+void timing_end(Timing *t);
+const TimingStats *timing_stats(const Timing *t);
+/* Non-NULL when the model met an impossible state (an internal error, never a user's). */
+const char *timing_error(const Timing *t);
+/* dst += src. */
+void timing_stats_add(TimingStats *dst, const TimingStats *src);
+/* cycles = busy + stalls, overall and per stage: 0, or -1 with the numbers in err. */
+int timing_check(const TimingStats *s, char *err, size_t errlen);
+
+#endif

@@ -1,0 +1,194 @@
+/* tests/unit/test_timing.c -- the timing model: the micro-benchmarks of kernels/bench/ against
+ * their hand-derived cycle counts, the event queue, the scene cache, and the accounting identity.
+ *
+ * Each kernels/bench file carries `;@ run NAME [define S=V]... [set K=V]... expect KEY=V...`
+ * lines (kernels/bench/README.md); every run is assembled with its defines, timed on the default
+ * machine with its overrides, and every expected figure must match exactly. A stall cause the
+ * line does not name must be 0. The expectations are written by hand in the files, with their
+ * derivations; nothing here derives a figure by running the model.
+ */
+#include <criterion/criterion.h>
+#include <glob.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../../asm/asm.h"
+#include "../../sim/config.h"
+#include "../../sim/core.h"
+#include "../../sim/event.h"
+#include "../../sim/scenemem.h"
+#include "../../sim/timing.h"
+
+/* A timing figure by its expect key, or -1 for an unknown key. */
+static long long figure(const TimingStats *s, const char *key)
+{
+    if (!strcmp(key, "cycles")) return (long long)s->cycles;
+    if (!strcmp(key, "busy")) return (long long)s->busy;
+    for (int c = 0; c < TM_CAUSE_COUNT; c++)
+        if (!strcmp(key, tm_cause_keys[c]))
+            return (long long)s->stalls[c];
+    if (!strcmp(key, "rb_conflicted")) return (long long)s->rb_conflicted;
+    if (!strcmp(key, "agu_fetches")) return (long long)s->agu_fetches;
+    if (!strcmp(key, "agu_ahead")) return (long long)s->agu_ahead;
+    if (!strcmp(key, "partitions")) return (long long)s->partitions;
+    if (!strcmp(key, "scene_hits")) return (long long)s->scene.hits;
+    if (!strcmp(key, "scene_misses")) return (long long)s->scene.misses;
+    if (!strcmp(key, "icn_unit_delay")) return (long long)s->icn_unit_delay;
+    return -1;
+}
+
+/* Run one `;@ run` line of file; returns the number of failed checks (each reported). */
+static int run_case(const char *file, int lineno, char *line)
+{
+    char *save = NULL, *tok = strtok_r(line, " \t\r\n", &save);
+    const char *name = tok ? strtok_r(NULL, " \t\r\n", &save) : NULL;
+    cr_assert(name, "%s:%d: `;@ run` without a name", file, lineno);
+    AsmDefine defs[16];
+    char *exp_key[32];
+    long long exp_val[32];
+    int ndefs = 0, nexp = 0, mode = 0, fails = 0;
+    CfgMachine cfg;
+    cfg_defaults(&cfg);
+    CfgErrors errs = {0};
+    while ((tok = strtok_r(NULL, " \t\r\n", &save))) {
+        if (!strcmp(tok, "define") || !strcmp(tok, "set") || !strcmp(tok, "expect")) {
+            mode = tok[0];
+            continue;
+        }
+        char *eq = strchr(tok, '=');
+        cr_assert(eq && mode, "%s:%d: bad token '%s'", file, lineno, tok);
+        if (mode == 'd') {
+            cr_assert(ndefs < 16);
+            *eq = 0;
+            defs[ndefs++] = (AsmDefine){tok, strtoll(eq + 1, NULL, 0)};
+        } else if (mode == 's') {
+            cr_assert(cfg_set(&cfg, tok, &errs) == 0, "%s:%d: %s", file, lineno, errs.text);
+        } else {
+            cr_assert(nexp < 32);
+            *eq = 0;
+            exp_key[nexp] = tok;
+            exp_val[nexp++] = strtoll(eq + 1, NULL, 10);
+        }
+    }
+    cr_assert(nexp > 0, "%s:%d: no expectations", file, lineno);
+
+    AsmOptions opt = {defs, ndefs, NULL, 0, NULL};
+    AsmObject obj;
+    cr_assert(asm_assemble_file(file, &opt, &obj) == 0, "%s: %s does not assemble", file, name);
+    CoreParams cp;
+    cfg_core_params(&cfg, &cp);
+    char err[512];
+    Core *c = core_new(&cp, &obj, err, sizeof err);
+    cr_assert(c, "%s %s: %s", file, name, err);
+    TimingParams tp;
+    timing_params(&cfg, &tp);
+    Timing *t = timing_new(&tp, err, sizeof err);
+    cr_assert(t, "%s", err);
+    core_set_hook(c, timing_hook, t);
+    CoreExit ex = core_run(c, 1000000);
+    timing_end(t);
+    cr_assert_eq(ex, CORE_EXIT_HALT, "%s %s: %s", file, name, core_trap_message(c));
+    cr_assert_null(timing_error(t), "%s %s: %s", file, name, timing_error(t));
+    const TimingStats *s = timing_stats(t);
+    cr_expect(timing_check(s, err, sizeof err) == 0, "%s %s: %s", file, name, err);
+    int named[TM_CAUSE_COUNT] = {0};
+    for (int i = 0; i < nexp; i++) {
+        long long got = figure(s, exp_key[i]);
+        cr_assert(got >= 0, "%s:%d: unknown expect key '%s'", file, lineno, exp_key[i]);
+        for (int k = 0; k < TM_CAUSE_COUNT; k++)
+            if (!strcmp(exp_key[i], tm_cause_keys[k]))
+                named[k] = 1;
+        if (got != exp_val[i]) {
+            cr_log_error("%s:%d %s: %s = %lld, derived %lld", file, lineno, name, exp_key[i], got, exp_val[i]);
+            fails++;
+        }
+    }
+    for (int k = 0; k < TM_CAUSE_COUNT; k++)
+        if (!named[k] && s->stalls[k]) {
+            cr_log_error("%s:%d %s: %s = %llu, derived 0", file, lineno, name, tm_cause_keys[k],
+                         (unsigned long long)s->stalls[k]);
+            fails++;
+        }
+    cfg_errors_free(&errs);
+    timing_free(t);
+    core_free(c);
+    asm_object_free(&obj);
+    return fails;
+}
+
+Test(timing, microbenchmarks_match_their_derivations)
+{
+    glob_t g;
+    cr_assert_eq(glob("kernels/bench/*.s", 0, NULL, &g), 0, "no kernels/bench/*.s (run from the repo root)");
+    int runs = 0, fails = 0;
+    for (size_t i = 0; i < g.gl_pathc; i++) {
+        FILE *f = fopen(g.gl_pathv[i], "r");
+        cr_assert(f);
+        char line[1024];
+        int lineno = 0;
+        while (fgets(line, sizeof line, f)) {
+            lineno++;
+            if (strncmp(line, ";@ run", 6))
+                continue;
+            fails += run_case(g.gl_pathv[i], lineno, line + 3);
+            runs++;
+        }
+        fclose(f);
+    }
+    globfree(&g);
+    cr_log_info("%d micro-benchmark runs, %d mismatches", runs, fails);
+    cr_expect_geq(runs, 40, "only %d runs found", runs);
+    cr_expect_eq(fails, 0, "%d figures differ from their derivations (see the log)", fails);
+}
+
+Test(timing, event_queue_orders_by_time_then_insertion)
+{
+    EvQueue q;
+    evq_init(&q);
+    uint64_t times[] = {50, 10, 30, 10, 70, 30, 10, 0};
+    for (int i = 0; i < 8; i++)
+        cr_assert_eq(evq_push(&q, times[i], 0, (uint16_t)i, 0, 0), 0);
+    int order[8], n = 0;
+    while (evq_top(&q)) {
+        order[n++] = evq_top(&q)->arg;
+        evq_pop(&q);
+    }
+    int want[8] = {7, 1, 3, 6, 2, 5, 0, 4};
+    cr_assert_eq(n, 8);
+    for (int i = 0; i < 8; i++)
+        cr_expect_eq(order[i], want[i], "position %d: event %d, expected %d", i, order[i], want[i]);
+    evq_free(&q);
+}
+
+Test(timing, scene_cache_lru_and_bus)
+{
+    /* 2 sets x 2 ways of 64-byte lines; latency 10, 16 bytes per cycle (4 cycles a line). */
+    SceneMemParams p = {10, 16, 64, 1, 256, 2};
+    SceneMem m;
+    smem_init(&m, &p);
+    cr_assert_eq(m.instantiated, 0, "the tag array exists before the first access");
+    cr_expect_eq(smem_access(&m, 0, 0, 0, 0), 14);      /* miss: bus 0..3, ready 0 + 10 + 4 */
+    cr_expect_eq(m.instantiated, 1);
+    cr_expect_eq(smem_access(&m, 0, 128, 0, 0), 18);    /* same set, other way: bus 4..7 */
+    cr_expect_eq(smem_access(&m, 0, 4, 20, 0), 21);     /* hit on line 0 (now most recent) */
+    cr_expect_eq(smem_access(&m, 0, 256, 30, 1), 44);   /* miss evicts line 128 (LRU), dirty */
+    cr_expect_eq(smem_access(&m, 0, 0, 50, 0), 51);     /* line 0 still there */
+    cr_expect_eq(smem_access(&m, 0, 128, 60, 0), 78);   /* 128 again: evicts dirty 256: write-back 60..63, fill 64..67 */
+    cr_expect_eq(m.st.writebacks, 1);
+    cr_expect_eq(m.st.hits, 2);
+    cr_expect_eq(m.st.misses, 4);
+    cr_expect_eq(smem_access(&m, 1, 0, 100, 0), 114);   /* framebuffer address 0 is another line */
+    smem_reset(&m);
+    cr_expect_eq(smem_access(&m, 0, 0, 0, 0), 14, "reset leaves a cold cache");
+    smem_free(&m);
+}
+
+Test(timing, every_cause_has_a_key_and_a_description)
+{
+    for (int c = 0; c < TM_CAUSE_COUNT; c++) {
+        cr_expect(tm_cause_keys[c] && tm_cause_keys[c][0]);
+        cr_expect(tm_cause_descs[c] && strlen(tm_cause_descs[c]) > 20);
+    }
+    cr_expect_eq(TM_CAUSE_COUNT, 10, "the ten causes of ARCHITECTURE.md Sec. 3");
+}
