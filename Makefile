@@ -49,7 +49,7 @@ help:
 	@echo "make test-asan  the unit tests under AddressSanitizer + UBSan"
 	@echo "make fuzz       build the libFuzzer targets, assembler and scene loader (clang);"
 	@echo "                make fuzz-run FUZZ_SECONDS=600 runs each for that long"
-	@echo "make bench      build and run the benchmarks in bench/"
+	@echo "make bench      build and run the benchmarks in bench/ (core, functional and detailed speed, Embree)"
 	@echo "make docs       regenerate docs/isa.md from isa/opcodes.def"
 
 deps:
@@ -175,7 +175,7 @@ $(BUILD)/fuzz/fuzz_rays: tests/fuzz/fuzz_rays.c sim/raybatch.c
 	@mkdir -p $(dir $@)
 	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ -lm
 
-$(BUILD)/fuzz/fuzz_config: tests/fuzz/fuzz_config.c sim/config.c
+$(BUILD)/fuzz/fuzz_config: tests/fuzz/fuzz_config.c sim/config.c sim/timing.c sim/event.c sim/scenemem.c isa/isa.c
 	@mkdir -p $(dir $@)
 	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ $(INIH) -lm
 
@@ -203,6 +203,10 @@ $(BUILD)/bench/functional_speed: bench/functional_speed.c $(BUILD)/libsfsim.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
 
+$(BUILD)/bench/detailed_speed: bench/detailed_speed.c $(BUILD)/libsfsim.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
+
 $(BUILD)/validation: tools/validation.c $(BUILD)/libsfsim.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
@@ -213,10 +217,12 @@ validation: deps
 	$(BUILD)/validation > docs/validation-data.md
 
 bench: deps
-	@$(MAKE) --no-print-directory $(BUILD)/bench/core_speed $(BUILD)/bench/embree_xcheck $(BUILD)/bench/functional_speed
+	@$(MAKE) --no-print-directory $(BUILD)/bench/core_speed $(BUILD)/bench/embree_xcheck $(BUILD)/bench/functional_speed \
+		$(BUILD)/bench/detailed_speed
 	$(BUILD)/bench/core_speed
 	$(BUILD)/bench/embree_xcheck
 	$(BUILD)/bench/functional_speed
+	$(BUILD)/bench/detailed_speed
 
 # ---- the example `make run` executes --------------------------------------------------------
 # The default scene on the default machine in detailed mode, sized to take about a minute here

@@ -301,8 +301,17 @@ static void add_timing_json(cJSON *root, const FuncStats *f, const CfgMachine *c
                                 ratio(f->core.active_lanes[k], (uint64_t)n * (t->stage_vec_busy[k] + stalls)));
     }
     cJSON *cg = cJSON_AddArrayToObject(root, "cycles_by_generation");
-    for (uint64_t g = 0; g < f->generations && g < CORE_GENERATIONS; g++)
+    cJSON *tg = cJSON_AddArrayToObject(root, "timing_by_generation");
+    for (uint64_t g = 0; g < f->generations && g < CORE_GENERATIONS; g++) {
         cJSON_AddItemToArray(cg, cJSON_CreateNumber((double)t->gen_cycles[g]));
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddNumberToObject(o, "cycles", (double)t->gen_cycles[g]);
+        cJSON_AddNumberToObject(o, "busy_cycles", (double)t->gen_busy[g]);
+        cJSON *gs = cJSON_AddObjectToObject(o, "stalls");
+        for (int c = 0; c < TM_CAUSE_COUNT; c++)
+            cJSON_AddNumberToObject(gs, tm_cause_keys[c], (double)t->gen_stalls[g][c]);
+        cJSON_AddItemToArray(tg, o);
+    }
     cJSON *u = cJSON_AddObjectToObject(root, "units");
     cJSON *rb = cJSON_AddObjectToObject(u, "ray_buffers");
     cJSON_AddNumberToObject(rb, "accesses", (double)t->rb_accesses);

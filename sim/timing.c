@@ -120,7 +120,7 @@ void timing_params(const CfgMachine *c, TimingParams *p)
     p->icn_latency = c->interconnect_latency;
     p->icn_ports = c->interconnect_ports;
     p->part_setup = c->partition_setup_cycles;
-    p->part_ids_per_cycle = c->partition_ids_per_cycle;
+    p->part_ids_per_cycle = c->partition_ids_per_cycle ? c->partition_ids_per_cycle : c->core_simd_width;
     p->spad_ports = c->spad_ports;
     p->spad_latency = c->spad_latency;
     p->spad_line = c->spad_line_bytes;
@@ -232,6 +232,7 @@ static inline void charge(Timing *t, int cause, uint64_t cycles, int stage, int 
     t->st.stage_stalls[stage][cause] += cycles;
     t->st.stage_cycles[stage] += cycles;
     t->st.gen_cycles[gen] += cycles;
+    t->st.gen_stalls[gen][cause] += cycles;
 }
 
 static void internal_error(Timing *t, const char *msg)
@@ -625,6 +626,7 @@ void timing_hook(void *ctx, const CoreRecord *rec)
     t->st.stage_busy[stage]++;
     t->st.stage_cycles[stage]++;
     t->st.gen_cycles[gen]++;
+    t->st.gen_busy[gen]++;
     if (oi->flags & ISA_FL_VEC)
         t->st.stage_vec_busy[stage]++;
     t->st.unit_uses[unit]++;
@@ -742,8 +744,17 @@ int timing_check(const TimingStats *s, char *err, size_t errlen)
         total += st;
     }
     uint64_t gsum = 0;
-    for (int g = 0; g < CORE_GENERATIONS; g++)
+    for (int g = 0; g < CORE_GENERATIONS; g++) {
+        uint64_t gs = s->gen_busy[g];
+        for (int c = 0; c < TM_CAUSE_COUNT; c++)
+            gs += s->gen_stalls[g][c];
+        if (gs != s->gen_cycles[g]) {
+            snprintf(err, errlen, "timing: generation %d: busy + stalls %llu != cycles %llu", g,
+                     (unsigned long long)gs, (unsigned long long)s->gen_cycles[g]);
+            return -1;
+        }
         gsum += s->gen_cycles[g];
+    }
     if (total != s->cycles || gsum != s->cycles) {
         snprintf(err, errlen, "timing: stage cycles %llu, generation cycles %llu, cycles %llu",
                  (unsigned long long)total, (unsigned long long)gsum, (unsigned long long)s->cycles);

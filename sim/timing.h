@@ -71,7 +71,8 @@ typedef struct TimingStats {
     uint64_t stage_cycles[ISA_STAGE_COUNT], stage_busy[ISA_STAGE_COUNT];
     uint64_t stage_vec_busy[ISA_STAGE_COUNT];               /* issue cycles of vector instructions */
     uint64_t stage_stalls[ISA_STAGE_COUNT][TM_CAUSE_COUNT];
-    uint64_t gen_cycles[CORE_GENERATIONS];
+    uint64_t gen_cycles[CORE_GENERATIONS], gen_busy[CORE_GENERATIONS];
+    uint64_t gen_stalls[CORE_GENERATIONS][TM_CAUSE_COUNT];
     uint64_t runs;                                          /* programs timed (tiles) */
     /* units */
     uint64_t rb_accesses, rb_lines, rb_conflicted;          /* gathers/scatters, lines, those with a conflict */

@@ -3,7 +3,8 @@
  * Tables 2-4) and Wald et al. 2007 (seed 000, Tables 1-4) measure, printed as markdown tables
  * with the papers' figures beside ours. `make validation` writes docs/validation-data.md.
  *
- * usage: validation [--quick]     (--quick: smaller images, for a smoke run)
+ * usage: validation [--quick] [--timing-only]   (--quick: smaller images, for a smoke run;
+ *                                                --timing-only: only the detailed-mode tables)
  *
  * Utilization = active lanes / (N x vector instructions) of a stage, over the generations the
  * experiment names: primary rays are generation 0 (camera rays only), secondary rays the later
@@ -18,6 +19,7 @@
 #include "../scenes/scene.h"
 #include "../sim/config.h"
 #include "../sim/functional.h"
+#include "../sim/timing.h"
 
 typedef struct Loaded {
     const char *name, *path;
@@ -66,6 +68,8 @@ typedef struct Run {
 /* mode: 0 stream of M rays, 1 packets of N rays */
 static int order = CFG_STREAM_ORDER_FIRST;
 
+static int timed; /* detailed mode for the runs of Tables 5-6 */
+
 static void run(Loaded *l, int lanes, int rays, int packet, int workload, int bounces, Run *r)
 {
     CfgMachine cfg;
@@ -80,7 +84,7 @@ static void run(Loaded *l, int lanes, int rays, int packet, int workload, int bo
     size_t n = 3 * (size_t)l->s.render.width * l->s.render.height;
     float *rgb = calloc(n, sizeof(float));
     static char err[65536];
-    FuncParams fp = {&cfg, "kernels/pathtrace.s", l->s.needs, 1, 2, NULL, NULL, NULL, NULL};
+    FuncParams fp = {&cfg, "kernels/pathtrace.s", l->s.needs, 1, 2, NULL, NULL, NULL, NULL, timed};
     if (!rgb || func_render(&l->p, &fp, rgb, &r->st, err, sizeof err) != 0) {
         fprintf(stderr, "%s: %s\n", l->name, err);
         exit(1);
@@ -296,9 +300,111 @@ static void diffuse(void)
     printf("\n");
 }
 
+
+/* ---- seed 001 Tables 5 and 6: detailed mode ---------------------------------------------------- */
+/* Table 6, fps at 500 MHz, 1024 x 1024, 64 spp: [N 8, 12, 16][32x32, 64x64] for rtrt, conf, kala */
+static const char *t6_paper[3][2] = {
+    {"16.60 / 8.15 / 6.73", "18.78 / 12.78 / 8.34"},
+    {"21.82 / 12.56 / 11.78", "24.52 / 18.32 / 13.45"},
+    {"22.36 / 14.35 / 13.34", "26.35 / 20.32 / 15.65"}};
+/* Table 5, N = 16, 64x64: load, store, compute, scatter/gather, partition (%) */
+static const char *t5_paper[3] = {"24.1 / 14.9 / 35.4 / 19.6 / 5.0", "23.2 / 19.7 / 34.5 / 18.7 / 3.8",
+                                  "23.8 / 20.3 / 31.9 / 21.7 / 2.0"};
+static const char *paper_name[3] = {"rtrt", "kala", "conf"}; /* beside cornell, sponza, conference */
+static const int paper_col[3] = {0, 2, 1};                   /* column in the paper's tables */
+
+static double pct(uint64_t a, uint64_t b) { return b ? 100.0 * (double)a / (double)b : 0.0; }
+
+static void timing_tables(void)
+{
+    const int widths[] = {4, 8, 12, 16, 32, 64};
+    const int w = quick ? 64 : 128, h = quick ? 64 : 128, spp = quick ? 1 : 2;
+    /* The paper's Table 1: rays per frame (rtrt, conf, kala) and its no-stall fps (Sec. 4.2). */
+    static const double paper_rays[3] = {1.18e8, 1.62e8, 1.57e8}, paper_max_fps[3] = {100, 64, 32};
+    printf("## Detailed mode: fps, stalls and operation mix (001 Tables 5 and 6)\n\n"
+           "Detailed mode (the timing model, docs/model.md) on the default machine (500 MHz) with the N and\n"
+           "stream size of each row; %d x %d pixels, %d spp, max depth 3 (the paper: 1024 x 1024, 64 spp,\n"
+           "three bounces). *fps* is for our frame; *rel* is fps relative to N = 16 at the same stream size\n"
+           "(ours and the paper's Table 6), the shape to compare. *rays/kc* is rays traced per 1000 cycles\n"
+           "(the paper's: Table 1's rays per frame x Table 6's fps / 500 MHz). *stalled* is the share of\n"
+           "cycles in which nothing issued (the paper's: 1 - fps / no-stall fps). The cause columns are\n"
+           "percent of all cycles. Operation mix: percent of executed instructions in the paper's five\n"
+           "categories, with integer and control apart (the paper folds them into load and store).\n\n",
+           w, h, spp);
+    for (int si = 0; si < NSCENES; si++) {
+        Loaded *l = &scenes[si];
+        load(l, w, h, spp, 3);
+        int pc = paper_col[si];
+        printf("### %s (beside %s)\n\n", l->name, paper_name[si]);
+        printf("| M | N | cycles | fps | rel | paper rel | rays/kc | paper rays/kc | stalled | paper stalled | addr | bank | "
+               "align | icn | fu | dep | part | spad | scene | ctrl | load | store | comp | s/g | part | int | ctrl | paper mix |\n"
+               "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+        for (int mi = 0; mi < 2; mi++) {
+            int rays = mi ? 4096 : 1024;
+            Run runs[6];
+            for (int wi = 0; wi < 6; wi++) {
+                timed = 1;
+                run(l, widths[wi], rays, 0, CFG_WORKLOAD_PATH, 0, &runs[wi]);
+                timed = 0;
+            }
+            double paper_fps[6] = {0};
+            for (int wi = 0; wi < 6; wi++) {
+                int prow = widths[wi] == 8 ? 0 : widths[wi] == 12 ? 1 : widths[wi] == 16 ? 2 : -1;
+                if (prow < 0)
+                    continue;
+                char tmp[64];
+                snprintf(tmp, sizeof tmp, "%s", t6_paper[prow][mi]);
+                char *save = NULL, *tok = strtok_r(tmp, "/", &save);
+                for (int k = 0; k < pc && tok; k++)
+                    tok = strtok_r(NULL, "/", &save);
+                paper_fps[wi] = tok ? atof(tok) : 0.0;
+            }
+            const uint64_t c16 = runs[3].st.timing.cycles;
+            for (int wi = 0; wi < 6; wi++) {
+                Run *r = &runs[wi];
+                const TimingStats *t = &r->st.timing;
+                uint64_t nrays = r->st.rays_camera + r->st.rays_indirect + r->st.rays_shadow;
+                char prel[16] = "", prk[16] = "", pst[16] = "";
+                if (paper_fps[wi] > 0) {
+                    snprintf(prel, sizeof prel, "%.2f", paper_fps[wi] / paper_fps[3]);
+                    snprintf(prk, sizeof prk, "%.0f", 1000.0 * paper_rays[pc] * paper_fps[wi] / 500e6);
+                    snprintf(pst, sizeof pst, "%.0f", 100.0 * (1.0 - paper_fps[wi] / paper_max_fps[pc]));
+                }
+                uint64_t ops[ISA_C_COUNT] = {0}, all = 0;
+                for (int c = 0; c < ISA_C_COUNT; c++) {
+                    for (int k = 0; k < ISA_STAGE_COUNT; k++)
+                        ops[c] += r->st.core.ops[k][c];
+                    all += ops[c];
+                }
+                printf("| %s | %d | %llu | %.1f | %.2f | %s | %.1f | %s | %.0f | %s |", mi ? "64x64" : "32x32",
+                       widths[wi], (unsigned long long)t->cycles, t->cycles ? 500e6 / (double)t->cycles : 0.0,
+                       t->cycles ? (double)c16 / (double)t->cycles : 0.0, prel,
+                       t->cycles ? 1000.0 * (double)nrays / (double)t->cycles : 0.0, prk,
+                       pct(t->cycles - t->busy, t->cycles), pst);
+                for (int c = 0; c < TM_CAUSE_COUNT; c++)
+                    printf(" %.1f |", pct(t->stalls[c], t->cycles));
+                printf(" %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %s |\n", pct(ops[ISA_C_LOAD], all),
+                       pct(ops[ISA_C_STORE], all), pct(ops[ISA_C_COMPUTE], all), pct(ops[ISA_C_SCATGATH], all),
+                       pct(ops[ISA_C_PARTITION], all), pct(ops[ISA_C_INTEGER], all), pct(ops[ISA_C_CONTROL], all),
+                       mi && widths[wi] == 16 ? t5_paper[pc] : "");
+            }
+            for (int wi = 0; wi < 6; wi++)
+                func_stats_free(&runs[wi].st);
+            fflush(stdout);
+        }
+        printf("\n");
+    }
+}
+
 int main(int argc, char **argv)
 {
-    quick = argc > 1 && !strcmp(argv[1], "--quick");
+    int timing_only = 0;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--quick"))
+            quick = 1;
+        else if (!strcmp(argv[i], "--timing-only"))
+            timing_only = 1;
+    }
     double t0 = now();
     printf("# Validation data\n\n<!-- GENERATED by tools/validation.c (make validation); do not edit. "
            "docs/validation.md discusses these numbers. -->\n\n");
@@ -306,10 +412,13 @@ int main(int argc, char **argv)
            "stream.order = first (the stream follows its first ray's near child, as the papers' traversal\n"
            "does) unless a row says *ray*. Percent, rounded. Our scenes: cornell (36 triangles, 2 lights), sponza (66K triangles, textures,\n"
            "punctual lights), conference (331K triangles, 72 quad lights).\n\n");
-    table2();
-    table3();
-    specular();
-    diffuse();
+    if (!timing_only) {
+        table2();
+        table3();
+        specular();
+        diffuse();
+    }
+    timing_tables();
     fprintf(stderr, "validation: %.0f s\n", now() - t0);
     for (int i = 0; i < NSCENES; i++) {
         pack_free(&scenes[i].p);

@@ -337,7 +337,7 @@ want_rc 0; want_out "cost.png"
 for f in frame.png frame.exr report.txt report.json cost.png; do [ -s "$T/det1/$f" ] || no "missing $f"; done
 grep -qE '"mode":[[:space:]]+"detailed"' "$T/det1/report.json" 2>/dev/null || no "report.json: mode is not detailed"
 for k in cycles busy_cycles fps fps_no_stall clock_mhz stalls stall_shares cycles_by_stage stalls_by_stage \
-         cycles_by_generation utilization_timed units units_not_exercised bank_conflict_cycles hit_rate; do
+         cycles_by_generation timing_by_generation utilization_timed units units_not_exercised bank_conflict_cycles hit_rate; do
     grep -q "\"$k\"" "$T/det1/report.json" 2>/dev/null || no "report.json lacks $k"
 done
 grep -qE '"cycles":[[:space:]]+null' "$T/det1/report.json" && no "cycles is null in detailed mode"
