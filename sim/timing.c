@@ -228,6 +228,8 @@ const char *timing_error(const Timing *t)
 
 static inline void charge(Timing *t, int cause, uint64_t cycles, int stage, int gen)
 {
+    if (!cycles)
+        return;
     t->st.stalls[cause] += cycles;
     t->st.stage_stalls[stage][cause] += cycles;
     t->st.stage_cycles[stage] += cycles;
@@ -532,7 +534,8 @@ void timing_hook(void *ctx, const CoreRecord *rec)
     }
 
     /* 2. waits on units working ahead, and per-access issue cycles */
-    uint64_t extra[TM_CAUSE_COUNT] = {0};
+    uint64_t extra[TM_CAUSE_COUNT];       /* extra issue cycles by cause; valid where has_extra says */
+    unsigned has_extra = 0;
     int rb_cycles = 0;
     uint64_t ready = 0;          /* result time for memory loads (0: by unit latency) */
     int res_cause = TM_DATA_DEPENDENCY;
@@ -541,7 +544,10 @@ void timing_hook(void *ctx, const CoreRecord *rec)
         if (rec->naddr > 0) {
             at = agu_serve(t, rec->base, rec->naddr, rec->count, at, stage, gen);
             if (rec->base & (uint32_t)(t->p.rb_line - 1))
-                extra[TM_ALIGNMENT] += (uint64_t)t->p.align_cycles;
+                if (t->p.align_cycles) {
+                    extra[TM_ALIGNMENT] = (uint64_t)t->p.align_cycles;
+                    has_extra |= 1u << TM_ALIGNMENT;
+                }
         }
         break;
     case ISA_OP_SAPP:
@@ -552,7 +558,10 @@ void timing_hook(void *ctx, const CoreRecord *rec)
             t->dp = (Ivl){at, at + 1};
             t->st.icn_transfers++;
             if (rec->base & (uint32_t)(t->p.rb_line - 1))
-                extra[TM_ALIGNMENT] += (uint64_t)t->p.align_cycles;
+                if (t->p.align_cycles) {
+                    extra[TM_ALIGNMENT] = (uint64_t)t->p.align_cycles;
+                    has_extra |= 1u << TM_ALIGNMENT;
+                }
         }
         break;
     case ISA_OP_RGAT:
@@ -566,7 +575,10 @@ void timing_hook(void *ctx, const CoreRecord *rec)
             charge(t, TM_INTERCONNECT, g - at, stage, gen);
             at = g;
             t->dp = (Ivl){at, at + (uint64_t)rb_cycles};
-            extra[TM_BANK_CONFLICT] += (uint64_t)rb_cycles - 1;
+            if (rb_cycles > 1) {
+                extra[TM_BANK_CONFLICT] = (uint64_t)rb_cycles - 1;
+                has_extra |= 1u << TM_BANK_CONFLICT;
+            }
             t->st.rb_accesses++;
             t->st.rb_lines += (uint64_t)nl;
             t->st.rb_conflicted += rb_cycles > 1;
@@ -583,7 +595,10 @@ void timing_hook(void *ctx, const CoreRecord *rec)
                 lines[i] = rec->addr[i] >> t->spad_shift;
             int k = distinct(lines, rec->naddr, d);
             uint64_t cyc = ((uint64_t)k + (uint64_t)t->p.spad_ports - 1) / (uint64_t)t->p.spad_ports;
-            extra[TM_SCRATCHPAD] += cyc - 1;
+            if (cyc > 1) {
+                extra[TM_SCRATCHPAD] = cyc - 1;
+                has_extra |= 1u << TM_SCRATCHPAD;
+            }
             t->st.spad_accesses++;
             t->st.spad_lines += (uint64_t)k;
         }
@@ -594,8 +609,8 @@ void timing_hook(void *ctx, const CoreRecord *rec)
 
     /* 3. issue */
     uint64_t ext = 0;
-    for (int c = 0; c < TM_CAUSE_COUNT; c++)
-        if (extra[c]) {
+    for (int c = 0; has_extra && c < TM_CAUSE_COUNT; c++)
+        if (has_extra & (1u << c)) {
             charge(t, c, extra[c], stage, gen);
             ext += extra[c];
         }
