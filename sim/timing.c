@@ -378,9 +378,13 @@ static uint64_t agu_serve(Timing *t, uint32_t addr, uint32_t k, uint32_t avail, 
         at = e.ready;
     }
     /* Run ahead: fetch the stream's next vectors, up to the queue depth. */
-    uint32_t next = addr + 4 * k, left = avail - k;
+    uint32_t next = addr + 4 * k, left = avail > k ? avail - k : 0;
     for (int i = 0; i < t->aq_n; i++) {
         const AguEntry *q = &t->aq[(t->aq_head + i) % AGU_MAX];
+        if (q->addr != next || q->n > left) { /* the stream changed under the queue: keep what still fits */
+            t->aq_n = i;
+            break;
+        }
         next = q->addr + 4 * q->n;
         left -= q->n;
     }
