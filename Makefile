@@ -207,6 +207,10 @@ $(BUILD)/bench/detailed_speed: bench/detailed_speed.c $(BUILD)/libsfsim.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
 
+$(BUILD)/bench/speed_vs_error: bench/speed_vs_error.c $(BUILD)/libsfsim.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
+
 $(BUILD)/validation: tools/validation.c $(BUILD)/libsfsim.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
@@ -218,11 +222,12 @@ validation: deps
 
 bench: deps
 	@$(MAKE) --no-print-directory $(BUILD)/bench/core_speed $(BUILD)/bench/embree_xcheck $(BUILD)/bench/functional_speed \
-		$(BUILD)/bench/detailed_speed
+		$(BUILD)/bench/detailed_speed $(BUILD)/bench/speed_vs_error
 	$(BUILD)/bench/core_speed
 	$(BUILD)/bench/embree_xcheck
 	$(BUILD)/bench/functional_speed
 	$(BUILD)/bench/detailed_speed
+	$(BUILD)/bench/speed_vs_error out/bench
 
 # ---- the example `make run` executes --------------------------------------------------------
 # The default scene on the default machine in detailed mode, sized to take about a minute here

@@ -40,7 +40,7 @@ static int render(const PackedScene *p, uint32_t needs, int timed, int threads, 
     static char err[65536];
     CfgMachine cfg;
     cfg_defaults(&cfg);
-    FuncParams fp = {&cfg, "kernels/pathtrace.s", needs, 1, threads, NULL, NULL, NULL, NULL, timed};
+    FuncParams fp = {.cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .needs = needs, .seed = 1, .threads = threads, .timed = timed};
     FuncStats st;
     r->rgb = calloc(n, sizeof(float));
     double t0 = now();

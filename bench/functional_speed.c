@@ -77,7 +77,7 @@ int main(int argc, char **argv)
         double t1 = now();
         CfgMachine cfg;
         cfg_defaults(&cfg);
-        FuncParams fp = {&cfg, "kernels/pathtrace.s", s.needs, 1, 1, NULL, NULL, NULL, NULL, 0};
+        FuncParams fp = {.cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .needs = s.needs, .seed = 1, .threads = 1};
         FuncStats st;
         if (func_render(&p, &fp, fun, &st, err, sizeof err) != 0) {
             fprintf(stderr, "%s: %s\n", scenes[i], err);

@@ -7,6 +7,7 @@
  * tile's pixels come from its own run only).
  */
 #include "functional.h"
+#include "sampling.h"
 
 #include <limits.h>
 #include <math.h>
@@ -93,6 +94,7 @@ typedef struct Job {
     float *rgb;
     uint32_t width, height, tile_w, tile_h, tiles_x, ntiles, rays;
     FuncTile *tiles;
+    uint8_t *sel;              /* sampled mode: the tiles to time */
     atomic_uint next_tile, done_tiles;
     atomic_int failed;
     int trapped;               /* the failure was the kernel's (trap, limit, error code) */
@@ -104,6 +106,7 @@ typedef struct Worker {
     Job *job;
     FuncStats st;
     Timing *tm;                /* detailed mode */
+    int tile_timed;            /* the current tile is timed (every tile, or the sample) */
 } Worker;
 
 
@@ -134,9 +137,12 @@ static void fail(Job *j, const char *msg, int trapped)
 }
 
 /* Detailed mode: start a cold machine for one tile or batch. */
-static void timing_begin(Worker *w, TimingStats *before)
+static void timing_begin(Worker *w, Core *c, uint32_t t, TimingStats *before)
 {
-    if (w->tm) {
+    w->tile_timed = w->tm && (!w->job->sel || w->job->sel[t]);
+    if (w->tm)
+        core_set_hook(c, w->tile_timed ? timing_hook : NULL, w->tile_timed ? w->tm : NULL);
+    if (w->tile_timed) {
         timing_reset(w->tm);
         *before = *timing_stats(w->tm);
     }
@@ -145,8 +151,9 @@ static void timing_begin(Worker *w, TimingStats *before)
 /* Detailed mode: close the run and give its figures to the tile; -1 if the model failed. */
 static int timing_close(Worker *w, const TimingStats *before, FuncTile *ft)
 {
-    if (!w->tm)
+    if (!w->tile_timed)
         return 0;
+    ft->sampled = 1;
     timing_end(w->tm);
     const TimingStats *s = timing_stats(w->tm);
     if (ft) {
@@ -203,7 +210,7 @@ static int trace_batch(Worker *w, Core *c, uint32_t t, FuncStats *st)
         rb_set(rb, a->f_prim + 4 * i, UINT32_MAX);
     }
     TimingStats before;
-    timing_begin(w, &before);
+    timing_begin(w, c, t, &before);
     CoreExit ex = core_run(c, (uint64_t)j->fp->cfg->sim_max_instructions);
     FuncTile *ft = &j->tiles[t];
     ft->x0 = first;
@@ -269,9 +276,11 @@ static int run_tile(Worker *w, Core *c, uint32_t t, FuncStats *st)
     spad_set(c, a->l_seed, j->fp->seed);
     uint8_t *fb = core_mem(c, CORE_MEM_FB, &size);
     memset(fb, 0, (size_t)ft->w * ft->h * 12);
-    uint64_t before = core_instructions(c);
+    uint64_t before = core_instructions(c), lanes_before[ISA_STAGE_COUNT];
+    for (int k = 0; k < ISA_STAGE_COUNT; k++)
+        lanes_before[k] = core_stats(c)->active_lanes[k];
     TimingStats tbefore;
-    timing_begin(w, &tbefore);
+    timing_begin(w, c, t, &tbefore);
     CoreExit ex = core_run(c, (uint64_t)j->fp->cfg->sim_max_instructions);
     if (timing_close(w, &tbefore, ft))
         return -1;
@@ -295,6 +304,8 @@ static int run_tile(Worker *w, Core *c, uint32_t t, FuncStats *st)
         memcpy(&j->rgb[3 * ((size_t)(ft->y0 + y) * j->width + ft->x0)], fb + (size_t)12 * y * ft->w,
                (size_t)12 * ft->w);
     ft->instructions = core_instructions(c) - before;
+    for (int k = 0; k < ISA_STAGE_COUNT; k++)
+        ft->active_lanes[k] = core_stats(c)->active_lanes[k] - lanes_before[k];
     st->dropped += spad_u32(c, a->st_dropped);
     st->rays_camera += spad_u32(c, a->st_camera);
     st->rays_indirect += spad_u32(c, a->st_indirect);
@@ -540,6 +551,19 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
     if (fp->batch)
         job->ntiles = (fp->batch->count + rays - 1) / rays;
     job->tiles = calloc(job->ntiles ? job->ntiles : 1, sizeof(FuncTile));
+    if (fp->timed && fp->sample > 0.0) {
+        if (fp->batch || !(fp->sample <= 1.0)) {
+            snprintf(err, errlen, fp->batch ? "sampled mode renders frames, not ray batches"
+                                            : "sample fraction %g outside (0, 1]", fp->sample);
+            goto out;
+        }
+        job->sel = calloc(job->ntiles ? job->ntiles : 1, 1);
+        if (!job->sel) {
+            snprintf(err, errlen, "out of memory");
+            goto out;
+        }
+        sample_select(job->ntiles, fp->sample, fp->sample_seed, job->sel);
+    }
     atomic_init(&job->next_tile, 0u);
     atomic_init(&job->done_tiles, 0u);
     atomic_init(&job->failed, 0);
@@ -616,6 +640,8 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
     }
     if (fp->timed) {
         st->timed = 1;
+        for (uint32_t i = 0; i < job->ntiles; i++)
+            st->tiles_timed += job->tiles[i].sampled;
         if (timing_check(&st->timing, err, errlen) != 0)
             goto out;
     }
@@ -627,6 +653,7 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
 out:
     if (job) {
         free(job->tiles);
+        free(job->sel);
         pthread_mutex_destroy(&job->lock);
     }
     free(job);

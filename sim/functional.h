@@ -37,14 +37,20 @@ typedef struct FuncParams {
     /* Detailed mode: time every instruction on the machine of cfg (sim/timing.h). Each tile (or
      * trace batch) starts on a cold machine, so the cycles do not depend on the host threads. */
     int timed;
+    /* Sampled mode (with timed): only a seeded random sample of this fraction of the tiles is
+     * timed (sim/sampling.h); the others run on the functional core alone. 0 = every tile. */
+    double sample;
+    uint32_t sample_seed;
 } FuncParams;
 
 typedef struct FuncTile {
     uint32_t x0, y0, w, h;
     uint64_t instructions;
     uint64_t rays;             /* traced, all kinds */
-    uint64_t cycles, busy;     /* detailed mode */
+    uint64_t cycles, busy;     /* detailed mode (sampled mode: the sampled tiles) */
     uint64_t stalls[TM_CAUSE_COUNT];
+    uint8_t sampled;           /* timed: every tile in detailed mode, the sample in sampled mode */
+    uint64_t active_lanes[ISA_STAGE_COUNT]; /* per stage (for sampled mode's utilization) */
 } FuncTile;
 
 typedef struct FuncStats {
@@ -63,7 +69,8 @@ typedef struct FuncStats {
     uint32_t tile_w, tile_h;                        /* pixels (= rays) of a stream's tile */
     char defines[512];                              /* the -D symbols the kernel was built with */
     int timed;                                      /* detailed mode: timing holds the sums */
-    TimingStats timing;
+    TimingStats timing;                             /* (sampled mode: of the sampled tiles) */
+    uint32_t tiles_timed;
 } FuncStats;
 
 /* Render the whole image through the kernel: rgb (width * height * 3 floats, zeroed by the

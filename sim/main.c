@@ -38,6 +38,7 @@ static void usage(FILE *out)
             "  config   list the machine-config keys (--dump) or write their reference (--markdown)\n"
             "  compare  compare two images: RMSE, PSNR, largest difference, NaN/Inf counts\n"
             "  trace    closest-hit / any-hit queries for a file of rays, through the kernel or the golden model\n"
+
             "  help     help on a command: sfsim help exec\n"
             "\n"
             "options everywhere: --help, --version\n"
@@ -80,7 +81,7 @@ static void usage_config(FILE *out)
 static void usage_run(FILE *out)
 {
     fprintf(out,
-            "usage: sfsim run [-s SCENE] [-o DIR] [-c CONFIG] [--mode detailed|functional|reference] [options]\n"
+            "usage: sfsim run [-s SCENE] [-o DIR] [-c CONFIG] [--mode detailed|sampled|functional|reference] [options]\n"
             "\n"
             "Renders SCENE (a .gltf/.glb file or a scene.ini) and writes DIR/frame.exr (linear),\n"
             "DIR/frame.png (tone-mapped sRGB), DIR/report.json and DIR/report.txt, and in detailed\n"
@@ -91,6 +92,9 @@ static void usage_run(FILE *out)
             "              with the cycle-accurate timing model of the machine in CONFIG: cycles, fps,\n"
             "              stalls by cause, per stage, generation and tile, the units' counters\n"
             "              (docs/model.md); the same image bits as functional mode\n"
+            "  sampled     detailed timing on a seeded random sample of the tiles (--sample F, default\n"
+            "              0.05), the functional core alone on the rest; cycles and fps estimated with a 95%%\n"
+            "              confidence interval (docs/sampling.md); the same image bits\n"
             "  functional  the kernel executed instruction by instruction, no timing (fastest\n"
             "              simulation): operation mix, SIMD utilization and stream lengths per stage\n"
             "  reference   the golden model: a plain C path tracer over the packed scene memory\n"
@@ -104,7 +108,9 @@ static void usage_run(FILE *out)
             "  -j, --threads N          host threads (default: all cores; results do not change)\n"
             "  --exposure X             scale before tone mapping frame.png (default 1)\n"
             "  --no-progress            no progress bar (it is shown only on a terminal anyway)\n"
-            "  --kernel FILE            detailed and functional modes: the kernel source (default:\n"
+            "  --sample F               sampled mode: the fraction of tiles timed, (0, 1] (default 0.05)\n"
+            "  --sample-seed S          sampled mode: which tiles (default 1)\n"
+            "  --kernel FILE            kernel modes: the kernel source (default:\n"
             "                           kernels/pathtrace.s beside the executable's folder, or $SFSIM_KERNEL)\n");
 }
 
@@ -488,6 +494,7 @@ static int cmd_run(int argc, char **argv)
     o.out_dir = "out";
     o.progress = isatty(2);
     const char *mode = "detailed";
+    int sample_given = 0;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         int has_next = i + 1 < argc;
@@ -514,6 +521,19 @@ static int cmd_run(int argc, char **argv)
                 fprintf(stderr, "sfsim run: --exposure %s: expected a positive number\n", argv[i]);
                 return EXIT_USAGE;
             }
+        } else if (!strcmp(a, "--sample") && has_next) {
+            char *end;
+            o.sample = strtod(argv[++i], &end);
+            if (*end || !(o.sample > 0.0 && o.sample <= 1.0)) {
+                fprintf(stderr, "sfsim run: --sample %s: expected a fraction of the tiles in (0, 1], e.g. 0.05\n",
+                        argv[i]);
+                return EXIT_USAGE;
+            }
+            sample_given = 1;
+        } else if (!strcmp(a, "--sample-seed") && has_next) {
+            if (parse_int(a, argv[++i], 0, 4294967295L, &v))
+                return EXIT_USAGE;
+            o.sample_seed = (uint32_t)v;
         } else if (!strcmp(a, "--no-progress")) {
             o.progress = 0;
         } else if (!strcmp(a, "--kernel") && has_next) {
@@ -544,8 +564,14 @@ static int cmd_run(int argc, char **argv)
             return EXIT_USAGE;
         }
     }
-    if (strcmp(mode, "reference") != 0 && strcmp(mode, "functional") != 0 && strcmp(mode, "detailed") != 0) {
-        fprintf(stderr, "sfsim run: --mode %s: expected detailed, functional or reference (sfsim help run)\n", mode);
+    if (strcmp(mode, "reference") != 0 && strcmp(mode, "functional") != 0 && strcmp(mode, "detailed") != 0 &&
+        strcmp(mode, "sampled") != 0) {
+        fprintf(stderr, "sfsim run: --mode %s: expected detailed, sampled, functional or reference (sfsim help run)\n",
+                mode);
+        return EXIT_USAGE;
+    }
+    if (sample_given && strcmp(mode, "sampled") != 0) {
+        fprintf(stderr, "sfsim run: --sample applies to --mode sampled only (sfsim help run)\n");
         return EXIT_USAGE;
     }
     o.mode = mode;
@@ -563,7 +589,7 @@ static int cmd_run(int argc, char **argv)
         return rrc == -2 ? EXIT_TRAP : EXIT_INPUT;
     }
     printf("sfsim run: wrote %s/frame.png, frame.exr, report.txt, report.json%s\n", o.out_dir,
-           !strcmp(mode, "detailed") ? ", cost.png" : "");
+           !strcmp(mode, "detailed") || !strcmp(mode, "sampled") ? ", cost.png" : "");
     return EXIT_OK;
 }
 

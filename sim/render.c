@@ -24,6 +24,7 @@
 #include "functional.h"
 #include "heatmap.h"
 #include "reference.h"
+#include "sampling.h"
 #include "timing.h"
 
 void render_default_options(RenderOptions *o)
@@ -36,7 +37,9 @@ void render_default_options(RenderOptions *o)
     o->bvh_leaf_size = 4;
     o->bvh_bins = 16;
     o->exposure = 1.0f;
-    o->mode = "reference";
+    o->mode = "detailed";
+    o->sample = 0.05;
+    o->sample_seed = 1;
 }
 
 static double now(void)
@@ -265,21 +268,78 @@ static void add_functional_json(cJSON *root, const RunStats *rs, const CfgMachin
     cJSON_AddNumberToObject(cf, "sim.max_instructions", (double)cfg->sim_max_instructions);
 }
 
-/* Detailed mode: the timing fields of report.json (names: ARCHITECTURE.md Sec. 1; docs/report.md). */
-static void add_timing_json(cJSON *root, const FuncStats *f, const CfgMachine *cfg)
+/* Active lanes of a stage over the timed tiles (all tiles in detailed mode, the sample in sampled
+ * mode), so that timed utilization compares like with like. */
+static uint64_t timed_lanes(const FuncStats *f, int stage)
+{
+    uint64_t s = 0;
+    for (uint32_t i = 0; i < f->ntiles; i++)
+        if (f->tiles[i].sampled)
+            s += f->tiles[i].active_lanes[stage];
+    return s;
+}
+
+/* The frame's timing figures: measured (detailed mode), or estimated from the sampled tiles
+ * (sampled mode: est != NULL). Busy cycles are one per instruction, known for every tile. */
+typedef struct FrameTiming {
+    double cycles, busy, fps, fps_no_stall;
+    double cycles_lo, cycles_hi, fps_lo, fps_hi;   /* sampled mode: the 95 % intervals */
+} FrameTiming;
+
+static FrameTiming frame_timing(const FuncStats *f, const CfgMachine *cfg, const SampleEstimate *est)
+{
+    FrameTiming ft;
+    double hz = cfg->core_clock_mhz * 1e6;
+    ft.cycles = est ? est->total : (double)f->timing.cycles;
+    ft.busy = est ? (double)f->instructions : (double)f->timing.busy;
+    ft.cycles_lo = est ? est->lo : ft.cycles;
+    ft.cycles_hi = est ? est->hi : ft.cycles;
+    ft.fps = ft.cycles > 0 ? hz / ft.cycles : 0.0;
+    ft.fps_no_stall = ft.busy > 0 ? hz / ft.busy : 0.0;
+    ft.fps_lo = ft.cycles_hi > 0 ? hz / ft.cycles_hi : 0.0;
+    ft.fps_hi = ft.cycles_lo > 0 ? hz / ft.cycles_lo : 0.0;
+    return ft;
+}
+
+/* Detailed and sampled modes: the timing fields of report.json (names: ARCHITECTURE.md Sec. 1;
+ * docs/report.md). In sampled mode the frame figures are estimates and the breakdowns (stages,
+ * generations, units) are those of the sampled tiles; stall cycles are the sample's shares of the
+ * estimated cycles. */
+static void add_timing_json(cJSON *root, const FuncStats *f, const CfgMachine *cfg, const SampleEstimate *est,
+                            double fraction, uint32_t seed)
 {
     const TimingStats *t = &f->timing;
-    double hz = cfg->core_clock_mhz * 1e6;
-    cJSON_ReplaceItemInObject(root, "cycles", cJSON_CreateNumber((double)t->cycles));
-    cJSON_ReplaceItemInObject(root, "busy_cycles", cJSON_CreateNumber((double)t->busy));
-    cJSON_ReplaceItemInObject(root, "fps", cJSON_CreateNumber(t->cycles ? hz / (double)t->cycles : 0.0));
-    cJSON_ReplaceItemInObject(root, "fps_no_stall", cJSON_CreateNumber(t->busy ? hz / (double)t->busy : 0.0));
+    FrameTiming ft = frame_timing(f, cfg, est);
+    cJSON_ReplaceItemInObject(root, "cycles", cJSON_CreateNumber(round(ft.cycles)));
+    cJSON_ReplaceItemInObject(root, "busy_cycles", cJSON_CreateNumber(ft.busy));
+    cJSON_ReplaceItemInObject(root, "fps", cJSON_CreateNumber(ft.fps));
+    cJSON_ReplaceItemInObject(root, "fps_no_stall", cJSON_CreateNumber(ft.fps_no_stall));
     cJSON_AddNumberToObject(root, "clock_mhz", cfg->core_clock_mhz);
+    if (est) {
+        cJSON *cc = cJSON_AddArrayToObject(root, "cycles_ci95");
+        cJSON_AddItemToArray(cc, cJSON_CreateNumber(round(ft.cycles_lo)));
+        cJSON_AddItemToArray(cc, cJSON_CreateNumber(round(ft.cycles_hi)));
+        cJSON *fc = cJSON_AddArrayToObject(root, "fps_ci95");
+        cJSON_AddItemToArray(fc, cJSON_CreateNumber(ft.fps_lo));
+        cJSON_AddItemToArray(fc, cJSON_CreateNumber(ft.fps_hi));
+        cJSON *sm = cJSON_AddObjectToObject(root, "sample");
+        cJSON_AddNumberToObject(sm, "fraction", fraction);
+        cJSON_AddNumberToObject(sm, "seed", seed);
+        cJSON_AddNumberToObject(sm, "tiles", est->N);
+        cJSON_AddNumberToObject(sm, "tiles_sampled", est->n);
+        cJSON_AddStringToObject(sm, "estimator", "ratio of cycles to instructions (docs/sampling.md)");
+        cJSON_AddNumberToObject(sm, "confidence", 0.95);
+        cJSON_AddNumberToObject(sm, "t", est->t);
+        cJSON_AddNumberToObject(sm, "std_error_cycles", est->std_error);
+        cJSON_AddNumberToObject(sm, "cycles_per_instruction", est->ratio);
+        cJSON_AddNumberToObject(sm, "sampled_cycles", (double)t->cycles);
+    }
     cJSON *st = cJSON_AddObjectToObject(root, "stalls");
     cJSON *sh = cJSON_AddObjectToObject(root, "stall_shares");
     for (int c = 0; c < TM_CAUSE_COUNT; c++) {
-        cJSON_AddNumberToObject(st, tm_cause_keys[c], (double)t->stalls[c]);
-        cJSON_AddNumberToObject(sh, tm_cause_keys[c], ratio(t->stalls[c], t->cycles));
+        double share = ratio(t->stalls[c], t->cycles);
+        cJSON_AddNumberToObject(st, tm_cause_keys[c], est ? round(share * ft.cycles) : (double)t->stalls[c]);
+        cJSON_AddNumberToObject(sh, tm_cause_keys[c], share);
     }
     cJSON *cs = cJSON_AddObjectToObject(root, "cycles_by_stage");
     cJSON *ss = cJSON_AddObjectToObject(root, "stalls_by_stage");
@@ -298,7 +358,7 @@ static void add_timing_json(cJSON *root, const FuncStats *f, const CfgMachine *c
         /* Lanes doing work over the lane-cycles of the stage's vector issue and stall cycles:
          * the paper's utilization with the overheads of address fetch, alignment, partition. */
         cJSON_AddNumberToObject(ut, isa_stage_keys[k],
-                                ratio(f->core.active_lanes[k], (uint64_t)n * (t->stage_vec_busy[k] + stalls)));
+                                ratio(timed_lanes(f, k), (uint64_t)n * (t->stage_vec_busy[k] + stalls)));
     }
     cJSON *cg = cJSON_AddArrayToObject(root, "cycles_by_generation");
     cJSON *tg = cJSON_AddArrayToObject(root, "timing_by_generation");
@@ -357,17 +417,26 @@ static void add_timing_json(cJSON *root, const FuncStats *f, const CfgMachine *c
     }
 }
 
-/* Detailed mode: report.txt lines for the timing. */
-static int timing_text(char *txt, size_t cap, const FuncStats *f, const CfgMachine *cfg)
+/* Detailed and sampled modes: report.txt lines for the timing. */
+static int timing_text(char *txt, size_t cap, const FuncStats *f, const CfgMachine *cfg, const SampleEstimate *est)
 {
     const TimingStats *t = &f->timing;
-    double hz = cfg->core_clock_mhz * 1e6;
-    int len = snprintf(txt, cap,
+    FrameTiming ft = frame_timing(f, cfg, est);
+    int len;
+    if (est)
+        len = snprintf(txt, cap,
+                       "cycles       ~%.0f (95%%: %.0f .. %.0f) = %.0f busy + ~%.0f stalled; estimated from %u of %u tiles\n"
+                       "fps          ~%.2f (95%%: %.2f .. %.2f) at %g MHz (%.2f fps with no stalls)\n"
+                       "sample       the shares and unit lines below are those of the %u sampled tiles (docs/sampling.md)\n"
+                       "stalls      ",
+                       ft.cycles, ft.cycles_lo, ft.cycles_hi, ft.busy, ft.cycles - ft.busy, est->n, est->N, ft.fps,
+                       ft.fps_lo, ft.fps_hi, cfg->core_clock_mhz, ft.fps_no_stall, est->n);
+    else
+        len = snprintf(txt, cap,
                        "cycles       %llu = %llu busy + %llu stalled; %.2f fps at %g MHz (%.2f fps with no stalls)\n"
                        "stalls      ",
                        (unsigned long long)t->cycles, (unsigned long long)t->busy,
-                       (unsigned long long)(t->cycles - t->busy), t->cycles ? hz / (double)t->cycles : 0.0,
-                       cfg->core_clock_mhz, t->busy ? hz / (double)t->busy : 0.0);
+                       (unsigned long long)(t->cycles - t->busy), ft.fps, cfg->core_clock_mhz, ft.fps_no_stall);
     for (int c = 0; c < TM_CAUSE_COUNT; c++)
         len += snprintf(txt + len, cap - (size_t)len, " %s %.1f%%%s", tm_cause_keys[c],
                         100.0 * ratio(t->stalls[c], t->cycles), c + 1 < TM_CAUSE_COUNT ? "," : "  (of all cycles)\n");
@@ -381,7 +450,7 @@ static int timing_text(char *txt, size_t cap, const FuncStats *f, const CfgMachi
         for (int c = 0; c < TM_CAUSE_COUNT; c++)
             stalls += t->stage_stalls[k][c];
         len += snprintf(txt + len, cap - (size_t)len, " %s %.1f%%%s", isa_stage_keys[k],
-                        100.0 * ratio(f->core.active_lanes[k],
+                        100.0 * ratio(timed_lanes(f, k),
                                       (uint64_t)cfg->core_simd_width * (t->stage_vec_busy[k] + stalls)),
                         k + 1 < ISA_STAGE_COUNT ? "," : "  (timed: stall cycles count as idle lanes)\n");
     }
@@ -410,8 +479,10 @@ static int timing_text(char *txt, size_t cap, const FuncStats *f, const CfgMachi
     return len;
 }
 
-/* Detailed mode: cost.png, simulated cycles per pixel of each tile. */
-static int write_cost_map(const char *dir, const FuncStats *f, int width, int height, char *err, size_t errlen)
+/* Detailed and sampled modes: cost.png, simulated cycles per pixel of each tile (sampled mode:
+ * tiles not sampled get the sample's cycles per instruction times their instructions). */
+static int write_cost_map(const char *dir, const FuncStats *f, const SampleEstimate *est, int width, int height,
+                          char *err, size_t errlen)
 {
     /* One value per pixel; an image wider or taller than the heat map takes (8192) is drawn one
      * value per tile instead (the values are per tile either way). */
@@ -428,7 +499,8 @@ static int write_cost_map(const char *dir, const FuncStats *f, int width, int he
     }
     for (uint32_t i = 0; i < f->ntiles; i++) {
         const FuncTile *t = &f->tiles[i];
-        double per = t->w && t->h ? (double)t->cycles / ((double)t->w * t->h) : 0.0;
+        double cyc = t->sampled || !est ? (double)t->cycles : est->ratio * (double)t->instructions;
+        double per = t->w && t->h ? cyc / ((double)t->w * t->h) : 0.0;
         for (uint32_t y = t->y0; y < t->y0 + t->h && y < (uint32_t)height; y += (uint32_t)scale_y)
             for (uint32_t x = t->x0; x < t->x0 + t->w && x < (uint32_t)width; x += (uint32_t)scale_x)
                 v[(size_t)(y / (uint32_t)scale_y) * (size_t)mw + x / (uint32_t)scale_x] = per;
@@ -437,7 +509,8 @@ static int write_cost_map(const char *dir, const FuncStats *f, int width, int he
     height = mh;
     char path[4200], title[128];
     snprintf(path, sizeof path, "%s/cost.png", dir);
-    snprintf(title, sizeof title, "simulated cycles per pixel (tiles of %u x %u)", f->tile_w, f->tile_h);
+    snprintf(title, sizeof title, "simulated cycles per pixel (tiles of %u x %u%s)", f->tile_w, f->tile_h,
+             est ? "; unsampled tiles estimated" : "");
     int rc = heatmap_write(path, v, width, height, title, "cycles", err, errlen);
     free(v);
     return rc;
@@ -457,12 +530,17 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     CfgMachine defcfg;
     cfg_defaults(&defcfg);
     const CfgMachine *cfg = o->cfg ? o->cfg : &defcfg;
-    int detailed = !strcmp(o->mode, "detailed");
-    int functional = detailed || !strcmp(o->mode, "functional");
+    int detailed = !strcmp(o->mode, "detailed"), sampled = !strcmp(o->mode, "sampled");
+    int functional = detailed || sampled || !strcmp(o->mode, "functional");
     if (!functional && strcmp(o->mode, "reference") != 0) {
-        snprintf(err, errlen, "--mode %s: this build renders with --mode detailed, functional or reference", o->mode);
+        snprintf(err, errlen, "--mode %s: expected detailed, sampled, functional or reference", o->mode);
         return -1;
     }
+    if (sampled && !(o->sample > 0.0 && o->sample <= 1.0)) {
+        snprintf(err, errlen, "--sample %g: expected a fraction of the tiles in (0, 1]", o->sample);
+        return -1;
+    }
+    SampleEstimate est_store, *est = NULL;
     double t0 = now();
     if (scene_load(o->scene_path, &s, err, errlen) != 0)
         return -1;
@@ -487,8 +565,16 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     int tile = (int)lrint(sqrt((double)o->stream_rays));
     if (functional) {
         char kpath[4200];
-        FuncParams fp = {cfg, o->kernel_path ? o->kernel_path : func_default_kernel(kpath, sizeof kpath),
-                         s.needs, o->seed, threads, progress_cb, &pr, NULL, NULL, detailed};
+        FuncParams fp = {.cfg = cfg,
+                         .kernel_path = o->kernel_path ? o->kernel_path : func_default_kernel(kpath, sizeof kpath),
+                         .needs = s.needs,
+                         .seed = o->seed,
+                         .threads = threads,
+                         .progress = progress_cb,
+                         .progress_ctx = &pr,
+                         .timed = detailed || sampled,
+                         .sample = sampled ? o->sample : 0.0,
+                         .sample_seed = o->sample_seed};
         int frc = func_render(&p, &fp, rgb, &rs.f, err, errlen);
         if (frc == -2) {
             /* The kernel failed in a tile: keep what the finished tiles rendered, marked partial;
@@ -523,6 +609,30 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
             goto out;
         }
         rs.functional = 1;
+        if (sampled) {
+            /* The frame's cycles from the sampled tiles (sim/sampling.h). */
+            uint32_t nt = rs.f.ntiles;
+            double *y = calloc(nt ? nt : 1, sizeof *y), *x = calloc(nt ? nt : 1, sizeof *x);
+            uint8_t *sel = calloc(nt ? nt : 1, 1);
+            int erc = -1;
+            if (y && x && sel) {
+                for (uint32_t i = 0; i < nt; i++) {
+                    y[i] = (double)rs.f.tiles[i].cycles;
+                    x[i] = (double)rs.f.tiles[i].instructions;
+                    sel[i] = rs.f.tiles[i].sampled;
+                }
+                erc = sample_ratio_estimate(y, x, sel, nt, &est_store);
+            }
+            free(y);
+            free(x);
+            free(sel);
+            if (erc != 0) {
+                snprintf(err, errlen, "sampled mode: cannot estimate from %u sampled of %u tiles (the frame needs at "
+                         "least 2 tiles; render more pixels or use --mode detailed)", rs.f.tiles_timed, nt);
+                goto out;
+            }
+            est = &est_store;
+        }
         rs.primary = rs.f.rays_camera;
         rs.shadow = rs.f.rays_shadow;
         rs.indirect = rs.f.rays_indirect;
@@ -583,8 +693,8 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         cJSON_AddItemToArray(gens, cJSON_CreateNumber((double)rs.per_gen[g]));
     if (functional) {
         add_functional_json(root, &rs, cfg);
-        if (detailed)
-            add_timing_json(root, &rs.f, cfg);
+        if (detailed || sampled)
+            add_timing_json(root, &rs.f, cfg, est, o->sample, o->sample_seed);
     } else {
         cJSON *trav = cJSON_AddObjectToObject(root, "traversal");
         cJSON_AddNumberToObject(trav, "nodes_visited", (double)rs.nodes_visited);
@@ -649,6 +759,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
              "rays         %llu total: %llu primary, %llu shadow, %llu indirect; %llu dropped\n",
              o->mode,
              detailed     ? "the kernel on the timing model of the machine"
+             : sampled    ? "the kernel; sampled tiles on the timing model, the frame's cycles estimated"
              : functional ? "the kernel on the functional core: no timing"
                           : "golden model: no timing",
              o->scene_path, s.ntris, s.nspheres, p.nlights, needs[0] ? needs : "-", p.bvh.nnodes,
@@ -681,8 +792,8 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
                             100.0 * ratio(f->core.active_lanes[k],
                                           (uint64_t)cfg->core_simd_width * f->core.vec_instructions[k]),
                             k + 1 < ISA_STAGE_COUNT ? ", " : "  (active lanes / (N x vector instructions))\n");
-        if (detailed)
-            len += timing_text(txt + len, sizeof txt - (size_t)len, f, cfg);
+        if (detailed || sampled)
+            len += timing_text(txt + len, sizeof txt - (size_t)len, f, cfg, est);
         len += snprintf(txt + len, sizeof txt - (size_t)len,
                         "streams      mean length: traversal %.1f, intersection %.1f, shading %.1f rays\n"
                         "host         %.2f s on %d threads: %.2f M instructions/s, %.3f M rays/s; load %.2f s, BVH+pack %.2f s\n",
@@ -700,7 +811,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     snprintf(path, sizeof path, "%s/report.txt", o->out_dir);
     if (write_text(path, txt, err, errlen) != 0)
         goto out;
-    if (detailed && write_cost_map(o->out_dir, &rs.f, s.render.width, s.render.height, err, errlen) != 0)
+    if ((detailed || sampled) && write_cost_map(o->out_dir, &rs.f, est, s.render.width, s.render.height, err, errlen) != 0)
         goto out;
     rc = 0;
 out:

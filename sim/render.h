@@ -20,9 +20,11 @@ typedef struct RenderOptions {
     int bvh_leaf_size, bvh_bins;
     float exposure;            /* for frame.png */
     int progress;              /* 1: progress bar on stderr (the CLI sets it when stderr is a tty) */
-    const char *mode;          /* "reference" or "functional" */
+    const char *mode;          /* "detailed", "sampled", "functional" or "reference" */
     const struct CfgMachine *cfg; /* the machine (functional mode; NULL: defaults) */
-    const char *kernel_path;   /* functional mode: the kernel source (NULL: next to the binary) */
+    const char *kernel_path;   /* kernel modes: the kernel source (NULL: next to the binary) */
+    double sample;             /* sampled mode: the fraction of tiles timed, (0, 1] */
+    uint32_t sample_seed;      /* sampled mode: which tiles */
 } RenderOptions;
 
 void render_default_options(RenderOptions *o);

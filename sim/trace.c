@@ -58,8 +58,14 @@ int trace_batch_run(const PackedScene *p, uint32_t needs, const RayBatch *b, Bat
         return -1;
     }
     char kpath[4200];
-    FuncParams fp = {cfg, kernel_path ? kernel_path : func_default_kernel(kpath, sizeof kpath), needs, 1, threads,
-                     NULL, NULL, b, hits, detailed};
+    FuncParams fp = {.cfg = cfg,
+                     .kernel_path = kernel_path ? kernel_path : func_default_kernel(kpath, sizeof kpath),
+                     .needs = needs,
+                     .seed = 1,
+                     .threads = threads,
+                     .batch = b,
+                     .hits = hits,
+                     .timed = detailed};
     FuncStats st;
     int rc = func_trace(p, &fp, &st, err, errlen);
     if (rc == 0 && sim_instructions)

@@ -84,7 +84,7 @@ static void run(Loaded *l, int lanes, int rays, int packet, int workload, int bo
     size_t n = 3 * (size_t)l->s.render.width * l->s.render.height;
     float *rgb = calloc(n, sizeof(float));
     static char err[65536];
-    FuncParams fp = {&cfg, "kernels/pathtrace.s", l->s.needs, 1, 2, NULL, NULL, NULL, NULL, timed};
+    FuncParams fp = {.cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .needs = l->s.needs, .seed = 1, .threads = 2, .timed = timed};
     if (!rgb || func_render(&l->p, &fp, rgb, &r->st, err, sizeof err) != 0) {
         fprintf(stderr, "%s: %s\n", l->name, err);
         exit(1);

@@ -365,6 +365,38 @@ run "$SFSIM" run -s scenes/cornell/scene.ini -o "$T/det3" --set scene.cache_kb=1
 want_rc 1; want_err "scene.cache_kb"
 end
 
+begin "sfsim run --mode sampled: same image, an interval; --sample 1 gives detailed mode's cycles"
+run "$SFSIM" run -s scenes/cornell/scene.ini -o "$T/det4" --set render.width=96 --set render.height=64 \
+    --set render.spp=1 --set stream.rays=1024 -j 2 --no-progress
+want_rc 0
+run "$SFSIM" run --mode sampled --sample 0.5 -s scenes/cornell/scene.ini -o "$T/samp1" --set render.width=96 \
+    --set render.height=64 --set render.spp=1 --set stream.rays=1024 -j 2 --no-progress
+want_rc 0; want_out "cost.png"
+grep -qE '"mode":[[:space:]]+"sampled"' "$T/samp1/report.json" 2>/dev/null || no "report.json: mode is not sampled"
+for k in fps_ci95 cycles_ci95 sample tiles_sampled cycles_per_instruction; do
+    grep -q "\"$k\"" "$T/samp1/report.json" 2>/dev/null || no "report.json lacks $k"
+done
+grep -qE '^cycles +~[0-9]+ \(95%: [0-9]+ \.\. [0-9]+\).*estimated from 3 of 6 tiles' "$T/samp1/report.txt" 2>/dev/null \
+    || no "report.txt has no estimated cycles line"
+run "$SFSIM" compare "$T/det4/frame.exr" "$T/samp1/frame.exr"
+want_rc 0; want_out "max diff +0$"
+run "$SFSIM" run --mode sampled --sample 1 -s scenes/cornell/scene.ini -o "$T/samp2" --set render.width=96 \
+    --set render.height=64 --set render.spp=1 --set stream.rays=1024 -j 2 --no-progress
+want_rc 0
+cd4=$(grep -E '^cycles +[0-9]' "$T/det4/report.txt" 2>/dev/null | sed -E 's/^cycles +([0-9]+).*/\1/')
+cs2=$(grep -E '^cycles +~' "$T/samp2/report.txt" 2>/dev/null | sed -E 's/^cycles +~([0-9]+) \(95%: ([0-9]+) \.\. ([0-9]+)\).*/\1 \2 \3/')
+[ -n "$cd4" ] && [ "$cs2" = "$cd4 $cd4 $cd4" ] || no "sampling every tile: '$cs2', detailed: '$cd4'"
+end
+
+begin "sfsim run: bad --sample values are usage errors (exit 2)"
+run "$SFSIM" run --mode sampled --sample 0 -o "$T/samp3"
+want_rc 2; want_err "--sample 0"
+run "$SFSIM" run --mode sampled --sample 1.5 -o "$T/samp3"
+want_rc 2; want_err "\(0, 1\]"
+run "$SFSIM" run --sample 0.1 -o "$T/samp3"
+want_rc 2; want_err "--mode sampled only"
+end
+
 begin "sfsim exec --timing prints the cycles of a micro-benchmark (kernels/bench/branch.s: 10 cycles)"
 run "$SFASM" kernels/bench/branch.s -o "$T/branch.sfo"
 want_rc 0

@@ -239,7 +239,7 @@ static float *render_kernel(Scene *s, uint32_t seed)
     float *rgb = calloc(n, sizeof(float));
     CfgMachine cfg;
     cfg_defaults(&cfg);
-    FuncParams fp = {&cfg, "kernels/pathtrace.s", s->needs, seed, 2, NULL, NULL, NULL, NULL, 0};
+    FuncParams fp = {.cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .needs = s->needs, .seed = seed, .threads = 2};
     FuncStats st;
     static char ferr[65536];
     cr_assert_eq(func_render(&p, &fp, rgb, &st, ferr, sizeof ferr), 0, "%s", ferr);

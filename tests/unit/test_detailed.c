@@ -44,7 +44,7 @@ static float *render(const CfgMachine *cfg, int threads, int timed, FuncStats *s
     size_t n = 3 * (size_t)scene.render.width * scene.render.height;
     float *rgb = calloc(n, sizeof *rgb);
     static char err[65536];
-    FuncParams fp = {cfg, "kernels/pathtrace.s", scene.needs, 1, threads, NULL, NULL, NULL, NULL, timed};
+    FuncParams fp = {.cfg = cfg, .kernel_path = "kernels/pathtrace.s", .needs = scene.needs, .seed = 1, .threads = threads, .timed = timed};
     cr_assert_eq(func_render(&packed, &fp, rgb, st, err, sizeof err), 0, "%s", err);
     return rgb;
 }

@@ -46,7 +46,7 @@ static Img kernel_cfg(const PackedScene *p, uint32_t needs, int w, int h, const 
 {
     Img im = {calloc(3 * (size_t)w * h, sizeof(float)), w, h};
     static char err[65536];
-    FuncParams fp = {cfg, "kernels/pathtrace.s", needs, 1, threads, NULL, NULL, NULL, NULL, 0};
+    FuncParams fp = {.cfg = cfg, .kernel_path = "kernels/pathtrace.s", .needs = needs, .seed = 1, .threads = threads};
     cr_assert_eq(func_render(p, &fp, im.rgb, st, err, sizeof err), 0, "%s", err);
     return im;
 }
@@ -257,7 +257,7 @@ Test(functional, machines_too_small_for_the_kernel_are_refused_by_key)
         float *rgb = calloc(3 * 16 * 16, sizeof(float));
         char err[4096];
         FuncStats st;
-        FuncParams fp = {&cfg, "kernels/pathtrace.s", s.needs, 1, 1, NULL, NULL, NULL, NULL, 0};
+        FuncParams fp = {.cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .needs = s.needs, .seed = 1, .threads = 1};
         cr_expect_neq(func_render(&p, &fp, rgb, &st, err, sizeof err), 0, "%s: accepted", cases[i].key);
         cr_expect(strstr(err, cases[i].want) != NULL, "%s: message '%s' does not name %s", cases[i].key, err,
                   cases[i].want);
@@ -277,7 +277,7 @@ Test(functional, a_missing_kernel_is_an_error_naming_it)
     float *rgb = calloc(3 * 16 * 16, sizeof(float));
     char err[4096];
     FuncStats st;
-    FuncParams fp = {&cfg, "kernels/no_such_kernel.s", s.needs, 1, 1, NULL, NULL, NULL, NULL, 0};
+    FuncParams fp = {.cfg = &cfg, .kernel_path = "kernels/no_such_kernel.s", .needs = s.needs, .seed = 1, .threads = 1};
     cr_expect_neq(func_render(&p, &fp, rgb, &st, err, sizeof err), 0);
     cr_expect(strstr(err, "no_such_kernel.s") != NULL, "%s", err);
     free(rgb);

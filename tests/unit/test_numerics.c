@@ -376,7 +376,7 @@ static void furnace(uint32_t mat, const char *what)
     CfgMachine cfg;
     cfg_defaults(&cfg);
     cfg.stream_rays = 1024;
-    FuncParams fp = {&cfg, "kernels/pathtrace.s", s.needs, 1, 2, NULL, NULL, NULL, NULL, 0};
+    FuncParams fp = {.cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .needs = s.needs, .seed = 1, .threads = 2};
     FuncStats st;
     static char ferr[65536];
     cr_assert_eq(func_render(&p, &fp, rgb, &st, ferr, sizeof ferr), 0, "%s", ferr);
@@ -420,7 +420,7 @@ static size_t render_both(const Scene *s, float **k, float **g, FuncStats *st, R
     cr_assert(*k && *g);
     CfgMachine cfg;
     cfg_defaults(&cfg);
-    FuncParams fp = {&cfg, "kernels/pathtrace.s", s->needs, 1, 2, NULL, NULL, NULL, NULL, 0};
+    FuncParams fp = {.cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .needs = s->needs, .seed = 1, .threads = 2};
     cr_assert_eq(func_render(&p, &fp, *k, st, err, sizeof err), 0, "%s", err);
     RefParams rp = {64, 1, 2, NULL, NULL};
     cr_assert_eq(ref_render(&p, &rp, *g, rs, err, sizeof err), 0, "%s", err);
