@@ -143,6 +143,7 @@ TEST_ENV = SFSIM_BUILD=$(BUILD) SFSIM_GEN_ISADOC=$(BUILD)/gen_isadoc
 
 test-built: all $(BUILD)/tests/unit $(BUILD)/tests/io
 	@bash tests/cli/run.sh
+	@bash tests/cli/sweep.sh
 	@$(TEST_ENV) $(BUILD)/tests/io --jobs 2
 	@$(TEST_ENV) $(BUILD)/tests/unit --jobs 2
 

@@ -16,6 +16,7 @@
 #include "core.h"
 #include "img.h"
 #include "render.h"
+#include "sweep.h"
 #include "timing.h"
 #include "trace.h"
 
@@ -38,7 +39,8 @@ static void usage(FILE *out)
             "  config   list the machine-config keys (--dump) or write their reference (--markdown)\n"
             "  compare  compare two images: RMSE, PSNR, largest difference, NaN/Inf counts\n"
             "  trace    closest-hit / any-hit queries for a file of rays, through the kernel or the golden model\n"
-
+            "  sweep    run a scene over many machine configs in parallel (sweep files, resumable; CSV, plots)\n"
+            "  merge    build a sweep's CSV and plots from its point folders (after Slurm or GNU parallel)\n"
             "  help     help on a command: sfsim help exec\n"
             "\n"
             "options everywhere: --help, --version\n"
@@ -709,6 +711,10 @@ int main(int argc, char **argv)
             usage_compare(stdout);
         else if (!strcmp(argv[2], "trace"))
             usage_trace(stdout);
+        else if (!strcmp(argv[2], "sweep"))
+            sweep_usage(stdout);
+        else if (!strcmp(argv[2], "merge"))
+            merge_usage(stdout);
         else {
             fprintf(stderr, "sfsim help: unknown command '%s'\n", argv[2]);
             return EXIT_USAGE;
@@ -725,6 +731,10 @@ int main(int argc, char **argv)
         return cmd_compare(argc - 2, argv + 2);
     if (!strcmp(cmd, "trace"))
         return cmd_trace(argc - 2, argv + 2);
+    if (!strcmp(cmd, "sweep"))
+        return sweep_main(argc - 2, argv + 2);
+    if (!strcmp(cmd, "merge"))
+        return merge_main(argc - 2, argv + 2);
     fprintf(stderr, "sfsim: unknown command '%s'\n\n", cmd);
     usage(stderr);
     return EXIT_USAGE;

@@ -1,0 +1,21 @@
+/* sim/sweep.h -- `sfsim sweep` and `sfsim merge`: runs of one scene over many machine configs.
+ *
+ * Owns: sweep files (the INI files in configs/sweeps: lists, ranges, cross products or explicit points),
+ * the sweep folder (manifest, one folder per point, done/failed markers), running points in
+ * parallel as child `sfsim run` processes, resuming, sweep.csv, the gnuplot plots, and the
+ * Slurm / GNU parallel scripts. Must not: simulate (each point is an `sfsim run`).
+ * docs/sweep.md is the user's reference.
+ */
+#ifndef SFSIM_SWEEP_H
+#define SFSIM_SWEEP_H
+
+#include <stdio.h>
+
+/* The commands; argv excludes "sfsim sweep" / "sfsim merge". Exit codes as sim/main.c:
+ * 0 ok, 1 input error or a failed point, 2 usage. */
+int sweep_main(int argc, char **argv);
+int merge_main(int argc, char **argv);
+void sweep_usage(FILE *out);
+void merge_usage(FILE *out);
+
+#endif
