@@ -498,6 +498,7 @@ box_chunk:
         rgat    iy, vid, r0, F_INVY @m1
         rgat    iz, vid, r0, F_INVZ @m1
         rgat    tf, vid, r0, F_TMAX @m1
+        vfmul   tf, tf, vscale @m1      ; the hit distance so far, widened like the slab's far end
         vli     tn, 0 @m1
 .macro  SLAB bmin, bmax, o, inv
         vfsub   t0, \bmin, \o @m1

@@ -34,7 +34,10 @@ void ref_inv_dir(const float *dir, float *inv)
 int ref_hit_box(const float *bmin, const float *bmax, const float *org, const float *inv_dir,
                 float tmax)
 {
-    float tn = 0.0f, tf = tmax;
+    /* tmax (the closest hit so far) is widened like the far slab distances: a hit distance from
+     * the triangle test and a box's entry distance from the slab test round differently, so a
+     * box whose entry rounds up past the hit could otherwise hide a hit a few ulps closer. */
+    float tn = 0.0f, tf = tmax * REF_SLAB_FAR_SCALE;
     for (int k = 0; k < 3; k++) {
         /* inv_dir is finite (sanitized directions), so no 0 x inf = NaN can arise here. */
         float t0 = (bmin[k] - org[k]) * inv_dir[k];
@@ -157,7 +160,6 @@ static void walk_done(Walk *w)
         free(w->stack);
 }
 
-/* Test primitive i of the packed array; 1 with t/u/v on a hit in (0, r->tmax). */
 static int hit_prim(const PackedScene *p, uint32_t prims, uint32_t i, const RefRay *r, float *t,
                     float *u, float *v)
 {
@@ -252,4 +254,9 @@ int ref_any_hit(const PackedScene *p, const RefRay *r, RefTraceStats *stats)
 {
     RefHit h;
     return walk(p, r, &h, 0, stats);
+}
+
+int ref_hit_prim(const PackedScene *p, uint32_t i, const RefRay *r, float *t, float *u, float *v)
+{
+    return hit_prim(p, sm_u32(p, sm_hdr(p, SM_HDR_PRIMS)), i, r, t, u, v);
 }

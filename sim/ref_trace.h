@@ -34,6 +34,10 @@ void ref_closest_hit(const PackedScene *p, const RefRay *r, RefHit *hit, RefTrac
 /* Any hit with 0 < t < tmax (occlusion); returns 1 if occluded. */
 int ref_any_hit(const PackedScene *p, const RefRay *r, RefTraceStats *stats);
 
+/* Test packed primitive i (triangle or sphere) with a sanitized ray: 1 with t, u, v on a hit
+ * with 0 < t < r->tmax (the test every traversal uses). */
+int ref_hit_prim(const PackedScene *p, uint32_t i, const RefRay *r, float *t, float *u, float *v);
+
 /* The primitive tests themselves (exposed for the hard-case tests). */
 int ref_hit_triangle(const float *v0, const float *v1, const float *v2, const RefRay *r,
                      float *t, float *u, float *v);

@@ -1,0 +1,221 @@
+/* sim/ref_kd.c -- kd-tree traversal variants of seed 004, Appendix A (see ref_kd.h). */
+#include "ref_kd.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char *const ref_kd_variant_names[REF_KD_VARIANTS] = {"stack", "restart", "pushdown", "shortstack"};
+
+/* The deepest stack a tree needs: one entry per level. */
+#define KD_MAX_STACK 64
+/* Widening of a split distance: 2^-20 of it, several times its rounding error (a subtraction, a
+ * multiplication and a reciprocal: at most 1.5 ulp = 1.8e-7 relative), plus a floor for 0. */
+#define KD_WIDEN 9.5367431640625e-7f
+#define KD_WIDEN_FLOOR 1e-30f
+
+int ref_kd_prim_boxes(const PackedScene *p, float **bmin, float **bmax)
+{
+    uint32_t n = p->nprims, prims = sm_u32(p, sm_hdr(p, SM_HDR_PRIMS));
+    *bmin = malloc(3 * ((size_t)n + 1) * sizeof **bmin);
+    *bmax = malloc(3 * ((size_t)n + 1) * sizeof **bmax);
+    if (!*bmin || !*bmax) {
+        free(*bmin);
+        free(*bmax);
+        *bmin = *bmax = NULL;
+        return -1;
+    }
+    for (uint32_t i = 0; i < n; i++) {
+        float g[9];
+        uint32_t a = sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_V0);
+        for (int k = 0; k < 9; k++)
+            g[k] = sm_f32(p, a + 4u * (uint32_t)k);
+        int sphere = sm_u32(p, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_KIND)) == 1;
+        for (int k = 0; k < 3; k++) {
+            float lo, hi;
+            if (sphere) {
+                lo = g[k] - g[3];
+                hi = g[k] + g[3];
+            } else {
+                lo = fminf(g[k], fminf(g[3 + k], g[6 + k]));
+                hi = fmaxf(g[k], fmaxf(g[3 + k], g[6 + k]));
+            }
+            (*bmin)[3 * i + k] = lo;
+            (*bmax)[3 * i + k] = hi;
+        }
+    }
+    return 0;
+}
+
+int ref_kd_build(const PackedScene *p, const KdParams *kp, KdTree *out, char *err, size_t errlen)
+{
+    float *bmin, *bmax;
+    if (ref_kd_prim_boxes(p, &bmin, &bmax)) {
+        snprintf(err, errlen, "kd-tree: out of memory for %u primitive boxes", p->nprims);
+        return -1;
+    }
+    int rc = kd_build(kp, bmin, bmax, p->nprims, out, err, errlen);
+    free(bmin);
+    free(bmax);
+    return rc;
+}
+
+typedef struct Entry {
+    uint32_t node;
+    float tmin, tmax;  /* the segment of the ray in the node's voxel (ends widened) */
+    float texit;       /* a lower bound of where the segment truly ends: the early-exit bound */
+} Entry;
+
+/* A bounded stack: with cap entries, a push onto a full stack drops the bottom entry. */
+typedef struct KdStack {
+    Entry e[KD_MAX_STACK];
+    int bottom, n, cap;
+} KdStack;
+
+static void push(KdStack *s, Entry x, RefKdStats *st)
+{
+    if (s->n == s->cap) {
+        s->bottom = (s->bottom + 1) % KD_MAX_STACK;
+        s->n--;
+        if (st)
+            st->stack_overflows++;
+    }
+    s->e[(s->bottom + s->n) % KD_MAX_STACK] = x;
+    s->n++;
+}
+
+static Entry pop(KdStack *s)
+{
+    s->n--;
+    return s->e[(s->bottom + s->n) % KD_MAX_STACK];
+}
+
+/* The query; closest = 0 stops at the first hit. Returns 1 on a hit. */
+static int trace(const PackedScene *p, const KdTree *t, RefKdVariant v, int depth, const RefRay *r, RefHit *hit,
+                 int closest, RefKdStats *st)
+{
+    hit->prim = REF_NO_HIT;
+    hit->t = r->tmax;
+    hit->u = hit->v = 0.0f;
+    RefRay q = *r;
+    ref_sanitize_dir(q.dir);
+    float inv[3];
+    ref_inv_dir(q.dir, inv);
+    /* The ray's segment inside the scene box (the slab test of the BVH traversal). */
+    float t0 = 0.0f, t1 = q.tmax * 1.00000072f; /* widened as in ref_hit_box */
+    for (int k = 0; k < 3; k++) {
+        float a = (t->bmin[k] - q.org[k]) * inv[k], b = (t->bmax[k] - q.org[k]) * inv[k];
+        t0 = ref_fmax(t0, ref_fmin(a, b));
+        t1 = ref_fmin(t1, ref_fmax(a, b) * 1.00000072f);
+    }
+    if (!(t0 <= t1) || t->nnodes == 0)
+        return 0;
+    KdStack s = {.bottom = 0, .n = 0, .cap = v == REF_KD_SHORTSTACK ? depth : KD_MAX_STACK};
+    if (s.cap < 1)
+        s.cap = 1;
+    if (s.cap > KD_MAX_STACK)
+        s.cap = KD_MAX_STACK;
+    const int stackful = v == REF_KD_STACK || v == REF_KD_SHORTSTACK;
+    const int pushdown_on = v == REF_KD_PUSHDOWN || v == REF_KD_SHORTSTACK;
+    uint32_t root = 0;
+    Entry cur = {0, t0, t0, t1};
+    int first = 1;
+    if (v == REF_KD_STACK)
+        push(&s, (Entry){0, t0, t1, t1}, st);
+    for (;;) {
+        int pushdown = 0;
+        if (s.n > 0) {
+            cur = pop(&s);
+        } else if (v == REF_KD_STACK) {
+            break;
+        } else {
+            /* Restart: the next segment starts where the last leaf's ended. */
+            if (!first && !(cur.tmax < t1))
+                break;
+            if (!first && st) {
+                st->restarts++;
+                if (v == REF_KD_SHORTSTACK)
+                    st->stack_underflows++;
+            }
+            cur = (Entry){root, cur.tmax, t1, t1};
+            pushdown = pushdown_on;
+        }
+        first = 0;
+        uint32_t node = cur.node;
+        float tmin = cur.tmin, tmax = cur.tmax, texit = cur.texit;
+        const KdNode *nd = &t->nodes[node];
+        while (nd->axis != KD_LEAF) {
+            if (st)
+                st->nodes_visited++;
+            uint32_t a = nd->axis;
+            float o = q.org[a], d = q.dir[a];
+            int below = o < nd->split || (o == nd->split && d < 0.0f);
+            uint32_t near = below ? nd->a : nd->a + 1, far = below ? nd->a + 1 : nd->a;
+            /* A.1 with the split distance widened to [lo, hi] (more than its rounding error):
+             * entirely beyond the segment or behind the origin: the near child only; entirely
+             * before it: the far child only; else both, the far one later, from hi -- where a
+             * restart would resume, so every variant descends alike. Moving away from the plane
+             * is "behind"; the sign test is exact where tSplit may round to 0. */
+            float ts = (nd->split - o) * inv[a];
+            float eps = fabsf(ts) * KD_WIDEN + KD_WIDEN_FLOOR, lo = ts - eps, hi = ts + eps;
+            if (below == (d < 0.0f) || lo > tmax) {
+                node = near;
+            } else if (hi <= tmin) {
+                node = far;
+            } else {
+                float nmax = hi < tmax ? hi : tmax;
+                if (stackful)
+                    push(&s, (Entry){far, nmax, tmax, texit}, st);
+                node = near;
+                tmax = nmax;
+                texit = lo < texit ? lo : texit;
+                pushdown = 0;
+            }
+            nd = &t->nodes[node];
+            if (pushdown)
+                root = node;
+        }
+        if (st) {
+            st->nodes_visited++;
+            st->leaves_visited++;
+        }
+        for (uint32_t i = nd->a; i < nd->a + nd->count; i++) {
+            uint32_t pr = t->prims[i];
+            float th, u, w;
+            if (st)
+                st->prims_tested++;
+            RefRay probe = q;
+            if (hit->prim != REF_NO_HIT)
+                probe.tmax = closest ? nextafterf(hit->t, INFINITY) : hit->t;
+            if (!ref_hit_prim(p, pr, &probe, &th, &u, &w))
+                continue;
+            if (hit->prim == REF_NO_HIT || th < hit->t || (th == hit->t && pr < hit->prim)) {
+                hit->t = th;
+                hit->u = u;
+                hit->v = w;
+                hit->prim = pr;
+            }
+            if (!closest)
+                return 1;
+        }
+        /* Early exit: nothing unvisited can be closer than the segment's (lower) end. */
+        if (hit->prim != REF_NO_HIT && hit->t < texit)
+            break;
+        cur.tmax = tmax;
+    }
+    return hit->prim != REF_NO_HIT;
+}
+
+void ref_kd_closest_hit(const PackedScene *p, const KdTree *t, RefKdVariant v, int stack_depth, const RefRay *r,
+                        RefHit *hit, RefKdStats *st)
+{
+    trace(p, t, v, stack_depth, r, hit, 1, st);
+}
+
+int ref_kd_any_hit(const PackedScene *p, const KdTree *t, RefKdVariant v, int stack_depth, const RefRay *r,
+                   RefKdStats *st)
+{
+    RefHit h;
+    return trace(p, t, v, stack_depth, r, &h, 0, st);
+}

@@ -1,0 +1,184 @@
+/* tests/unit/test_kdtree.c -- the kd-tree (scenes/kdtree.c) and the golden model's kd-tree
+ * traversals (sim/ref_kd.c): tree invariants on shipped scenes; every traversal variant returns
+ * exactly the BVH traversal's closest hit (primitive, t, u, v bit for bit) and any-hit answer on
+ * random rays; the counters relate as seed 004 says they must (restart visits the most nodes,
+ * push-down no more than restart, a short stack as deep as the tree never restarts and visits
+ * exactly what the full stack visits).
+ */
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../../scenes/kdtree.h"
+#include "../../scenes/pack.h"
+#include "../../scenes/scene.h"
+#include "../../sim/ref_kd.h"
+#include "../../sim/ref_trace.h"
+
+Test(kdtree, small_builds_and_invariants)
+{
+    /* Two pairs of boxes far apart: testing all four costs 4; cutting the empty space between
+     * the pairs costs 1 + (6/46) 2 + (42/46) 2 = 3 (the SAH with equal costs), so the root cuts x
+     * between them. (One box per side would cost 2 either way: a leaf.) */
+    float bmin[12] = {0, 0, 0, 0, 0, 0, 10, 0, 0, 10, 0, 0}, bmax[12] = {1, 1, 1, 1, 1, 1, 11, 1, 1, 11, 1, 1};
+    KdParams kp;
+    kd_default_params(&kp);
+    KdTree t;
+    char err[512];
+    cr_assert_eq(kd_build(&kp, bmin, bmax, 4, &t, err, sizeof err), 0, "%s", err);
+    cr_expect_eq(kd_check(&t, bmin, bmax, err, sizeof err), 0, "%s", err);
+    cr_expect_eq(t.nodes[0].axis, 0u, "the root splits x");
+    cr_expect(t.nodes[0].split >= 1.0f && t.nodes[0].split <= 10.0f, "split %g between the boxes", t.nodes[0].split);
+    cr_expect_geq(t.nleaves, 2);
+    kd_free(&t);
+    /* Flat primitives on one plane and an empty set. */
+    float fmin[9] = {0, 0, 5, 2, 0, 5, 0, 2, 5}, fmax[9] = {1, 1, 5, 3, 1, 5, 1, 3, 5};
+    cr_assert_eq(kd_build(&kp, fmin, fmax, 3, &t, err, sizeof err), 0, "%s", err);
+    cr_expect_eq(kd_check(&t, fmin, fmax, err, sizeof err), 0, "%s", err);
+    kd_free(&t);
+    cr_assert_eq(kd_build(&kp, NULL, NULL, 0, &t, err, sizeof err), 0, "%s", err);
+    cr_expect_eq(t.nleaves, 1);
+    kd_free(&t);
+    /* A NaN box is named. */
+    float nmin[3] = {0, NAN, 0}, nmax[3] = {1, 1, 1};
+    cr_expect_eq(kd_build(&kp, nmin, nmax, 1, &t, err, sizeof err), -1);
+    cr_expect(strstr(err, "primitive 0"), "%s", err);
+    /* The checker finds a missing primitive. */
+    cr_assert_eq(kd_build(&kp, bmin, bmax, 4, &t, err, sizeof err), 0, "%s", err);
+    for (uint32_t i = 0; i < t.nnodes; i++)
+        if (t.nodes[i].axis == KD_LEAF && t.nodes[i].count > 0) {
+            t.nodes[i].count--;
+            break;
+        }
+    cr_expect_eq(kd_check(&t, bmin, bmax, err, sizeof err), -1, "a dropped primitive went unnoticed");
+    kd_free(&t);
+}
+
+static uint64_t rng_state;
+static float rnd(void)
+{
+    rng_state = rng_state * 6364136223846793005ull + 1442695040888963407ull;
+    return (float)((rng_state >> 40) & 0xffffff) / 16777216.0f;
+}
+
+typedef struct Agg {
+    RefKdStats st;
+    long mismatches;
+} Agg;
+
+/* Trace nrays random rays through the scene with the BVH and every kd variant; returns the
+ * aggregate counters per variant (index: variant, and for short-stack depth d: 4 + d). */
+static void compare_scene(const char *path, uint32_t nrays, Agg agg[12], uint32_t *tree_depth)
+{
+    Scene s;
+    PackedScene p;
+    char err[1024];
+    cr_assert_eq(scene_load(path, &s, err, sizeof err), 0, "%s", err);
+    BvhParams bp;
+    bvh_default_params(&bp);
+    cr_assert_eq(pack_scene(&s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
+    KdParams kp;
+    kd_default_params(&kp);
+    KdTree t;
+    cr_assert_eq(ref_kd_build(&p, &kp, &t, err, sizeof err), 0, "%s", err);
+    float *bmin, *bmax;
+    cr_assert_eq(ref_kd_prim_boxes(&p, &bmin, &bmax), 0);
+    cr_assert_eq(kd_check(&t, bmin, bmax, err, sizeof err), 0, "%s: %s", path, err);
+    *tree_depth = t.depth;
+    printf("kd-tree %s: %u primitives, %u nodes, %u leaves (%u empty), depth %u, %u references (%.2f per "
+           "primitive), largest leaf %u, SAH cost %.1f\n",
+           path, p.nprims, t.nnodes, t.nleaves, t.nempty, t.depth, t.nrefs, (double)t.nrefs / (p.nprims ? p.nprims : 1),
+           t.max_leaf, t.sah_cost);
+    memset(agg, 0, 12 * sizeof *agg);
+    rng_state = 12345;
+    const int depths[8] = {0, 1, 2, 3, 4, 8, 0, 0};
+    for (uint32_t i = 0; i < nrays; i++) {
+        RefRay r;
+        for (int k = 0; k < 3; k++) {
+            float c = 0.5f * (t.bmin[k] + t.bmax[k]), e = 0.5f * (t.bmax[k] - t.bmin[k]);
+            r.org[k] = c + e * 0.9f * (2.0f * rnd() - 1.0f);
+            r.dir[k] = 2.0f * rnd() - 1.0f;
+        }
+        if (i % 16 == 0)
+            r.dir[i / 16 % 3] = 0.0f; /* axis-parallel rays too */
+        r.tmax = i % 4 == 3 ? 0.3f * (t.bmax[0] - t.bmin[0]) : INFINITY;
+        RefHit ref;
+        ref_closest_hit(&p, &r, &ref, NULL);
+        int occl = ref_any_hit(&p, &r, NULL);
+        for (int slot = 0; slot < 10; slot++) {
+            RefKdVariant v = slot < 4 ? (RefKdVariant)slot : REF_KD_SHORTSTACK;
+            int d = slot < 4 ? 2 : depths[slot - 4 + 1];
+            if (slot >= 4 && d == 0)
+                continue;
+            RefHit h;
+            ref_kd_closest_hit(&p, &t, v, d, &r, &h, &agg[slot].st);
+            int same = h.prim == ref.prim && (h.prim == REF_NO_HIT ||
+                                               (memcmp(&h.t, &ref.t, 4) == 0 && memcmp(&h.u, &ref.u, 4) == 0 &&
+                                                memcmp(&h.v, &ref.v, 4) == 0));
+            int o = ref_kd_any_hit(&p, &t, v, d, &r, NULL);
+            if (!same || o != occl) {
+                if (agg[slot].mismatches < 3)
+                    cr_log_error("%s ray %u, %s depth %d: kd prim %u t %.9g, bvh prim %u t %.9g; any-hit %d vs %d",
+                                 path, i, ref_kd_variant_names[v], d, h.prim, h.t, ref.prim, ref.t, o, occl);
+                agg[slot].mismatches++;
+            }
+        }
+    }
+    free(bmin);
+    free(bmax);
+    kd_free(&t);
+    pack_free(&p);
+    scene_free(&s);
+}
+
+static void check_scene(const char *path, uint32_t nrays)
+{
+    Agg agg[12];
+    uint32_t depth;
+    compare_scene(path, nrays, agg, &depth);
+    for (int slot = 0; slot < 10; slot++)
+        cr_expect_eq(agg[slot].mismatches, 0, "%s: %ld of %u rays differ from the BVH (slot %d)", path,
+                     agg[slot].mismatches, nrays, slot);
+    const RefKdStats *stack = &agg[REF_KD_STACK].st, *rs = &agg[REF_KD_RESTART].st, *pd = &agg[REF_KD_PUSHDOWN].st;
+    printf("  %s, %u rays: nodes visited: stack %llu, restart %llu (%.2fx), push-down %llu (%.2fx)", path, nrays,
+           (unsigned long long)stack->nodes_visited, (unsigned long long)rs->nodes_visited,
+           (double)rs->nodes_visited / (double)stack->nodes_visited, (unsigned long long)pd->nodes_visited,
+           (double)pd->nodes_visited / (double)stack->nodes_visited);
+    static const int sd[5] = {1, 2, 3, 4, 8};
+    for (int k = 0; k < 5; k++)
+        printf(", short %d: %.3fx", sd[k], (double)agg[4 + k].st.nodes_visited / (double)stack->nodes_visited);
+    printf("\n");
+    cr_expect_eq(stack->restarts, 0);
+    cr_expect_geq(rs->nodes_visited, pd->nodes_visited, "push-down visits more nodes than restart");
+    cr_expect_geq(pd->nodes_visited, stack->nodes_visited, "push-down visits fewer nodes than the full stack");
+    cr_expect_eq(pd->prims_tested, rs->prims_tested, "push-down and restart visit the same leaves");
+    for (int k = 0; k < 5; k++) {
+        const RefKdStats *ss = &agg[4 + k].st;
+        cr_expect_geq(ss->nodes_visited, stack->nodes_visited, "short %d below the full stack", sd[k]);
+        cr_expect_leq(ss->nodes_visited, pd->nodes_visited, "short %d above push-down", sd[k]);
+        cr_expect_eq(ss->restarts, ss->stack_underflows);
+        if (k > 0)
+            cr_expect_leq(ss->nodes_visited, agg[4 + k - 1].st.nodes_visited, "a deeper short stack visits more");
+        if ((uint32_t)sd[k] >= depth) {
+            cr_expect_eq(ss->restarts, 0, "a short stack as deep as the tree restarted");
+            cr_expect_eq(ss->nodes_visited, stack->nodes_visited);
+        }
+    }
+}
+
+Test(kdtree, cornell_every_variant_matches_the_bvh, .timeout = 120)
+{
+    check_scene("scenes/cornell/scene.ini", 20000);
+}
+
+Test(kdtree, spheres_every_variant_matches_the_bvh, .timeout = 120)
+{
+    check_scene("scenes/cornell/spheres.ini", 20000);
+}
+
+Test(kdtree, conference_every_variant_matches_the_bvh, .timeout = 300)
+{
+    check_scene("scenes/conference/scene.ini", 5000);
+}
