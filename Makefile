@@ -240,7 +240,7 @@ run-built: all
 	@cat out/report.txt
 	@echo "== outputs: out/frame.png (tone-mapped), out/frame.exr (linear), out/cost.png (cycles per pixel),"
 	@echo "==          out/report.txt (above), out/report.json (everything; docs/report.md)"
-	@grep -E '^cycles +[0-9]' out/report.txt | sed 's/^cycles */== headline: /'
+	@grep -E '^cycles +[0-9]' out/report.txt | sed 's/^/== headline: /'
 
 clean:
 	rm -rf $(BUILD) bin
