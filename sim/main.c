@@ -542,21 +542,20 @@ static int cmd_run(int argc, char **argv)
             o.kernel_path = argv[++i];
         } else if (!strcmp(a, "--set") && has_next) {
             const char *s = argv[++i];
-            static const struct { const char *key; long lo, hi; } render_keys[] = {
-                {"render.width=", 1, 16384}, {"render.height=", 1, 16384}, {"render.spp=", 1, 1 << 20},
-                {"render.max_depth=", 0, 63}, {"render.seed=", 0, 4294967295L}};
             int handled = 0;
-            for (size_t k = 0; k < sizeof render_keys / sizeof render_keys[0]; k++) {
+            for (int k = 0; k < RENDER_KEY_COUNT; k++) {
                 size_t kl = strlen(render_keys[k].key);
-                if (strncmp(s, render_keys[k].key, kl) != 0)
+                if (strncmp(s, render_keys[k].key, kl) != 0 || s[kl] != '=')
                     continue;
-                if (parse_int("--set", s + kl, render_keys[k].lo, render_keys[k].hi, &v))
+                char opt[64];
+                snprintf(opt, sizeof opt, "--set %s =", render_keys[k].key);
+                if (parse_int(opt, s + kl + 1, (long)render_keys[k].lo, (long)render_keys[k].hi, &v))
                     return EXIT_USAGE;
-                if (k == 0) o.width = (int)v;
-                if (k == 1) o.height = (int)v;
-                if (k == 2) o.spp = (int)v;
-                if (k == 3) o.max_depth = (int)v;
-                if (k == 4) o.seed = (uint32_t)v;
+                if (k == RENDER_KEY_WIDTH) o.width = (int)v;
+                if (k == RENDER_KEY_HEIGHT) o.height = (int)v;
+                if (k == RENDER_KEY_SPP) o.spp = (int)v;
+                if (k == RENDER_KEY_MAX_DEPTH) o.max_depth = (int)v;
+                if (k == RENDER_KEY_SEED) o.seed = (uint32_t)v;
                 handled = 1;
             }
             if (!handled && add_set(&ca, s))

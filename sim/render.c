@@ -27,6 +27,14 @@
 #include "sampling.h"
 #include "timing.h"
 
+const RenderKey render_keys[RENDER_KEY_COUNT] = {
+    {"render.width", 1, 16384},
+    {"render.height", 1, 16384},
+    {"render.spp", 1, 1 << 20},
+    {"render.max_depth", 0, REF_MAX_GENERATIONS - 1},
+    {"render.seed", 0, 4294967295LL},
+};
+
 void render_default_options(RenderOptions *o)
 {
     memset(o, 0, sizeof *o);

@@ -27,6 +27,15 @@ typedef struct RenderOptions {
     uint32_t sample_seed;      /* sampled mode: which tiles */
 } RenderOptions;
 
+/* The render keys `--set` takes beside the machine keys (sfsim run, sfsim sweep), with their
+ * ranges: one table for every command that accepts them. */
+enum { RENDER_KEY_WIDTH, RENDER_KEY_HEIGHT, RENDER_KEY_SPP, RENDER_KEY_MAX_DEPTH, RENDER_KEY_SEED, RENDER_KEY_COUNT };
+typedef struct RenderKey {
+    const char *key;       /* "render.width" */
+    long long lo, hi;
+} RenderKey;
+extern const RenderKey render_keys[RENDER_KEY_COUNT];
+
 void render_default_options(RenderOptions *o);
 
 /* A run in o->mode: "reference" (the golden model, sim/reference.c) or "functional" (the

@@ -33,6 +33,7 @@
 #include <unistd.h>
 
 #include "config.h"
+#include "render.h"
 #include "timing.h"
 
 enum { SW_EXIT_OK = 0, SW_EXIT_INPUT = 1, SW_EXIT_USAGE = 2 };
@@ -381,11 +382,8 @@ static void buf_shell_word(Buf *b, const char *s, int always_quote)
 
 /* ---- keys and values ------------------------------------------------------------------------ */
 
-/* The render keys `sfsim run --set` takes beside the machine keys, with its ranges (sim/main.c). */
-static const struct { const char *key; long long lo, hi; } render_keys[] = {
-    {"render.width", 1, 16384}, {"render.height", 1, 16384}, {"render.spp", 1, 1 << 20},
-    {"render.max_depth", 0, 63}, {"render.seed", 0, 4294967295LL}};
-#define N_RENDER_KEYS (int)(sizeof render_keys / sizeof render_keys[0])
+/* The render keys `sfsim run --set` takes beside the machine keys: render_keys (sim/render.h). */
+#define N_RENDER_KEYS RENDER_KEY_COUNT
 
 /* 0 when VALUE is a valid value of KEY; else -1 with the reason in msg, *unknown set when KEY
  * is no key at all. Machine keys go through cfg_set on a scratch config. */

@@ -397,6 +397,13 @@ run "$SFSIM" run --sample 0.1 -o "$T/samp3"
 want_rc 2; want_err "--mode sampled only"
 end
 
+begin "sfsim run: a render key out of range names the key and its range (exit 2)"
+run "$SFSIM" run --set render.spp=0 -o "$T/rk"
+want_rc 2; want_err "--set render.spp = 0: expected an integer in 1\.\.1048576"
+run "$SFSIM" run --set render.max_depth=64 -o "$T/rk"
+want_rc 2; want_err "render.max_depth = 64: expected an integer in 0\.\.63"
+end
+
 begin "sfsim exec --timing prints the cycles of a micro-benchmark (kernels/bench/branch.s: 10 cycles)"
 run "$SFASM" kernels/bench/branch.s -o "$T/branch.sfo"
 want_rc 0
