@@ -219,3 +219,206 @@ int ref_kd_any_hit(const PackedScene *p, const KdTree *t, RefKdVariant v, int st
     RefHit h;
     return trace(p, t, v, stack_depth, r, &h, 0, st);
 }
+
+/* ---- A.5: the packetized short stack ---------------------------------------------------------- */
+
+#define KD_PACKET 64
+
+typedef struct PEntry {
+    uint32_t node;
+    uint64_t live;
+    float tmin[KD_PACKET], tmax[KD_PACKET], texit[KD_PACKET];
+} PEntry;
+
+void ref_kd_packet_closest_hit(const PackedScene *p, const KdTree *t, int stack_depth, const RefRay *rays, int n,
+                               RefHit *hits, RefKdStats *st)
+{
+    if (n < 1)
+        return;
+    if (n > KD_PACKET)
+        n = KD_PACKET;
+    int cap = stack_depth < 1 ? 1 : stack_depth > KD_MAX_STACK ? KD_MAX_STACK : stack_depth;
+    PEntry *stack = malloc((size_t)cap * sizeof *stack), cur;
+    if (!stack)
+        abort(); /* out of memory for a few kilobytes of stack: nothing sensible to return */
+    int bottom = 0, depth = 0;
+    RefRay q[KD_PACKET];
+    float inv[KD_PACKET][3], t1[KD_PACKET], prog[KD_PACKET];
+    uint64_t done = 0, all = n >= 64 ? ~0ull : (1ull << n) - 1;
+    for (int i = 0; i < n; i++) {
+        RefHit *h = &hits[i];
+        h->prim = REF_NO_HIT;
+        h->t = rays[i].tmax;
+        h->u = h->v = 0.0f;
+        q[i] = rays[i];
+        ref_sanitize_dir(q[i].dir);
+        ref_inv_dir(q[i].dir, inv[i]);
+        float a0 = 0.0f, a1 = q[i].tmax * 1.00000072f;
+        for (int k = 0; k < 3; k++) {
+            float a = (t->bmin[k] - q[i].org[k]) * inv[i][k], b = (t->bmax[k] - q[i].org[k]) * inv[i][k];
+            a0 = ref_fmax(a0, ref_fmin(a, b));
+            a1 = ref_fmin(a1, ref_fmax(a, b) * 1.00000072f);
+        }
+        prog[i] = a0;
+        t1[i] = a1;
+        if (!(a0 <= a1) || t->nnodes == 0)
+            done |= 1ull << i;
+    }
+    uint32_t root = 0;
+    int first = 1;
+    float last_prog[KD_PACKET];
+    uint64_t last_done = done;
+    memcpy(last_prog, prog, sizeof prog);
+    while (done != all || depth > 0) {
+        int pushdown = 0;
+        if (depth > 0) {
+            depth--;
+            cur = stack[(bottom + depth) % cap];
+            cur.live &= ~done;
+            if (!cur.live)
+                continue;
+        } else {
+            cur.node = root;
+            cur.live = 0;
+            for (int i = 0; i < n; i++)
+                if (!((done >> i) & 1u) && (first || prog[i] < t1[i])) {
+                    cur.live |= 1ull << i;
+                    cur.tmin[i] = prog[i];
+                    cur.tmax[i] = cur.texit[i] = t1[i];
+                } else if (!((done >> i) & 1u)) {
+                    done |= 1ull << i; /* the whole segment was visited */
+                }
+            if (!cur.live)
+                break;
+            if (!first) {
+                if (st)
+                    st->restarts++, st->stack_underflows++;
+                /* No ray advanced since the last restart (rays of opposite directions keep pushing
+                 * each other's near sides off a short stack): the rays left finish one by one. */
+                if (memcmp(last_prog, prog, sizeof prog) == 0 && last_done == done) {
+                    for (int i = 0; i < n; i++)
+                        if ((cur.live >> i) & 1u) {
+                            RefHit h;
+                            trace(p, t, REF_KD_SHORTSTACK, cap, &rays[i], &h, 1, st);
+                            if (h.prim != REF_NO_HIT && (hits[i].prim == REF_NO_HIT || h.t < hits[i].t ||
+                                                         (h.t == hits[i].t && h.prim < hits[i].prim)))
+                                hits[i] = h;
+                        }
+                    break;
+                }
+            }
+            memcpy(last_prog, prog, sizeof prog);
+            last_done = done;
+            pushdown = 1;
+        }
+        first = 0;
+        const KdNode *nd = &t->nodes[cur.node];
+        while (nd->axis != KD_LEAF) {
+            if (st)
+                st->nodes_visited++;
+            uint32_t a = nd->axis;
+            int lead = __builtin_ctzll(cur.live);
+            int lead_below = q[lead].org[a] < nd->split || (q[lead].org[a] == nd->split && q[lead].dir[a] < 0.0f);
+            uint32_t firstc = lead_below ? nd->a : nd->a + 1, second = lead_below ? nd->a + 1 : nd->a;
+            PEntry fe, se;
+            fe.live = se.live = 0;
+            int deferred = 0; /* some ray's far side was left to a restart */
+            for (int i = 0; i < n; i++) {
+                if (!((cur.live >> i) & 1u))
+                    continue;
+                float o = q[i].org[a], d = q[i].dir[a], tmin = cur.tmin[i], tmax = cur.tmax[i], tx = cur.texit[i];
+                int below = o < nd->split || (o == nd->split && d < 0.0f);
+                int near_is_first = below == lead_below;
+                float ts = (nd->split - o) * inv[i][a];
+                float eps = fabsf(ts) * KD_WIDEN + KD_WIDEN_FLOOR, lo = ts - eps, hi = ts + eps;
+                int want_near = 1, want_far = 1;
+                float nmax = tmax;
+                if (below == (d < 0.0f) || lo > tmax)
+                    want_far = 0;
+                else if (hi <= tmin)
+                    want_near = 0;
+                else
+                    nmax = hi < tmax ? hi : tmax;
+                PEntry *ne = near_is_first ? &fe : &se, *fa = near_is_first ? &se : &fe;
+                if (want_near) {
+                    ne->live |= 1ull << i;
+                    ne->tmin[i] = tmin;
+                    ne->tmax[i] = want_far ? nmax : tmax;
+                    ne->texit[i] = want_far ? (lo < tx ? lo : tx) : tx;
+                }
+                /* A ray whose near child is the packet's second goes there only: its far side
+                 * is left to a restart, so every ray still meets its space front to back. */
+                if (want_far && (near_is_first || !want_near)) {
+                    fa->live |= 1ull << i;
+                    fa->tmin[i] = want_near ? nmax : tmin;
+                    fa->tmax[i] = tmax;
+                    fa->texit[i] = tx;
+                } else if (want_far) {
+                    deferred = 1;
+                }
+            }
+            if (!se.live) {
+                fe.node = firstc;
+                cur = fe;
+            } else if (!fe.live) {
+                se.node = second;
+                cur = se;
+            } else {
+                se.node = second;
+                if (depth == cap) { /* full: drop the bottom entry */
+                    bottom = (bottom + 1) % cap;
+                    depth--;
+                    if (st)
+                        st->stack_overflows++;
+                }
+                stack[(bottom + depth) % cap] = se;
+                depth++;
+                fe.node = firstc;
+                cur = fe;
+                pushdown = 0;
+            }
+            if (deferred) /* a restart must be able to reach the deferred side */
+                pushdown = 0;
+            nd = &t->nodes[cur.node];
+            if (pushdown)
+                root = cur.node;
+        }
+        if (st) {
+            st->nodes_visited++;
+            st->leaves_visited++;
+        }
+        for (uint32_t k = nd->a; k < nd->a + nd->count; k++) {
+            uint32_t pr = t->prims[k];
+            for (int i = 0; i < n; i++) {
+                if (!((cur.live >> i) & 1u))
+                    continue;
+                RefHit *h = &hits[i];
+                float th, u, w;
+                if (st)
+                    st->prims_tested++;
+                RefRay probe = q[i];
+                if (h->prim != REF_NO_HIT)
+                    probe.tmax = nextafterf(h->t, INFINITY);
+                if (!ref_hit_prim(p, pr, &probe, &th, &u, &w))
+                    continue;
+                if (h->prim == REF_NO_HIT || th < h->t || (th == h->t && pr < h->prim)) {
+                    h->t = th;
+                    h->u = u;
+                    h->v = w;
+                    h->prim = pr;
+                }
+            }
+        }
+        /* A ray whose segment started at its progress point has visited everything before the
+         * segment's end: it advances, and is done when its hit lies before the segment's (lower) end. */
+        for (int i = 0; i < n; i++) {
+            if (!((cur.live >> i) & 1u) || cur.tmin[i] > prog[i])
+                continue;
+            if (cur.tmax[i] > prog[i])
+                prog[i] = cur.tmax[i];
+            if (hits[i].prim != REF_NO_HIT && hits[i].t < cur.texit[i])
+                done |= 1ull << i;
+        }
+    }
+    free(stack);
+}

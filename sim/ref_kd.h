@@ -44,6 +44,16 @@ typedef struct RefKdStats {
     uint64_t prims_tested;
 } RefKdStats;
 
+/* The packetized short-stack of A.5: n <= 64 rays traverse together with a live mask, one stack
+ * of `depth` entries for the packet (each entry holds every ray's segment), push-down, restart
+ * on underflow. Generalized so that any rays may share a packet: the packet follows the first
+ * live ray's near child; a ray whose segment does not start at its progress point (it met its far
+ * child first) does not advance its restart point past unvisited space. hits[i] is exactly ray
+ * i's BVH closest hit. Counters: nodes_visited counts packet steps (a node entered once by the
+ * packet counts once), leaves_visited likewise; prims_tested counts ray-primitive tests. */
+void ref_kd_packet_closest_hit(const PackedScene *p, const KdTree *t, int stack_depth, const RefRay *rays, int n,
+                               RefHit *hits, RefKdStats *st);
+
 /* Build a kd-tree over the packed scene's primitives (packed indices), from their boxes. */
 int ref_kd_build(const PackedScene *p, const KdParams *kp, KdTree *out, char *err, size_t errlen);
 /* The primitives' boxes as ref_kd_build uses them (n * 3 floats each, malloc'ed). */
