@@ -81,17 +81,7 @@ int main(int argc, char **argv)
         char err[65536];
         Scene s;
         PackedScene p;
-        memset(&p, 0, sizeof p);
-        if (scene_load(scenes[i], &s, err, sizeof err) != 0) {
-            fprintf(stderr, "%s\n", err);
-            return 1;
-        }
-        s.render.width = w;
-        s.render.height = h;
-        s.render.spp = spp;
-        BvhParams bp;
-        bvh_default_params(&bp);
-        if (pack_scene(&s, &bp, 0, &p, err, sizeof err) != 0) {
+        if (pack_load_file(scenes[i], w, h, spp, &s, &p, err, sizeof err) != 0) {
             fprintf(stderr, "%s\n", err);
             return 1;
         }

@@ -331,3 +331,24 @@ void pack_free(PackedScene *p)
     bvh_free(&p->bvh);
     memset(p, 0, sizeof *p);
 }
+
+int pack_load_file(const char *path, int width, int height, int spp, Scene *s, PackedScene *p, char *err,
+                   size_t errlen)
+{
+    memset(p, 0, sizeof *p);
+    if (scene_load(path, s, err, errlen) != 0)
+        return -1;
+    if (width > 0)
+        s->render.width = width;
+    if (height > 0)
+        s->render.height = height;
+    if (spp > 0)
+        s->render.spp = spp;
+    BvhParams bp;
+    bvh_default_params(&bp);
+    if (pack_scene(s, &bp, 0, p, err, errlen) != 0) {
+        scene_free(s);
+        return -1;
+    }
+    return 0;
+}

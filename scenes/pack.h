@@ -47,6 +47,11 @@ int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *
                size_t errlen);
 void pack_free(PackedScene *p);
 
+/* Load a scene file, override its render size and samples (values > 0), and pack it with the
+ * default BVH: the set-up of benchmarks and tools. 0, or -1 with a message (nothing to free). */
+int pack_load_file(const char *path, int width, int height, int spp, Scene *s, PackedScene *p, char *err,
+                   size_t errlen);
+
 /* Readers of packed words (addresses are scene-memory byte addresses). */
 static inline uint32_t sm_u32(const PackedScene *p, uint32_t addr)
 {

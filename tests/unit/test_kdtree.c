@@ -75,10 +75,7 @@ static void compare_scene(const char *path, uint32_t nrays, Agg agg[12], uint32_
     Scene s;
     PackedScene p;
     char err[1024];
-    cr_assert_eq(scene_load(path, &s, err, sizeof err), 0, "%s", err);
-    BvhParams bp;
-    bvh_default_params(&bp);
-    cr_assert_eq(pack_scene(&s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(pack_load_file(path, 0, 0, 0, &s, &p, err, sizeof err), 0, "%s", err);
     KdParams kp;
     kd_default_params(&kp);
     KdTree t;
@@ -190,10 +187,7 @@ static void check_packets(const char *path, int npackets)
     Scene s;
     PackedScene p;
     char err[1024];
-    cr_assert_eq(scene_load(path, &s, err, sizeof err), 0, "%s", err);
-    BvhParams bp;
-    bvh_default_params(&bp);
-    cr_assert_eq(pack_scene(&s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(pack_load_file(path, 0, 0, 0, &s, &p, err, sizeof err), 0, "%s", err);
     KdParams kp;
     kd_default_params(&kp);
     KdTree t;
