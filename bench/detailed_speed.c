@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include "../scenes/pack.h"
+#include "bench_args.h"
 #include "../scenes/scene.h"
 #include "../sim/config.h"
 #include "../sim/functional.h"
@@ -58,16 +59,9 @@ static int render(const PackedScene *p, uint32_t needs, int timed, int threads, 
 
 int main(int argc, char **argv)
 {
-    int w = 128, h = 96, spp = 4;
-    if (argc == 4) {
-        w = atoi(argv[1]);
-        h = atoi(argv[2]);
-        spp = atoi(argv[3]);
-    }
-    if (w < 1 || h < 1 || spp < 1 || w > 4096 || h > 4096 || spp > 4096) {
-        fprintf(stderr, "usage: detailed_speed [WIDTH HEIGHT SPP]\n");
+    int w, h, spp;
+    if (bench_size_args(argc, argv, "detailed_speed", &w, &h, &spp))
         return 2;
-    }
     int all = (int)sysconf(_SC_NPROCESSORS_ONLN);
     if (all < 1)
         all = 1;

@@ -18,6 +18,7 @@
 #include <time.h>
 
 #include "../scenes/pack.h"
+#include "bench_args.h"
 #include "../scenes/scene.h"
 #include "../sim/config.h"
 #include "../sim/functional.h"
@@ -32,16 +33,9 @@ static double now(void)
 
 int main(int argc, char **argv)
 {
-    int w = 128, h = 96, spp = 4;
-    if (argc == 4) {
-        w = atoi(argv[1]);
-        h = atoi(argv[2]);
-        spp = atoi(argv[3]);
-    }
-    if (w < 1 || h < 1 || spp < 1 || w > 4096 || h > 4096 || spp > 4096) {
-        fprintf(stderr, "usage: functional_speed [WIDTH HEIGHT SPP]\n");
+    int w, h, spp;
+    if (bench_size_args(argc, argv, "functional_speed", &w, &h, &spp))
         return 2;
-    }
     static const char *const scenes[] = {"scenes/cornell/scene.ini", "scenes/sponza-dabrovic/scene.ini",
                                          "scenes/conference/scene.ini"};
     printf("functional mode vs golden model, %d x %d, %d spp, 1 host thread, N = 16, M = 4096\n", w, h, spp);

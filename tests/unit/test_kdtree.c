@@ -63,6 +63,16 @@ static float rnd(void)
     return (float)((rng_state >> 40) & 0xffffff) / 16777216.0f;
 }
 
+/* A shipped scene, packed, with its kd-tree (default parameters). */
+static void load_kd(const char *path, Scene *s, PackedScene *p, KdTree *t)
+{
+    char err[1024];
+    cr_assert_eq(pack_load_file(path, 0, 0, 0, s, p, err, sizeof err), 0, "%s", err);
+    KdParams kp;
+    kd_default_params(&kp);
+    cr_assert_eq(ref_kd_build(p, &kp, t, err, sizeof err), 0, "%s", err);
+}
+
 typedef struct Agg {
     RefKdStats st;
     long mismatches;
@@ -74,12 +84,9 @@ static void compare_scene(const char *path, uint32_t nrays, Agg agg[12], uint32_
 {
     Scene s;
     PackedScene p;
-    char err[1024];
-    cr_assert_eq(pack_load_file(path, 0, 0, 0, &s, &p, err, sizeof err), 0, "%s", err);
-    KdParams kp;
-    kd_default_params(&kp);
     KdTree t;
-    cr_assert_eq(ref_kd_build(&p, &kp, &t, err, sizeof err), 0, "%s", err);
+    char err[1024];
+    load_kd(path, &s, &p, &t);
     float *bmin, *bmax;
     cr_assert_eq(ref_kd_prim_boxes(&p, &bmin, &bmax), 0);
     cr_assert_eq(kd_check(&t, bmin, bmax, err, sizeof err), 0, "%s: %s", path, err);
@@ -186,12 +193,8 @@ static void check_packets(const char *path, int npackets)
 {
     Scene s;
     PackedScene p;
-    char err[1024];
-    cr_assert_eq(pack_load_file(path, 0, 0, 0, &s, &p, err, sizeof err), 0, "%s", err);
-    KdParams kp;
-    kd_default_params(&kp);
     KdTree t;
-    cr_assert_eq(ref_kd_build(&p, &kp, &t, err, sizeof err), 0, "%s", err);
+    load_kd(path, &s, &p, &t);
     rng_state = 777;
     long bad = 0;
     RefKdStats coh = {0}, inc = {0}, single = {0};
