@@ -14,6 +14,7 @@
         .include "abi.inc"
         .include "layout.inc"
         .include "vmath.inc"
+        .include "isect.inc"
 
 INV_PI_F  = 0.318309886
 INV_2PI_F = 0.159154943
@@ -437,6 +438,21 @@ setup_chunk:
 setup_done:
         jr      r30
 
+; the slab test of a ray against a box (BVH node or kd-tree voxel); far ends widened
+.macro  SLAB bmin, bmax, o, inv
+        vfsub   t0, \bmin, \o @m1
+        vfmul   t0, t0, \inv @m1
+        vfsub   t1, \bmax, \o @m1
+        vfmul   t1, t1, \inv @m1
+        vfmin   tlo, t0, t1 @m1
+        vfmax   t1, t0, t1 @m1
+        vfmul   t1, t1, vscale @m1
+        vfmax   tn, tn, tlo @m1
+        vfmin   tf, tf, t1 @m1
+.endm
+.ifdef ACCEL_KD
+        .include "kdtrace.inc"
+.else
 ; ==== traversal: stream filtering down the BVH (Fig. 3), front to back per ray ==================
 ; A stack entry is (node address, begin, end) of an ID range in IDM; ranges are partitioned in
 ; place, so a child's range is a prefix of its parent's. At an inner node the passing rays are
@@ -500,17 +516,6 @@ box_chunk:
         rgat    tf, vid, r0, F_TMAX @m1
         vfmul   tf, tf, vscale @m1      ; the hit distance so far, widened like the slab's far end
         vli     tn, 0 @m1
-.macro  SLAB bmin, bmax, o, inv
-        vfsub   t0, \bmin, \o @m1
-        vfmul   t0, t0, \inv @m1
-        vfsub   t1, \bmax, \o @m1
-        vfmul   t1, t1, \inv @m1
-        vfmin   tlo, t0, t1 @m1
-        vfmax   t1, t0, t1 @m1
-        vfmul   t1, t1, vscale @m1
-        vfmax   tn, tn, tlo @m1
-        vfmin   tf, tf, t1 @m1
-.endm
         SLAB    bminx, bmaxx, ox, ix
         SLAB    bminy, bmaxy, oy, iy
         SLAB    bminz, bmaxz, oz, iz
@@ -585,45 +590,27 @@ trace_done:
         stage   0
         jr      r30
 
+.endif
+
+.if !defined(ACCEL_KD) || KD_VARIANT == KD_STREAM
 ; ==== intersection: the leaf's primitives against the stream [r3, r5) ===========================
 ; Per ray the primitives are tested in order (the golden model's order); the best hit stays in
 ; registers over the leaf and is scattered once per chunk (conditional scatter).
 ; In: r7 first primitive, r6 count. Clobbers r1-r15 (not r24, r26, r27).
 isect:
-.alias  vid, v0
-.alias  kx, v1
-.alias  ky, v2
-.alias  kz, v3
-.alias  sx, v4
-.alias  sy, v5
-.alias  sz, v6
-.alias  pox, v7
-.alias  poy, v8
-.alias  poz, v9
-.alias  tm, v10
-.alias  prim, v11
-.alias  bu, v12
-.alias  bv, v13
-.alias  ptm, v14
-.alias  adx, v15
-.alias  ady, v16
-.alias  adz, v17
-.alias  ex, v18
-.alias  ey, v19
-.alias  ez, v20
-.alias  fx, v21
-.alias  fy, v22
-.alias  fz, v23
-.alias  gx, v24
-.alias  gy, v25
-.alias  gz, v26
-.alias  vt, v27
-.alias  vi, v28
+        ISECT_REGS
         COUNT_STREAM ST_G_ISECT, r3, r5, r8, r9, r10
+.ifdef ACCEL_KD
+        shli    r8, r7, 2               ; kd-tree leaf: r7 is its first KD_PRIMS entry
+        add     r8, r8, r14
+        shli    r9, r6, 2
+        add     r9, r9, r8              ; one past its last
+.else
         li      r8, SM_PRIM_BYTES
         mul     r8, r8, r7
         add     r8, r8, r27             ; address of the first primitive
         add     r9, r7, r6              ; one past the last index
+.endif
         mov     r16, r3
 isect_chunk:
         sfetch  vid, m1, r16, r5
@@ -641,185 +628,57 @@ isect_chunk:
         vieq    m2, prim, vm2 @m1       ; shadow rays
         mclr    m3                      ; lanes whose tmax changed
         mclr    m4                      ; lanes with a new closest hit
+.ifdef ACCEL_KD
+        mov     r13, r8
+isect_prim:
+        ld      r11, r13, 0             ; primitive index and address
+        muli    r10, r11, SM_PRIM_BYTES
+        add     r10, r10, r27
+.else
         mov     r10, r8                 ; primitive address
         mov     r11, r7                 ; primitive index
 isect_prim:
+.endif
 .ifdef HAS_SPHERES
         ld      r12, r10, SM_PRIM_KIND
         bne     r12, r0, isect_sphere
 .endif
         vbcast  vt, r10 @m1
-        vadd    adx, kx, vt @m1
-        vadd    ady, ky, vt @m1
-        vadd    adz, kz, vt @m1
-        ; vertex -> (x, y, z) in the ray's sheared frame; the z value stays unscaled until later
-.macro  SHEAR ox, oy, oz, off
-        ldg     \ox, adx, \off @m1
-        ldg     \oy, ady, \off @m1
-        ldg     \oz, adz, \off @m1
-        vfsub   \ox, \ox, pox @m1
-        vfsub   \oy, \oy, poy @m1
-        vfsub   \oz, \oz, poz @m1        ; A[kz]
-        vfmul   vt, sx, \oz @m1
-        vfsub   \ox, \ox, vt @m1         ; A[kx] - sx A[kz]
-        vfmul   vt, sy, \oz @m1
-        vfsub   \oy, \oy, vt @m1
-.endm
-        SHEAR   ex, ey, ez, SM_PRIM_V0
-        SHEAR   fx, fy, fz, SM_PRIM_V1
-        SHEAR   gx, gy, gz, SM_PRIM_V2
-        ; U = Cx By - Cy Bx, V = Ax Cy - Ay Cx, W = Bx Ay - By Ax  (A = e, B = f, C = g)
-        vfmul   adx, gx, fy @m1
-        vfmul   vt, gy, fx @m1
-        vfsub   adx, adx, vt @m1        ; U
-        vfmul   ady, ex, gy @m1
-        vfmul   vt, ey, gx @m1
-        vfsub   ady, ady, vt @m1        ; V
-        vfmul   adz, fx, ey @m1
-        vfmul   vt, fy, ex @m1
-        vfsub   adz, adz, vt @m1        ; W
-        vflt    m5, adx, vz @m1
-        vflt    m6, ady, vz @m1
-        mor     m5, m5, m6
-        vflt    m6, adz, vz @m1
-        mor     m5, m5, m6              ; some edge function negative
-        vflt    m6, vz, adx @m1
-        vflt    m7, vz, ady @m1
-        mor     m6, m6, m7
-        vflt    m7, vz, adz @m1
-        mor     m6, m6, m7              ; some edge function positive
-        mand    m5, m5, m6
-        mandn   m5, m1, m5              ; inside (or on an edge)
-        bmz     m5, isect_next
-        ; the rest of the test runs on every lane of the chunk (the paper's N-wide SIMD test
-        ; makes its hit mask at the end); m5 collects the lanes still hitting
-        vfadd   ex, adx, ady @m1
-        vfadd   ex, ex, adz @m1         ; det = U + V + W
-        vfne    m6, ex, vz @m1
-        mand    m5, m5, m6
-        ; Az, Bz, Cz scaled by sz; T = U Az + V Bz + W Cz
-        vfmul   ez, sz, ez @m1
-        vfmul   fz, sz, fz @m1
-        vfmul   gz, sz, gz @m1
-        vfmul   ey, adx, ez @m1
-        vfmul   vt, ady, fz @m1
-        vfadd   ey, ey, vt @m1
-        vfmul   vt, adz, gz @m1
-        vfadd   ey, ey, vt @m1          ; T
-        vflt    m6, ex, vz @m1          ; seen from behind: flip the signs
-        vfneg   ey, ey @m6
-        vfneg   ex, ex @m6
-        vfneg   ady, ady @m6
-        vfneg   adz, adz @m6
-        ; probe distance: a ray with a hit tests up to nextafter(best), so ties are seen
-        vmov    ptm, tm @m1
-        viltu   m6, prim, vm2 @m1
-        vaddi   ptm, ptm, 1 @m6
-        vflt    m6, vz, ey @m1          ; T > 0
-        mand    m5, m5, m6
-        vfmul   vt, ptm, ex @m1
-        vflt    m6, ey, vt @m1          ; T < tmax det
-        mand    m5, m5, m6
-        bmz     m5, isect_next
-        vrcp    ex, ex @m1
-        vfmul   ey, ey, ex @m1          ; t
-        vfmul   ady, ady, ex @m1        ; u
-        vfmul   adz, adz, ex @m1        ; v
-        vflt    m6, vz, ey @m1
-        mand    m5, m5, m6
-        vflt    m6, ey, ptm @m1
-        mand    m5, m5, m6
+        TRI_TEST isect_next
 isect_update:
-        ; shadow rays: occluded, done
-        mand    m6, m5, m2
-        vli     tm, -1.0 @m6
-        mor     m3, m3, m6
-        ; closest: t < best, or a tie won by the lower index
-        mandn   m5, m5, m2
-        vbcast  vi, r11 @m5
-        vflt    m6, ey, tm @m5
-        vfeq    m7, ey, tm @m5
-        viltu   m7, vi, prim @m7
-        mor     m6, m6, m7
-        vmov    tm, ey @m6
-        vmov    bu, ady @m6
-        vmov    bv, adz @m6
-        vmov    prim, vi @m6
-        mor     m3, m3, m6
-        mor     m4, m4, m6
+        HIT_UPDATE vbcast, r11
 .ifdef HAS_SPHERES
         jmp     isect_next
-        ; ray/sphere (Haines et al. 2019): discriminant from the closest-approach vector; the
-        ; hit distance goes to the shared update with u = v = 0
 isect_sphere:
-.macro  SPH_OC o, f, off
-        rgat    \o, vid, r0, \f @m1
-        ldb     vt, r10, SM_PRIM_V0 + \off @m1
-        vfsub   \o, \o, vt @m1
-.endm
-        SPH_OC  ex, F_ORGX, 0           ; oc = o - center
-        SPH_OC  ey, F_ORGY, 4
-        SPH_OC  ez, F_ORGZ, 8
-        rgat    fx, vid, r0, F_DIRX @m1
-        rgat    fy, vid, r0, F_DIRY @m1
-        rgat    fz, vid, r0, F_DIRZ @m1
-        SANITIZE1 fx, vt, vi, m6
-        SANITIZE1 fy, vt, vi, m6
-        SANITIZE1 fz, vt, vi, m6
-        DOT3    gx, f, f, vt            ; a
-        vflt    m5, vz, gx @m1
-        DOT3    gy, e, f, vt, m5
-        vfneg   gy, gy @m5              ; b = -(oc . d)
-        vfdiv   gz, gy, gx @m5          ; s = b / a
-        vfmul   vt, gz, fx @m5
-        vfadd   fx, ex, vt @m5          ; l = oc + s d
-        vfmul   vt, gz, fy @m5
-        vfadd   fy, ey, vt @m5
-        vfmul   vt, gz, fz @m5
-        vfadd   fz, ez, vt @m5
-        ldb     vt, r10, SM_PRIM_V1 @m5 ; radius
-        vfmul   adx, vt, vt @m5         ; r2
-        DOT3    gz, f, f, vt, m5
-        vfsub   gz, adx, gz @m5
-        vfmul   gz, gx, gz @m5          ; disc = a (r2 - l . l)
-        vflt    m6, gz, vz @m5
-        mandn   m5, m5, m6
-        DOT3    fx, e, e, vt, m5
-        vfsub   fx, fx, adx @m5         ; c = oc . oc - r2
-        vsqrt   fy, gz @m5
-        vandi   vt, fy, 0x7FFFFFFF @m5
-        vandi   vi, gy, 0x80000000 @m5
-        vor     vt, vt, vi @m5
-        vfadd   fy, gy, vt @m5          ; q = b + copysign(sqrt(disc), b)
-        vfne    m5, fy, vz @m5
-        vfdiv   fz, fx, fy @m5          ; t0 = c / q
-        vfdiv   ex, fy, gx @m5          ; t1 = q / a
-        vfmin   adx, fz, ex @m5         ; lo
-        vfmax   ady, fz, ex @m5         ; hi
-        vmov    ptm, tm @m5
-        viltu   m6, prim, vm2 @m5
-        vaddi   ptm, ptm, 1 @m6
-        vflt    m6, vz, adx @m5
-        vflt    m6, adx, ptm @m6        ; lo in (0, tmax)
-        vflt    m7, vz, ady @m5
-        vflt    m7, ady, ptm @m7        ; hi in (0, tmax)
-        vmov    ey, ady @m7
-        vmov    ey, adx @m6
-        mor     m5, m6, m7
-        vli     ady, 0 @m5
-        vli     adz, 0 @m5
+        SPH_TEST ldb, r10
         jmp     isect_update
 .endif
 isect_next:
+.ifdef ACCEL_KD
+        addi    r13, r13, 4
+        blt     r13, r9, isect_prim
+.else
         addi    r10, r10, SM_PRIM_BYTES
         addi    r11, r11, 1
         blt     r11, r9, isect_prim
+.endif
         rsct    tm, vid, r0, F_TMAX @m3
         rsct    prim, vid, r0, F_PRIM @m4
         rsct    bu, vid, r0, F_U @m4
         rsct    bv, vid, r0, F_V @m4
+.ifdef ACCEL_KD
+        rgatn   ex, vid, r0, KS_CLEAVES @m1 ; per-ray counters (kdstream.inc)
+        vaddi   ex, ex, 1 @m1
+        rsctn   ex, vid, r0, KS_CLEAVES @m1
+        rgatn   ex, vid, r0, KS_CPRIMS @m1
+        vbcast  ey, r6 @m1
+        vadd    ex, ex, ey @m1
+        rsctn   ex, vid, r0, KS_CPRIMS @m1
+.endif
         blt     r16, r5, isect_chunk
         jr      r31
+
+.endif
 
 ; ==== shading: the filter stack of Fig. 4 ========================================================
 ; Stream [r19, r20) after traversal. Shadow filter, miss filter, surface + hit-light filter, then

@@ -325,6 +325,74 @@ int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *
     return 0;
 }
 
+/* KDNODE INFO keeps an index in 30 bits (the low 2 hold the axis or the leaf tag). The tree's
+ * other invariants are kd_check's. */
+static int kd_indices_fit(const KdTree *t, char *err, size_t errlen)
+{
+    for (uint32_t i = 0; i < t->nnodes; i++)
+        if (t->nodes[i].a > SM_KD_MAX_INDEX) {
+            snprintf(err, errlen, "pack: kd-tree node %u: %s %u does not fit the 30 bits of KDNODE INFO", i,
+                     t->nodes[i].axis == KD_LEAF ? "leaf-list index" : "child index", t->nodes[i].a);
+            return -1;
+        }
+    return 0;
+}
+
+static void kd_write(Writer *w, const KdTree *t, uint32_t nodes, uint32_t prims)
+{
+    for (uint32_t i = 0; i < t->nnodes; i++) {
+        const KdNode *n = &t->nodes[i];
+        uint32_t split_at = sm_rec(nodes, SM_KDNODE_WORDS, i, SM_KDNODE_SPLIT);
+        if (n->axis == KD_LEAF)
+            put_u32(w, split_at, n->count);
+        else
+            put_f32(w, split_at, n->split);
+        put_u32(w, sm_rec(nodes, SM_KDNODE_WORDS, i, SM_KDNODE_INFO),
+                n->a << SM_KD_SHIFT | (n->axis == KD_LEAF ? SM_KD_LEAF : n->axis));
+    }
+    for (uint32_t r = 0; r < t->nrefs; r++)
+        put_u32(w, prims + 4u * r, t->prims[r]);
+    uint32_t h = w->base;
+    put_u32(w, hdr(h, SM_HDR_KD_NODES), nodes);
+    put_u32(w, hdr(h, SM_HDR_KD_PRIMS), prims);
+    put_u32(w, hdr(h, SM_HDR_KD_NNODES), t->nnodes);
+    put_vec(w, hdr(h, SM_HDR_KD_BMIN), t->bmin, 3);
+    put_vec(w, hdr(h, SM_HDR_KD_BMAX), t->bmax, 3);
+}
+
+int pack_add_kd(PackedScene *p, const KdTree *t, char *err, size_t errlen)
+{
+    if (sm_u32(p, sm_hdr(p, SM_HDR_KD_NODES)) != 0) {
+        snprintf(err, errlen, "pack: the scene already has a kd-tree");
+        return -1;
+    }
+    if (t->nprims != p->nprims) {
+        snprintf(err, errlen, "pack: the kd-tree was built over %u primitives; the scene has %u", t->nprims,
+                 p->nprims);
+        return -1;
+    }
+    if (kd_indices_fit(t, err, errlen) != 0)
+        return -1;
+    Writer w = {p->mem, p->size, p->size, p->base, 0};
+    uint32_t nodes = w_alloc(&w, (size_t)SM_KDNODE_WORDS * t->nnodes);
+    uint32_t prims = w_alloc(&w, t->nrefs);
+    p->mem = w.mem; /* possibly moved by realloc; the bytes up to p->size are the same */
+    if (w.oom) {
+        snprintf(err, errlen, "pack: out of memory for a kd-tree of %u nodes", t->nnodes);
+        return -1;
+    }
+    if (w.size > (size_t)UINT32_MAX - p->base) {
+        snprintf(err, errlen,
+                 "pack: a kd-tree of %u nodes and %u leaf-list entries takes the scene past 4 GiB of addresses "
+                 "(%zu bytes from 0x%x)", t->nnodes, t->nrefs, w.size, p->base);
+        return -1;
+    }
+    kd_write(&w, t, nodes, prims);
+    p->size = (uint32_t)w.size;
+    p->kd_depth = t->depth;
+    return 0;
+}
+
 void pack_free(PackedScene *p)
 {
     free(p->mem);

@@ -1,4 +1,5 @@
-/* scenes/pack.h -- packing a loaded scene and its BVH into simulated scene memory.
+/* scenes/pack.h -- packing a loaded scene and its BVH (and, on request, a kd-tree) into
+ * simulated scene memory.
  *
  * Owns: the byte image of a scene in scene memory, laid out per scenes/layout.def.
  * Must not: load files or execute anything; readers (golden model, kernels) use the layout
@@ -12,6 +13,7 @@
 #include <string.h>
 
 #include "bvh.h"
+#include "kdtree.h"
 #include "scene.h"
 
 /* Word offsets and record sizes: SM_HDR_WORDS, SM_HDR_MAGIC, SM_NODE_BMIN, ... */
@@ -26,6 +28,10 @@ enum {
 #define SM_MAGIC 0x4D534653u
 #define SM_VERSION 1u
 #define SM_NODE_INNER 0x80000000u
+/* KDNODE INFO: an index shifted past the 2-bit tag (axis 0..2, or 3 = leaf). */
+#define SM_KD_SHIFT 2u
+#define SM_KD_LEAF 3u
+#define SM_KD_MAX_INDEX ((1u << (32u - SM_KD_SHIFT)) - 1u)
 
 typedef enum SmLightKind {
     SM_LIGHT_POINT = 0, SM_LIGHT_SPOT = 1, SM_LIGHT_DIRECTIONAL = 2, SM_LIGHT_QUAD = 3,
@@ -39,6 +45,7 @@ typedef struct PackedScene {
     Bvh bvh;             /* the tree that was packed (node i = packed node i) */
     uint32_t nprims;     /* triangles + spheres */
     uint32_t nlights;
+    uint32_t kd_depth;   /* levels of the kd-tree pack_add_kd appended (root = 1); 0: none */
 } PackedScene;
 
 /* Pack s with a BVH built by bp, for loading at scene-memory address base (a multiple of 64).
@@ -46,6 +53,12 @@ typedef struct PackedScene {
 int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *out, char *err,
                size_t errlen);
 void pack_free(PackedScene *p);
+
+/* Append kd-tree t, built over p's packed primitives (packed indices, as ref_kd_build builds it),
+ * to the image: its KDNODE array and its leaf lists, each on a 64-byte boundary, and fill the
+ * header's KD_* fields. 0, or -1 with a message (a second tree, a tree over other primitives, an
+ * index that does not fit 30 bits, an image past 4 GiB of addresses); p is unchanged then. */
+int pack_add_kd(PackedScene *p, const KdTree *t, char *err, size_t errlen);
 
 /* Load a scene file, override its render size and samples (values > 0), and pack it with the
  * default BVH: the set-up of benchmarks and tools. 0, or -1 with a message (nothing to free). */

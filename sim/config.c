@@ -16,10 +16,13 @@
 typedef enum CfgType { CFG_INT, CFG_I64, CFG_FLOAT, CFG_ENUM } CfgType;
 
 /* The names of ENUM keys' values, in index order (sim/config.h has the index constants). */
-static const struct { const char *section, *key; const char *names[4]; } enum_names[] = {
+#define CFG_ENUM_NAMES 8
+static const struct { const char *section, *key; const char *names[CFG_ENUM_NAMES]; } enum_names[] = {
     {"stream", "mode", {"stream", "packet"}},
     {"stream", "order", {"ray", "first"}},
     {"workload", "kind", {"path", "specular", "diffuse"}},
+    {"accel", "structure", {"bvh", "kd"}},
+    {"kd", "traversal", {"stack", "restart", "pushdown", "shortstack", "packet", "stream"}},
 };
 
 static const char *const *enum_of(const char *section, const char *key)
@@ -33,7 +36,7 @@ static const char *const *enum_of(const char *section, const char *key)
 const char *cfg_enum_name(const char *section, const char *key, int value)
 {
     const char *const *n = enum_of(section, key);
-    if (!n || value < 0 || value >= 4)
+    if (!n || value < 0 || value >= CFG_ENUM_NAMES)
         return NULL;
     return n[value];
 }
@@ -142,6 +145,18 @@ static int section_known(const char *section)
     return 0;
 }
 
+/* Keys whose range excludes its lower end 0: kd_build takes costs > 0 and an empty bonus in (0, 1]
+ * (a bonus of 0 would make every split with an empty side free). Checked in binary32, the
+ * builder's precision, so that a tiny value does not reach it as 0. */
+static int must_be_positive(const CfgKeyInfo *k)
+{
+    static const char *const kd_keys[] = {"cost_traversal", "cost_intersect", "empty_bonus"};
+    for (size_t i = 0; i < sizeof kd_keys / sizeof kd_keys[0]; i++)
+        if (strcmp(k->section, "kd") == 0 && strcmp(k->key, kd_keys[i]) == 0)
+            return 1;
+    return 0;
+}
+
 /* Parse and range-check; returns NULL on success or a message in buf. */
 static const char *parse_value(const CfgKeyInfo *k, const char *text, CfgValue *out, char *buf, size_t buflen)
 {
@@ -196,6 +211,10 @@ static const char *parse_value(const CfgKeyInfo *k, const char *text, CfgValue *
     }
     if (strcmp(k->section, "stream") == 0 && strcmp(k->key, "rays") == 0 && out->i != 1024 && out->i != 4096) {
         snprintf(buf, buflen, "value %s: must be 1024 or 4096", text);
+        return buf;
+    }
+    if (k->type == CFG_FLOAT && must_be_positive(k) && !((float)out->f > 0.0f)) {
+        snprintf(buf, buflen, "value %s: must be greater than 0", text);
         return buf;
     }
     return NULL;

@@ -16,9 +16,15 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "../asm/asm.h"
+#include "ref_kd.h"
+
+const char *const func_kd_kind_keys[FUNC_KD_KINDS] = {"camera", "indirect", "shadow"};
+const char *const func_kd_counter_keys[FUNC_KD_COUNTERS] = {"nodes", "leaves", "prims", "restarts", "overflows",
+                                                            "underflows"};
 
 const char *func_default_kernel(char *buf, size_t len)
 {
@@ -48,7 +54,20 @@ typedef struct Abi {
     uint32_t st_gen_base, st_gen_bytes, st_g_trav, st_g_isect, st_g_shade;
     uint32_t stack_base, ray_fields, err_stack, err_generations;
     uint32_t f_org[3], f_dir[3], f_tmax, f_kind, f_prim, f_u, f_v;
+    uint32_t spad_clear;       /* the host zeroes the scratchpad below it before each run */
+    uint32_t kc_base, kc_counters, kc_vec_bytes;
+    uint32_t kc[FUNC_KD_COUNTERS], kind[FUNC_KD_KINDS]; /* in FuncStats order */
+    uint32_t kstack_base;      /* ACCEL_KD builds only */
 } Abi;
+
+static const AsmSymbol *abi_find(const AsmObject *obj, const char *name)
+{
+    const AsmSymbol *found = NULL;
+    for (uint32_t s = 0; s < obj->nsyms; s++)
+        if (!strcmp(obj->syms[s].name, name))
+            found = &obj->syms[s];
+    return found;
+}
 
 static int abi_lookup(const AsmObject *obj, Abi *abi, char *err, size_t errlen)
 {
@@ -63,14 +82,16 @@ static int abi_lookup(const AsmObject *obj, Abi *abi, char *err, size_t errlen)
         A(err_stack, "ERR_STACK"), A(err_generations, "ERR_GENERATIONS"), A(f_org[0], "F_ORGX"),
         A(f_org[1], "F_ORGY"), A(f_org[2], "F_ORGZ"), A(f_dir[0], "F_DIRX"), A(f_dir[1], "F_DIRY"),
         A(f_dir[2], "F_DIRZ"), A(f_tmax, "F_TMAX"), A(f_kind, "F_KIND"), A(f_prim, "F_PRIM"), A(f_u, "F_U"),
-        A(f_v, "F_V"),
+        A(f_v, "F_V"), A(spad_clear, "SPAD_CLEAR"), A(kc_base, "KC_BASE"), A(kc_counters, "KC_COUNTERS"),
+        A(kc_vec_bytes, "KC_VEC_BYTES"), A(kc[FUNC_KD_NODES], "KC_NODES"), A(kc[FUNC_KD_LEAVES], "KC_LEAVES"),
+        A(kc[FUNC_KD_PRIMS], "KC_PRIMS"), A(kc[FUNC_KD_RESTARTS], "KC_RESTARTS"),
+        A(kc[FUNC_KD_OVERFLOWS], "KC_OVERFLOWS"), A(kc[FUNC_KD_UNDERFLOWS], "KC_UNDERFLOWS"),
+        A(kind[FUNC_KD_CAMERA], "KIND_CAMERA"), A(kind[FUNC_KD_INDIRECT], "KIND_INDIRECT"),
+        A(kind[FUNC_KD_SHADOW], "KIND_SHADOW"),
 #undef A
     };
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
-        const AsmSymbol *found = NULL;
-        for (uint32_t s = 0; s < obj->nsyms; s++)
-            if (!strcmp(obj->syms[s].name, names[i].name))
-                found = &obj->syms[s];
+        const AsmSymbol *found = abi_find(obj, names[i].name);
         if (!found) {
             snprintf(err, errlen, "kernel: symbol %s missing (kernels/lib/abi.inc defines the host interface)",
                      names[i].name);
@@ -80,6 +101,184 @@ static int abi_lookup(const AsmObject *obj, Abi *abi, char *err, size_t errlen)
     }
     if (abi->st_max_gen > FUNC_MAX_GENERATIONS) {
         snprintf(err, errlen, "kernel: ST_MAX_GEN %u exceeds the host's %d", abi->st_max_gen, FUNC_MAX_GENERATIONS);
+        return -1;
+    }
+    return 0;
+}
+
+/* ---- kd-tree (accel.structure = kd) ------------------------------------------------------------ */
+
+/* Bytes per entry of the kd kernel's stacks (kernels/pathtrace.s owns their layout). */
+#define KD_PACKET_ENTRY_BYTES 1040u /* packet short stack, in the scratchpad from KSTACK_BASE */
+#define KD_STREAM_ENTRY_BYTES 36u   /* stream-filter stack, 3 * depth + 8 entries like the BVH kernel's */
+#define KD_LANE_ENTRY_BYTES 1024u   /* per-lane stacks, in the next generation's ray buffer */
+
+/* abi.inc's KD_VARIANT constants, in kd.traversal order. */
+static const char *const kd_variant_syms[CFG_KD_TRAVERSALS] = {"KD_STACK", "KD_RESTART", "KD_PUSHDOWN",
+                                                               "KD_SHORTSTACK", "KD_PACKET", "KD_STREAM"};
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void kd_params(const CfgMachine *cfg, KdParams *kp)
+{
+    kd_default_params(kp);
+    kp->cost_traversal = (float)cfg->kd_cost_traversal;
+    kp->cost_intersect = (float)cfg->kd_cost_intersect;
+    kp->empty_bonus = (float)cfg->kd_empty_bonus;
+    kp->max_depth = cfg->kd_max_depth;
+    kp->leaf_size = cfg->kd_leaf_size;
+}
+
+static void kd_info(const KdTree *t, FuncKdInfo *info)
+{
+    info->nodes = t->nnodes;
+    info->leaves = t->nleaves;
+    info->empty_leaves = t->nempty;
+    info->depth = t->depth;
+    info->largest_leaf = t->max_leaf;
+    info->prims = t->nprims;
+    info->refs = t->nrefs;
+    info->sah_cost = t->sah_cost;
+}
+
+/* The invariants are checked on every build, as the BVH's are (scenes/pack.c): a broken tree
+ * would silently lose geometry. */
+static int kd_check_packed(const PackedScene *p, const KdTree *t, const CfgMachine *cfg, char *err, size_t errlen)
+{
+    float *bmin, *bmax;
+    if (ref_kd_prim_boxes(p, &bmin, &bmax) != 0) {
+        snprintf(err, errlen, "accel.structure = kd: out of memory for %u primitive boxes", p->nprims);
+        return -1;
+    }
+    char why[512];
+    int rc = kd_check(t, bmin, bmax, why, sizeof why);
+    if (rc != 0)
+        snprintf(err, errlen,
+                 "accel.structure = kd: the kd-tree built with kd.cost_traversal = %g, kd.cost_intersect = %g, "
+                 "kd.empty_bonus = %g, kd.max_depth = %d, kd.leaf_size = %d breaks an invariant: %s",
+                 cfg->kd_cost_traversal, cfg->kd_cost_intersect, cfg->kd_empty_bonus, cfg->kd_max_depth,
+                 cfg->kd_leaf_size, why);
+    free(bmin);
+    free(bmax);
+    return rc;
+}
+
+int func_add_kd(PackedScene *p, const CfgMachine *cfg, FuncKdInfo *info, char *err, size_t errlen)
+{
+    memset(info, 0, sizeof *info);
+    if (cfg->accel_structure != CFG_ACCEL_KD)
+        return 0;
+    double t0 = now();
+    KdParams kp;
+    kd_params(cfg, &kp);
+    KdTree t;
+    char why[512];
+    if (ref_kd_build(p, &kp, &t, why, sizeof why) != 0) {
+        snprintf(err, errlen, "accel.structure = kd: %s", why);
+        return -1;
+    }
+    int rc = kd_check_packed(p, &t, cfg, err, errlen);
+    if (rc == 0 && (rc = pack_add_kd(p, &t, why, sizeof why)) != 0)
+        snprintf(err, errlen, "accel.structure = kd: %s", why);
+    if (rc == 0)
+        kd_info(&t, info);
+    kd_free(&t);
+    info->build_seconds = now() - t0;
+    return rc;
+}
+
+/* KD_STACK_DEPTH: the entries of the kernel's per-ray (or per-packet) stack. */
+static uint32_t kd_stack_depth(const CfgMachine *cfg, const PackedScene *p)
+{
+    switch (cfg->kd_traversal) {
+    case CFG_KD_STACK:
+        return p->kd_depth + 1; /* a full stack never overflows: an entry per level, and one more */
+    case CFG_KD_SHORTSTACK:
+    case CFG_KD_PACKET:
+        return (uint32_t)cfg->kd_stack_depth;
+    default:
+        return 1;               /* restart, push-down and the stream filter keep no per-ray stack */
+    }
+}
+
+/* The kd part of the object's interface: KSTACK_BASE; the chosen variant's constant must be the
+ * value the host passed as KD_VARIANT; the counters of N lanes must lie below SPAD_CLEAR, so that
+ * each run starts them at 0. */
+static int kd_abi_lookup(const AsmObject *obj, const CfgMachine *cfg, Abi *abi, char *err, size_t errlen)
+{
+    const AsmSymbol *ks = abi_find(obj, "KSTACK_BASE");
+    const AsmSymbol *vs = abi_find(obj, kd_variant_syms[cfg->kd_traversal]);
+    if (!ks || !vs) {
+        snprintf(err, errlen, "kernel: symbol %s missing (kernels/lib/abi.inc defines the host interface)",
+                 ks ? kd_variant_syms[cfg->kd_traversal] : "KSTACK_BASE");
+        return -1;
+    }
+    if (vs->value != (uint32_t)cfg->kd_traversal) {
+        snprintf(err, errlen, "kernel: %s = %u, but the host passes KD_VARIANT = %d for kd.traversal = %s",
+                 vs->name, vs->value, cfg->kd_traversal, cfg_enum_name("kd", "traversal", cfg->kd_traversal));
+        return -1;
+    }
+    abi->kstack_base = ks->value;
+    uint64_t lanes_bytes = 4ull * (uint64_t)cfg->core_simd_width;
+    uint64_t top = abi->kc_base + (uint64_t)FUNC_KD_KINDS * abi->kc_counters * abi->kc_vec_bytes;
+    if (abi->kc_vec_bytes < lanes_bytes || top > abi->spad_clear) {
+        snprintf(err, errlen, "kernel: kd counters (KC_BASE %u, KC_VEC_BYTES %u) must hold core.simd_width = %d lanes "
+                 "below SPAD_CLEAR %u", abi->kc_base, abi->kc_vec_bytes, cfg->core_simd_width, abi->spad_clear);
+        return -1;
+    }
+    for (int k = 0; k < FUNC_KD_KINDS; k++)
+        if (abi->kind[k] >= FUNC_KD_KINDS) {
+            snprintf(err, errlen, "kernel: ray kind %s = %u has no kd counters (3 kinds)", func_kd_kind_keys[k],
+                     abi->kind[k]);
+            return -1;
+        }
+    for (int c = 0; c < FUNC_KD_COUNTERS; c++)
+        if (abi->kc[c] >= abi->kc_counters) {
+            snprintf(err, errlen, "kernel: kd counter %s = %u is not below KC_COUNTERS = %u", func_kd_counter_keys[c],
+                     abi->kc[c], abi->kc_counters);
+            return -1;
+        }
+    return 0;
+}
+
+/* The scratchpad and the ray buffers must hold the kd kernel's stacks (depth: KD_STACK_DEPTH). */
+static int kd_memories_ok(const CfgMachine *cfg, const CoreParams *cp, const Abi *a, const PackedScene *p,
+                          uint32_t depth, char *err, size_t errlen)
+{
+    uint64_t spad = cp->mem_bytes[CORE_MEM_SPAD], rb = cp->mem_bytes[CORE_MEM_RB1];
+    int v = cfg->kd_traversal;
+    if (spad < a->kstack_base) {
+        snprintf(err, errlen, "spad.size_kb = %d: the kd-tree traversal keeps %u bytes of counters and per-lane state "
+                 "in the scratchpad", cfg->spad_size_kb, a->kstack_base);
+        return -1;
+    }
+    uint64_t need = a->kstack_base + (uint64_t)KD_PACKET_ENTRY_BYTES * depth;
+    if (v == CFG_KD_PACKET && spad < need) {
+        snprintf(err, errlen, "spad.size_kb = %d: kd.traversal = packet with kd.stack_depth = %u needs %llu KiB of "
+                 "scratchpad (stack entries of %u bytes from byte %u)", cfg->spad_size_kb, depth,
+                 (unsigned long long)((need + 1023) / 1024), KD_PACKET_ENTRY_BYTES, a->kstack_base);
+        return -1;
+    }
+    need = a->kstack_base + (uint64_t)KD_STREAM_ENTRY_BYTES * (3ull * p->kd_depth + 8);
+    if (v == CFG_KD_STREAM && spad < need) {
+        snprintf(err, errlen, "spad.size_kb = %d: kd.traversal = stream over a kd-tree of depth %u needs %llu KiB of "
+                 "scratchpad for its stack (kd.max_depth limits the depth)", cfg->spad_size_kb, p->kd_depth,
+                 (unsigned long long)((need + 1023) / 1024));
+        return -1;
+    }
+    /* Per-lane stacks (the packet variant falls back to them) live in the next generation's ray
+     * buffer. */
+    need = (uint64_t)KD_LANE_ENTRY_BYTES * depth;
+    if ((v == CFG_KD_STACK || v == CFG_KD_SHORTSTACK || v == CFG_KD_PACKET) && rb < need) {
+        snprintf(err, errlen, "raybuf.size_kb = %d: kd.traversal = %s keeps per-lane stacks of %u entries (%s) in "
+                 "a ray buffer: needs %llu KiB", cfg->raybuf_size_kb, cfg_enum_name("kd", "traversal", v), depth,
+                 v == CFG_KD_STACK ? "the kd-tree's depth + 1; kd.max_depth limits it" : "kd.stack_depth",
+                 (unsigned long long)((need + 1023) / 1024));
         return -1;
     }
     return 0;
@@ -123,6 +322,17 @@ static void spad_set(Core *c, uint32_t addr, uint32_t v)
     uint32_t size;
     uint8_t *m = core_mem(c, CORE_MEM_SPAD, &size);
     memcpy(m + addr, &v, 4);
+}
+
+/* Add one run's kd counters, lanes 0..N-1 of each (kind, counter) vector. */
+static void kd_counts_add(Core *c, const Abi *a, int lanes, FuncStats *st)
+{
+    for (int k = 0; k < FUNC_KD_KINDS; k++)
+        for (int n = 0; n < FUNC_KD_COUNTERS; n++) {
+            uint32_t at = a->kc_base + (a->kind[k] * a->kc_counters + a->kc[n]) * a->kc_vec_bytes;
+            for (int l = 0; l < lanes; l++)
+                st->kd_counts[k][n] += spad_u32(c, at + 4u * (uint32_t)l);
+        }
 }
 
 static void fail(Job *j, const char *msg, int trapped)
@@ -187,7 +397,7 @@ static int trace_batch(Worker *w, Core *c, uint32_t t, FuncStats *st)
     core_restart(c);
     uint32_t size;
     uint8_t *sp = core_mem(c, CORE_MEM_SPAD, &size);
-    memset(sp, 0, a->stack_base);
+    memset(sp, 0, a->spad_clear);
     spad_set(c, a->l_w, n);
     uint8_t *rb = core_mem(c, CORE_MEM_RB0, &size);
     const float nan = NAN;
@@ -251,6 +461,8 @@ static int trace_batch(Worker *w, Core *c, uint32_t t, FuncStats *st)
         }
     }
     st->rays_camera += n;
+    if (j->fp->cfg->accel_structure == CFG_ACCEL_KD)
+        kd_counts_add(c, a, j->cp.lanes, st);
     return 0;
 }
 
@@ -268,7 +480,7 @@ static int run_tile(Worker *w, Core *c, uint32_t t, FuncStats *st)
     core_restart(c);
     uint32_t size;
     uint8_t *sp = core_mem(c, CORE_MEM_SPAD, &size);
-    memset(sp, 0, a->stack_base);
+    memset(sp, 0, a->spad_clear);
     spad_set(c, a->l_x0, ft->x0);
     spad_set(c, a->l_y0, ft->y0);
     spad_set(c, a->l_w, ft->w);
@@ -323,6 +535,8 @@ static int run_tile(Worker *w, Core *c, uint32_t t, FuncStats *st)
             st->gen_streams[k][s] += spad_u32(c, at);
             st->gen_rays[k][s] += spad_u32(c, at + 4);
         }
+    if (j->fp->cfg->accel_structure == CFG_ACCEL_KD)
+        kd_counts_add(c, a, j->cp.lanes, st);
     return 0;
 }
 
@@ -390,7 +604,7 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
     memset(st, 0, sizeof *st);
     const CfgMachine *cfg = fp->cfg;
     /* Build symbols from the packed scene itself (docs/kernel.md). */
-    AsmDefine defs[16];
+    AsmDefine defs[24];
     int nd = 0;
     /* Stream mode: tiles of sqrt(M) x sqrt(M) rays; packet mode: packets of N rays, as square as
      * N allows (2 x 2, 4 x 2, 4 x 3, 4 x 4, 8 x 8). */
@@ -464,6 +678,17 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
         add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_BACKGROUND", 1);
     if (amb > 0.0f)
         add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_AMBIENT", 1);
+    if (cfg->accel_structure == CFG_ACCEL_KD) {
+        if (sm_u32(p, sm_hdr(p, SM_HDR_KD_NODES)) == 0) {
+            snprintf(err, errlen, "accel.structure = kd: the scene was packed without a kd-tree (func_add_kd)");
+            return -1;
+        }
+        st->kd = 1;
+        st->kd_stack_depth = kd_stack_depth(cfg, p);
+        add_define(defs, &nd, st->defines, sizeof st->defines, "ACCEL_KD", 1);
+        add_define(defs, &nd, st->defines, sizeof st->defines, "KD_VARIANT", cfg->kd_traversal);
+        add_define(defs, &nd, st->defines, sizeof st->defines, "KD_STACK_DEPTH", st->kd_stack_depth);
+    }
 
     char libdir[PATH_MAX + 8];
     snprintf(libdir, sizeof libdir, "%s", fp->kernel_path);
@@ -499,7 +724,7 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
         goto out;
     }
     pthread_mutex_init(&job->lock, NULL);
-    if (abi_lookup(&obj, &abi, err, errlen) != 0)
+    if (abi_lookup(&obj, &abi, err, errlen) != 0 || (st->kd && kd_abi_lookup(&obj, cfg, &abi, err, errlen) != 0))
         goto out;
     st->kernel_instructions = obj.ntext;
 
@@ -523,12 +748,19 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
                  (12u * rays + 1023u) / 1024u);
         goto out;
     }
+    if (cp.mem_bytes[CORE_MEM_SPAD] < abi.spad_clear) {
+        snprintf(err, errlen, "spad.size_kb = %d: the kernel's launch block and counters need %u bytes",
+                 cfg->spad_size_kb, abi.spad_clear);
+        goto out;
+    }
     uint64_t stack_need = abi.stack_base + 12ull * (3ull * p->bvh.depth + 8);
-    if (cp.mem_bytes[CORE_MEM_SPAD] < stack_need) {
+    if (!st->kd && cp.mem_bytes[CORE_MEM_SPAD] < stack_need) {
         snprintf(err, errlen, "spad.size_kb = %d: the traversal stack of a BVH of depth %u needs %llu KiB",
                  cfg->spad_size_kb, p->bvh.depth, (unsigned long long)((stack_need + 1023) / 1024));
         goto out;
     }
+    if (st->kd && kd_memories_ok(cfg, &cp, &abi, p, st->kd_stack_depth, err, errlen) != 0)
+        goto out;
     if (cp.mem_bytes[CORE_MEM_SCENE] < p->size) {
         snprintf(err, errlen, "scene.size_mb = %d: the packed scene needs %u bytes", cfg->scene_size_mb, p->size);
         goto out;
@@ -629,6 +861,9 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
                 st->gen_streams[g][k] += s->gen_streams[g][k];
                 st->gen_rays[g][k] += s->gen_rays[g][k];
             }
+        for (int k = 0; k < FUNC_KD_KINDS; k++)
+            for (int c = 0; c < FUNC_KD_COUNTERS; c++)
+                st->kd_counts[k][c] += s->kd_counts[k][c];
     }
     for (int g = 0; g < FUNC_MAX_GENERATIONS; g++) {
         st->trav_streams += st->gen_streams[g][0];

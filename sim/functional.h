@@ -21,6 +21,22 @@
 #define FUNC_MAX_GENERATIONS 64
 #define FUNC_STAGES 3          /* stream counters: traversal, intersection, shading */
 
+/* accel.structure = kd: the kernel's kd-tree counters (kernels/lib/abi.inc, KC_*), per ray kind. */
+enum { FUNC_KD_CAMERA, FUNC_KD_INDIRECT, FUNC_KD_SHADOW, FUNC_KD_KINDS };
+enum { FUNC_KD_NODES, FUNC_KD_LEAVES, FUNC_KD_PRIMS, FUNC_KD_RESTARTS, FUNC_KD_OVERFLOWS, FUNC_KD_UNDERFLOWS,
+       FUNC_KD_COUNTERS };
+extern const char *const func_kd_kind_keys[FUNC_KD_KINDS];       /* "camera", "indirect", "shadow" */
+extern const char *const func_kd_counter_keys[FUNC_KD_COUNTERS]; /* "nodes", "leaves", "prims", "restarts",
+                                                                    "overflows", "underflows" */
+
+/* accel.structure = kd: the tree func_add_kd built and packed. */
+typedef struct FuncKdInfo {
+    uint32_t nodes, leaves, empty_leaves, depth, largest_leaf;
+    uint32_t prims, refs;      /* primitives; leaf-list entries (a primitive may be in several leaves) */
+    double sah_cost;
+    double build_seconds;      /* build, invariant check and packing */
+} FuncKdInfo;
+
 typedef struct FuncParams {
     const CfgMachine *cfg;     /* SIMD width, stream size, memories, instruction limit */
     const char *kernel_path;   /* kernels/pathtrace.s */
@@ -71,6 +87,11 @@ typedef struct FuncStats {
     int timed;                                      /* detailed mode: timing holds the sums */
     TimingStats timing;                             /* (sampled mode: of the sampled tiles) */
     uint32_t tiles_timed;
+    /* accel.structure = kd: the kernel's KD_STACK_DEPTH, and its counters summed over lanes,
+     * tiles and threads */
+    int kd;
+    uint32_t kd_stack_depth;
+    uint64_t kd_counts[FUNC_KD_KINDS][FUNC_KD_COUNTERS];
 } FuncStats;
 
 /* Render the whole image through the kernel: rgb (width * height * 3 floats, zeroed by the
@@ -80,6 +101,11 @@ typedef struct FuncStats {
 int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStats *st, char *err,
                 size_t errlen);
 void func_stats_free(FuncStats *st);
+
+/* accel.structure = kd (cfg): build the kd-tree of the kd.* keys over p's packed primitives, check
+ * its invariants and append it to p (pack_add_kd); info receives its figures. For accel.structure
+ * = bvh nothing happens. 0, or -1 with a message naming the keys. func_render needs this first. */
+int func_add_kd(PackedScene *p, const CfgMachine *cfg, FuncKdInfo *info, char *err, size_t errlen);
 
 /* `sfsim trace` through the kernel: fp->batch and fp->hits must be set. Same returns. */
 int func_trace(const PackedScene *p, const FuncParams *fp, FuncStats *st, char *err, size_t errlen);

@@ -91,14 +91,20 @@ static Entry pop(KdStack *s)
     return s->e[(s->bottom + s->n) % KD_MAX_STACK];
 }
 
-/* The query; closest = 0 stops at the first hit. Returns 1 on a hit. */
+/* The query; closest = 0 stops at the first hit. Returns 1 on a hit. With keep, a hit already in
+ * *hit is kept and bounds the ray (the packet's fallback continues from its hits, as the kernel
+ * does with the hit in its ray buffer). */
 static int trace(const PackedScene *p, const KdTree *t, RefKdVariant v, int depth, const RefRay *r, RefHit *hit,
-                 int closest, RefKdStats *st)
+                 int closest, int keep, RefKdStats *st)
 {
-    hit->prim = REF_NO_HIT;
-    hit->t = r->tmax;
-    hit->u = hit->v = 0.0f;
     RefRay q = *r;
+    if (keep && hit->prim != REF_NO_HIT) {
+        q.tmax = hit->t;
+    } else {
+        hit->prim = REF_NO_HIT;
+        hit->t = r->tmax;
+        hit->u = hit->v = 0.0f;
+    }
     ref_sanitize_dir(q.dir);
     float inv[3];
     ref_inv_dir(q.dir, inv);
@@ -210,19 +216,21 @@ static int trace(const PackedScene *p, const KdTree *t, RefKdVariant v, int dept
 void ref_kd_closest_hit(const PackedScene *p, const KdTree *t, RefKdVariant v, int stack_depth, const RefRay *r,
                         RefHit *hit, RefKdStats *st)
 {
-    trace(p, t, v, stack_depth, r, hit, 1, st);
+    trace(p, t, v, stack_depth, r, hit, 1, 0, st);
 }
 
 int ref_kd_any_hit(const PackedScene *p, const KdTree *t, RefKdVariant v, int stack_depth, const RefRay *r,
                    RefKdStats *st)
 {
     RefHit h;
-    return trace(p, t, v, stack_depth, r, &h, 0, st);
+    return trace(p, t, v, stack_depth, r, &h, 0, 0, st);
 }
 
 /* ---- A.5: the packetized short stack ---------------------------------------------------------- */
 
 #define KD_PACKET 64
+
+static uint64_t live_rays(uint64_t live) { return (uint64_t)__builtin_popcountll(live); }
 
 typedef struct PEntry {
     uint32_t node;
@@ -291,19 +299,17 @@ void ref_kd_packet_closest_hit(const PackedScene *p, const KdTree *t, int stack_
             if (!cur.live)
                 break;
             if (!first) {
-                if (st)
-                    st->restarts++, st->stack_underflows++;
+                if (st) {
+                    st->restarts += live_rays(cur.live);
+                    st->stack_underflows += live_rays(cur.live);
+                }
                 /* No ray advanced since the last restart (rays of opposite directions keep pushing
-                 * each other's near sides off a short stack): the rays left finish one by one. */
+                 * each other's near sides off a short stack): the rays left finish one by one,
+                 * each continuing from its hit so far. */
                 if (memcmp(last_prog, prog, sizeof prog) == 0 && last_done == done) {
                     for (int i = 0; i < n; i++)
-                        if ((cur.live >> i) & 1u) {
-                            RefHit h;
-                            trace(p, t, REF_KD_SHORTSTACK, cap, &rays[i], &h, 1, st);
-                            if (h.prim != REF_NO_HIT && (hits[i].prim == REF_NO_HIT || h.t < hits[i].t ||
-                                                         (h.t == hits[i].t && h.prim < hits[i].prim)))
-                                hits[i] = h;
-                        }
+                        if ((cur.live >> i) & 1u)
+                            trace(p, t, REF_KD_SHORTSTACK, cap, &rays[i], &hits[i], 1, 1, st);
                     break;
                 }
             }
@@ -314,8 +320,10 @@ void ref_kd_packet_closest_hit(const PackedScene *p, const KdTree *t, int stack_
         first = 0;
         const KdNode *nd = &t->nodes[cur.node];
         while (nd->axis != KD_LEAF) {
-            if (st)
-                st->nodes_visited++;
+            if (st) {
+                st->nodes_visited += live_rays(cur.live);
+                st->packet_steps++;
+            }
             uint32_t a = nd->axis;
             int lead = __builtin_ctzll(cur.live);
             int lead_below = q[lead].org[a] < nd->split || (q[lead].org[a] == nd->split && q[lead].dir[a] < 0.0f);
@@ -369,7 +377,7 @@ void ref_kd_packet_closest_hit(const PackedScene *p, const KdTree *t, int stack_
                     bottom = (bottom + 1) % cap;
                     depth--;
                     if (st)
-                        st->stack_overflows++;
+                        st->stack_overflows += live_rays(cur.live);
                 }
                 stack[(bottom + depth) % cap] = se;
                 depth++;
@@ -384,8 +392,9 @@ void ref_kd_packet_closest_hit(const PackedScene *p, const KdTree *t, int stack_
                 root = cur.node;
         }
         if (st) {
-            st->nodes_visited++;
-            st->leaves_visited++;
+            st->nodes_visited += live_rays(cur.live);
+            st->leaves_visited += live_rays(cur.live);
+            st->packet_steps++;
         }
         for (uint32_t k = nd->a; k < nd->a + nd->count; k++) {
             uint32_t pr = t->prims[k];

@@ -42,6 +42,7 @@ typedef struct RefKdStats {
     uint64_t stack_overflows;  /* pushes that dropped the bottom entry (short-stack) */
     uint64_t stack_underflows; /* pops from an empty short stack while the ray was unfinished */
     uint64_t prims_tested;
+    uint64_t packet_steps;     /* packets: nodes entered by the packet (one per node however many rays) */
 } RefKdStats;
 
 /* The packetized short-stack of A.5: n <= 64 rays traverse together with a live mask, one stack
@@ -49,8 +50,11 @@ typedef struct RefKdStats {
  * on underflow. Generalized so that any rays may share a packet: the packet follows the first
  * live ray's near child; a ray whose segment does not start at its progress point (it met its far
  * child first) does not advance its restart point past unvisited space. hits[i] is exactly ray
- * i's BVH closest hit. Counters: nodes_visited counts packet steps (a node entered once by the
- * packet counts once), leaves_visited likewise; prims_tested counts ray-primitive tests. */
+ * i's BVH closest hit. Counters count per ray, as the single-ray traversals do: a node the packet
+ * enters counts once for each ray live in it (nodes_visited, leaves_visited), a restart or an
+ * overflowing push once for each live ray; prims_tested counts ray-primitive tests. When a
+ * restart finds that no ray advanced, the rays left finish with single-ray short stacks that
+ * continue from their hits (counted as such). */
 void ref_kd_packet_closest_hit(const PackedScene *p, const KdTree *t, int stack_depth, const RefRay *rays, int n,
                                RefHit *hits, RefKdStats *st);
 

@@ -99,7 +99,12 @@ int ref_hit_triangle(const float *v0, const float *v1, const float *v2, const Re
         V = -V;
         W = -W;
     }
-    if (!(T > 0.0f) || !(T < r->tmax * det))
+    /* T must exceed its rounding error, which grows with the vertices' depths along the ray
+     * (Az, Bz, Cz), not with t: a ray leaving a large triangle from an offset origin just above
+     * it would otherwise "hit" it at a tiny t of either sign (docs/numerics.md). */
+    float zmax = ref_fmax(ref_fmax(fabsf(Az), fabsf(Bz)), fabsf(Cz));
+    float tlo = zmax * REF_T_ROUND * det;
+    if (!(T > tlo) || !(T < r->tmax * det))
         return 0;
     float rcp = 1.0f / det;
     *t = T * rcp;

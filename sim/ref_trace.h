@@ -38,6 +38,10 @@ int ref_any_hit(const PackedScene *p, const RefRay *r, RefTraceStats *stats);
  * with 0 < t < r->tmax (the test every traversal uses). */
 int ref_hit_prim(const PackedScene *p, uint32_t i, const RefRay *r, float *t, float *u, float *v);
 
+/* The smallest T / det a triangle hit may have, relative to the largest depth of its vertices
+ * along the ray: 2^-19, 32 times the unit roundoff (kernels/lib/isect.inc: T_ROUND_F). */
+#define REF_T_ROUND 0x1p-19f
+
 /* The primitive tests themselves (exposed for the hard-case tests). */
 int ref_hit_triangle(const float *v0, const float *v1, const float *v2, const RefRay *r,
                      float *t, float *u, float *v);

@@ -157,7 +157,93 @@ typedef struct RunStats {
     uint64_t nodes_visited, prims_tested;   /* reference only */
     int functional;
     FuncStats f;
+    FuncKdInfo kd;                          /* accel.structure = kd */
 } RunStats;
+
+/* One kd counter object: each counter's total and per ray of the kind. */
+static void add_kd_counts_json(cJSON *kd, const char *name, const uint64_t *counts, uint64_t rays)
+{
+    cJSON *o = cJSON_AddObjectToObject(kd, name);
+    cJSON_AddNumberToObject(o, "rays", (double)rays);
+    for (int c = 0; c < FUNC_KD_COUNTERS; c++) {
+        char key[64];
+        snprintf(key, sizeof key, "%s_per_ray", func_kd_counter_keys[c]);
+        cJSON_AddNumberToObject(o, func_kd_counter_keys[c], (double)counts[c]);
+        cJSON_AddNumberToObject(o, key, ratio(counts[c], rays));
+    }
+}
+
+/* The counters of all kinds together, and the rays of each kind (FUNC_KD_* order). */
+static void kd_totals(const FuncStats *f, uint64_t rays[FUNC_KD_KINDS], uint64_t total[FUNC_KD_COUNTERS],
+                      uint64_t *all_rays)
+{
+    rays[FUNC_KD_CAMERA] = f->rays_camera;
+    rays[FUNC_KD_INDIRECT] = f->rays_indirect;
+    rays[FUNC_KD_SHADOW] = f->rays_shadow;
+    *all_rays = 0;
+    for (int c = 0; c < FUNC_KD_COUNTERS; c++)
+        total[c] = 0;
+    for (int k = 0; k < FUNC_KD_KINDS; k++) {
+        *all_rays += rays[k];
+        for (int c = 0; c < FUNC_KD_COUNTERS; c++)
+            total[c] += f->kd_counts[k][c];
+    }
+}
+
+/* accel.structure = kd: the tree and the kernel's kd counters (docs/report.md). */
+static void add_kd_json(cJSON *root, const RunStats *rs, const CfgMachine *cfg)
+{
+    const FuncStats *f = &rs->f;
+    const FuncKdInfo *t = &rs->kd;
+    cJSON *kd = cJSON_AddObjectToObject(root, "kd");
+    cJSON_AddStringToObject(kd, "structure", cfg_enum_name("accel", "structure", cfg->accel_structure));
+    cJSON_AddStringToObject(kd, "traversal", cfg_enum_name("kd", "traversal", cfg->kd_traversal));
+    cJSON_AddNumberToObject(kd, "stack_depth", f->kd_stack_depth);
+    cJSON *tr = cJSON_AddObjectToObject(kd, "tree");
+    cJSON_AddNumberToObject(tr, "nodes", t->nodes);
+    cJSON_AddNumberToObject(tr, "leaves", t->leaves);
+    cJSON_AddNumberToObject(tr, "empty_leaves", t->empty_leaves);
+    cJSON_AddNumberToObject(tr, "depth", t->depth);
+    cJSON_AddNumberToObject(tr, "primitives", t->prims);
+    cJSON_AddNumberToObject(tr, "references", t->refs);
+    cJSON_AddNumberToObject(tr, "references_per_primitive", ratio(t->refs, t->prims));
+    cJSON_AddNumberToObject(tr, "largest_leaf", t->largest_leaf);
+    cJSON_AddNumberToObject(tr, "sah_cost", t->sah_cost);
+    cJSON_AddNumberToObject(tr, "build_seconds", t->build_seconds);
+    uint64_t rays[FUNC_KD_KINDS], total[FUNC_KD_COUNTERS], all;
+    kd_totals(f, rays, total, &all);
+    for (int k = 0; k < FUNC_KD_KINDS; k++)
+        add_kd_counts_json(kd, func_kd_kind_keys[k], f->kd_counts[k], rays[k]);
+    add_kd_counts_json(kd, "total", total, all);
+}
+
+/* accel.structure = kd: report.txt lines for the tree and the counters per ray. */
+static int kd_text(char *txt, size_t cap, const RunStats *rs, const CfgMachine *cfg)
+{
+    const FuncStats *f = &rs->f;
+    const FuncKdInfo *t = &rs->kd;
+    int len = snprintf(txt, cap,
+                       "kd-tree      %s traversal, stack depth %u; %u nodes, %u leaves (%u empty), depth %u, "
+                       "%.2f references per primitive, largest leaf %u, SAH cost %.2f; built in %.2f s\n"
+                       "kd per ray   %-8s",
+                       cfg_enum_name("kd", "traversal", cfg->kd_traversal), f->kd_stack_depth, t->nodes, t->leaves,
+                       t->empty_leaves, t->depth, ratio(t->refs, t->prims), t->largest_leaf, t->sah_cost,
+                       t->build_seconds, "");
+    for (int c = 0; c < FUNC_KD_COUNTERS; c++)
+        len += snprintf(txt + len, cap - (size_t)len, " %10s", func_kd_counter_keys[c]);
+    len += snprintf(txt + len, cap - (size_t)len, "\n");
+    uint64_t rays[FUNC_KD_KINDS], total[FUNC_KD_COUNTERS], all;
+    kd_totals(f, rays, total, &all);
+    for (int k = 0; k <= FUNC_KD_KINDS; k++) {
+        const uint64_t *n = k < FUNC_KD_KINDS ? f->kd_counts[k] : total;
+        uint64_t r = k < FUNC_KD_KINDS ? rays[k] : all;
+        len += snprintf(txt + len, cap - (size_t)len, "             %-8s", k < FUNC_KD_KINDS ? func_kd_kind_keys[k] : "all");
+        for (int c = 0; c < FUNC_KD_COUNTERS; c++)
+            len += snprintf(txt + len, cap - (size_t)len, " %10.3f", ratio(n[c], r));
+        len += snprintf(txt + len, cap - (size_t)len, "\n");
+    }
+    return len;
+}
 
 static void add_functional_json(cJSON *root, const RunStats *rs, const CfgMachine *cfg)
 {
@@ -273,6 +359,16 @@ static void add_functional_json(cJSON *root, const RunStats *rs, const CfgMachin
     cJSON_AddNumberToObject(cf, "fb.size_kb", cfg->fb_size_kb);
     cJSON_AddNumberToObject(cf, "bvh.leaf_size", cfg->bvh_leaf_size);
     cJSON_AddNumberToObject(cf, "bvh.bins", cfg->bvh_bins);
+    cJSON_AddStringToObject(cf, "accel.structure", cfg_enum_name("accel", "structure", cfg->accel_structure));
+    if (f->kd) {
+        cJSON_AddStringToObject(cf, "kd.traversal", cfg_enum_name("kd", "traversal", cfg->kd_traversal));
+        cJSON_AddNumberToObject(cf, "kd.stack_depth", cfg->kd_stack_depth);
+        cJSON_AddNumberToObject(cf, "kd.cost_traversal", cfg->kd_cost_traversal);
+        cJSON_AddNumberToObject(cf, "kd.cost_intersect", cfg->kd_cost_intersect);
+        cJSON_AddNumberToObject(cf, "kd.empty_bonus", cfg->kd_empty_bonus);
+        cJSON_AddNumberToObject(cf, "kd.max_depth", cfg->kd_max_depth);
+        cJSON_AddNumberToObject(cf, "kd.leaf_size", cfg->kd_leaf_size);
+    }
     cJSON_AddNumberToObject(cf, "sim.max_instructions", (double)cfg->sim_max_instructions);
 }
 
@@ -562,6 +658,10 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     if (pack_scene(&s, &bp, 0, &p, err, errlen) != 0)
         goto out;
     double t_pack = now();
+    /* The kernel modes with accel.structure = kd traverse a kd-tree; the golden model, the BVH. */
+    if (functional && func_add_kd(&p, cfg, &rs.kd, err, errlen) != 0)
+        goto out;
+    double t_kd = now();
     size_t npx = (size_t)s.render.width * (size_t)s.render.height;
     rgb = calloc(3 * npx, sizeof(float));
     if (!rgb) {
@@ -681,7 +781,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
             sum += rgb[i];
     }
     uint64_t total_rays = rs.primary + rs.shadow + rs.indirect;
-    double secs = t_render - t_pack;
+    double secs = t_render - t_kd;
 
     /* report.json: the names of ARCHITECTURE.md Sec. 1; the timing fields stay null unless detailed. */
     root = cJSON_CreateObject();
@@ -703,6 +803,8 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         add_functional_json(root, &rs, cfg);
         if (detailed || sampled)
             add_timing_json(root, &rs.f, cfg, est, o->sample, o->sample_seed);
+        if (rs.f.kd)
+            add_kd_json(root, &rs, cfg);
     } else {
         cJSON *trav = cJSON_AddObjectToObject(root, "traversal");
         cJSON_AddNumberToObject(trav, "nodes_visited", (double)rs.nodes_visited);
@@ -802,6 +904,8 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
                             k + 1 < ISA_STAGE_COUNT ? ", " : "  (active lanes / (N x vector instructions))\n");
         if (detailed || sampled)
             len += timing_text(txt + len, sizeof txt - (size_t)len, f, cfg, est);
+        if (f->kd)
+            len += kd_text(txt + len, sizeof txt - (size_t)len, &rs, cfg);
         len += snprintf(txt + len, sizeof txt - (size_t)len,
                         "streams      mean length: traversal %.1f, intersection %.1f, shading %.1f rays\n"
                         "host         %.2f s on %d threads: %.2f M instructions/s, %.3f M rays/s; load %.2f s, BVH+pack %.2f s\n",

@@ -33,6 +33,7 @@
 #include <unistd.h>
 
 #include "config.h"
+#include "functional.h"
 #include "render.h"
 #include "timing.h"
 
@@ -1794,6 +1795,8 @@ enum {
     M_OPS = M_STALL + TM_CAUSE_COUNT, /* ISA_C_COUNT categories */
     M_RAYS = M_OPS + ISA_C_COUNT,
     M_HOST,
+    M_KD,                           /* kd_<counter>_per_ray over all rays, FUNC_KD_COUNTERS of them */
+    M_KD_CAMERA_NODES = M_KD + FUNC_KD_COUNTERS, /* kd_camera_nodes_per_ray */
     M_COUNT
 };
 
@@ -1813,8 +1816,12 @@ static void metric_name(int m, char *buf, size_t len)
         snprintf(buf, len, "stall_share_%s", tm_cause_keys[m - M_STALL]);
     else if (m < M_RAYS)
         snprintf(buf, len, "ops_share_%s", isa_category_keys[m - M_OPS]);
-    else
+    else if (m < M_KD)
         snprintf(buf, len, "%s", m == M_RAYS ? "rays_total" : "host_seconds");
+    else if (m < M_KD_CAMERA_NODES)
+        snprintf(buf, len, "kd_%s_per_ray", func_kd_counter_keys[m - M_KD]);
+    else
+        snprintf(buf, len, "kd_camera_nodes_per_ray");
 }
 
 typedef struct Row {
@@ -1879,6 +1886,13 @@ static int row_read_report(Row *row, const char *path, char *err, size_t errlen)
     }
     row_num(row, M_RAYS, jget(jget(j, "rays"), "total"));
     row_num(row, M_HOST, jget(jget(j, "host"), "seconds"));
+    const cJSON *kd = jget(j, "kd");
+    for (int c = 0; c < FUNC_KD_COUNTERS; c++) {
+        char key[64];
+        snprintf(key, sizeof key, "%s_per_ray", func_kd_counter_keys[c]);
+        row_num(row, M_KD + c, jget(jget(kd, "total"), key));
+    }
+    row_num(row, M_KD_CAMERA_NODES, jget(jget(kd, "camera"), "nodes_per_ray"));
     cJSON_Delete(j);
     return 0;
 }
@@ -2015,6 +2029,7 @@ static const char *key_unit(const char *key)
     static const struct { const char *suffix, *unit; } units[] = {
         {"core.simd_width", "lanes"}, {"stream.rays", "rays per stream"}, {"render.width", "pixels"},
         {"render.height", "pixels"}, {"render.spp", "samples per pixel"}, {"render.max_depth", "bounces"},
+        {"kd.max_depth", "levels"},
         {"_per_cycle", "per cycle"}, {"_kb", "KiB"}, {"_mb", "MiB"}, {"_mhz", "MHz"}, {"_bytes", "bytes"},
         {"_cycles", "cycles"}, {"_penalty", "cycles"}, {"latency", "cycles"}, {"banks", "banks"}, {"ports", "ports"},
         {"_ways", "ways"}, {"_depth", "entries"}, {"bins", "bins"}, {"leaf_size", "primitives"},

@@ -94,6 +94,10 @@ int trace_run(const TraceOptions *o, TraceSummary *sum, char *err, size_t errlen
     bp.bins = o->cfg->bvh_bins;
     if (pack_scene(&s, &bp, 0, &p, err, errlen) != 0)
         goto out;
+    /* The kernel with accel.structure = kd traverses a kd-tree; the golden model, the BVH. */
+    FuncKdInfo kd;
+    if (strcmp(o->mode, "reference") != 0 && func_add_kd(&p, o->cfg, &kd, err, errlen) != 0)
+        goto out;
     if (raybatch_load(o->rays_path, &b, err, errlen) != 0)
         goto out;
     hits = calloc(b.count ? b.count : 1, sizeof *hits);

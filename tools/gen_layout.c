@@ -44,6 +44,8 @@ static void gen_md(void)
            "Every field is a 32-bit little-endian word; `addr` fields hold scene-memory byte addresses;\n"
            "arrays start on 64-byte boundaries. The header sits at the packed scene's base address.\n"
            "Primitives are stored in BVH leaf order, so a leaf's primitives are one contiguous run.\n"
+           "With `accel.structure = kd` (docs/kdtree.md) `pack_add_kd` appends a kd-tree over the same\n"
+           "packed primitives: a `KDNODE` array and its leaf lists, located by the header's `KD_*` fields.\n"
            "Textures are stored as one word per texel (sRGB-encoded 8-bit colour, linear 8-bit alpha);\n"
            "the header's `SRGB_LUT` decodes a colour byte to linear.\n");
     for (size_t r = 0; r < sizeof recs / sizeof recs[0]; r++) {

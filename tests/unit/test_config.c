@@ -609,3 +609,74 @@ Test(config_params, enum_keys_take_names_and_reject_others)
     cr_expect_null(cfg_enum_name("core", "simd_width", 0));
     cfg_errors_free(&e);
 }
+
+/* ==== kd-tree keys (accel.structure, kd.*) ============================================================ */
+
+Test(config_params, kd_keys_defaults)
+{
+    CfgMachine c;
+    cfg_defaults(&c);
+    cr_expect_eq(c.accel_structure, CFG_ACCEL_BVH);
+    cr_expect_eq(c.kd_traversal, CFG_KD_STACK);
+    cr_expect_eq(c.kd_stack_depth, 3);
+    cr_expect_eq(c.kd_cost_traversal, 1.0);
+    cr_expect_eq(c.kd_cost_intersect, 1.0);
+    cr_expect_eq(c.kd_empty_bonus, 0.8);
+    cr_expect_eq(c.kd_max_depth, 0);
+    cr_expect_eq(c.kd_leaf_size, 1);
+}
+
+Test(config_load, kd_keys)
+{
+    CfgMachine c;
+    expect_clean("[accel]\nstructure = kd\n[kd]\ntraversal = shortstack\nstack_depth = 64\ncost_traversal = 0.5\n"
+                 "cost_intersect = 2\nempty_bonus = 1\nmax_depth = 60\nleaf_size = 8\n",
+                 &c);
+    cr_expect_eq(c.accel_structure, CFG_ACCEL_KD);
+    cr_expect_eq(c.kd_traversal, CFG_KD_SHORTSTACK);
+    cr_expect_eq(c.kd_stack_depth, 64);
+    cr_expect_eq(c.kd_cost_traversal, 0.5);
+    cr_expect_eq(c.kd_cost_intersect, 2.0);
+    cr_expect_eq(c.kd_empty_bonus, 1.0);
+    cr_expect_eq(c.kd_max_depth, 60);
+    cr_expect_eq(c.kd_leaf_size, 8);
+    /* every traversal name, in abi.inc's KD_VARIANT order */
+    const char *names[] = {"stack", "restart", "pushdown", "shortstack", "packet", "stream"};
+    CfgErrors e = {0};
+    for (int i = 0; i < 6; i++) {
+        char set[64];
+        snprintf(set, sizeof set, "kd.traversal=%s", names[i]);
+        cr_expect_eq(cfg_set(&c, set, &e), 0, "%s", e.text ? e.text : "");
+        cr_expect_eq(c.kd_traversal, i, "%s", names[i]);
+        cr_expect_str_eq(cfg_enum_name("kd", "traversal", i), names[i]);
+    }
+    cr_expect_eq(c.kd_traversal, CFG_KD_STREAM);
+    cr_expect_null(cfg_enum_name("kd", "traversal", 6));
+    cr_expect_str_eq(cfg_enum_name("accel", "structure", CFG_ACCEL_KD), "kd");
+    cfg_errors_free(&e);
+}
+
+Test(config_load, kd_bad_values_name_the_key)
+{
+    expect_one_error("[accel]\nstructure = octree\n", "2: key 'accel.structure': expected one of bvh, kd, got 'octree'");
+    expect_one_error("[kd]\ntraversal = shortstak\n",
+                     "2: key 'kd.traversal': expected one of stack, restart, pushdown, shortstack, packet, stream, got "
+                     "'shortstak'");
+    expect_one_error("[kd]\nstack_depth = 0\n", "2: key 'kd.stack_depth': value 0 out of range 1..64");
+    expect_one_error("[kd]\nstack_depth = 65\n", "2: key 'kd.stack_depth': value 65 out of range 1..64");
+    expect_one_error("[kd]\nmax_depth = 61\n", "2: key 'kd.max_depth': value 61 out of range 0..60");
+    expect_one_error("[kd]\nleaf_size = 0\n", "2: key 'kd.leaf_size': value 0 out of range 1..64");
+    expect_one_error("[kd]\nempty_bonus = 1.5\n", "2: key 'kd.empty_bonus': value 1.5 out of range 0..1");
+    /* the builder takes costs > 0 and a bonus in (0, 1]: 0 (or what rounds to 0 in binary32) is refused */
+    expect_one_error("[kd]\nempty_bonus = 0\n", "2: key 'kd.empty_bonus': value 0: must be greater than 0");
+    expect_one_error("[kd]\ncost_traversal = 0\n", "2: key 'kd.cost_traversal': value 0: must be greater than 0");
+    expect_one_error("[kd]\ncost_intersect = 1e-60\n",
+                     "2: key 'kd.cost_intersect': value 1e-60: must be greater than 0");
+    CfgMachine c;
+    cfg_defaults(&c);
+    CfgErrors e = {0};
+    cr_expect_eq(cfg_set(&c, "kd.traversal=bogus", &e), 1);
+    cr_expect(e.text && strstr(e.text, "--set kd.traversal=bogus: expected one of stack,"), "%s", e.text ? e.text : "");
+    cr_expect_eq(c.kd_traversal, CFG_KD_STACK);
+    cfg_errors_free(&e);
+}

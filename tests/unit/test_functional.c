@@ -2,7 +2,9 @@
  * functional core against the golden model: same pixels on the Cornell variants and on shared
  * scenes with textures, glass, punctual lights and the conference room; the same image for
  * every SIMD width N and stream size M (stream filtering changes nothing about any one ray)
- * and every host thread count; clear errors for machines too small for the kernel. */
+ * and every host thread count; clear errors for machines too small for the kernel. The host side
+ * of accel.structure = kd (tree, build symbols, memory checks, counters) runs with
+ * tests/unit/kd_stub.s in place of the kernel. */
 #include <criterion/criterion.h>
 #include <math.h>
 #include <stdio.h>
@@ -13,6 +15,7 @@
 #include "../../scenes/scene.h"
 #include "../../sim/config.h"
 #include "../../sim/functional.h"
+#include "../../sim/ref_kd.h"
 #include "../../sim/reference.h"
 
 typedef struct Img {
@@ -400,6 +403,169 @@ Test(functional, first_ray_order_differs_only_in_rare_ties, .timeout = 300)
     cr_expect(strstr(st.defines, "ORDER_FIRST") != NULL, "%s", st.defines);
     free(g.rgb);
     free(k.rgb);
+    func_stats_free(&st);
+    pack_free(&p);
+    scene_free(&s);
+}
+
+/* ---- accel.structure = kd: the host side, with tests/unit/kd_stub.s standing in for the kernel ---- */
+
+#define KD_STUB "tests/unit/kd_stub.s"
+
+static void kd_cfg(CfgMachine *cfg, int traversal)
+{
+    cfg_defaults(cfg);
+    cfg->accel_structure = CFG_ACCEL_KD;
+    cfg->kd_traversal = traversal;
+    cfg->stream_rays = 1024;
+}
+
+static int kd_render(const PackedScene *p, uint32_t needs, const CfgMachine *cfg, int w, int h, FuncStats *st,
+                     char *err, size_t errlen)
+{
+    float *rgb = calloc(3 * (size_t)w * h, sizeof(float));
+    cr_assert_not_null(rgb);
+    FuncParams fp = {.cfg = cfg, .kernel_path = KD_STUB, .needs = needs, .seed = 1, .threads = 2};
+    int rc = func_render(p, &fp, rgb, st, err, errlen);
+    free(rgb);
+    return rc;
+}
+
+Test(functional, kd_tree_from_the_kd_keys_is_packed)
+{
+    Scene s;
+    PackedScene p;
+    load_packed("scenes/cornell/scene.ini", 16, 16, 1, &s, &p);
+    CfgMachine cfg;
+    cfg_defaults(&cfg);
+    FuncKdInfo info;
+    char err[1024];
+    /* accel.structure = bvh: nothing to add */
+    cr_expect_eq(func_add_kd(&p, &cfg, &info, err, sizeof err), 0, "%s", err);
+    cr_expect_eq(sm_u32(&p, sm_hdr(&p, SM_HDR_KD_NODES)), 0u);
+    cr_expect_eq(info.nodes, 0u);
+    kd_cfg(&cfg, CFG_KD_STACK);
+    cfg.kd_leaf_size = 4;
+    cfg.kd_empty_bonus = 0.5;
+    cr_assert_eq(func_add_kd(&p, &cfg, &info, err, sizeof err), 0, "%s", err);
+    /* The tree of those keys: the builder's with the same parameters. */
+    KdParams kp;
+    kd_default_params(&kp);
+    kp.leaf_size = 4;
+    kp.empty_bonus = 0.5f;
+    KdTree t;
+    cr_assert_eq(ref_kd_build(&p, &kp, &t, err, sizeof err), 0, "%s", err);
+    cr_expect_eq(info.nodes, t.nnodes);
+    cr_expect_eq(info.leaves, t.nleaves);
+    cr_expect_eq(info.empty_leaves, t.nempty);
+    cr_expect_eq(info.depth, t.depth);
+    cr_expect_eq(info.refs, t.nrefs);
+    cr_expect_eq(info.prims, p.nprims);
+    cr_expect_eq(info.largest_leaf, t.max_leaf);
+    cr_expect_eq(info.sah_cost, t.sah_cost);
+    cr_expect(info.build_seconds >= 0.0);
+    cr_expect_eq(p.kd_depth, t.depth);
+    cr_expect_eq(sm_u32(&p, sm_hdr(&p, SM_HDR_KD_NNODES)), t.nnodes);
+    kd_default_params(&kp);
+    KdTree d;
+    cr_assert_eq(ref_kd_build(&p, &kp, &d, err, sizeof err), 0, "%s", err);
+    cr_expect_neq(d.nnodes, t.nnodes, "kd.leaf_size and kd.empty_bonus changed nothing");
+    kd_free(&d);
+    kd_free(&t);
+    pack_free(&p);
+    scene_free(&s);
+}
+
+/* Counters: lanes 0..N-1 of every (kind, counter) vector summed over tiles and threads, cleared
+ * before each run; KD_STACK_DEPTH per traversal. */
+Test(functional, kd_counters_and_build_symbols)
+{
+    Scene s;
+    PackedScene p;
+    int w = 128, h = 64;           /* 8 tiles of 32 x 32 */
+    load_packed("scenes/cornell/scene.ini", w, h, 1, &s, &p);
+    CfgMachine cfg;
+    kd_cfg(&cfg, CFG_KD_STACK);
+    FuncKdInfo info;
+    char err[65536];
+    cr_assert_eq(func_add_kd(&p, &cfg, &info, err, sizeof err), 0, "%s", err);
+    struct { int traversal, lanes; uint32_t depth; } cases[] = {
+        {CFG_KD_STACK, 16, info.depth + 1}, {CFG_KD_RESTART, 16, 1}, {CFG_KD_PUSHDOWN, 5, 1},
+        {CFG_KD_SHORTSTACK, 5, 7}, {CFG_KD_PACKET, 16, 7}, {CFG_KD_STREAM, 8, 1}};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        kd_cfg(&cfg, cases[i].traversal);
+        cfg.core_simd_width = cases[i].lanes;
+        cfg.kd_stack_depth = 7;
+        FuncStats st;
+        cr_assert_eq(kd_render(&p, s.needs, &cfg, w, h, &st, err, sizeof err), 0, "%s", err);
+        char want[128];
+        snprintf(want, sizeof want, "ACCEL_KD=1 KD_VARIANT=%d KD_STACK_DEPTH=%u", cases[i].traversal,
+                 cases[i].depth);
+        cr_expect(strstr(st.defines, want) != NULL, "defines '%s' lack '%s'", st.defines, want);
+        cr_expect_eq(st.kd, 1);
+        cr_expect_eq(st.kd_stack_depth, cases[i].depth);
+        cr_expect_eq(st.rays_camera, 8u * 2);
+        cr_expect_eq(st.rays_indirect, 8u * 3);
+        uint64_t lanes = (uint64_t)cases[i].lanes, per_vector = 8 * lanes * (lanes + 1) / 2;
+        for (int k = 0; k < FUNC_KD_KINDS; k++)
+            for (int c = 0; c < FUNC_KD_COUNTERS; c++) {
+                uint64_t want_n = per_vector * (uint64_t)(k * FUNC_KD_COUNTERS + c + 1);
+                cr_expect_eq(st.kd_counts[k][c], want_n, "%s, N = %d: %s %s = %llu, expected %llu",
+                             cfg_enum_name("kd", "traversal", cases[i].traversal), cases[i].lanes,
+                             func_kd_kind_keys[k], func_kd_counter_keys[c], (unsigned long long)st.kd_counts[k][c],
+                             (unsigned long long)want_n);
+            }
+        func_stats_free(&st);
+    }
+    pack_free(&p);
+    scene_free(&s);
+}
+
+Test(functional, kd_memory_checks_name_the_keys)
+{
+    Scene s;
+    PackedScene p;
+    load_packed("scenes/cornell/scene.ini", 16, 16, 1, &s, &p);
+    CfgMachine cfg;
+    kd_cfg(&cfg, CFG_KD_STACK);
+    FuncKdInfo info;
+    char err[65536];
+    FuncStats st;
+    /* A kd run needs the tree in the packed scene. */
+    cr_expect_neq(kd_render(&p, s.needs, &cfg, 16, 16, &st, err, sizeof err), 0);
+    cr_expect(strstr(err, "accel.structure = kd") && strstr(err, "without a kd-tree"), "%s", err);
+    cr_assert_eq(func_add_kd(&p, &cfg, &info, err, sizeof err), 0, "%s", err);
+    cr_assert_geq(p.kd_depth, 4u, "the stream case below assumes a depth of 4 or more");
+    /* Counters end at 4096 + 3 x 6 x 256 = 8704 bytes, the per-lane state at 8704 + 29 x 256 = 16128;
+     * packet stacks of 3 x 1040 bytes need 19248; the stream filter's 36 x (3 x depth + 8) bytes
+     * more than 16 KiB. Packet mode (RAYS = N = 16) leaves the ray buffer small enough for per-lane
+     * stacks of 1 KiB per entry to overflow it. */
+    struct { int traversal, packet_mode, spad_kb, raybuf_kb, depth; const char *key, *why; } cases[] = {
+        {CFG_KD_STACK, 0, 8, 512, 3, "spad.size_kb = 8", "counters"},
+        {CFG_KD_RESTART, 0, 15, 512, 3, "spad.size_kb = 15", "per-lane state"},
+        {CFG_KD_PACKET, 0, 18, 512, 3, "spad.size_kb = 18", "kd.stack_depth"},
+        {CFG_KD_STREAM, 0, 16, 512, 3, "spad.size_kb = 16", "kd.max_depth"},
+        {CFG_KD_SHORTSTACK, 1, 64, 8, 16, "raybuf.size_kb = 8", "kd.stack_depth"},
+        {CFG_KD_PACKET, 1, 64, 8, 16, "raybuf.size_kb = 8", "kd.stack_depth"},
+        {CFG_KD_STACK, 1, 64, 4, 3, "raybuf.size_kb = 4", "kd.max_depth"}};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        kd_cfg(&cfg, cases[i].traversal);
+        cfg.stream_mode = cases[i].packet_mode ? CFG_STREAM_MODE_PACKET : CFG_STREAM_MODE_STREAM;
+        cfg.spad_size_kb = cases[i].spad_kb;
+        cfg.raybuf_size_kb = cases[i].raybuf_kb;
+        cfg.kd_stack_depth = cases[i].depth;
+        cr_expect_eq(kd_render(&p, s.needs, &cfg, 16, 16, &st, err, sizeof err), -1, "case %zu accepted", i);
+        cr_expect(strstr(err, cases[i].key) && strstr(err, cases[i].why), "case %zu: '%s' lacks '%s' or '%s'", i, err,
+                  cases[i].key, cases[i].why);
+    }
+    /* The same machines with room enough run. */
+    kd_cfg(&cfg, CFG_KD_PACKET);
+    cfg.spad_size_kb = 19;
+    cr_expect_eq(kd_render(&p, s.needs, &cfg, 16, 16, &st, err, sizeof err), 0, "%s", err);
+    func_stats_free(&st);
+    kd_cfg(&cfg, CFG_KD_STREAM);
+    cfg.spad_size_kb = 64;
+    cr_expect_eq(kd_render(&p, s.needs, &cfg, 16, 16, &st, err, sizeof err), 0, "%s", err);
     func_stats_free(&st);
     pack_free(&p);
     scene_free(&s);

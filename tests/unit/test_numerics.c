@@ -12,6 +12,8 @@
 #include "../../sim/config.h"
 #include "../../sim/functional.h"
 #include "../../sim/reference.h"
+#include "../../sim/ref_trace.h"
+#include "../../sim/trace.h"
 #include "../support/numerics.h"
 
 static void pack_mesh(Mesh *m, Scene *s, PackedScene *p)
@@ -340,6 +342,71 @@ Test(numerics, degenerate_needle_tiny_and_huge_triangles, .timeout = 120)
     cr_expect_eq(grazing_ok, 20);
     cr_expect_eq(differ, 0);
     cr_expect_eq(nonfinite_hits(&bt, kh), 0);
+    free(kh);
+    free(rh);
+    raybatch_free(&bt);
+    pack_free(&p);
+    mesh_free(&m);
+}
+
+/* Rays leaving a large floor upwards from offset origins (the conference room's floor: 2,600 x
+ * 1,685 units at y = -1.572, origins 256 ulps above it, shadow-ray directions of length ~1,000 to
+ * a ceiling): the triangle test's rounding error grows with the vertices' depths along the ray,
+ * not with t, and exceeded the offset, so some rays "hit" the floor at t ~ 1e-8. A BVH hid it
+ * (the floor's flat box lies behind the origin); a kd-tree leaf holding the floor did not. No ray
+ * may hit, in the golden model, the BVH kernel or the kd-tree kernel (docs/numerics.md). */
+Test(numerics, rays_leaving_a_large_triangle_do_not_hit_it, .timeout = 120)
+{
+    Mesh m;
+    mesh_init(&m);
+    float a[3] = {-946.887512f, -1.57215905f, -1016.10486f}, b[3] = {-946.887512f, -1.57215905f, 668.48938f},
+          c[3] = {1653.24707f, -1.57215905f, -1016.10486f}, d[3] = {1653.24707f, -1.57215905f, 668.48938f};
+    mesh_tri(&m, a, b, c, 0);
+    mesh_tri(&m, b, d, c, 0);
+    float e[3] = {-946.887512f, 700.0f, -1016.10486f}, f[3] = {1653.24707f, 700.0f, -1016.10486f},
+          g[3] = {-946.887512f, 700.0f, 668.48938f};
+    mesh_tri(&m, e, f, g, 0); /* a ceiling above the lights: the scene's box encloses the rays */
+    Scene s;
+    PackedScene p;
+    pack_mesh(&m, &s, &p);
+    RayBatch bt = {0};
+    uint32_t cap = 0, seed = 77;
+    const float up[3] = {0, 1, 0};
+    for (int i = 0; i < 2000; i++) {
+        float on[3] = {-940.0f + 2590.0f * frand(&seed), a[1], -1010.0f + 1675.0f * frand(&seed)}, o[3];
+        ref_offset_point(on, up, o);
+        float light[3] = {-940.0f + 2590.0f * frand(&seed), 640.0f, -1010.0f + 1675.0f * frand(&seed)};
+        float dir[3] = {light[0] - o[0], light[1] - o[1], light[2] - o[2]};
+        batch_add(&bt, &cap, o, dir, 0.999f, i % 2 ? RAY_ANY : RAY_CLOSEST);
+    }
+    BatchHit *kh, *rh;
+    uint32_t differ = trace_both(&p, s.needs, &bt, 16, 1024, &kh, &rh);
+    uint32_t hits = 0, kdhits = 0;
+    for (uint32_t i = 0; i < bt.count; i++)
+        hits += (bt.rays[i].query == RAY_ANY ? kh[i].prim == 1 : kh[i].prim != UINT32_MAX) ||
+                (bt.rays[i].query == RAY_ANY ? rh[i].prim == 1 : rh[i].prim != UINT32_MAX);
+    /* the kd-tree kernel, every traversal */
+    CfgMachine cfg;
+    cfg_defaults(&cfg);
+    CfgErrors ce = {0};
+    cr_assert_eq(cfg_set(&cfg, "accel.structure=kd", &ce), 0);
+    FuncKdInfo info;
+    char err[4096];
+    cr_assert_eq(func_add_kd(&p, &cfg, &info, err, sizeof err), 0, "%s", err);
+    const char *trav[] = {"kd.traversal=stack", "kd.traversal=restart", "kd.traversal=shortstack",
+                          "kd.traversal=packet", "kd.traversal=stream"};
+    for (int v = 0; v < 5; v++) {
+        cr_assert_eq(cfg_set(&cfg, trav[v], &ce), 0);
+        cr_assert_eq(trace_batch_run(&p, s.needs, &bt, kh, "functional", &cfg, "kernels/pathtrace.s", 2, NULL, NULL, err,
+                                     sizeof err), 0, "%s", err);
+        for (uint32_t i = 0; i < bt.count; i++)
+            kdhits += bt.rays[i].query == RAY_ANY ? kh[i].prim == 1 : kh[i].prim != UINT32_MAX;
+    }
+    printf("rays leaving a large floor: %u rays, %u differ, %u hits (BVH kernel and golden model), %u (kd kernels)\n",
+           bt.count, differ, hits, kdhits);
+    cr_expect_eq(differ, 0);
+    cr_expect_eq(hits, 0, "rays from just above the floor hit it");
+    cr_expect_eq(kdhits, 0, "rays from just above the floor hit it in a kd-tree leaf");
     free(kh);
     free(rh);
     raybatch_free(&bt);

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "../../scenes/pack.h"
+#include "../../sim/ref_kd.h"
 
 /* A hand-made scene: two triangles (one emissive), one sphere, two materials, a 2x1 texture,
  * a quad light; camera at the origin looking down -z, 90 degree fov, 2:1 image. */
@@ -152,6 +153,103 @@ Test(pack, rejects_unaligned_base)
     char err[256];
     cr_expect_eq(pack_scene(&s, &bp, 100, &p, err, sizeof err), -1);
     cr_expect_str_eq(err, "pack: base address 0x64 is not a multiple of 64");
+}
+
+/* pack_add_kd: the Cornell box's kd-tree read back word by word through the layout constants. */
+Test(pack, kd_tree_round_trip)
+{
+    Scene s;
+    PackedScene p;
+    char err[1024];
+    cr_assert_eq(pack_load_file("scenes/cornell/scene.ini", 0, 0, 0, &s, &p, err, sizeof err), 0, "%s", err);
+    KdParams kp;
+    kd_default_params(&kp);
+    KdTree t;
+    cr_assert_eq(ref_kd_build(&p, &kp, &t, err, sizeof err), 0, "%s", err);
+    cr_expect_eq(sm_u32(&p, sm_hdr(&p, SM_HDR_KD_NODES)), 0u, "no kd-tree before pack_add_kd");
+    uint32_t old_size = p.size;
+    uint8_t *before = malloc(old_size);
+    cr_assert_not_null(before);
+    memcpy(before, p.mem, old_size);
+    cr_assert_eq(pack_add_kd(&p, &t, err, sizeof err), 0, "%s", err);
+    /* Only the header's KD_* words change in the old image. */
+    for (uint32_t w = 0; w < old_size / 4; w++)
+        if (w < (uint32_t)SM_HDR_KD_NODES || w > (uint32_t)SM_HDR_KD_BMAX + 2)
+            cr_expect(memcmp(before + 4 * w, p.mem + 4 * w, 4) == 0, "word %u of the image changed", w);
+    free(before);
+
+    uint32_t nodes = sm_u32(&p, sm_hdr(&p, SM_HDR_KD_NODES)), prims = sm_u32(&p, sm_hdr(&p, SM_HDR_KD_PRIMS));
+    cr_expect(nodes >= old_size && nodes % 64 == 0, "KDNODE array at 0x%x", nodes);
+    cr_expect(prims >= nodes + 8u * t.nnodes && prims % 64 == 0, "leaf lists at 0x%x", prims);
+    cr_expect_eq(p.size, prims + 4u * t.nrefs);
+    cr_expect_eq(sm_u32(&p, sm_hdr(&p, SM_HDR_KD_NNODES)), t.nnodes);
+    cr_expect_eq(p.kd_depth, t.depth);
+    for (int k = 0; k < 3; k++) {
+        cr_expect_eq(sm_f32(&p, sm_hdr(&p, SM_HDR_KD_BMIN + k)), t.bmin[k]);
+        cr_expect_eq(sm_f32(&p, sm_hdr(&p, SM_HDR_KD_BMAX + k)), t.bmax[k]);
+    }
+    uint32_t leaves = 0;
+    for (uint32_t i = 0; i < t.nnodes; i++) {
+        const KdNode *n = &t.nodes[i];
+        uint32_t info = sm_u32(&p, sm_rec(nodes, SM_KDNODE_WORDS, i, SM_KDNODE_INFO));
+        uint32_t split = sm_rec(nodes, SM_KDNODE_WORDS, i, SM_KDNODE_SPLIT);
+        cr_expect_eq(info & 3u, n->axis, "node %u: tag %u, axis %u", i, info & 3u, n->axis);
+        cr_expect_eq(info >> 2, n->a, "node %u: index %u, expected %u", i, info >> 2, n->a);
+        if (n->axis == KD_LEAF) {
+            leaves++;
+            cr_expect_eq(sm_u32(&p, split), n->count, "leaf %u: count", i);
+        } else {
+            cr_expect_eq(sm_f32(&p, split), n->split, "node %u: split", i);
+        }
+    }
+    cr_expect_eq(leaves, t.nleaves);
+    for (uint32_t r = 0; r < t.nrefs; r++)
+        cr_expect_eq(sm_u32(&p, prims + 4u * r), t.prims[r], "leaf-list entry %u", r);
+    /* One tree per scene. */
+    cr_expect_eq(pack_add_kd(&p, &t, err, sizeof err), -1);
+    cr_expect(strstr(err, "already has a kd-tree"), "%s", err);
+    kd_free(&t);
+    pack_free(&p);
+    scene_free(&s);
+}
+
+Test(pack, kd_tree_errors)
+{
+    Scene s;
+    tiny_scene(&s);
+    BvhParams bp;
+    bvh_default_params(&bp);
+    PackedScene p;
+    char err[512];
+    cr_assert_eq(pack_scene(&s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
+    uint32_t size = p.size;
+    KdParams kp;
+    kd_default_params(&kp);
+    KdTree t;
+    cr_assert_eq(ref_kd_build(&p, &kp, &t, err, sizeof err), 0, "%s", err);
+    /* An index past 30 bits cannot be encoded. */
+    uint32_t a = t.nodes[0].a;
+    t.nodes[0].a = 1u << 30;
+    cr_expect_eq(pack_add_kd(&p, &t, err, sizeof err), -1);
+    cr_expect(strstr(err, "node 0") && strstr(err, "30 bits"), "%s", err);
+    t.nodes[0].a = a;
+    /* A tree over other primitives. */
+    t.nprims++;
+    cr_expect_eq(pack_add_kd(&p, &t, err, sizeof err), -1);
+    cr_expect(strstr(err, "primitives"), "%s", err);
+    t.nprims--;
+    cr_expect_eq(p.size, size);
+    cr_expect_eq(sm_u32(&p, sm_hdr(&p, SM_HDR_KD_NODES)), 0u);
+    pack_free(&p);
+    /* Packed right below 4 GiB, the scene fits but its kd-tree does not. */
+    uint32_t base = (uint32_t)(0x100000000ull - ((size + 63u) & ~63u) - 64u);
+    cr_assert_eq(pack_scene(&s, &bp, base, &p, err, sizeof err), 0, "%s", err);
+    cr_expect_eq(pack_add_kd(&p, &t, err, sizeof err), -1);
+    cr_expect(strstr(err, "4 GiB"), "%s", err);
+    cr_expect_eq(p.size, size);
+    cr_expect_eq(sm_u32(&p, sm_hdr(&p, SM_HDR_KD_NODES)), 0u);
+    kd_free(&t);
+    pack_free(&p);
 }
 
 /* The generated include and docs must match scenes/layout.def. */
