@@ -67,7 +67,7 @@ int main(int argc, char **argv)
         }
         double tb = now() - t0;
         XcheckResult x;
-        if (xcheck_run(&s, &p, rays / 4, rays - rays / 4, 17, &x, err, sizeof err) != 0) {
+        if (xcheck_run(&s, &p, NULL, rays / 4, rays - rays / 4, 17, &x, err, sizeof err) != 0) {
             printf("%-58s error: %s\n", list[i], err);
             failed = 1;
         } else {

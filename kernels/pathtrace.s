@@ -23,6 +23,7 @@ SHADOW_TMAX = 0.999
 RR_START_DEPTH = 3
 RR_MAX_SURVIVAL = 0.95
 SLAB_FAR_SCALE = 1.00000072
+HIT_SCALE_F = 1.000244140625    ; 1 + 2^-12: pruning beyond the hit so far (REF_HIT_SCALE)
 INF_BITS  = 0x7F800000
 NODE_BYTES_LOG2 = 5
 MAT_LAMBERT = 0
@@ -514,7 +515,8 @@ box_chunk:
         rgat    iy, vid, r0, F_INVY @m1
         rgat    iz, vid, r0, F_INVZ @m1
         rgat    tf, vid, r0, F_TMAX @m1
-        vfmul   tf, tf, vscale @m1      ; the hit distance so far, widened like the slab's far end
+        vli     t0, HIT_SCALE_F @m1
+        vfmul   tf, tf, t0 @m1          ; the hit distance so far, widened (REF_HIT_SCALE)
         vli     tn, 0 @m1
         SLAB    bminx, bmaxx, ox, ix
         SLAB    bminy, bmaxy, oy, iy

@@ -109,7 +109,7 @@ static int trace(const PackedScene *p, const KdTree *t, RefKdVariant v, int dept
     float inv[3];
     ref_inv_dir(q.dir, inv);
     /* The ray's segment inside the scene box (the slab test of the BVH traversal). */
-    float t0 = 0.0f, t1 = q.tmax * 1.00000072f; /* widened as in ref_hit_box */
+    float t0 = 0.0f, t1 = q.tmax * REF_HIT_SCALE; /* widened as in ref_hit_box */
     for (int k = 0; k < 3; k++) {
         float a = (t->bmin[k] - q.org[k]) * inv[k], b = (t->bmax[k] - q.org[k]) * inv[k];
         t0 = ref_fmax(t0, ref_fmin(a, b));
@@ -193,7 +193,7 @@ static int trace(const PackedScene *p, const KdTree *t, RefKdVariant v, int dept
                 st->prims_tested++;
             RefRay probe = q;
             if (hit->prim != REF_NO_HIT)
-                probe.tmax = closest ? nextafterf(hit->t, INFINITY) : hit->t;
+                probe.tmax = closest ? ref_tie_probe(hit->t) : hit->t;
             if (!ref_hit_prim(p, pr, &probe, &th, &u, &w))
                 continue;
             if (hit->prim == REF_NO_HIT || th < hit->t || (th == hit->t && pr < hit->prim)) {
@@ -206,7 +206,7 @@ static int trace(const PackedScene *p, const KdTree *t, RefKdVariant v, int dept
                 return 1;
         }
         /* Early exit: nothing unvisited can be closer than the segment's (lower) end. */
-        if (hit->prim != REF_NO_HIT && hit->t < texit)
+        if (hit->prim != REF_NO_HIT && hit->t * REF_HIT_SCALE < texit)
             break;
         cur.tmax = tmax;
     }
@@ -261,7 +261,7 @@ void ref_kd_packet_closest_hit(const PackedScene *p, const KdTree *t, int stack_
         q[i] = rays[i];
         ref_sanitize_dir(q[i].dir);
         ref_inv_dir(q[i].dir, inv[i]);
-        float a0 = 0.0f, a1 = q[i].tmax * 1.00000072f;
+        float a0 = 0.0f, a1 = q[i].tmax * REF_HIT_SCALE;
         for (int k = 0; k < 3; k++) {
             float a = (t->bmin[k] - q[i].org[k]) * inv[i][k], b = (t->bmax[k] - q[i].org[k]) * inv[i][k];
             a0 = ref_fmax(a0, ref_fmin(a, b));
@@ -407,7 +407,7 @@ void ref_kd_packet_closest_hit(const PackedScene *p, const KdTree *t, int stack_
                     st->prims_tested++;
                 RefRay probe = q[i];
                 if (h->prim != REF_NO_HIT)
-                    probe.tmax = nextafterf(h->t, INFINITY);
+                    probe.tmax = ref_tie_probe(h->t);
                 if (!ref_hit_prim(p, pr, &probe, &th, &u, &w))
                     continue;
                 if (h->prim == REF_NO_HIT || th < h->t || (th == h->t && pr < h->prim)) {
@@ -425,7 +425,7 @@ void ref_kd_packet_closest_hit(const PackedScene *p, const KdTree *t, int stack_
                 continue;
             if (cur.tmax[i] > prog[i])
                 prog[i] = cur.tmax[i];
-            if (hits[i].prim != REF_NO_HIT && hits[i].t < cur.texit[i])
+            if (hits[i].prim != REF_NO_HIT && hits[i].t * REF_HIT_SCALE < cur.texit[i])
                 done |= 1ull << i;
         }
     }

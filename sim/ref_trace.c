@@ -34,10 +34,10 @@ void ref_inv_dir(const float *dir, float *inv)
 int ref_hit_box(const float *bmin, const float *bmax, const float *org, const float *inv_dir,
                 float tmax)
 {
-    /* tmax (the closest hit so far) is widened like the far slab distances: a hit distance from
-     * the triangle test and a box's entry distance from the slab test round differently, so a
-     * box whose entry rounds up past the hit could otherwise hide a hit a few ulps closer. */
-    float tn = 0.0f, tf = tmax * REF_SLAB_FAR_SCALE;
+    /* tmax (the closest hit so far) is widened by REF_HIT_SCALE: a hit distance from the triangle
+     * test and a box's entry distance from the slab test round differently, so a box whose
+     * entry rounds up past the hit could otherwise hide a closer or tied hit. */
+    float tn = 0.0f, tf = tmax * REF_HIT_SCALE;
     for (int k = 0; k < 3; k++) {
         /* inv_dir is finite (sanitized directions), so no 0 x inf = NaN can arise here. */
         float t0 = (bmin[k] - org[k]) * inv_dir[k];
@@ -230,7 +230,7 @@ static int walk(const PackedScene *p, const RefRay *r, RefHit *hit, int closest,
              * index wins a tie whatever the visiting order. */
             RefRay probe = q;
             if (closest && hit->prim != REF_NO_HIT)
-                probe.tmax = nextafterf(q.tmax, INFINITY);
+                probe.tmax = ref_tie_probe(q.tmax);
             if (!hit_prim(p, prims, i, &probe, &t, &u, &v))
                 continue;
             if (hit->prim == REF_NO_HIT || t < hit->t || (t == hit->t && i < hit->prim)) {

@@ -9,6 +9,7 @@
 #define SFSIM_REF_TRACE_H
 
 #include <stdint.h>
+#include <string.h>
 
 #include "../scenes/pack.h"
 
@@ -41,6 +42,27 @@ int ref_hit_prim(const PackedScene *p, uint32_t i, const RefRay *r, float *t, fl
 /* The smallest T / det a triangle hit may have, relative to the largest depth of its vertices
  * along the ray: 2^-19, 32 times the unit roundoff (kernels/lib/isect.inc: T_ROUND_F). */
 #define REF_T_ROUND 0x1p-19f
+
+/* A traversal prunes a box, voxel or leaf segment only beyond the closest hit so far widened by
+ * 2^-12: a triangle's computed t errs by up to many ulps when its vertices lie far away compared
+ * with t (the error grows with their depths, as REF_T_ROUND says), and a box entered just past
+ * the hit could hide a closer or tied hit, so that different structures returned different hits
+ * (kernels: HIT_SCALE_F). Only pruning widens; a hit still needs t < tmax. */
+#define REF_HIT_SCALE 1.000244140625f
+
+/* Once a ray has a hit at t, primitives are tested up to t + 4 ulps (the integer add on the bits;
+ * kernels: isect.inc), so that a primitive hit at exactly t -- a tie, won by the lower index --
+ * or closer is always accepted whatever the order of the tests: with 1 ulp, T < tmax det could
+ * round false for a hit whose T / det rounds to t, and structures visiting primitives in
+ * different orders returned different ties. t is positive and finite. */
+static inline float ref_tie_probe(float t)
+{
+    uint32_t u;
+    memcpy(&u, &t, 4);
+    u += 4;
+    memcpy(&t, &u, 4);
+    return t;
+}
 
 /* The primitive tests themselves (exposed for the hard-case tests). */
 int ref_hit_triangle(const float *v0, const float *v1, const float *v2, const RefRay *r,

@@ -9,6 +9,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "../../sim/ref_kd.h"
 #include "../../sim/ref_trace.h"
 #include "../../sim/reference.h"
 
@@ -86,8 +87,8 @@ static float t_tolerance(const Scene *s, const RefRay *r, uint32_t tri, float t)
     return 32.0f * FLT_EPSILON * mag * (1.0f + sliver) / fmaxf(c, 1e-3f);
 }
 
-int xcheck_run(const Scene *scene, const PackedScene *p, uint32_t camera_rays, uint32_t random_rays,
-               uint32_t seed, XcheckResult *out, char *err, size_t errlen)
+int xcheck_run(const Scene *scene, const PackedScene *p, const XcheckTracer *tr, uint32_t camera_rays,
+               uint32_t random_rays, uint32_t seed, XcheckResult *out, char *err, size_t errlen)
 {
     memset(out, 0, sizeof *out);
     out->first_bad = UINT64_MAX;
@@ -136,8 +137,16 @@ int xcheck_run(const Scene *scene, const PackedScene *p, uint32_t camera_rays, u
         make_ray(p, i, camera_rays, seed, &rays[i]);
     double t0 = now();
     for (uint32_t i = 0; i < n; i++)
-        ref_closest_hit(p, &rays[i], &ours[i], NULL);
+        if (tr && tr->kd)
+            ref_kd_closest_hit(p, tr->kd, (RefKdVariant)tr->variant, tr->depth, &rays[i], &ours[i], NULL);
+        else
+            ref_closest_hit(p, &rays[i], &ours[i], NULL);
     double t1 = now();
+    for (uint32_t i = 0; tr && tr->kd && i < n; i++) {
+        RefHit b;
+        ref_closest_hit(p, &rays[i], &b, NULL);
+        out->unlike_bvh += b.prim != ours[i].prim || (b.prim != REF_NO_HIT && memcmp(&b, &ours[i], sizeof b) != 0);
+    }
     uint32_t prims = sm_u32(p, sm_hdr(p, SM_HDR_PRIMS));
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);

@@ -9,6 +9,7 @@
 
 #include <stdint.h>
 
+#include "../../scenes/kdtree.h"
 #include "../../scenes/pack.h"
 
 typedef struct XcheckResult {
@@ -19,12 +20,20 @@ typedef struct XcheckResult {
     uint64_t hits;         /* rays our tracer says hit something */
     double ours_seconds, embree_seconds;
     uint64_t first_bad;    /* index of the first disagreeing ray, for diagnosis */
+    uint64_t unlike_bvh;   /* kd-tree runs: rays whose hit differs in any bit from the BVH's */
 } XcheckResult;
 
+/* Which of our traversals to check: the golden model's BVH (kd = NULL), or its kd-tree traversal
+ * `variant` (RefKdVariant) with a short stack of `depth` entries over kd. */
+typedef struct XcheckTracer {
+    const KdTree *kd;
+    int variant, depth;
+} XcheckTracer;
+
 /* Trace `camera_rays` camera rays and `random_rays` random rays through both tracers.
- * `scene` gives the source triangles Embree builds from; p is its packing. 0, or -1 with a
- * message (Embree device or build failure). */
-int xcheck_run(const Scene *scene, const PackedScene *p, uint32_t camera_rays, uint32_t random_rays,
-               uint32_t seed, XcheckResult *out, char *err, size_t errlen);
+ * `scene` gives the source triangles Embree builds from; p is its packing; tr NULL: the BVH.
+ * 0, or -1 with a message (Embree device or build failure). */
+int xcheck_run(const Scene *scene, const PackedScene *p, const XcheckTracer *tr, uint32_t camera_rays,
+               uint32_t random_rays, uint32_t seed, XcheckResult *out, char *err, size_t errlen);
 
 #endif
