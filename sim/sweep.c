@@ -2267,33 +2267,39 @@ static const Series stall_series = {M_STALL, TM_CAUSE_COUNT, tm_cause_keys, "sta
 static const Series ops_series = {M_OPS, ISA_C_COUNT, isa_category_keys, "operation mix",
                                   "share of executed instructions", "ops", 1};
 
-/* fps (lines, with the confidence interval as error bars when every point has one) or SIMD
- * utilization (three panels) against a numeric key. */
-static void plot_lines(Plotter *p, const char *xkey, int util)
+/* fps (lines, with the confidence interval as error bars when every point has one), SIMD
+ * utilization (three panels) or, for kd-tree runs, nodes visited per ray against a numeric key.
+ * what: 0 fps, 1 utilization, 2 kd-tree nodes. */
+static void plot_lines(Plotter *p, const char *xkey, int what)
 {
-    int m0 = util ? M_UTIL : M_FPS, nm = util ? 3 : 1;
+    const int util = what == 1, kd = what == 2;
+    int m0 = util ? M_UTIL : kd ? M_KD : M_FPS, nm = util ? 3 : 1;
     Group *g;
     int ng = groups_make(p, xkey, m0, nm, &g);
     if (!ng) {
         groups_free(g, ng);
         return;
     }
-    int ci = !util;
+    int ci = !util && !kd;
     for (int i = 0; i < ng && ci; i++)
         for (int j = 0; j < g[i].n && ci; j++)
             ci = p->rows[g[i].rows[j]].has[M_FPS_LO] && p->rows[g[i].rows[j]].has[M_FPS_HI];
-    char *base = xasprintf("%s_%s", util ? "utilization" : "fps", xkey);
+    char *base = xasprintf("%s_%s", util ? "utilization" : kd ? "kd_nodes" : "fps", xkey);
     Buf gp = {0}, dat = {0};
     for (int i = 0; i < ng; i++) {
         buf_printf(&dat, "%s# %s\n# %s %s\n", i ? "\n\n" : "", g[i].label[0] ? g[i].label : "all points", xkey,
-                   util ? "utilization_traversal utilization_intersection utilization_shading" : "fps fps_lo fps_hi");
+                   util ? "utilization_traversal utilization_intersection utilization_shading"
+                   : kd ? "kd_camera_nodes_per_ray kd_nodes_per_ray" : "fps fps_lo fps_hi");
         for (int j = 0; j < g[i].n; j++) {
             const Row *row = &p->rows[g[i].rows[j]];
             buf_printf(&dat, "%s", plan_value(p->pl, g[i].rows[j], xkey));
-            if (util)
+            if (util) {
                 for (int s = 0; s < 3; s++)
                     dat_num(&dat, row, M_UTIL + s);
-            else {
+            } else if (kd) {
+                dat_num(&dat, row, M_KD_CAMERA_NODES);
+                dat_num(&dat, row, M_KD);
+            } else {
                 dat_num(&dat, row, M_FPS);
                 dat_num(&dat, row, M_FPS_LO);
                 dat_num(&dat, row, M_FPS_HI);
@@ -2301,8 +2307,8 @@ static void plot_lines(Plotter *p, const char *xkey, int util)
             buf_puts(&dat, "\n");
         }
     }
-    gp_head(p, &gp, base, util ? 1500 : 960, util ? 560 : 620, util ? "SIMD utilization per stage" : "frames per second",
-            xkey);
+    gp_head(p, &gp, base, util ? 1500 : 960, util ? 560 : 620,
+            util ? "SIMD utilization per stage" : kd ? "kd-tree nodes visited per ray" : "frames per second", xkey);
     buf_puts(&gp, "set xlabel ");
     axis_label(&gp, xkey);
     buf_puts(&gp, "\n");
@@ -2332,7 +2338,7 @@ static void plot_lines(Plotter *p, const char *xkey, int util)
         buf_puts(&gp, ")\n");
     }
     buf_puts(&gp, "set offsets graph 0.03, graph 0.03, 0, 0\n");
-    buf_puts(&gp, ng > 1 ? "set key outside below center horizontal\n" : "unset key\n");
+    buf_puts(&gp, ng > 1 || kd ? "set key outside below center horizontal\n" : "unset key\n");
     if (util) {
         buf_puts(&gp, "set yrange [0:1]\nset ylabel \"SIMD utilization (active lanes / N)\"\n");
         buf_puts(&gp, "set multiplot layout 1,3 title ");
@@ -2341,6 +2347,8 @@ static void plot_lines(Plotter *p, const char *xkey, int util)
         gp_str(&gp, buf_str(&t));
         buf_free(&t);
         buf_printf(&gp, " . \"\\n\" . %s\nunset title\n", p->subtitle);
+    } else if (kd) {
+        buf_puts(&gp, "set yrange [0:*]\nset ylabel \"nodes visited per ray (inner nodes and leaves)\"\n");
     } else {
         buf_printf(&gp, "set yrange [0:*]\nset ylabel \"frames per second (at core.clock_mhz)%s\"\n",
                    ci ? "; bars: 95% confidence interval" : "");
@@ -2349,7 +2357,16 @@ static void plot_lines(Plotter *p, const char *xkey, int util)
         if (util)
             buf_printf(&gp, "set title \"%s\"\n", isa_stage_keys[util_stages[s]]);
         buf_puts(&gp, "plot ");
-        for (int i = 0; i < ng; i++) {
+        for (int i = 0; i < ng && kd; i++)
+            for (int c = 0; c < 2; c++) {
+                Buf t = {0};
+                buf_printf(&t, "%s%s%s", c ? "all rays" : "camera rays", g[i].label[0] ? ", " : "", g[i].label);
+                buf_printf(&gp, "%s\"%s.dat\" index %d using 1:%d with linespoints lw 2 pt 7 ps 1.2 title ",
+                           i || c ? ", \\\n     " : "", base, i, 2 + c);
+                gp_str(&gp, buf_str(&t));
+                buf_free(&t);
+            }
+        for (int i = 0; i < ng && !kd; i++) {
             buf_printf(&gp, "%s\"%s.dat\" index %d using 1:%d%s with %s lw 2 pt 7 ps 1.2 title ", i ? ", \\\n     " : "",
                        base, i, 2 + s, ci ? ":3:4" : "", ci ? "yerrorlines" : "linespoints");
             gp_str(&gp, g[i].label[0] ? g[i].label : (ci ? "fps, 95% confidence interval" : "all points"));
@@ -2424,10 +2441,10 @@ static void plot_bars(Plotter *p, int kind)
 {
     const Plan *pl = p->pl;
     const Series *se = kind == 2 ? &stall_series : kind == 3 ? &ops_series : NULL;
-    int m0 = se ? se->m0 : kind == 1 ? M_UTIL : M_FPS, nm = se ? se->n : kind == 1 ? 3 : 1;
-    static const char *const bases[] = {"fps_point", "utilization_point", "stalls_point", "ops_point"};
+    int m0 = se ? se->m0 : kind == 1 ? M_UTIL : kind == 4 ? M_KD : M_FPS, nm = se ? se->n : kind == 1 ? 3 : 1;
+    static const char *const bases[] = {"fps_point", "utilization_point", "stalls_point", "ops_point", "kd_nodes_point"};
     static const char *const whats[] = {"frames per second", "SIMD utilization per stage", "stall cycles by cause",
-                                        "operation mix"};
+                                        "operation mix", "kd-tree nodes visited per ray"};
     Buf gp = {0}, dat = {0};
     int n = 0, ci = kind == 0, longest = 0;
     for (int r = 0; r < pl->npoints; r++) {
@@ -2451,6 +2468,9 @@ static void plot_bars(Plotter *p, int kind)
             dat_num(&dat, &p->rows[r], M_FPS_LO);
             dat_num(&dat, &p->rows[r], M_FPS_HI);
             ci = ci && p->rows[r].has[M_FPS_LO] && p->rows[r].has[M_FPS_HI];
+        } else if (kind == 4) {
+            dat_num(&dat, &p->rows[r], M_KD_CAMERA_NODES);
+            dat_num(&dat, &p->rows[r], M_KD);
         } else {
             for (int m = m0; m < m0 + nm; m++)
                 dat_num(&dat, &p->rows[r], m);
@@ -2462,7 +2482,7 @@ static void plot_bars(Plotter *p, int kind)
         buf_free(&dat);
         return;
     }
-    int w = 300 + 70 * n * (kind == 1 ? 2 : 1);
+    int w = 300 + 70 * n * (kind == 1 || kind == 4 ? 2 : 1);
     int wmin = kind == 0 ? 900 : 1100;
     gp_head(p, &gp, bases[kind], w < wmin ? wmin : w, 600 + 6 * (longest > 12 ? longest : 0), whats[kind], "the point");
     buf_puts(&gp, "set style fill solid 0.85 border -1\nset xlabel \"point\"\n");
@@ -2477,6 +2497,12 @@ static void plot_bars(Plotter *p, int kind)
             buf_printf(&gp, ", \\\n     \"%s.dat\" using 0:2:3:4 with yerrorbars lc rgb \"black\" pt -1 "
                             "title \"95%% confidence interval\"", bases[kind]);
         buf_puts(&gp, "\n");
+    } else if (kind == 4) {
+        buf_puts(&gp, "set style data histograms\nset style histogram clustered gap 1\nset yrange [0:*]\n"
+                      "set ylabel \"nodes visited per ray (inner nodes and leaves)\"\nset key outside right top\n");
+        gp_palette(&gp, 2);
+        buf_printf(&gp, "plot \"%s.dat\" using 2:xtic(1) title \"camera rays\", \\\n     \"%s.dat\" using 3 "
+                        "title \"all rays\"\n", bases[kind], bases[kind]);
     } else if (kind == 1) {
         buf_puts(&gp, "set style data histograms\nset style histogram clustered gap 1\nset yrange [0:1]\n"
                       "set ylabel \"SIMD utilization (active lanes / N)\"\nset key outside right top\n");
@@ -2569,12 +2595,13 @@ static int plots_make(const Plan *pl, const Row *rows, const char *dir, int *fai
         lines++;
         plot_lines(&p, pl->keys[k], 0);
         plot_lines(&p, pl->keys[k], 1);
+        plot_lines(&p, pl->keys[k], 2); /* only when some point ran on a kd-tree */
         plot_stacked(&p, pl->keys[k], &stall_series);
         plot_stacked(&p, pl->keys[k], &ops_series);
     }
     if (!lines)
-        for (int kind = 0; kind < 4; kind++)
-            plot_bars(&p, kind);
+        for (int kind = 0; kind < 5; kind++)
+            plot_bars(&p, kind); /* (kd_nodes_point: only when some point ran on a kd-tree) */
     free(p.subtitle);
     free(pdir);
     *failed = p.gnuplot_failed || p.gnuplot_missing;

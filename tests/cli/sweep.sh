@@ -103,6 +103,26 @@ done
 grep -q 'core.simd_width = 4' "$T/width/points/000/point.ini" 2>/dev/null || no "points/000/point.ini lacks its setting"
 end
 
+begin "configs/sweeps/kdtree.ini at tiny size: 11 points, the same image, kd columns, kd_nodes plots"
+run "$SFSIM" sweep --sweep configs/sweeps/kdtree.ini -o "$T/kd" -j 2 "${TINY[@]}"
+want_rc 0
+want_err "11/11 done"
+csv="$T/kd/sweep.csv"
+[ "$(col "$csv" status | sort -u)" = "ok" ] || no "statuses: $(col "$csv" status | sort | uniq -c | tr '\n' ' ')"
+[ "$(col "$csv" kd_nodes_per_ray | head -1)" = "" ] || no "the BVH point has kd counters"
+bad=$(col "$csv" kd_camera_nodes_per_ray | tail -n +2 | grep -cvE '^[0-9]+(\.[0-9]+)?$')
+[ "$bad" -eq 0 ] || no "kd points without numeric camera nodes per ray: $(col "$csv" kd_camera_nodes_per_ray | tr '\n' ' ')"
+# restart re-descends from the root after every leaf: more nodes per ray than the full stack
+st=$(col "$csv" kd_nodes_per_ray | sed -n 2p) re=$(col "$csv" kd_nodes_per_ray | sed -n 3p)
+awk -v a="$re" -v b="$st" 'BEGIN { exit !(a > b) }' || no "restart $re nodes per ray, not more than the stack's $st"
+is_png "$T/kd/plots/kd_nodes_point.png" || no "plots/kd_nodes_point.png is missing"
+is_png "$T/kd/plots/fps_point.png" || no "plots/fps_point.png is missing"
+for i in 001 002 003 004 005 006 007 008 009 010; do
+    "$SFSIM" compare "$T/kd/points/000/frame.exr" "$T/kd/points/$i/frame.exr" 2>/dev/null | grep -qE 'max diff +0$' ||
+        no "point $i's image differs from the BVH's"
+done
+end
+
 # ---- 2: kill and resume ---------------------------------------------------------------------
 
 printf '[sweep]\ncore.simd_width = 4, 8, 12, 16\nrender.seed = 1, 2\n' >"$T/kill.ini"
