@@ -200,3 +200,57 @@ Test(kdkernel, conference_every_variant_matches_bvh_and_golden_counters, .timeou
 {
     check_kernel("scenes/conference/scene.ini", 2048, all_cases, sizeof all_cases / sizeof *all_cases);
 }
+
+/* The structure must not change the picture: the path tracer renders the same image bits with the
+ * BVH and with every kd-tree traversal (a small frame of the Cornell box and the conference room). */
+static void check_images(const char *path, int w, int h)
+{
+    Scene s;
+    PackedScene p;
+    char err[65536];
+    cr_assert_eq(pack_load_file(path, w, h, 1, &s, &p, err, sizeof err), 0, "%s", err);
+    CfgMachine cfg;
+    cfg_defaults(&cfg);
+    CfgErrors ce = {0};
+    cr_assert_eq(cfg_set(&cfg, "accel.structure=kd", &ce), 0);
+    FuncKdInfo info;
+    cr_assert_eq(func_add_kd(&p, &cfg, &info, err, sizeof err), 0, "%s", err);
+    static const char *const trav[] = {NULL, "stack", "restart", "pushdown", "shortstack", "packet", "stream"};
+    size_t n = 3 * (size_t)w * h;
+    float *ref = calloc(n, sizeof(float)), *rgb = calloc(n, sizeof(float));
+    cr_assert(ref && rgb);
+    for (int v = 0; v < 7; v++) {
+        CfgMachine c = cfg;
+        char a[64];
+        snprintf(a, sizeof a, "%s", v ? "accel.structure=kd" : "accel.structure=bvh");
+        cr_assert_eq(cfg_set(&c, a, &ce), 0);
+        if (v) {
+            snprintf(a, sizeof a, "kd.traversal=%s", trav[v]);
+            cr_assert_eq(cfg_set(&c, a, &ce), 0);
+        }
+        FuncParams fp = {.cfg = &c, .kernel_path = "kernels/pathtrace.s", .needs = s.needs, .seed = 1, .threads = 2};
+        FuncStats st;
+        memset(rgb, 0, n * sizeof(float));
+        cr_assert_eq(func_render(&p, &fp, v ? rgb : ref, &st, err, sizeof err), 0, "%s %s: %s", path,
+                     v ? trav[v] : "bvh", err);
+        if (v) {
+            size_t differ = 0;
+            for (size_t i = 0; i < n; i++)
+                differ += memcmp(&ref[i], &rgb[i], sizeof(float)) != 0;
+            cr_expect_eq(differ, 0, "%s: kd.traversal = %s: %zu of %zu values differ from the BVH's image", path,
+                         trav[v], differ, n);
+            cr_expect_gt(st.kd_counts[FUNC_KD_CAMERA][FUNC_KD_NODES], 0, "%s %s: no nodes counted", path, trav[v]);
+        }
+        func_stats_free(&st);
+    }
+    free(ref);
+    free(rgb);
+    pack_free(&p);
+    scene_free(&s);
+}
+
+Test(kdkernel, every_traversal_renders_the_bvh_image, .timeout = 600)
+{
+    check_images("scenes/cornell/scene.ini", 48, 48);
+    check_images("scenes/conference/scene.ini", 40, 32);
+}
