@@ -52,7 +52,7 @@ int main(int argc, char **argv)
         }
         size_t n = 3 * (size_t)w * h;
         float *ref = calloc(n, sizeof(float)), *fun = calloc(n, sizeof(float));
-        RefParams rp = {64, 1, 1, NULL, NULL};
+        RefParams rp = {.tile = 64, .seed = 1, .threads = 1};
         double t0 = now();
         if (!ref || !fun || ref_render(&p, &rp, ref, NULL, err, sizeof err) != 0) {
             fprintf(stderr, "%s: %s\n", scenes[i], err);

@@ -9,7 +9,8 @@
 ; docs/kernel.md describes the structure, registers and memories.
 ;
 ; Assembled by the host with -D RAYS=M and one -D per scene feature (docs/kernel.md):
-;   HAS_GLOSSY, HAS_DIELECTRIC, HAS_LAMBERT, HAS_NORMALS, HAS_BACKGROUND, HAS_AMBIENT.
+;   HAS_GLOSSY, HAS_DIELECTRIC, HAS_LAMBERT, HAS_NORMALS, HAS_BACKGROUND, HAS_AMBIENT; and
+;   WORKLOAD (with BOUNCES) for the utilization workloads instead of the material shaders.
 
         .include "abi.inc"
         .include "layout.inc"
@@ -40,12 +41,14 @@ DIM_RR = 7
 WL_PATH = 0                     ; WORKLOAD: the path tracer, or a utilization workload
 WL_SPECULAR = 1
 WL_DIFFUSE = 2
+WL_PHONG = 3
 .ifndef WORKLOAD
 WORKLOAD = WL_PATH
 .endif
-.if WORKLOAD == WL_SPECULAR && !defined(BOUNCES)
-        .error "the specular workload needs -D BOUNCES=n"
+.if (WORKLOAD == WL_SPECULAR || WORKLOAD == WL_PHONG) && !defined(BOUNCES)
+        .error "the specular and phong workloads need -D BOUNCES=n"
 .endif
+PHONG_AMBIENT = 0.05            ; phong: the ambient light of a scene without render.ambient
 LIGHT_POINT = 0
 LIGHT_SPOT = 1
 LIGHT_DIRECTIONAL = 2
@@ -695,28 +698,30 @@ isect_next:
         spld    r4, r0, L_SCRATCH
 .endm
 
-; New ray into the next buffer for the lanes of mask k; o, d, th triples; vid the parent.
-.macro  EMIT k, o, d, th, tmaxv, kind, spec, slot, t
+; New ray into the next buffer for the lanes of mask k; o, d, th triples; vid the parent. The
+; Phong workload's shadow rays go into the current buffer instead (sct = rsct, slots from r23 and
+; IDs to r22 as set by phong).
+.macro  EMIT k, o, d, th, tmaxv, kind, spec, slot, t, sct=rsctn
         ralloc  \slot, r23 @\k
-        rsctn   \o\()x, \slot, r0, F_ORGX @\k
-        rsctn   \o\()y, \slot, r0, F_ORGY @\k
-        rsctn   \o\()z, \slot, r0, F_ORGZ @\k
-        rsctn   \d\()x, \slot, r0, F_DIRX @\k
-        rsctn   \d\()y, \slot, r0, F_DIRY @\k
-        rsctn   \d\()z, \slot, r0, F_DIRZ @\k
-        rsctn   \th\()x, \slot, r0, F_THRR @\k
-        rsctn   \th\()y, \slot, r0, F_THRG @\k
-        rsctn   \th\()z, \slot, r0, F_THRB @\k
+        \sct    \o\()x, \slot, r0, F_ORGX @\k
+        \sct    \o\()y, \slot, r0, F_ORGY @\k
+        \sct    \o\()z, \slot, r0, F_ORGZ @\k
+        \sct    \d\()x, \slot, r0, F_DIRX @\k
+        \sct    \d\()y, \slot, r0, F_DIRY @\k
+        \sct    \d\()z, \slot, r0, F_DIRZ @\k
+        \sct    \th\()x, \slot, r0, F_THRR @\k
+        \sct    \th\()y, \slot, r0, F_THRG @\k
+        \sct    \th\()z, \slot, r0, F_THRB @\k
         vli     \t, \tmaxv @\k
-        rsctn   \t, \slot, r0, F_TMAX @\k
+        \sct    \t, \slot, r0, F_TMAX @\k
         rgat    \t, vid, r0, F_FBOFF @\k
-        rsctn   \t, \slot, r0, F_FBOFF @\k
+        \sct    \t, \slot, r0, F_FBOFF @\k
         rgat    \t, vid, r0, F_KEY @\k
-        rsctn   \t, \slot, r0, F_KEY @\k
+        \sct    \t, \slot, r0, F_KEY @\k
         vli     \t, \kind @\k
-        rsctn   \t, \slot, r0, F_KIND @\k
+        \sct    \t, \slot, r0, F_KIND @\k
         vli     \t, \spec @\k
-        rsctn   \t, \slot, r0, F_SPEC @\k
+        \sct    \t, \slot, r0, F_SPEC @\k
         sapp    r22, \slot @\k
 .endm
 
@@ -762,6 +767,73 @@ isect_next:
         rgat    \v\()z, vid, r0, \f2 @\k
 .endm
 
+; d := c > 0 ? 2^(n log2 c) : 0 -- c^n as sim/reference.c's pow_lobe computes it (vexp2 and
+; vlog2 are exp2f and log2f, sim/core.c); d may be c; t (not c or n) and the mask mt clobbered.
+.macro  POW_LOBE d, c, n, t, mt, k=m1
+        vflt    \mt, vz, \c @\k
+        vlog2   \t, \c @\mt
+        vfmul   \t, \n, \t @\mt
+        vexp2   \t, \t @\mt
+        vli     \d, 0 @\k
+        vmov    \d, \t @\mt
+.endm
+
+; n := the Phong exponent 2 / max(roughness^2, 0.001) - 2 of the roughness in n; t = 2.0 after.
+.macro  GLOSSY_EXP n, t, k=m1
+        vfmul   \n, \n, \n @\k
+        vli     \t, 0.001 @\k
+        vfmax   \n, \n, \t @\k
+        vli     \t, 2.0 @\k
+        vfdiv   \n, \t, \n @\k
+        vfsub   \n, \n, \t @\k
+.endm
+
+; Ambient term of the m1 rays' hits: thr x base x the scene's ambient (render.ambient), or
+; PHONG_AMBIENT when it has none (the Phong workload). th, b triples and t clobbered.
+.macro  AMBIENT_ADD th, b, t
+        GATHER3 \th, F_THRR, F_THRG, F_THRB
+        GATHER3 \b, F_BASER, F_BASEG, F_BASEB
+        vfmul   \th\()x, \th\()x, \b\()x @m1
+        vfmul   \th\()y, \th\()y, \b\()y @m1
+        vfmul   \th\()z, \th\()z, \b\()z @m1
+.ifdef HAS_AMBIENT
+        ldb     \b\()x, r0, SM_HDR_AMBIENT @m1
+        ldb     \b\()y, r0, SM_HDR_AMBIENT + 4 @m1
+        ldb     \b\()z, r0, SM_HDR_AMBIENT + 8 @m1
+        vfmul   \th\()x, \th\()x, \b\()x @m1
+        vfmul   \th\()y, \th\()y, \b\()y @m1
+        vfmul   \th\()z, \th\()z, \b\()z @m1
+.else
+        vli     \t, PHONG_AMBIENT @m1
+        SCALE3  \th, \t
+.endif
+        FBADD3  \th, \t, m1
+.endm
+
+; Shadow filter: the unoccluded shadow rays of [b, e) (occluded ones have tmax = -1) add the
+; radiance they carry. tm, t and the triple th clobbered; r16 runs over the stream.
+.macro  SHADOW_ADD b, e, tm, th, t
+        mov     r16, \b
+sa\@:
+        sfetch  vid, m1, r16, \e
+        rgat    \tm, vid, r0, F_TMAX @m1
+        vfle    m2, vz, \tm @m1
+        GATHER3 \th, F_THRR, F_THRG, F_THRB, m2
+        FBADD3  \th, \t, m2
+        blt     r16, \e, sa\@
+.endm
+
+; The m1 hits' mirror rays about the facing geometric normal, from the hit point moved off on
+; that side, with throughput th (the forced specular and Phong bounces). Triples d, nf, p, o and
+; vt, vt2, m2 clobbered.
+.macro  MIRROR_EMIT th
+        FACING_NORMAL nf, d, vt, vt2, m2
+        REFLECT3 d, d, nf, vt, vt2
+        GATHER3 p, F_PX, F_PY, F_PZ
+        OFFSET3 o, p, nf, vt, vt2, vz, m2
+        EMIT    m1, o, d, \th, INF_BITS, KIND_INDIRECT, 1, vt, vt2
+.endm
+
 ; filter: partition [\b, \e) so the rays whose field \field equals \val (integer) come first;
 ; \split := end of that part
 .macro  FILTER_EQ b, e, split, field, val
@@ -777,6 +849,177 @@ fe\@:
         blt     r16, \e, fe\@
         part    \split, \b, \e
 fd\@:
+.endm
+
+; The registers of direct lighting (direct) and the Phong workload's light passes (phong),
+; which share LIGHT_SAMPLE; wi names lu, lv, lk once the light is sampled.
+.macro  LIGHT_ALIASES
+.alias  vid, v0
+.alias  kb, v1
+.alias  px, v2
+.alias  py, v3
+.alias  pz, v4
+.alias  nfx, v5
+.alias  nfy, v6
+.alias  nfz, v7
+.alias  ox, v8
+.alias  oy, v9
+.alias  oz, v10
+.alias  la, v11
+.alias  lu, v12
+.alias  lv, v13
+.alias  lk, v14
+.alias  lpx, v15
+.alias  lpy, v16
+.alias  lpz, v17
+.alias  e1x, v18
+.alias  e1y, v19
+.alias  e1z, v20
+.alias  e2x, v21
+.alias  e2y, v22
+.alias  e2z, v23
+.alias  nlx, v24
+.alias  nly, v25
+.alias  nlz, v26
+.alias  vt, v27
+.alias  vt2, v28
+.alias  vt3, v29
+.alias  wix, v12
+.alias  wiy, v13
+.alias  wiz, v14
+.endm
+
+.macro  LPOINT p, e1, e2, o
+        vfmul   vt, lu, \e1 @m4
+        vfadd   \p, \p, vt @m4
+        vfmul   vt, lv, \e2 @m4
+        vfadd   \p, \p, vt @m4
+        vfsub   \p, \p, \o @m1         ; shadow ray direction: light point - origin
+.endm
+
+; The light at la (per lane) seen from the origins o, at the point (lu, lv) of its sampling
+; parametrization (P + c1 E1 + c2 E2; quad: c = (u, v); triangle: sqrt(u) (1 - v), sqrt(u) v):
+; lp := the shadow-ray direction (light point - o, or 4 scene scales along a directional
+; light), wi := it normalized, e1 := le, the radiance it brings x geometry, e2 := the shading
+; normal, vt3 := cos at it; m2 := the m1 lanes that receive light and see it from both
+; normals (nf facing the ray). sample_light and shade_direct of sim/reference.c, operation
+; for operation. Aliases of LIGHT_ALIASES; clobbers m3-m7, nl, vt, vt2, r1, r7.
+.macro  LIGHT_SAMPLE
+        ldg     lk, la, SM_LIGHT_KIND @m1
+        ; light kinds: m4 area (quad, triangle), m5 spot, m6 directional, m7 point
+.ifdef HAS_PUNCTUAL
+        vli     vt, LIGHT_QUAD @m1
+        vilt    m4, lk, vt @m1
+        mandn   m4, m1, m4
+        vli     vt, LIGHT_SPOT @m1
+        vieq    m5, lk, vt @m1
+        vli     vt, LIGHT_DIRECTIONAL @m1
+        vieq    m6, lk, vt @m1
+        vli     vt, LIGHT_POINT @m1
+        vieq    m7, lk, vt @m1
+.else
+        mmov    m4, m1
+.endif
+        vli     vt, LIGHT_TRIANGLE @m1
+        vieq    m2, lk, vt @m1
+        vsqrt   vt, lu @m2
+        vli     vt2, 1.0 @m2
+        vfsub   vt2, vt2, lv @m2
+        vfmul   vt2, vt, vt2 @m2
+        vfmul   lv, vt, lv @m2
+        vmov    lu, vt2 @m2
+        ldg     lpx, la, SM_LIGHT_P @m1
+        ldg     lpy, la, SM_LIGHT_P + 4 @m1
+        ldg     lpz, la, SM_LIGHT_P + 8 @m1
+        ldg     e1x, la, SM_LIGHT_E1 @m1
+        ldg     e1y, la, SM_LIGHT_E1 + 4 @m1
+        ldg     e1z, la, SM_LIGHT_E1 + 8 @m1
+        ldg     e2x, la, SM_LIGHT_E2 @m4
+        ldg     e2y, la, SM_LIGHT_E2 + 4 @m4
+        ldg     e2z, la, SM_LIGHT_E2 + 8 @m4
+        LPOINT  lpx, e1x, e2x, ox
+        LPOINT  lpy, e1y, e2y, oy
+        LPOINT  lpz, e1z, e2z, oz
+        DOT3    vt3, lp, lp, vt         ; d2
+        vflt    m2, vz, vt3 @m1         ; d2 > 0
+        vrsqrt  vt, vt3 @m2
+        vfmul   lu, lpx, vt @m2         ; wi (in lu, lv, lk)
+        vfmul   lv, lpy, vt @m2
+        vfmul   lk, lpz, vt @m2
+        ; area lights: the cosine at the light (front side unless two-sided); scale in vt2
+        mand    m3, m2, m4
+        CROSS3  nl, e1, e2, vt, m3
+        NORMALIZE3 nl, vt, vt2, m3
+        DOT3    vt2, nl, wi, vt, m3
+        vfneg   vt2, vt2 @m3            ; cosl
+        ldg     vt, la, SM_LIGHT_TWO_SIDED @m3
+        vsub    nlx, vz, vt @m3
+        vor     vt, vt, nlx @m3
+        vshri   vt, vt, 31 @m3
+        vshli   vt, vt, 31 @m3
+        vxori   vt, vt, -1 @m3
+        vand    vt2, vt2, vt @m3        ; two-sided: |cosl|
+        vflt    m3, vz, vt2 @m3         ; cosl > 0
+        mandn   m4, m4, m3
+        mandn   m2, m2, m4              ; area lanes failing it are out
+        ldg     vt, la, SM_LIGHT_AREA @m3
+        vfmul   vt2, vt2, vt @m3
+        vfdiv   vt2, vt2, vt3 @m3       ; scale = cosl area / d2
+.ifdef HAS_PUNCTUAL
+        ; spot: falloff between the cone angles / d2
+        mand    m3, m2, m5
+        NORMALIZE3 e1, vt, nlx, m3
+        DOT3    nlx, e1, wi, vt, m3
+        vfneg   nlx, nlx @m3            ; cd
+        ldg     nly, la, SM_LIGHT_COS_INNER @m3
+        ldg     nlz, la, SM_LIGHT_COS_OUTER @m3
+        vfsub   nlx, nlx, nlz @m3
+        vfsub   nly, nly, nlz @m3
+        vli     vt, 0.000001 @m3
+        vfmax   nly, nly, vt @m3
+        vfdiv   nlx, nlx, nly @m3
+        vfmax   nlx, nlx, vz @m3
+        vli     vt, 1.0 @m3
+        vfmin   nlx, nlx, vt @m3
+        vfdiv   vt2, nlx, vt3 @m3
+        ; point: 1 / d2
+        mand    m3, m2, m7
+        vrcp    vt2, vt3 @m3
+        ; directional: wi = normalize(-P), direction wi x 4 scene scale, scale 1
+        bmz     m6, ls_nodir\@
+        ldg     lu, la, SM_LIGHT_P @m6
+        ldg     lv, la, SM_LIGHT_P + 4 @m6
+        ldg     lk, la, SM_LIGHT_P + 8 @m6
+        vfneg   lu, lu @m6
+        vfneg   lv, lv @m6
+        vfneg   lk, lk @m6
+        NORMALIZE3 wi, vt, nlx, m6
+        ld      r7, r0, SM_HDR_EPSILON
+        li      r1, 4.0
+        fmul    r7, r1, r7
+        vbcast  vt, r7 @m6
+        vfmul   lpx, wix, vt @m6
+        vfmul   lpy, wiy, vt @m6
+        vfmul   lpz, wiz, vt @m6
+        vli     vt2, 1.0 @m6
+        mor     m2, m2, m6
+        ld      r1, r0, SM_HDR_LIGHTS   ; (r1: direct's light array, clobbered above)
+ls_nodir\@:
+.endif
+        ldg     e1x, la, SM_LIGHT_RADIANCE @m2
+        ldg     e1y, la, SM_LIGHT_RADIANCE + 4 @m2
+        ldg     e1z, la, SM_LIGHT_RADIANCE + 8 @m2
+        SCALE3  e1, vt2, m2             ; le
+        vflt    m2, vz, vt2 @m2         ; scale > 0
+        ; both normals must see the light
+        DOT3    vt, wi, nf, vt3, m2
+        vfle    m3, vt, vz @m2
+        mandn   m2, m2, m3
+        GATHER3 e2, F_NSX, F_NSY, F_NSZ, m2
+        DOT3    vt, wi, e2, vt3, m2
+        vfle    m3, vt, vz @m2
+        mandn   m2, m2, m3
+        DOT3    vt3, e2, wi, vt, m2     ; cosi = ns . wi
 .endm
 
 shade:
@@ -807,14 +1050,7 @@ sh_count:
 .alias  thy, v3
 .alias  thz, v4
 .alias  vt, v5
-        mov     r16, r19
-sh_shadow:
-        sfetch  vid, m1, r16, r3
-        rgat    tm, vid, r0, F_TMAX @m1
-        vfle    m2, vz, tm @m1          ; not occluded (occluded rays have tmax = -1)
-        GATHER3 th, F_THRR, F_THRG, F_THRB, m2
-        FBADD3  th, vt, m2
-        blt     r16, r3, sh_shadow
+        SHADOW_ADD r19, r3, tm, th, vt
 sh_shadow_done:
         ; ---- miss filter
         FILTER_EQ r3, r20, r4, F_PRIM, -1
@@ -852,6 +1088,11 @@ sh_miss_done:
         mov     r12, r5
         mov     r13, r20
         jal     r31, one_bounce_diffuse
+        jmp     sh_return
+.elif WORKLOAD == WL_PHONG
+        mov     r12, r5
+        mov     r13, r20
+        jal     r31, phong
         jmp     sh_return
 .else
         ; ---- one filter per material kind on [r5, r20)
@@ -1145,8 +1386,8 @@ surf_notex:
         mandn   m4, m1, m4
         mor     m3, m3, m4
         mand    m2, m2, m3
-.if WORKLOAD != WL_PATH
-        mclr    m2                      ; (the utilization workloads treat emitters as surfaces)
+.if WORKLOAD == WL_SPECULAR || WORKLOAD == WL_DIFFUSE
+        mclr    m2                      ; (these utilization workloads treat emitters as surfaces)
 .endif
         pmask   m2
         ; emission counts for camera rays and after delta bounces
@@ -1215,18 +1456,7 @@ diff_split:
 .alias  bx, v8
 .alias  by, v9
 .alias  bz, v10
-        GATHER3 th, F_THRR, F_THRG, F_THRB
-        GATHER3 b, F_BASER, F_BASEG, F_BASEB
-        vfmul   thx, thx, bx @m1
-        vfmul   thy, thy, by @m1
-        vfmul   thz, thz, bz @m1
-        ldb     bx, r0, SM_HDR_AMBIENT @m1
-        ldb     by, r0, SM_HDR_AMBIENT + 4 @m1
-        ldb     bz, r0, SM_HDR_AMBIENT + 8 @m1
-        vfmul   thx, thx, bx @m1
-        vfmul   thy, thy, by @m1
-        vfmul   thz, thz, bz @m1
-        FBADD3  th, vt, m1
+        AMBIENT_ADD th, b, vt
 diff_noamb:
 .endif
         blt     r16, r13, diff_split
@@ -1246,36 +1476,7 @@ diff_done:
 ; Scalars: r8 = 16 * vertex, r10 = number of lights, r11 = p_direct (float), r14 = kind.
 ; Clobbers r1-r4, r7, r16.
 direct:
-.alias  vid, v0
-.alias  kb, v1
-.alias  px, v2
-.alias  py, v3
-.alias  pz, v4
-.alias  nfx, v5
-.alias  nfy, v6
-.alias  nfz, v7
-.alias  ox, v8
-.alias  oy, v9
-.alias  oz, v10
-.alias  la, v11
-.alias  lu, v12
-.alias  lv, v13
-.alias  lk, v14
-.alias  lpx, v15
-.alias  lpy, v16
-.alias  lpz, v17
-.alias  e1x, v18
-.alias  e1y, v19
-.alias  e1z, v20
-.alias  e2x, v21
-.alias  e2y, v22
-.alias  e2z, v23
-.alias  nlx, v24
-.alias  nly, v25
-.alias  nlz, v26
-.alias  vt, v27
-.alias  vt2, v28
-.alias  vt3, v29
+        LIGHT_ALIASES
         ld      r1, r0, SM_HDR_LIGHTS
         cvtif   r2, r10                 ; (float) nlights
         fdiv    r3, r2, r11             ; weight nlights / p_direct
@@ -1305,131 +1506,7 @@ dir_chunk:
         ; point on the light: P + c1 E1 + c2 E2 (quad: c = (u, v); triangle: sqrt(u) (1 - v), sqrt(u) v)
         RAND    lu, kb, DIM_LIGHT_U, vt
         RAND    lv, kb, DIM_LIGHT_V, vt
-        ldg     lk, la, SM_LIGHT_KIND @m1
-        ; light kinds: m4 area (quad, triangle), m5 spot, m6 directional, m7 point
-.ifdef HAS_PUNCTUAL
-        vli     vt, LIGHT_QUAD @m1
-        vilt    m4, lk, vt @m1
-        mandn   m4, m1, m4
-        vli     vt, LIGHT_SPOT @m1
-        vieq    m5, lk, vt @m1
-        vli     vt, LIGHT_DIRECTIONAL @m1
-        vieq    m6, lk, vt @m1
-        vli     vt, LIGHT_POINT @m1
-        vieq    m7, lk, vt @m1
-.else
-        mmov    m4, m1
-.endif
-        vli     vt, LIGHT_TRIANGLE @m1
-        vieq    m2, lk, vt @m1
-        vsqrt   vt, lu @m2
-        vli     vt2, 1.0 @m2
-        vfsub   vt2, vt2, lv @m2
-        vfmul   vt2, vt, vt2 @m2
-        vfmul   lv, vt, lv @m2
-        vmov    lu, vt2 @m2
-        ldg     lpx, la, SM_LIGHT_P @m1
-        ldg     lpy, la, SM_LIGHT_P + 4 @m1
-        ldg     lpz, la, SM_LIGHT_P + 8 @m1
-        ldg     e1x, la, SM_LIGHT_E1 @m1
-        ldg     e1y, la, SM_LIGHT_E1 + 4 @m1
-        ldg     e1z, la, SM_LIGHT_E1 + 8 @m1
-        ldg     e2x, la, SM_LIGHT_E2 @m4
-        ldg     e2y, la, SM_LIGHT_E2 + 4 @m4
-        ldg     e2z, la, SM_LIGHT_E2 + 8 @m4
-.macro  LPOINT p, e1, e2, o
-        vfmul   vt, lu, \e1 @m4
-        vfadd   \p, \p, vt @m4
-        vfmul   vt, lv, \e2 @m4
-        vfadd   \p, \p, vt @m4
-        vfsub   \p, \p, \o @m1         ; shadow ray direction: light point - origin
-.endm
-        LPOINT  lpx, e1x, e2x, ox
-        LPOINT  lpy, e1y, e2y, oy
-        LPOINT  lpz, e1z, e2z, oz
-        DOT3    vt3, lp, lp, vt         ; d2
-        vflt    m2, vz, vt3 @m1         ; d2 > 0
-        vrsqrt  vt, vt3 @m2
-        vfmul   lu, lpx, vt @m2         ; wi (in lu, lv, lk)
-        vfmul   lv, lpy, vt @m2
-        vfmul   lk, lpz, vt @m2
-.alias  wix, v12
-.alias  wiy, v13
-.alias  wiz, v14
-        ; area lights: the cosine at the light (front side unless two-sided); scale in vt2
-        mand    m3, m2, m4
-        CROSS3  nl, e1, e2, vt, m3
-        NORMALIZE3 nl, vt, vt2, m3
-        DOT3    vt2, nl, wi, vt, m3
-        vfneg   vt2, vt2 @m3            ; cosl
-        ldg     vt, la, SM_LIGHT_TWO_SIDED @m3
-        vsub    nlx, vz, vt @m3
-        vor     vt, vt, nlx @m3
-        vshri   vt, vt, 31 @m3
-        vshli   vt, vt, 31 @m3
-        vxori   vt, vt, -1 @m3
-        vand    vt2, vt2, vt @m3        ; two-sided: |cosl|
-        vflt    m3, vz, vt2 @m3         ; cosl > 0
-        mandn   m4, m4, m3
-        mandn   m2, m2, m4              ; area lanes failing it are out
-        ldg     vt, la, SM_LIGHT_AREA @m3
-        vfmul   vt2, vt2, vt @m3
-        vfdiv   vt2, vt2, vt3 @m3       ; scale = cosl area / d2
-.ifdef HAS_PUNCTUAL
-        ; spot: falloff between the cone angles / d2
-        mand    m3, m2, m5
-        NORMALIZE3 e1, vt, nlx, m3
-        DOT3    nlx, e1, wi, vt, m3
-        vfneg   nlx, nlx @m3            ; cd
-        ldg     nly, la, SM_LIGHT_COS_INNER @m3
-        ldg     nlz, la, SM_LIGHT_COS_OUTER @m3
-        vfsub   nlx, nlx, nlz @m3
-        vfsub   nly, nly, nlz @m3
-        vli     vt, 0.000001 @m3
-        vfmax   nly, nly, vt @m3
-        vfdiv   nlx, nlx, nly @m3
-        vfmax   nlx, nlx, vz @m3
-        vli     vt, 1.0 @m3
-        vfmin   nlx, nlx, vt @m3
-        vfdiv   vt2, nlx, vt3 @m3
-        ; point: 1 / d2
-        mand    m3, m2, m7
-        vrcp    vt2, vt3 @m3
-        ; directional: wi = normalize(-P), direction wi x 4 scene scale, scale 1
-        bmz     m6, dir_nodirectional
-        ldg     lu, la, SM_LIGHT_P @m6
-        ldg     lv, la, SM_LIGHT_P + 4 @m6
-        ldg     lk, la, SM_LIGHT_P + 8 @m6
-        vfneg   lu, lu @m6
-        vfneg   lv, lv @m6
-        vfneg   lk, lk @m6
-        NORMALIZE3 wi, vt, nlx, m6
-        ld      r7, r0, SM_HDR_EPSILON
-        li      r1, 4.0
-        fmul    r7, r1, r7
-        vbcast  vt, r7 @m6
-        vfmul   lpx, wix, vt @m6
-        vfmul   lpy, wiy, vt @m6
-        vfmul   lpz, wiz, vt @m6
-        vli     vt2, 1.0 @m6
-        mor     m2, m2, m6
-        ld      r1, r0, SM_HDR_LIGHTS   ; (r1: light array, clobbered above)
-dir_nodirectional:
-.endif
-        ldg     e1x, la, SM_LIGHT_RADIANCE @m2
-        ldg     e1y, la, SM_LIGHT_RADIANCE + 4 @m2
-        ldg     e1z, la, SM_LIGHT_RADIANCE + 8 @m2
-        SCALE3  e1, vt2, m2             ; le
-        vflt    m2, vz, vt2 @m2         ; scale > 0
-        ; both normals must see the light
-        DOT3    vt, wi, nf, vt3, m2
-        vfle    m3, vt, vz @m2
-        mandn   m2, m2, m3
-        GATHER3 e2, F_NSX, F_NSY, F_NSZ, m2
-        DOT3    vt, wi, e2, vt3, m2
-        vfle    m3, vt, vz @m2
-        mandn   m2, m2, m3
-        DOT3    vt3, e2, wi, vt, m2     ; cosi = ns . wi
+        LIGHT_SAMPLE
         ; brdf x cos into px, py, pz
         GATHER3 p, F_BASER, F_BASEG, F_BASEB, m2
 .ifdef HAS_GLOSSY
@@ -1450,31 +1527,13 @@ dir_glossy:
         ; (wi in v12-14, ns in v21-23 (e2), base in p, cosi vt3; free: v15-17 (shadow dir: keep),
         ;  v5-7 (nf), v24-26, v27, v28)
         GATHER3 nf, F_DIRX, F_DIRY, F_DIRZ, m2
-        DOT3    nlx, nf, e2, vt, m2     ; d . ns
-        vfadd   nlx, nlx, nlx @m2       ; 2 dn  (2.0f * dn: exact either way)
-        vfmul   vt, nlx, e2x @m2
-        vfsub   nfx, nfx, vt @m2
-        vfmul   vt, nlx, e2y @m2
-        vfsub   nfy, nfy, vt @m2
-        vfmul   vt, nlx, e2z @m2
-        vfsub   nfz, nfz, vt @m2        ; mirror direction
+        REFLECT3 nf, nf, e2, nlx, vt, m2 ; mirror direction
         DOT3    nly, nf, wi, vt, m2     ; cos alpha
         rgat    nlz, vid, r0, F_MAT @m2
         ldg     vt2, nlz, SM_MAT_ROUGHNESS @m2
         ldg     nlz, nlz, SM_MAT_METALLIC @m2
-        vfmul   vt2, vt2, vt2 @m2
-        vli     vt, 0.001 @m2
-        vfmax   vt2, vt2, vt @m2
-        vli     vt, 2.0 @m2
-        vfdiv   vt2, vt, vt2 @m2
-        vfsub   vt2, vt2, vt @m2        ; exponent n
-        ; cos^n (0 unless cos > 0)
-        vflt    m3, vz, nly @m2
-        vlog2   nlx, nly @m3
-        vfmul   nlx, vt2, nlx @m3
-        vexp2   nlx, nlx @m3
-        vli     nly, 0 @m2
-        vmov    nly, nlx @m3
+        GLOSSY_EXP vt2, vt, m2          ; exponent n (vt = 2)
+        POW_LOBE nly, nly, vt2, nlx, m3, m2 ; cos^n (0 unless cos > 0)
         vfadd   nlx, vt2, vt @m2        ; n + 2
         vli     vt, INV_2PI_F @m2
         vfmul   nlx, nlx, vt @m2
@@ -1602,12 +1661,7 @@ ind_glossy:
         rgat    vt, vid, r0, F_MAT @m1
         ldg     vt2, vt, SM_MAT_ROUGHNESS @m1
         ldg     vt, vt, SM_MAT_METALLIC @m1
-        vfmul   vt2, vt2, vt2 @m1
-        vli     vt3, 0.001 @m1
-        vfmax   vt2, vt2, vt3 @m1
-        vli     vt3, 2.0 @m1
-        vfdiv   vt2, vt3, vt2 @m1
-        vfsub   vt2, vt2, vt3 @m1       ; n
+        GLOSSY_EXP vt2, vt3             ; n
         vli     vt3, 1.0 @m1
         vfsub   vt3, vt3, vt @m1        ; 1 - metallic
 .macro  KDKS b, kd, t
@@ -1653,14 +1707,7 @@ ind_glossy:
         COSINE_DIR d, ns, u5, phi, c, vt, vt3, vt5, vt6, vt7, m4
         ; -- specular lanes: around the mirror direction, cos a = exp2(log2(u5) / (n + 1))
         GATHER3 b, F_DIRX, F_DIRY, F_DIRZ, m3
-        DOT3    vt, b, ns, vt3, m3
-        vfadd   vt, vt, vt @m3          ; 2 dn
-        vfmul   vt3, vt, nsx @m3
-        vfsub   nfx, bx, vt3 @m3
-        vfmul   vt3, vt, nsy @m3
-        vfsub   nfy, by, vt3 @m3
-        vfmul   vt3, vt, nsz @m3
-        vfsub   nfz, bz, vt3 @m3        ; refl (in nf)
+        REFLECT3 nf, b, ns, vt, vt3, m3 ; refl (in nf)
         vli     vt, 1.0 @m3
         vfadd   vt6, vt2, vt @m3        ; n + 1
         vlog2   cz, u5 @m3
@@ -1792,14 +1839,7 @@ diel_chunk:
         vflt    m2, vt, fr @m1          ; reflect
         mandn   m3, m1, m2              ; refract
         ; reflection: d - 2 (d . nn) nn
-        DOT3    vt, d, nn, vt2, m2
-        vfadd   vt, vt, vt @m2
-        vfmul   vt2, vt, nnx @m2
-        vfsub   ox, dx, vt2 @m2
-        vfmul   vt2, vt, nny @m2
-        vfsub   oy, dy, vt2 @m2
-        vfmul   vt2, vt, nnz @m2
-        vfsub   oz, dz, vt2 @m2
+        REFLECT3 o, d, nn, vt, vt2, m2
         ; refraction: eta d + (eta cc - ct) nn, normalized; tinted by the base colour
         vfmul   vt, eta, cc @m3
         vfsub   vt, vt, ct @m3
@@ -1878,18 +1918,7 @@ fs_chunk:
         FBADD3  th, vt, m1
         jmp     fs_next
 fs_bounce:
-        FACING_NORMAL nf, d, vt, vt2, m2
-        DOT3    vt, d, nf, vt2
-        vfadd   vt, vt, vt @m1
-        vfmul   vt2, vt, nfx @m1
-        vfsub   dx, dx, vt2 @m1
-        vfmul   vt2, vt, nfy @m1
-        vfsub   dy, dy, vt2 @m1
-        vfmul   vt2, vt, nfz @m1
-        vfsub   dz, dz, vt2 @m1         ; mirror direction
-        GATHER3 p, F_PX, F_PY, F_PZ
-        OFFSET3 o, p, nf, vt, vt2, vz, m2
-        EMIT    m1, o, d, th, INF_BITS, KIND_INDIRECT, 1, vt, vt2
+        MIRROR_EMIT th
 fs_next:
         blt     r16, r13, fs_chunk
 fs_done:
@@ -1962,5 +1991,167 @@ od_bounce:
 od_next:
         blt     r16, r13, od_chunk
 od_done:
+        jr      r31
+.endif
+
+.if WORKLOAD == WL_PHONG
+; ---- Phong workload on the hits [r12, r13) (seed 004 Sec. 4: "for each light ... a shadow ray
+; for each hit ... local Phong shading for the hits not in shadow"; specular bounces "Phong shaded
+; and accumulated, with weights"). Emitters were handled by the hit-light filter. Each hit adds
+; the ambient term; then one pass per light: each hit's shadow ray toward the light (a quad's
+; centre, a triangle's centroid, a punctual light) carries thr x (base cos + ks cos_r^shininess)
+; x le, and the pass's shadow stream is traced and added at once -- so every pixel receives its
+; lights in light order, as in the golden model (sim/reference.c, shade_phong). The shadow rays
+; live beside the hits, in the upper half of the current ray buffer and stream region (the host
+; gives phong tiles of at most RAYS / 2 pixels), which keeps the next buffer dead during their
+; traversal, as the kd-tree traversals need. Last, in generations below BOUNCES, each hit's
+; mirror ray about the facing normal, throughput thr x ks. docs/kernel.md, "Variants".
+PHONG_EXP_MIN = 1.0             ; lowest shininess: no cos^0 step at the highlight's edge
+PHONG_TRI_U = 4.0 / 9.0         ; a triangle's centroid: sqrt(u) (1 - v) = sqrt(u) v = 1/3
+PH_SLOT0 = RAYS / 2             ; the shadow rays' first slot in the current buffer
+PH_IDS = FIELD_BYTES / 2        ; their stream: the upper half of the current stream region
+PH_LINK = L_SAVE                ; phong's return address (trace calls through r31)
+PH_BEGIN = L_SAVE + 4           ; the hits [r12, r13)
+PH_END = L_SAVE + 8
+PH_LIGHT = L_SAVE + 12          ; the light of the running pass
+PH_R19 = L_SAVE + 16            ; the generation's stream, while a shadow stream has r19, r20
+PH_R20 = L_SAVE + 20
+
+; ks := 0.04 + 0.96 metallic of the hits' materials (lanes k); t scratch.
+.macro  PHONG_KS ks, t, k=m1
+        rgat    \ks, vid, r0, F_MAT @\k
+        ldg     \ks, \ks, SM_MAT_METALLIC @\k
+        vli     \t, 0.96 @\k
+        vfmul   \ks, \ks, \t @\k
+        vli     \t, 0.04 @\k
+        vfadd   \ks, \t, \ks @\k
+.endm
+
+; one channel of a shadow ray's radiance: thr x (base cos + ks lobe) x le (b: base, in place)
+.macro  PHONG_RAD b, le, thr
+        vfmul   \b, \b, vt3 @m2
+        vfadd   \b, \b, nly @m2
+        rgat    vt, vid, r0, \thr @m2
+        vfmul   vt, vt, \b @m2
+        vfmul   \b, vt, \le @m2
+.endm
+
+phong:
+        beq     r12, r13, ph_return
+        spst    r31, r0, PH_LINK
+        spst    r12, r0, PH_BEGIN
+        spst    r13, r0, PH_END
+        SHADE_STREAM r12, r13
+        LIGHT_ALIASES
+        mov     r16, r12
+ph_ambient:
+        sfetch  vid, m1, r16, r13
+        AMBIENT_ADD p, nf, vt
+        blt     r16, r13, ph_ambient
+        spst    r0, r0, PH_LIGHT
+ph_light:
+        spld    r1, r0, PH_LIGHT
+        ld      r2, r0, SM_HDR_NLIGHTS
+        bge     r1, r2, ph_bounce
+        muli    r11, r1, SM_LIGHT_BYTES
+        ld      r2, r0, SM_HDR_LIGHTS
+        add     r11, r11, r2            ; the light's record
+        ld      r2, r11, SM_LIGHT_KIND
+        li      r9, 0.5                 ; (u, v) = (1/2, 1/2): a quad's centre
+        li      r3, LIGHT_TRIANGLE
+        bne     r2, r3, ph_centre
+        li      r9, PHONG_TRI_U
+ph_centre:
+        spld    r12, r0, PH_BEGIN
+        spld    r13, r0, PH_END
+        SHADE_STREAM r12, r13
+        li      r23, PH_SLOT0
+        addi    r22, r19, PH_IDS
+        mov     r16, r12
+ph_chunk:
+        sfetch  vid, m1, r16, r13
+        vbcast  la, r11 @m1
+        ; origin: the hit point moved off the surface on the incoming side
+        GATHER3 p, F_PX, F_PY, F_PZ
+        FACING_NORMAL nf, o, vt, vt2, m2
+        OFFSET3 o, p, nf, vt, vt2, vz, m2
+        vbcast  lu, r9 @m1
+        vli     lv, 0.5 @m1
+        LIGHT_SAMPLE
+        ; highlight: ks max(0, refl . wi)^shininess, refl = the ray's direction mirrored about
+        ; ns, shininess = max(2 / max(roughness^2, 0.001) - 2, PHONG_EXP_MIN)
+        rgat    vt2, vid, r0, F_MAT @m2
+        ldg     vt2, vt2, SM_MAT_ROUGHNESS @m2
+        GLOSSY_EXP vt2, vt, m2
+        vli     vt, PHONG_EXP_MIN @m2
+        vfmax   vt2, vt2, vt @m2
+        GATHER3 nf, F_DIRX, F_DIRY, F_DIRZ, m2
+        REFLECT3 nf, nf, e2, nlx, vt, m2
+        DOT3    nly, nf, wi, vt, m2
+        POW_LOBE nly, nly, vt2, nlx, m3, m2
+        PHONG_KS nlz, vt, m2
+        vfmul   nly, nlz, nly @m2       ; ks x lobe
+        GATHER3 p, F_BASER, F_BASEG, F_BASEB, m2
+        PHONG_RAD px, e1x, F_THRR
+        PHONG_RAD py, e1y, F_THRG
+        PHONG_RAD pz, e1z, F_THRB
+        EMIT    m2, o, lp, p, SHADOW_TMAX, KIND_SHADOW, 0, vt, vt2, rsct
+        blt     r16, r13, ph_chunk
+        ; the pass's shadow stream [r19 + PH_IDS, r22): set-up, traversal, shadow filter
+        spst    r19, r0, PH_R19
+        spst    r20, r0, PH_R20
+        addi    r19, r19, PH_IDS
+        mov     r20, r22
+        beq     r19, r20, ph_next
+        stage   0
+        jal     r30, setup
+        sub     r4, r20, r19
+        shri    r4, r4, 2               ; rays traced: shadow rays of this generation
+        spld    r3, r0, ST_SHADOW
+        add     r3, r3, r4
+        spst    r3, r0, ST_SHADOW
+        shli    r2, r18, 2
+        spld    r3, r2, ST_PER_GEN
+        add     r3, r3, r4
+        spst    r3, r2, ST_PER_GEN
+        beq     r19, r20, ph_traced     ; everything dropped
+        jal     r30, trace
+        stage   3
+        SHADE_STREAM r19, r20
+        SHADOW_ADD r19, r20, kb, p, vt
+ph_traced:
+        stage   3
+ph_next:
+        spld    r19, r0, PH_R19
+        spld    r20, r0, PH_R20
+        spld    r1, r0, PH_LIGHT
+        addi    r1, r1, 1
+        spst    r1, r0, PH_LIGHT
+        jmp     ph_light
+ph_bounce:
+        mov     r22, r21                ; (the next generation is still empty)
+        li      r23, 0
+        li      r1, BOUNCES
+        bge     r18, r1, ph_done
+        spld    r12, r0, PH_BEGIN
+        spld    r13, r0, PH_END
+        SHADE_STREAM r12, r13
+.alias  thx, v11
+.alias  thy, v12
+.alias  thz, v13
+.alias  dx, v14
+.alias  dy, v15
+.alias  dz, v16
+        mov     r16, r12
+ph_mirror:
+        sfetch  vid, m1, r16, r13
+        GATHER3 th, F_THRR, F_THRG, F_THRB
+        PHONG_KS vt, vt2
+        SCALE3  th, vt
+        MIRROR_EMIT th
+        blt     r16, r13, ph_mirror
+ph_done:
+        spld    r31, r0, PH_LINK
+ph_return:
         jr      r31
 .endif

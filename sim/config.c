@@ -20,7 +20,7 @@ typedef enum CfgType { CFG_INT, CFG_I64, CFG_FLOAT, CFG_ENUM } CfgType;
 static const struct { const char *section, *key; const char *names[CFG_ENUM_NAMES]; } enum_names[] = {
     {"stream", "mode", {"stream", "packet"}},
     {"stream", "order", {"ray", "first"}},
-    {"workload", "kind", {"path", "specular", "diffuse"}},
+    {"workload", "kind", {"path", "specular", "diffuse", "phong"}},
     {"accel", "structure", {"bvh", "kd"}},
     {"kd", "traversal", {"stack", "restart", "pushdown", "shortstack", "packet", "stream"}},
 };
@@ -370,6 +370,10 @@ int cfg_check(const CfgMachine *cfg, CfgErrors *errs)
     if ((int64_t)cfg->stream_rays * 8 > (int64_t)cfg->idm_size_kb * 1024)
         add_error(errs, "config: stream.rays = %d needs %d KiB of ID-stream memory (two streams), idm.size_kb = %d",
                   cfg->stream_rays, cfg->stream_rays * 8 / 1024, cfg->idm_size_kb);
+    /* The forced specular workload bounces at least once (phong may stop at its shadow rays). */
+    if (cfg->workload_kind == CFG_WORKLOAD_SPECULAR && cfg->workload_bounces < 1)
+        add_error(errs, "config: workload.bounces = %d: workload.kind = specular needs at least 1 bounce",
+                  cfg->workload_bounces);
     /* Timing model: line sizes are powers of two; the scene cache divides into whole sets. */
     const struct { const char *key; int v; } pow2[] = {
         {"raybuf.line_bytes", cfg->raybuf_line_bytes}, {"spad.line_bytes", cfg->spad_line_bytes},
@@ -457,7 +461,8 @@ void cfg_markdown(FILE *out)
                  "`bin/sfsim config --dump [-c FILE] [--set ...]` prints the values in force. Unknown sections\n"
                  "and keys, values that are not numbers, and values out of range are errors naming the file,\n"
                  "line and key; every error of a file is reported. Cross-key checks: a ray buffer holds M rays\n"
-                 "of 128 bytes; ID-stream memory holds two streams of M IDs; ray-buffer size divides into banks.\n\n"
+                 "of 128 bytes; ID-stream memory holds two streams of M IDs; ray-buffer size divides into banks;\n"
+                 "`workload.kind = specular` needs `workload.bounces` >= 1.\n\n"
                  "| key | type | default | range | meaning |\n|---|---|---|---|---|\n");
     for (size_t i = 0; i < NKEYS; i++) {
         const CfgKeyInfo *k = &keys[i];

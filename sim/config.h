@@ -48,7 +48,7 @@ void cfg_core_params(const CfgMachine *cfg, CoreParams *p);
 /* Values of the ENUM keys (index = stored value). */
 enum { CFG_STREAM_MODE_STREAM = 0, CFG_STREAM_MODE_PACKET = 1 };
 enum { CFG_STREAM_ORDER_RAY = 0, CFG_STREAM_ORDER_FIRST = 1 };
-enum { CFG_WORKLOAD_PATH = 0, CFG_WORKLOAD_SPECULAR = 1, CFG_WORKLOAD_DIFFUSE = 2 };
+enum { CFG_WORKLOAD_PATH = 0, CFG_WORKLOAD_SPECULAR = 1, CFG_WORKLOAD_DIFFUSE = 2, CFG_WORKLOAD_PHONG = 3 };
 enum { CFG_ACCEL_BVH = 0, CFG_ACCEL_KD = 1 };
 /* kd.traversal; the kernel's KD_VARIANT takes these values (kernels/lib/abi.inc: KD_STACK..KD_STREAM). */
 enum { CFG_KD_STACK = 0, CFG_KD_RESTART = 1, CFG_KD_PUSHDOWN = 2, CFG_KD_SHORTSTACK = 3, CFG_KD_PACKET = 4,

@@ -624,6 +624,15 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
         tile_h = tile_w;
     }
     uint32_t rays = tile_w * tile_h;
+    /* The Phong workload traces each hit's shadow rays from the current ray buffer, beside the
+     * hits (kernels/pathtrace.s, phong): two ray records per pixel, so a stream-mode tile holds
+     * M/2 pixels (64 x 32 for M = 4096) and a packet's buffers 2N records. */
+    int phong = cfg->workload_kind == CFG_WORKLOAD_PHONG && !fp->batch;
+    if (phong) {
+        if (cfg->stream_mode != CFG_STREAM_MODE_PACKET)
+            tile_h = (tile_w + 1) / 2;
+        rays = 2 * tile_w * tile_h;
+    }
     st->tile_w = tile_w;
     st->tile_h = tile_h;
     add_define(defs, &nd, st->defines, sizeof st->defines, "RAYS", rays);
@@ -636,6 +645,9 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
         add_define(defs, &nd, st->defines, sizeof st->defines, "BOUNCES", cfg->workload_bounces);
     } else if (cfg->workload_kind == CFG_WORKLOAD_DIFFUSE) {
         add_define(defs, &nd, st->defines, sizeof st->defines, "WORKLOAD", 2);
+    } else if (phong) {
+        add_define(defs, &nd, st->defines, sizeof st->defines, "WORKLOAD", 3);
+        add_define(defs, &nd, st->defines, sizeof st->defines, "BOUNCES", cfg->workload_bounces);
     }
     uint32_t spad_bytes = (uint32_t)cfg->spad_size_kb * 1024u;
     add_define(defs, &nd, st->defines, sizeof st->defines, "SPAD_BYTES", spad_bytes);
@@ -743,9 +755,9 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
                  8u * rays / 1024u);
         goto out;
     }
-    if (cp.mem_bytes[CORE_MEM_FB] < 12u * rays) {
-        snprintf(err, errlen, "fb.size_kb = %d: a tile of %u RGB pixels needs %u KiB", cfg->fb_size_kb, rays,
-                 (12u * rays + 1023u) / 1024u);
+    if (cp.mem_bytes[CORE_MEM_FB] < 12u * tile_w * tile_h) {
+        snprintf(err, errlen, "fb.size_kb = %d: a tile of %u RGB pixels needs %u KiB", cfg->fb_size_kb,
+                 tile_w * tile_h, (12u * tile_w * tile_h + 1023u) / 1024u);
         goto out;
     }
     if (cp.mem_bytes[CORE_MEM_SPAD] < abi.spad_clear) {

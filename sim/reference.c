@@ -24,6 +24,10 @@
 #define SHADOW_TMAX 0.999f    /* shadow rays stop short of the light's own surface */
 #define RR_START_DEPTH 3      /* Russian roulette on rays of this depth and deeper */
 #define RR_MAX_SURVIVAL 0.95f
+/* The Phong workload (docs/golden-model.md, "The Phong workload"). */
+#define PHONG_AMBIENT 0.05f   /* ambient light when the scene has none (render.ambient) */
+#define PHONG_EXP_MIN 1.0f    /* lowest shininess: no cos^0 step at the highlight's edge */
+#define PHONG_TRI_U (4.0f / 9.0f) /* sample_light's u of a triangle's centroid (sqrt(u) = 2/3) */
 
 /* ---- random numbers ------------------------------------------------------------------------ */
 
@@ -138,6 +142,8 @@ typedef struct Ctx {
     float background[3], ambient[3];
     int ambient_mode;
     float scene_scale;
+    RefWorkload workload;
+    uint32_t bounces;         /* phong: mirror bounces */
 } Ctx;
 
 typedef struct Worker {
@@ -267,6 +273,9 @@ static void surface(const Ctx *c, const Ray *r, Surface *s)
  * 2 / max(roughness^2, 1e-3) - 2. */
 typedef struct Glossy { float kd[3], ks[3], n, ps; } Glossy;
 
+/* The Phong exponent of a roughness: 2 / max(roughness^2, 1e-3) - 2. */
+static float phong_exponent(float rough) { return 2.0f / ref_fmax(rough * rough, 1e-3f) - 2.0f; }
+
 static void glossy_params(const Ctx *c, const Surface *s, Glossy *g)
 {
     float metal = mat_f32(c, s->mat, SM_MAT_METALLIC), rough = mat_f32(c, s->mat, SM_MAT_ROUGHNESS);
@@ -274,7 +283,7 @@ static void glossy_params(const Ctx *c, const Surface *s, Glossy *g)
         g->kd[k] = s->base[k] * (1.0f - metal);
         g->ks[k] = 0.04f * (1.0f - metal) + s->base[k] * metal;
     }
-    g->n = 2.0f / ref_fmax(rough * rough, 1e-3f) - 2.0f;
+    g->n = phong_exponent(rough);
     float ls = g->ks[0] + g->ks[1] + g->ks[2], ld = g->kd[0] + g->kd[1] + g->kd[2];
     g->ps = ls / (ls + ld);
 }
@@ -416,14 +425,11 @@ static void shade_direct(Worker *w, const Ray *r, const Surface *s, float p_dire
     q->specular = 0;
 }
 
-/* Continue the path with a new ray of direction d (unit) and throughput thr. */
-static void spawn(Worker *w, const Ray *r, const Surface *s, const float *d, const float *thr,
-                  int specular, uint32_t *n)
+/* Continue the path with a new ray of direction d (unit) and throughput thr, leaving the hit
+ * point on the side of the unit normal nside. */
+static void spawn_from(Worker *w, const Ray *r, const Surface *s, const float *nside, const float *d,
+                       const float *thr, int specular, uint32_t *n)
 {
-    float nside[3];
-    float sgn = dot3(d, s->nf) >= 0.0f ? 1.0f : -1.0f;
-    for (int k = 0; k < 3; k++)
-        nside[k] = sgn * s->nf[k];
     Ray *q = push(w, n);
     offset_point(s->p, nside, q->org);
     memcpy(q->dir, d, sizeof q->dir);
@@ -434,6 +440,89 @@ static void spawn(Worker *w, const Ray *r, const Surface *s, const float *d, con
     q->depth = r->depth + 1;
     q->kind = REF_RAY_INDIRECT;
     q->specular = (uint8_t)specular;
+}
+
+/* The same, leaving on the side of the geometry d points to. */
+static void spawn(Worker *w, const Ray *r, const Surface *s, const float *d, const float *thr,
+                  int specular, uint32_t *n)
+{
+    float nside[3];
+    float sgn = dot3(d, s->nf) >= 0.0f ? 1.0f : -1.0f;
+    for (int k = 0; k < 3; k++)
+        nside[k] = sgn * s->nf[k];
+    spawn_from(w, r, s, nside, d, thr, specular, n);
+}
+
+/* throughput x base colour x ambient, added at the hit */
+static void add_ambient(const Ctx *c, const Ray *r, const Surface *s, const float *amb)
+{
+    float a[3] = {r->thr[0] * s->base[0] * amb[0], r->thr[1] * s->base[1] * amb[1], r->thr[2] * s->base[2] * amb[2]};
+    add_radiance(c, r->pixel, a);
+}
+
+/* A shadow ray traced where it is made (the Phong workload's light passes): counted like the
+ * rays of its generation, dropped if not finite, its radiance added if unoccluded. */
+static void trace_shadow(Worker *w, const Ray *q)
+{
+    const Ctx *c = w->c;
+    if (q->depth < REF_MAX_GENERATIONS)
+        w->st.rays_per_generation[q->depth]++;
+    if (!finite3(q->org) || !finite3(q->dir) || !finite3(q->thr)) {
+        w->st.dropped++;
+        return;
+    }
+    RefRay rr = {{q->org[0], q->org[1], q->org[2]}, {q->dir[0], q->dir[1], q->dir[2]}, q->tmax};
+    RefTraceStats ts = {0, 0, 0};
+    w->st.rays[REF_RAY_SHADOW]++;
+    int occluded = ref_any_hit(c->p, &rr, &ts);
+    w->st.nodes_visited += ts.nodes_visited;
+    w->st.prims_tested += ts.prims_tested;
+    if (!occluded)
+        add_radiance(c, q->pixel, q->thr);
+}
+
+/* The Phong workload (seed 004 Sec. 4; docs/golden-model.md): ambient, then one shadow ray per
+ * light carrying that light's diffuse and specular terms, then (generation < bounces) a mirror
+ * bounce about the facing normal weighted by ks. Emitters were handled by the hit-light filter. */
+static void shade_phong(Worker *w, const Ray *r, const Surface *s, uint32_t *n)
+{
+    const Ctx *c = w->c;
+    const PackedScene *p = c->p;
+    static const float amb0[3] = {PHONG_AMBIENT, PHONG_AMBIENT, PHONG_AMBIENT};
+    add_ambient(c, r, s, c->ambient_mode ? c->ambient : amb0);
+    float metal = mat_f32(c, s->mat, SM_MAT_METALLIC), rough = mat_f32(c, s->mat, SM_MAT_ROUGHNESS);
+    float shin = ref_fmax(phong_exponent(rough), PHONG_EXP_MIN);
+    float ks = 0.04f + metal * 0.96f;
+    float o[3], refl[3];
+    offset_point(s->p, s->nf, o);
+    reflect_dir(r->dir, s->ns, refl);
+    for (uint32_t l = 0; l < c->nlights; l++) {
+        uint32_t kind = sm_u32(p, sm_rec(c->lights, SM_LIGHT_WORDS, l, SM_LIGHT_KIND));
+        /* Area lights as a point: a quad's centre, a triangle's centroid. */
+        float u = kind == SM_LIGHT_TRIANGLE ? PHONG_TRI_U : 0.5f;
+        Ray q = {0};
+        float wi[3], le[3];
+        if (!sample_light(c, l, o, u, 0.5f, q.dir, wi, le))
+            continue;
+        if (dot3(wi, s->nf) <= 0.0f || dot3(wi, s->ns) <= 0.0f)
+            continue;
+        float cosi = dot3(s->ns, wi);
+        float sp = ks * pow_lobe(dot3(refl, wi), shin);
+        for (int k = 0; k < 3; k++)
+            q.thr[k] = r->thr[k] * (s->base[k] * cosi + sp) * le[k];
+        memcpy(q.org, o, sizeof o);
+        q.tmax = SHADOW_TMAX;
+        q.pixel = r->pixel;
+        q.depth = r->depth;
+        trace_shadow(w, &q);
+    }
+    if (r->depth >= c->bounces)
+        return;
+    float d[3], thr[3];
+    reflect_dir(r->dir, s->nf, d);
+    for (int k = 0; k < 3; k++)
+        thr[k] = r->thr[k] * ks;
+    spawn_from(w, r, s, s->nf, d, thr, 1, n);
 }
 
 /* Russian roulette for a ray about to be spawned at depth `depth`: 0 = terminate; else thr
@@ -466,6 +555,10 @@ static void shade_hit(Worker *w, const Ray *r, uint32_t *n)
             float v[3] = {r->thr[0] * em[0], r->thr[1] * em[1], r->thr[2] * em[2]};
             add_radiance(c, r->pixel, v);
         }
+        return;
+    }
+    if (c->workload == REF_WORKLOAD_PHONG) {
+        shade_phong(w, r, &s, n);
         return;
     }
     uint32_t v = r->depth + 1;
@@ -505,11 +598,8 @@ static void shade_hit(Worker *w, const Ray *r, uint32_t *n)
         return;
     }
 
-    if (c->ambient_mode && s.kind == SCENE_MAT_LAMBERT) {
-        float a[3] = {r->thr[0] * s.base[0] * c->ambient[0], r->thr[1] * s.base[1] * c->ambient[1],
-                      r->thr[2] * s.base[2] * c->ambient[2]};
-        add_radiance(c, r->pixel, a);
-    }
+    if (c->ambient_mode && s.kind == SCENE_MAT_LAMBERT)
+        add_ambient(c, r, &s, c->ambient);
     float p_direct = (!can_bounce || (c->ambient_mode && s.kind == SCENE_MAT_LAMBERT)) ? 1.0f : 0.5f;
     if (c->nlights == 0)
         p_direct = 0.0f;
@@ -648,6 +738,12 @@ int ref_render(const PackedScene *p, const RefParams *rp, float *rgb, RefStats *
         snprintf(err, errlen, "reference: tile size %d out of range", rp->tile);
         return -1;
     }
+    if ((rp->workload != REF_WORKLOAD_PATH && rp->workload != REF_WORKLOAD_PHONG) || rp->bounces < 0 ||
+        rp->bounces >= REF_MAX_GENERATIONS) {
+        snprintf(err, errlen, "reference: workload %d with %d bounces is not one the golden model renders",
+                 (int)rp->workload, rp->bounces);
+        return -1;
+    }
     Ctx c;
     memset(&c, 0, sizeof c);
     c.p = p;
@@ -666,6 +762,8 @@ int ref_render(const PackedScene *p, const RefParams *rp, float *rgb, RefStats *
     c.uvs = sm_u32(p, sm_hdr(p, SM_HDR_UVS));
     c.lut = sm_u32(p, sm_hdr(p, SM_HDR_SRGB_LUT));
     c.scene_scale = sm_f32(p, sm_hdr(p, SM_HDR_EPSILON));
+    c.workload = rp->workload;
+    c.bounces = (uint32_t)rp->bounces;
     for (int k = 0; k < 3; k++) {
         c.background[k] = sm_f32(p, sm_hdr(p, SM_HDR_BACKGROUND + k));
         c.ambient[k] = sm_f32(p, sm_hdr(p, SM_HDR_AMBIENT + k));

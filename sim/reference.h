@@ -17,6 +17,10 @@
 
 typedef enum RefRayKind { REF_RAY_CAMERA = 0, REF_RAY_INDIRECT = 1, REF_RAY_SHADOW = 2, REF_RAY_KINDS } RefRayKind;
 
+/* What the golden model renders: the path tracer, or the Phong workload of seed 004 Sec. 4
+ * (docs/golden-model.md; the kernel's workload.kind = phong). */
+typedef enum RefWorkload { REF_WORKLOAD_PATH = 0, REF_WORKLOAD_PHONG = 1 } RefWorkload;
+
 typedef struct RefParams {
     int tile;          /* tile edge in pixels: sqrt(M), 32 for M = 1024, 64 for M = 4096 */
     uint32_t seed;     /* render.seed */
@@ -25,6 +29,8 @@ typedef struct RefParams {
      * can come from several threads at once. */
     void (*progress)(void *ctx, uint32_t tiles_done, uint32_t tiles_total);
     void *progress_ctx;
+    RefWorkload workload;  /* 0 (the default of a zeroed struct): the path tracer */
+    int bounces;       /* phong: mirror bounces after the camera hit (workload.bounces, >= 0) */
 } RefParams;
 
 typedef struct RefStats {

@@ -326,7 +326,7 @@ static void add_functional_json(cJSON *root, const RunStats *rs, const CfgMachin
     cJSON *k = cJSON_AddObjectToObject(root, "kernel");
     cJSON_AddStringToObject(k, "stream_mode", cfg_enum_name("stream", "mode", cfg->stream_mode));
     cJSON_AddStringToObject(k, "workload", cfg_enum_name("workload", "kind", cfg->workload_kind));
-    if (cfg->workload_kind == CFG_WORKLOAD_SPECULAR)
+    if (cfg->workload_kind == CFG_WORKLOAD_SPECULAR || cfg->workload_kind == CFG_WORKLOAD_PHONG)
         cJSON_AddNumberToObject(k, "bounces", cfg->workload_bounces);
     cJSON_AddNumberToObject(k, "tile_width", f->tile_w);
     cJSON_AddNumberToObject(k, "tile_height", f->tile_h);
@@ -749,7 +749,16 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         for (int g = 0; g < REF_MAX_GENERATIONS && g < FUNC_MAX_GENERATIONS; g++)
             rs.per_gen[g] = rs.f.rays_per_generation[g];
     } else {
-        RefParams rp = {tile, o->seed, threads, progress_cb, &pr};
+        /* The golden model renders the path tracer and the Phong workload; the forced specular and
+         * diffuse workloads exist only as kernel variants (docs/kernel.md). */
+        if (cfg->workload_kind != CFG_WORKLOAD_PATH && cfg->workload_kind != CFG_WORKLOAD_PHONG) {
+            snprintf(err, errlen, "--mode reference: workload.kind = %s has no golden model (path and phong do)",
+                     cfg_enum_name("workload", "kind", cfg->workload_kind));
+            goto out;
+        }
+        RefParams rp = {.tile = tile, .seed = o->seed, .threads = threads, .progress = progress_cb,
+                        .progress_ctx = &pr, .bounces = cfg->workload_bounces,
+                        .workload = cfg->workload_kind == CFG_WORKLOAD_PHONG ? REF_WORKLOAD_PHONG : REF_WORKLOAD_PATH};
         RefStats st;
         if (ref_render(&p, &rp, rgb, &st, err, errlen) != 0)
             goto out;

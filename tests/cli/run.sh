@@ -304,6 +304,33 @@ run "$SFSIM" compare "$T/ref1/frame.exr" "$T/fun1/frame.exr"
 want_rc 0; want_out "max diff +0$"
 end
 
+begin "sfsim run --set workload.kind=phong: kernel and golden model give the same image, shadow rays"
+run "$SFSIM" run --mode functional -s scenes/cornell/scene.ini -o "$T/ph1" --set workload.kind=phong \
+    --set workload.bounces=1 --set render.width=40 --set render.height=24 --set render.spp=1 --no-progress
+want_rc 0
+grep -qE '"workload":[[:space:]]+"phong"' "$T/ph1/report.json" 2>/dev/null || no "report.json: workload is not phong"
+grep -qE '"bounces":[[:space:]]+1,?$' "$T/ph1/report.json" 2>/dev/null || no "report.json: no bounces"
+grep -qE '"shadow":[[:space:]]+[1-9]' "$T/ph1/report.json" 2>/dev/null || no "report.json: no shadow rays"
+grep -qE '"indirect":[[:space:]]+[1-9]' "$T/ph1/report.json" 2>/dev/null || no "report.json: no bounce rays"
+run "$SFSIM" run --mode reference -s scenes/cornell/scene.ini -o "$T/ph2" --set workload.kind=phong \
+    --set workload.bounces=1 --set render.width=40 --set render.height=24 --set render.spp=1 --no-progress
+want_rc 0
+run "$SFSIM" compare "$T/ph1/frame.exr" "$T/ph2/frame.exr"
+want_rc 0; want_out "max diff +0$"
+end
+
+begin "workload.kind = specular with workload.bounces = 0 is a config error naming the key (exit 1)"
+run "$SFSIM" run --mode functional -s scenes/cornell/scene.ini -o "$T/ph3" --set workload.kind=specular \
+    --set workload.bounces=0 --no-progress
+want_rc 1; want_err "workload.bounces = 0: workload.kind = specular needs at least 1 bounce"
+end
+
+begin "sfsim run --mode reference refuses a workload without a golden model (exit 1)"
+run "$SFSIM" run --mode reference -s scenes/cornell/scene.ini -o "$T/ph4" --set workload.kind=diffuse \
+    --set render.width=8 --set render.height=8 --no-progress
+want_rc 1; want_err "workload.kind = diffuse has no golden model"
+end
+
 begin "sfsim run --mode functional on a too small ray buffer names the key (exit 1)"
 run "$SFSIM" run --mode functional -s scenes/cornell/scene.ini -o "$T/fun2" --set raybuf.size_kb=64 \
     --set render.width=16 --set render.height=16 --set render.spp=1 --no-progress

@@ -439,6 +439,14 @@ Test(config_check, cross_key_errors)
                  "config: raybuf.size_kb = 100 is not divisible by raybuf.banks = 32\n"
                  "config: stream.rays = 4096 needs 512 KiB of ray buffer at 128 bytes per ray, raybuf.size_kb = 100\n"
                  "config: stream.rays = 4096 needs 32 KiB of ID-stream memory (two streams), idm.size_kb = 31\n");
+    /* the forced specular workload bounces at least once; phong may have no bounce at all, and
+     * the bounce count of another workload is not checked */
+    const char *e[] = {"workload.kind=specular", "workload.bounces=0"};
+    expect_check(e, 2, "config: workload.bounces = 0: workload.kind = specular needs at least 1 bounce\n");
+    const char *f[] = {"workload.kind=phong", "workload.bounces=0"};
+    expect_check(f, 2, "");
+    const char *g[] = {"workload.bounces=0"};
+    expect_check(g, 1, "");
 }
 
 Test(config_check, boundaries_pass)
@@ -602,9 +610,13 @@ Test(config_params, enum_keys_take_names_and_reject_others)
     cr_expect_eq(c.workload_kind, CFG_WORKLOAD_DIFFUSE);
     cr_expect_eq(cfg_set(&c, "workload.kind=2", &e), 1);
     cr_expect_eq(cfg_set(&c, "workload.kind=specularity", &e), 1);
-    cr_expect(e.text && strstr(e.text, "expected one of path, specular, diffuse, got 'specularity'"), "%s",
+    cr_expect(e.text && strstr(e.text, "expected one of path, specular, diffuse, phong, got 'specularity'"), "%s",
               e.text ? e.text : "");
     cr_expect_eq(c.workload_kind, CFG_WORKLOAD_DIFFUSE);
+    cr_expect_eq(cfg_set(&c, "workload.kind=phong", &e), 0);
+    cr_expect_eq(c.workload_kind, CFG_WORKLOAD_PHONG);
+    cr_expect_eq(cfg_set(&c, "workload.bounces=0", &e), 0);
+    cr_expect_eq(cfg_set(&c, "workload.bounces=-1", &e), 1);
     cr_expect_str_eq(cfg_enum_name("stream", "mode", 1), "packet");
     cr_expect_null(cfg_enum_name("core", "simd_width", 0));
     cfg_errors_free(&e);

@@ -39,7 +39,7 @@ static Img golden(const PackedScene *p, int w, int h, int tile)
 {
     Img im = {calloc(3 * (size_t)w * h, sizeof(float)), w, h};
     char err[1024];
-    RefParams rp = {tile, 1, 2, NULL, NULL};
+    RefParams rp = {.tile = tile, .seed = 1, .threads = 2};
     cr_assert_eq(ref_render(p, &rp, im.rgb, NULL, err, sizeof err), 0, "%s", err);
     return im;
 }
@@ -376,6 +376,116 @@ Test(functional, one_bounce_diffuse_workload_has_two_generations, .timeout = 300
     func_stats_free(&st);
     pack_free(&p);
     scene_free(&s);
+}
+
+/* ---- workload.kind = phong (seed 004 Sec. 4-5): local Phong shading with one shadow ray per light
+ * at every hit and workload.bounces mirror bounces, the same bits as the golden model ---------- */
+
+static Img golden_phong(const PackedScene *p, int w, int h, int bounces, RefStats *rs)
+{
+    Img im = {calloc(3 * (size_t)w * h, sizeof(float)), w, h};
+    char err[1024];
+    RefParams rp = {.tile = 64, .seed = 1, .threads = 2, .workload = REF_WORKLOAD_PHONG, .bounces = bounces};
+    cr_assert_eq(ref_render(p, &rp, im.rgb, rs, err, sizeof err), 0, "%s", err);
+    return im;
+}
+
+/* B = 0 (the paper's "Shadow"), 1 ("1 Bounce") and 3: bit-identical images, the same rays of every
+ * kind and generation as the golden model; shadow rays always, bounce rays (generation g <= B)
+ * only with B >= 1, at most one shadow ray per light per hit. Then packet mode (tiles of N
+ * pixels, buffers of 2N rays) and M = 1024 (tiles of 32 x 16) give the same image. */
+static void phong_matches_golden(const char *path, int w, int h, int spp)
+{
+    Scene s;
+    PackedScene p;
+    load_packed(path, w, h, spp, &s, &p);
+    uint32_t nlights = sm_u32(&p, sm_hdr(&p, SM_HDR_NLIGHTS));
+    static const int bounces[] = {0, 1, 3};
+    for (size_t b = 0; b < sizeof bounces / sizeof bounces[0]; b++) {
+        int B = bounces[b];
+        RefStats rs;
+        Img g = golden_phong(&p, w, h, B, &rs);
+        CfgMachine cfg;
+        cfg_defaults(&cfg);
+        cfg.workload_kind = CFG_WORKLOAD_PHONG;
+        cfg.workload_bounces = B;
+        FuncStats st;
+        Img k = kernel_cfg(&p, s.needs, w, h, &cfg, 2, &st);
+        double maxd, mean;
+        long bad;
+        diff(&k, &g, &maxd, &mean, &bad);
+        printf("phong B = %d vs golden  %-40s %3dx%-3d %d spp  max |diff| %.3g  mean %.4f  rays: %llu camera, %llu "
+               "shadow, %llu indirect; %llu generations  [%s]\n",
+               B, path, w, h, spp, maxd, mean, (unsigned long long)st.rays_camera,
+               (unsigned long long)st.rays_shadow, (unsigned long long)st.rays_indirect,
+               (unsigned long long)st.generations, st.defines);
+        cr_expect(memcmp(k.rgb, g.rgb, sizeof(float) * 3 * (size_t)w * h) == 0,
+                  "%s, B = %d: the kernel's image differs from the golden model's (max %g)", path, B, maxd);
+        cr_expect(mean > 0.0, "%s, B = %d: black image", path, B);
+        cr_expect_eq(bad, 0);
+        cr_expect(strstr(st.defines, "WORKLOAD=3") != NULL, "%s", st.defines);
+        cr_expect_eq(st.tile_w, 64);
+        cr_expect_eq(st.tile_h, 32);
+        cr_expect_eq(st.rays_camera, (uint64_t)w * h * spp);
+        cr_expect_eq(st.rays_camera, rs.rays[REF_RAY_CAMERA]);
+        cr_expect_eq(st.rays_shadow, rs.rays[REF_RAY_SHADOW], "%s, B = %d: %llu shadow rays, golden %llu", path, B,
+                     (unsigned long long)st.rays_shadow, (unsigned long long)rs.rays[REF_RAY_SHADOW]);
+        cr_expect_eq(st.rays_indirect, rs.rays[REF_RAY_INDIRECT]);
+        cr_expect_eq(st.dropped + rs.dropped, 0);
+        cr_expect_eq(st.generations, rs.generations);
+        for (int gen = 0; gen < FUNC_MAX_GENERATIONS; gen++)
+            cr_expect_eq(st.rays_per_generation[gen], rs.rays_per_generation[gen], "generation %d: %llu vs %llu",
+                         gen, (unsigned long long)st.rays_per_generation[gen],
+                         (unsigned long long)rs.rays_per_generation[gen]);
+        cr_expect(st.rays_shadow > 0, "%s, B = %d: no shadow rays", path, B);
+        cr_expect(st.rays_shadow <= (uint64_t)nlights * (st.rays_camera + st.rays_indirect));
+        if (B == 0) {
+            cr_expect_eq(st.rays_indirect, 0);
+            cr_expect_eq(st.generations, 1);
+        } else {
+            cr_expect(st.rays_indirect > 0, "%s, B = %d: no bounce rays", path, B);
+            cr_expect(st.generations >= 2 && st.generations <= (uint64_t)B + 1, "%llu generations",
+                      (unsigned long long)st.generations);
+        }
+        free(k.rgb);
+        func_stats_free(&st);
+        if (B == 1) {
+            static const struct { int mode, lanes, rays; } m[] = {{CFG_STREAM_MODE_PACKET, 8, 4096},
+                                                                  {CFG_STREAM_MODE_STREAM, 12, 1024}};
+            for (size_t i = 0; i < sizeof m / sizeof m[0]; i++) {
+                cfg.stream_mode = m[i].mode;
+                cfg.core_simd_width = m[i].lanes;
+                cfg.stream_rays = m[i].rays;
+                Img a = kernel_cfg(&p, s.needs, w, h, &cfg, 2, &st);
+                cr_expect(memcmp(a.rgb, g.rgb, sizeof(float) * 3 * (size_t)w * h) == 0,
+                          "%s: %s, N = %d, M = %d: the image differs", path, m[i].mode ? "packets" : "streams",
+                          m[i].lanes, m[i].rays);
+                cr_expect_eq(st.tile_w * st.tile_h, m[i].mode ? 8u : 512u);
+                free(a.rgb);
+                func_stats_free(&st);
+            }
+        }
+        free(g.rgb);
+    }
+    pack_free(&p);
+    scene_free(&s);
+}
+
+Test(functional, phong_workload_cornell_box_matches_the_golden_model, .timeout = 300)
+{
+    phong_matches_golden("scenes/cornell/scene.ini", 32, 32, 2);
+}
+
+/* point, spot, directional and quad lights, ambient, background, an emitter, a glass sphere */
+Test(functional, phong_workload_every_light_kind_matches_the_golden_model, .timeout = 300)
+{
+    phong_matches_golden("tests/scenes/ok_every_section.ini", 32, 32, 2);
+}
+
+/* glTF punctual lights and 600-odd emissive triangles, textures, vertex normals */
+Test(functional, phong_workload_punctual_lamp_matches_the_golden_model, .timeout = 300)
+{
+    phong_matches_golden("scenes/lights-punctual-lamp/scene.ini", 24, 24, 1);
 }
 
 /* stream.order = first (the papers' traversal: the stream follows its first ray) visits children

@@ -489,7 +489,7 @@ static size_t render_both(const Scene *s, float **k, float **g, FuncStats *st, R
     cfg_defaults(&cfg);
     FuncParams fp = {.cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .needs = s->needs, .seed = 1, .threads = 2};
     cr_assert_eq(func_render(&p, &fp, *k, st, err, sizeof err), 0, "%s", err);
-    RefParams rp = {64, 1, 2, NULL, NULL};
+    RefParams rp = {.tile = 64, .seed = 1, .threads = 2};
     cr_assert_eq(ref_render(&p, &rp, *g, rs, err, sizeof err), 0, "%s", err);
     pack_free(&p);
     return n;

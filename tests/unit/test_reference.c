@@ -1,6 +1,6 @@
 /* tests/unit/test_reference.c -- the golden model on scenes built in the test: an analytic
- * direct-lighting value, determinism across host threads and reruns, no NaN/Inf, and Monte
- * Carlo convergence at the 1/sqrt(spp) rate. */
+ * direct-lighting value (path tracer and Phong workload), determinism across host threads and
+ * reruns, no NaN/Inf, and Monte Carlo convergence at the 1/sqrt(spp) rate. */
 #include <criterion/criterion.h>
 #include <math.h>
 #include <stdlib.h>
@@ -81,7 +81,7 @@ static void floor_scene(Builder *b, Scene *s, int spp, int depth)
     s->camera = (SceneCamera){{0, 0.5f, 0}, {0, 0, 0}, {0, 0, -1}, 10.0f, 0, 0, SCENE_CAMERA_FILE};
 }
 
-static float *render(const Scene *s, uint32_t seed, int threads, RefStats *st)
+static float *render_rp(const Scene *s, const RefParams *rp, RefStats *st)
 {
     BvhParams bp;
     bvh_default_params(&bp);
@@ -89,10 +89,15 @@ static float *render(const Scene *s, uint32_t seed, int threads, RefStats *st)
     char err[256];
     cr_assert_eq(pack_scene(s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
     float *rgb = calloc(3 * (size_t)s->render.width * s->render.height, sizeof(float));
-    RefParams rp = {32, seed, threads, NULL, NULL};
-    cr_assert_eq(ref_render(&p, &rp, rgb, st, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(ref_render(&p, rp, rgb, st, err, sizeof err), 0, "%s", err);
     pack_free(&p);
     return rgb;
+}
+
+static float *render(const Scene *s, uint32_t seed, int threads, RefStats *st)
+{
+    RefParams rp = {.tile = 32, .seed = seed, .threads = threads};
+    return render_rp(s, &rp, st);
 }
 
 Test(reference, direct_light_matches_the_analytic_value)
@@ -144,6 +149,62 @@ static void box_scene(Builder *b, Scene *s, int spp)
     quad(b, lc, la, lb, 1, 1);
     to_scene(b, s, 24, 24, spp, 3);
     s->camera = (SceneCamera){{0, 1, 0.9f}, {0, 1, -1}, {0, 1, 0}, 70.0f, 0, 0, SCENE_CAMERA_FILE};
+}
+
+/* The Phong workload under the same light (docs/golden-model.md): ambient 0.05 x albedo, plus for
+ * each of the light's two triangles (area 0.005, centroid ~1 above) (albedo cos + ks cos_r^n) x
+ * L A cos_l / d^2, with ks = 0.04 and, at roughness 1, shininess max(2 / 1 - 2, 1) = 1:
+ * 0.025 + (0.5 + 0.04) x 100 x 0.01 = 0.565 (every cosine within 0.3% of 1). One shadow ray per
+ * light per hit; a bounce (here: straight up, into the light for the middle pixels) only adds. */
+Test(reference, phong_workload_matches_the_analytic_value)
+{
+    Builder b;
+    Scene s;
+    floor_scene(&b, &s, 4, 0);
+    b.mats[0].roughness = 1.0f;
+    RefStats st;
+    RefParams rp = {.tile = 32, .seed = 1, .threads = 2, .workload = REF_WORKLOAD_PHONG, .bounces = 0};
+    float *rgb = render_rp(&s, &rp, &st);
+    double sum = 0.0;
+    for (int i = 0; i < 16 * 16; i++)
+        sum += rgb[3 * i];
+    double mean = sum / 256.0, expect = 0.05 * 0.5 + (0.5 + 0.04) * 100.0 * 0.01;
+    cr_log_info("phong: mean %.5f, analytic %.5f", mean, expect);
+    cr_expect(fabs(mean - expect) < 0.01 * expect, "mean %.5f vs analytic %.5f", mean, expect);
+    cr_expect_eq(st.rays[REF_RAY_CAMERA], 4u * 256u);
+    cr_expect_eq(st.rays[REF_RAY_SHADOW], 2u * 4u * 256u, "one shadow ray per light per hit");
+    cr_expect_eq(st.rays[REF_RAY_INDIRECT], 0u);
+    cr_expect_eq(st.generations, 1u);
+    rp.bounces = 2;
+    RefStats st2;
+    float *rgb2 = render_rp(&s, &rp, &st2);
+    cr_expect_eq(st2.rays[REF_RAY_INDIRECT], 4u * 256u,
+                 "every camera hit bounces once (then misses or meets the light)");
+    cr_expect_eq(st2.rays[REF_RAY_SHADOW], st.rays[REF_RAY_SHADOW]);
+    int brighter = 0;
+    for (int i = 0; i < 3 * 16 * 16; i++) {
+        /* the same terms in the same order, then more non-negative ones */
+        cr_expect(rgb2[i] >= rgb[i], "value %d: %g with bounces below %g without", i, rgb2[i], rgb[i]);
+        brighter += rgb2[i] > rgb[i];
+    }
+    cr_expect(brighter > 0, "no pixel sees the light in the mirror");
+    free(rgb);
+    free(rgb2);
+    /* parameters the golden model does not render */
+    BvhParams bp;
+    bvh_default_params(&bp);
+    PackedScene p;
+    char err[256];
+    cr_assert_eq(pack_scene(&s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
+    float *img = calloc(3 * 16 * 16, sizeof(float));
+    RefParams bad[] = {{.tile = 32, .workload = (RefWorkload)7},
+                       {.tile = 32, .workload = REF_WORKLOAD_PHONG, .bounces = -1}};
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        cr_expect_neq(ref_render(&p, &bad[k], img, NULL, err, sizeof err), 0);
+        cr_expect(strstr(err, "golden model") != NULL, "%s", err);
+    }
+    free(img);
+    pack_free(&p);
 }
 
 Test(reference, identical_bits_for_any_thread_count_and_rerun)
