@@ -1,6 +1,7 @@
 /* scenes/kdtree.c -- SAH kd-tree build by event sweep, invariants (see kdtree.h). */
 #include "kdtree.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -31,6 +32,7 @@ typedef struct Builder {
     size_t cap_ev;
     int max_depth;
     int oom;
+    float min_gap;         /* no child voxel thinner than this (KD_MIN_GAP of the scene's extent) */
 } Builder;
 
 static int cmp_event(const void *a, const void *b)
@@ -113,7 +115,7 @@ static Split find_split(Builder *b, const uint32_t *prims, uint32_t n, const flo
                 i++;
             }
             nr -= pp + pe;
-            if (pos > vmin[axis] && pos < vmax[axis]) {
+            if (pos - vmin[axis] >= b->min_gap && vmax[axis] - pos >= b->min_gap) {
                 memcpy(lo_box, vmin, sizeof lo_box);
                 memcpy(hi_box, vmax, sizeof hi_box);
                 hi_box[axis] = pos;
@@ -267,7 +269,12 @@ int kd_build(const KdParams *p, const float *bmin, const float *bmax, uint32_t n
             out->bmax[k] = hi > out->bmax[k] ? hi : out->bmax[k];
         }
     out->nprims = n;
-    Builder b = {p, bmin, bmax, out, 0, 0, NULL, 0, 0, 0};
+    Builder b = {p, bmin, bmax, out, 0, 0, NULL, 0, 0, 0, 0.0f};
+    for (int k = 0; k < 3; k++)
+        if (n && (float)(KD_MIN_GAP * ((double)out->bmax[k] - out->bmin[k])) > b.min_gap)
+            b.min_gap = (float)(KD_MIN_GAP * ((double)out->bmax[k] - out->bmin[k]));
+    if (!(b.min_gap > 0.0f))
+        b.min_gap = FLT_MIN; /* a point-sized scene: any split strictly inside */
     b.max_depth = p->max_depth ? p->max_depth : (int)lrint(8.0 + 1.3 * log2((double)(n > 1 ? n : 1)));
     if (b.max_depth > KD_DEPTH_LIMIT)
         b.max_depth = KD_DEPTH_LIMIT;

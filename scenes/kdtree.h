@@ -20,6 +20,13 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/* No split leaves a child voxel thinner than this fraction of the scene's largest extent. The
+ * traversals widen split distances by 2^-20 of the distance (sim/ref_kd.c); two planes closer
+ * than that along a ray look like one, and a ray would step over the thin voxel between them --
+ * found on Sponza, whose walls the SAH isolated in voxels one ulp thick. 2^-16 keeps planes 16x
+ * farther apart than the widening for any origin inside the scene. */
+#define KD_MIN_GAP 0x1p-16
+
 typedef struct KdParams {
     float cost_traversal;  /* cost of one traversal step (default 1) */
     float cost_intersect;  /* cost of one primitive test (default 1: seed 004's setting) */

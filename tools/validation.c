@@ -475,18 +475,118 @@ typedef struct KdRow {
     int depth;
 } KdRow;
 
+static const KdRow kd_rows[] = {
+        {"BVH stream filter", NULL, 0},  {"kd stack", "stack", 3},          {"kd restart", "restart", 3},
+        {"kd push-down", "pushdown", 3}, {"kd short 1", "shortstack", 1},   {"kd short 2", "shortstack", 2},
+        {"kd short 3", "shortstack", 3}, {"kd short 4", "shortstack", 4},   {"kd short 8", "shortstack", 8},
+        {"kd packet 3", "packet", 3},    {"kd packet 8", "packet", 8},      {"kd stream filter", "stream", 3},
+};
+
+/* One scene: the kernels of rows[] (rows[0] the BVH), on the workload given; prints a table. */
+static void kd_kernel_scene(const char *name, const char *path, int w, int h, int workload, int bounces,
+                            const int *rows, int nrows)
+{
+    Loaded l = {name, path, {0}, {0}};
+    load(&l, w, h, 1, 3);
+    CfgMachine cfg;
+    cfg_defaults(&cfg);
+    cfg.workload_kind = workload;
+    cfg.workload_bounces = bounces;
+    static char err[65536];
+    CfgErrors ce = {0};
+    FuncKdInfo info;
+    if (cfg_set(&cfg, "accel.structure=kd", &ce) != 0 || func_add_kd(&l.p, &cfg, &info, err, sizeof err) != 0) {
+        fprintf(stderr, "%s: %s%s\n", l.name, ce.text ? ce.text : "", err);
+        exit(1);
+    }
+    if (workload == CFG_WORKLOAD_PHONG)
+        printf("### %s, Phong, %d bounce%s (%u triangles; kd-tree %u nodes, depth %u)\n\n"
+               "| kernel | cycles | fps | rel | image | trav util | nodes/camera ray | nodes/shadow ray | "
+               "nodes/bounce ray | restarts/ray |\n|---|---|---|---|---|---|---|---|---|---|\n",
+               l.name, bounces, bounces == 1 ? "" : "s", l.s.ntris, info.nodes, info.depth);
+    else
+        printf("### %s (%u triangles; kd-tree %u nodes, depth %u)\n\n"
+               "| kernel | instructions | cycles | fps | rel | image | trav util | camera nodes/ray | nodes/ray | "
+               "prims/ray | restarts/ray | overflows/ray |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+               l.name, l.s.ntris, info.nodes, info.depth);
+    size_t n = 3 * (size_t)w * h;
+    float *ref = calloc(n, sizeof(float)), *rgb = calloc(n, sizeof(float));
+    uint64_t bvh_cycles = 0;
+    for (int i = 0; i < nrows; i++) {
+        const KdRow *row = &kd_rows[rows[i]];
+        CfgMachine c = cfg;
+        char a[96];
+        if (!row->traversal) {
+            cfg_set(&c, "accel.structure=bvh", &ce);
+        } else {
+            snprintf(a, sizeof a, "kd.traversal=%s", row->traversal);
+            cfg_set(&c, a, &ce);
+            snprintf(a, sizeof a, "kd.stack_depth=%d", row->depth);
+            cfg_set(&c, a, &ce);
+        }
+        FuncParams fp = {.cfg = &c, .kernel_path = "kernels/pathtrace.s", .needs = l.s.needs, .seed = 1,
+                         .threads = 2, .timed = 1};
+        FuncStats st;
+        memset(rgb, 0, n * sizeof(float));
+        if (!ref || !rgb || func_render(&l.p, &fp, i ? rgb : ref, &st, err, sizeof err) != 0) {
+            fprintf(stderr, "%s %s: %s\n", l.name, row->label, err);
+            exit(1);
+        }
+        const TimingStats *t = &st.timing;
+        if (i == 0)
+            bvh_cycles = t->cycles;
+        double tu = t->stage_cycles[ISA_STAGE_TRAVERSAL]
+                        ? 100.0 * (double)st.core.active_lanes[ISA_STAGE_TRAVERSAL] /
+                              ((double)c.core_simd_width * (double)t->stage_cycles[ISA_STAGE_TRAVERSAL])
+                        : 0.0;
+        const char *same = i == 0 ? "-" : memcmp(ref, rgb, n * sizeof(float)) == 0 ? "same" : "DIFFERS";
+        double rel = bvh_cycles ? (double)t->cycles / (double)bvh_cycles : 0.0;
+        uint64_t all[FUNC_KD_COUNTERS] = {0};
+        for (int k = 0; k < FUNC_KD_KINDS; k++)
+            for (int q = 0; q < FUNC_KD_COUNTERS; q++)
+                all[q] += st.kd_counts[k][q];
+        double rays = (double)(st.rays_camera + st.rays_indirect + st.rays_shadow);
+        if (workload == CFG_WORKLOAD_PHONG) {
+            printf("| %s | %llu | %.2f | %.2f | %s | %.1f |", row->label, (unsigned long long)t->cycles,
+                   t->cycles ? 500e6 / (double)t->cycles : 0.0, rel, same, tu);
+            char bounce[32] = "-";
+            if (st.rays_indirect)
+                snprintf(bounce, sizeof bounce, "%.1f",
+                         (double)st.kd_counts[FUNC_KD_INDIRECT][FUNC_KD_NODES] / (double)st.rays_indirect);
+            if (st.kd)
+                printf(" %.1f | %.1f | %s | %.3f |\n",
+                       (double)st.kd_counts[FUNC_KD_CAMERA][FUNC_KD_NODES] / (double)st.rays_camera,
+                       (double)st.kd_counts[FUNC_KD_SHADOW][FUNC_KD_NODES] / (double)st.rays_shadow, bounce,
+                       (double)all[FUNC_KD_RESTARTS] / rays);
+            else
+                printf(" | | | |\n");
+        } else {
+            printf("| %s | %llu | %llu | %.2f | %.2f | %s | %.1f |", row->label, (unsigned long long)st.instructions,
+                   (unsigned long long)t->cycles, t->cycles ? 500e6 / (double)t->cycles : 0.0, rel, same, tu);
+            if (st.kd)
+                printf(" %.1f | %.1f | %.1f | %.3f | %.3f |\n",
+                       (double)st.kd_counts[FUNC_KD_CAMERA][FUNC_KD_NODES] / (double)st.rays_camera,
+                       (double)all[FUNC_KD_NODES] / rays, (double)all[FUNC_KD_PRIMS] / rays,
+                       (double)all[FUNC_KD_RESTARTS] / rays, (double)all[FUNC_KD_OVERFLOWS] / rays);
+            else
+                printf(" | | | | |\n");
+        }
+        fflush(stdout);
+        func_stats_free(&st);
+    }
+    free(ref);
+    free(rgb);
+    printf("\n");
+    pack_free(&l.p);
+    scene_free(&l.s);
+}
+
 static void kd_kernel_tables(void)
 {
     static const char *const names[3] = {"cornell", "toy-car", "conference"};
     static const char *const paths[3] = {"scenes/cornell/scene.ini", "scenes/toy-car/scene.ini",
                                          "scenes/conference/scene.ini"};
-    static const KdRow rows[] = {
-        {"BVH stream filter", NULL, 0},  {"kd stack", "stack", 3},          {"kd restart", "restart", 3},
-        {"kd push-down", "pushdown", 3}, {"kd short 1", "shortstack", 1},   {"kd short 2", "shortstack", 2},
-        {"kd short 3", "shortstack", 3}, {"kd short 4", "shortstack", 4},   {"kd short 8", "shortstack", 8},
-        {"kd packet 3", "packet", 3},    {"kd packet 8", "packet", 8},      {"kd stream filter", "stream", 3},
-    };
-    const int nrows = (int)(sizeof rows / sizeof rows[0]);
+    const int all[] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11}, few[] = {0, 1, 2, 3, 6, 9, 11};
     const int w = quick ? 32 : 128, h = quick ? 32 : 128;
     printf("## kd-tree kernels against the BVH kernel: cycles and fps (seed 004 on our machine)\n\n"
            "Detailed mode on the default machine (N = 16, streams of 64 x 64 rays, 500 MHz); the path\n"
@@ -495,77 +595,14 @@ static void kd_kernel_tables(void)
            "util*: SIMD utilization of the traversal stage (timed). *nodes/ray*: the kernels' counters, inner\n"
            "nodes and leaves entered per ray (camera rays; all rays); *prims/ray*, *restarts/ray* all rays.\n\n",
            w, h);
-    for (int si = 0; si < 3; si++) {
-        Loaded l = {names[si], paths[si], {0}, {0}};
-        load(&l, w, h, 1, 3);
-        CfgMachine cfg;
-        cfg_defaults(&cfg);
-        char err[65536];
-        CfgErrors ce = {0};
-        FuncKdInfo info;
-        if (cfg_set(&cfg, "accel.structure=kd", &ce) != 0 || func_add_kd(&l.p, &cfg, &info, err, sizeof err) != 0) {
-            fprintf(stderr, "%s: %s%s\n", l.name, ce.text ? ce.text : "", err);
-            exit(1);
-        }
-        printf("### %s (%u triangles; kd-tree %u nodes, depth %u)\n\n"
-               "| kernel | instructions | cycles | fps | rel | image | trav util | camera nodes/ray | nodes/ray | "
-               "prims/ray | restarts/ray | overflows/ray |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
-               l.name, l.s.ntris, info.nodes, info.depth);
-        size_t n = 3 * (size_t)w * h;
-        float *ref = calloc(n, sizeof(float)), *rgb = calloc(n, sizeof(float));
-        uint64_t bvh_cycles = 0;
-        for (int ri = 0; ri < nrows; ri++) {
-            CfgMachine c = cfg;
-            char a[96];
-            if (!rows[ri].traversal) {
-                cfg_set(&c, "accel.structure=bvh", &ce);
-            } else {
-                snprintf(a, sizeof a, "kd.traversal=%s", rows[ri].traversal);
-                cfg_set(&c, a, &ce);
-                snprintf(a, sizeof a, "kd.stack_depth=%d", rows[ri].depth);
-                cfg_set(&c, a, &ce);
-            }
-            FuncParams fp = {.cfg = &c, .kernel_path = "kernels/pathtrace.s", .needs = l.s.needs, .seed = 1,
-                             .threads = 2, .timed = 1};
-            FuncStats st;
-            memset(rgb, 0, n * sizeof(float));
-            if (!ref || !rgb || func_render(&l.p, &fp, ri ? rgb : ref, &st, err, sizeof err) != 0) {
-                fprintf(stderr, "%s %s: %s\n", l.name, rows[ri].label, err);
-                exit(1);
-            }
-            const TimingStats *t = &st.timing;
-            if (ri == 0)
-                bvh_cycles = t->cycles;
-            double tu = t->stage_cycles[ISA_STAGE_TRAVERSAL]
-                            ? 100.0 * (double)st.core.active_lanes[ISA_STAGE_TRAVERSAL] /
-                                  ((double)c.core_simd_width * (double)t->stage_cycles[ISA_STAGE_TRAVERSAL])
-                            : 0.0;
-            printf("| %s | %llu | %llu | %.2f | %.2f | %s | %.1f |", rows[ri].label, (unsigned long long)st.instructions,
-                   (unsigned long long)t->cycles, t->cycles ? 500e6 / (double)t->cycles : 0.0,
-                   bvh_cycles ? (double)t->cycles / (double)bvh_cycles : 0.0,
-                   ri == 0 ? "-" : memcmp(ref, rgb, n * sizeof(float)) == 0 ? "same" : "DIFFERS", tu);
-            if (st.kd) {
-                uint64_t all[FUNC_KD_COUNTERS] = {0};
-                for (int k = 0; k < FUNC_KD_KINDS; k++)
-                    for (int q = 0; q < FUNC_KD_COUNTERS; q++)
-                        all[q] += st.kd_counts[k][q];
-                double rays = (double)(st.rays_camera + st.rays_indirect + st.rays_shadow);
-                printf(" %.1f | %.1f | %.1f | %.3f | %.3f |\n",
-                       (double)st.kd_counts[FUNC_KD_CAMERA][FUNC_KD_NODES] / (double)st.rays_camera,
-                       (double)all[FUNC_KD_NODES] / rays, (double)all[FUNC_KD_PRIMS] / rays,
-                       (double)all[FUNC_KD_RESTARTS] / rays, (double)all[FUNC_KD_OVERFLOWS] / rays);
-            } else {
-                printf(" | | | | |\n");
-            }
-            fflush(stdout);
-            func_stats_free(&st);
-        }
-        free(ref);
-        free(rgb);
-        printf("\n");
-        pack_free(&l.p);
-        scene_free(&l.s);
-    }
+    for (int si = 0; si < 3; si++)
+        kd_kernel_scene(names[si], paths[si], w, h, CFG_WORKLOAD_PATH, 0, all, 12);
+    printf("The paper's workloads (seed 004 Sec. 5): Sponza (66,450 triangles, one light) rendered with\n"
+           "workload.kind = phong -- camera rays, one shadow ray per light per hit carrying local Phong\n"
+           "shading, and 0, 1 or 3 mirror bounces (docs/golden-model.md); %d x %d pixels, 1 spp. Nodes per\n"
+           "ray by ray kind.\n\n", w, h);
+    for (int b = 0; b <= 3; b += b ? 2 : 1)
+        kd_kernel_scene("sponza", "scenes/sponza-dabrovic/scene.ini", w, h, CFG_WORKLOAD_PHONG, b, few, 7);
 }
 
 int main(int argc, char **argv)
