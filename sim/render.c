@@ -915,11 +915,16 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
             len += timing_text(txt + len, sizeof txt - (size_t)len, f, cfg, est);
         if (f->kd)
             len += kd_text(txt + len, sizeof txt - (size_t)len, &rs, cfg);
+        char trav_len[32] = "-", isect_len[32] = "-"; /* per-lane kd-tree traversals filter no streams */
+        if (f->trav_streams)
+            snprintf(trav_len, sizeof trav_len, "%.1f", ratio(f->trav_rays, f->trav_streams));
+        if (f->isect_streams)
+            snprintf(isect_len, sizeof isect_len, "%.1f", ratio(f->isect_rays, f->isect_streams));
         len += snprintf(txt + len, sizeof txt - (size_t)len,
-                        "streams      mean length: traversal %.1f, intersection %.1f, shading %.1f rays\n"
+                        "streams      mean length: traversal %s, intersection %s, shading %.1f rays%s\n"
                         "host         %.2f s on %d threads: %.2f M instructions/s, %.3f M rays/s; load %.2f s, BVH+pack %.2f s\n",
-                        ratio(f->trav_rays, f->trav_streams), ratio(f->isect_rays, f->isect_streams),
-                        ratio(f->shade_rays, f->shade_streams), secs, threads,
+                        trav_len, isect_len, ratio(f->shade_rays, f->shade_streams),
+                        f->trav_streams ? "" : " (traversal one ray per lane: no stream filters)", secs, threads,
                         secs > 0 ? 1e-6 * (double)f->instructions / secs : 0.0,
                         secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, t_load - t0, t_pack - t_load);
     } else {
