@@ -1796,8 +1796,9 @@ enum {
     M_RAYS = M_OPS + ISA_C_COUNT,
     M_HOST,
     M_KD,                           /* kd_<counter>_per_ray over all rays, FUNC_KD_COUNTERS of them */
-    M_KD_CAMERA_NODES = M_KD + FUNC_KD_COUNTERS, /* kd_camera_nodes_per_ray */
-    M_COUNT
+    M_KD_KIND = M_KD + FUNC_KD_COUNTERS, /* kd_<kind>_<counter>_per_ray: per ray kind, kind-major */
+    M_KD_CAMERA_NODES = M_KD_KIND + FUNC_KD_CAMERA * FUNC_KD_COUNTERS + FUNC_KD_NODES,
+    M_COUNT = M_KD_KIND + FUNC_KD_KINDS * FUNC_KD_COUNTERS
 };
 
 /* The report's stages, in the CSV's order. */
@@ -1818,10 +1819,11 @@ static void metric_name(int m, char *buf, size_t len)
         snprintf(buf, len, "ops_share_%s", isa_category_keys[m - M_OPS]);
     else if (m < M_KD)
         snprintf(buf, len, "%s", m == M_RAYS ? "rays_total" : "host_seconds");
-    else if (m < M_KD_CAMERA_NODES)
+    else if (m < M_KD_KIND)
         snprintf(buf, len, "kd_%s_per_ray", func_kd_counter_keys[m - M_KD]);
     else
-        snprintf(buf, len, "kd_camera_nodes_per_ray");
+        snprintf(buf, len, "kd_%s_%s_per_ray", func_kd_kind_keys[(m - M_KD_KIND) / FUNC_KD_COUNTERS],
+                 func_kd_counter_keys[(m - M_KD_KIND) % FUNC_KD_COUNTERS]);
 }
 
 typedef struct Row {
@@ -1892,7 +1894,12 @@ static int row_read_report(Row *row, const char *path, char *err, size_t errlen)
         snprintf(key, sizeof key, "%s_per_ray", func_kd_counter_keys[c]);
         row_num(row, M_KD + c, jget(jget(kd, "total"), key));
     }
-    row_num(row, M_KD_CAMERA_NODES, jget(jget(kd, "camera"), "nodes_per_ray"));
+    for (int k = 0; k < FUNC_KD_KINDS; k++)
+        for (int c = 0; c < FUNC_KD_COUNTERS; c++) {
+            char key[64];
+            snprintf(key, sizeof key, "%s_per_ray", func_kd_counter_keys[c]);
+            row_num(row, M_KD_KIND + k * FUNC_KD_COUNTERS + c, jget(jget(kd, func_kd_kind_keys[k]), key));
+        }
     cJSON_Delete(j);
     return 0;
 }
