@@ -619,20 +619,7 @@ isect:
         mov     r16, r3
 isect_chunk:
         sfetch  vid, m1, r16, r5
-        rgat    kx, vid, r0, F_KX @m1
-        rgat    ky, vid, r0, F_KY @m1
-        rgat    kz, vid, r0, F_KZ @m1
-        rgat    sx, vid, r0, F_SX @m1
-        rgat    sy, vid, r0, F_SY @m1
-        rgat    sz, vid, r0, F_SZ @m1
-        rgat    pox, vid, r0, F_POX @m1
-        rgat    poy, vid, r0, F_POY @m1
-        rgat    poz, vid, r0, F_POZ @m1
-        rgat    tm, vid, r0, F_TMAX @m1
-        rgat    prim, vid, r0, F_PRIM @m1
-        vieq    m2, prim, vm2 @m1       ; shadow rays
-        mclr    m3                      ; lanes whose tmax changed
-        mclr    m4                      ; lanes with a new closest hit
+        ISECT_LOAD
 .ifdef ACCEL_KD
         mov     r13, r8
 isect_prim:
