@@ -440,7 +440,7 @@ end
 
 # ---- sfsim trace ---------------------------------------------------------------------------------
 begin "sfsim trace: kernel and golden model give the same hits, text and binary (docs/trace.md)"
-cp tests/fuzz/ray_seeds/cornell.txt "$T/rays.txt"
+cp tests/cli/cornell_rays.txt "$T/rays.txt"
 run "$SFSIM" trace -s scenes/cornell/scene.ini --rays "$T/rays.txt" -o "$T/hits_f.txt" -j 2
 want_rc 0; want_out "7 rays \(functional\): 2 hits, 1 misses, 1 occluded, 1 clear, 2 invalid"
 run "$SFSIM" trace --mode reference -s scenes/cornell/scene.ini --rays "$T/rays.txt" -o "$T/hits_r.txt"

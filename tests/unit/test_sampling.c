@@ -110,7 +110,7 @@ static void render(const CfgMachine *cfg, double sample, uint32_t seed, FuncStat
     free(rgb);
 }
 
-Test(sampling, interval_covers_the_full_run_in_95_of_100_seeds, .fini = unload, .timeout = 300)
+Test(sampling, interval_covers_the_full_run_at_its_nominal_95_percent, .fini = unload, .timeout = 300)
 {
     char err[1024];
     cr_assert_eq(scene_load("scenes/cornell/scene.ini", &scene, err, sizeof err), 0, "%s", err);
@@ -165,7 +165,7 @@ Test(sampling, interval_covers_the_full_run_in_95_of_100_seeds, .fini = unload, 
             worst = rel;
         width += (e.hi - e.lo) / truth / 100.0;
     }
-    /* For the record: the coverage over many more seeds (not asserted; seeds 1..100 are). */
+    /* The coverage over many more seeds (asserted below). */
     int covered_k = 0;
     for (uint32_t seed = 1; seed <= 2000; seed++) {
         sample_select(N, 0.05, seed, sel);
@@ -176,7 +176,14 @@ Test(sampling, interval_covers_the_full_run_in_95_of_100_seeds, .fini = unload, 
     printf("sampling: cornell 512x512, 256 tiles, 5 %% (13 tiles): the 95 %% interval covers the full run in %d of "
            "100 seeds (%d of 2000); largest error %.2f %%, mean interval width %.2f %% of the cycles\n",
            covered, covered_k, 100.0 * worst, 100.0 * width);
-    cr_expect_geq(covered, 95, "the interval covered the full-run cycles in %d of 100 seeds", covered);
+    /* A 95 % interval covers the truth in 95 % of samples, so over 100 seeds it falls below 95
+     * about half the time even when it is right: the assertion is on the 2000 seeds instead,
+     * allowing three binomial standard errors below 95 % (a 0.1 % false alarm); an interval that
+     * is too narrow or biased (90 % coverage, say) fails it. */
+    const double se = sqrt(0.95 * 0.05 / 2000.0);
+    cr_expect_geq(covered_k, (int)ceil(2000.0 * (0.95 - 3.0 * se)),
+                  "the interval covered the full-run cycles in %d of 2000 seeds (%d of the first 100)", covered_k,
+                  covered);
     free(y);
     free(x);
     free(sel);

@@ -17,6 +17,7 @@
 
 #include "../../scenes/gltf.h"
 #include "../../scenes/scene.h"
+#include "../support/shared.h"
 
 /* ---- temporary files ------------------------------------------------------------------------ */
 
@@ -215,18 +216,11 @@ static char *needs_of(const Scene *s)
 #define expect_near(a, b, eps)                                                                                         \
     cr_expect(fabsf((float)(a) - (float)(b)) <= (eps), "%s = %g, expected %g", #a, (double)(a), (double)(b))
 
-/* ---- shipped scenes: every shared scene through its scene.ini ------------------------------- */
-
-static int have_shared(void)
-{
-    struct stat st;
-    return stat("../shared/scenes/README.md", &st) == 0;
-}
+/* ---- shipped scenes: every scene.ini of scenes/ (most name a glTF file in ../shared) --------- */
 
 static void check_shipped(const char *ini, uint32_t tris, const char *needs, int camera_source)
 {
-    if (!have_shared())
-        cr_skip_test("../shared/scenes is not there");
+    NEEDS_SCENE(ini);
     Scene s;
     load_ok(ini, &s);
     cr_expect_eq(s.ntris, tris, "%s: %u triangles, the README says %u", ini, s.ntris, tris);
@@ -246,7 +240,31 @@ static void check_shipped(const char *ini, uint32_t tris, const char *needs, int
 
 Test(scene_shipped, cornell)
 {
-    check_shipped("scenes/cornell/scene.ini", 36, "lambert,area_lights", SCENE_CAMERA_FILE);
+    check_shipped("scenes/cornell/scene.ini", 32, "lambert,area_lights", SCENE_CAMERA_FILE);
+}
+
+/* The default scene is the repository's own: the published Cornell box measurements (mm). */
+Test(scene_shipped, cornell_is_the_published_box)
+{
+    Scene s;
+    load_ok("scenes/cornell/scene.ini", &s);
+    cr_expect_eq(s.ntris, 32, "16 published quads");
+    cr_expect_eq(s.nemissive, 2, "the light quad is two triangles");
+    cr_expect_null(s.nrm);
+    expect_near(s.bounds_min[0], 0.0f, 1e-3f);
+    expect_near(s.bounds_min[1], 0.0f, 1e-3f);
+    expect_near(s.bounds_min[2], 0.0f, 1e-3f);
+    expect_near(s.bounds_max[0], 556.0f, 1e-3f);
+    expect_near(s.bounds_max[1], 548.8f, 1e-3f);
+    expect_near(s.bounds_max[2], 559.2f, 1e-3f);
+    expect_near(s.camera.position[0], 278.0f, 1e-3f);
+    expect_near(s.camera.position[2], -800.0f, 1e-3f);
+    scene_free(&s);
+}
+
+Test(scene_shipped, cornell_mcguire)
+{
+    check_shipped("scenes/cornell/mcguire.ini", 36, "lambert,area_lights", SCENE_CAMERA_FILE);
 }
 Test(scene_shipped, cornell_spheres)
 {
@@ -254,7 +272,7 @@ Test(scene_shipped, cornell_spheres)
 }
 Test(scene_shipped, cornell_glossy)
 {
-    check_shipped("scenes/cornell/glossy.ini", 36, "lambert,glossy,area_lights", SCENE_CAMERA_FILE);
+    check_shipped("scenes/cornell/glossy.ini", 32, "lambert,glossy,area_lights", SCENE_CAMERA_FILE);
 }
 Test(scene_shipped, glass_vase_flowers)
 {
@@ -321,8 +339,7 @@ Test(scene_shipped, metal_rough_spheres, .timeout = 60)
 /* A .glb given directly: the default camera frames the bounds. */
 Test(scene_shipped, cornell_glb_default_camera)
 {
-    if (!have_shared())
-        cr_skip_test("../shared/scenes is not there");
+    NEEDS_SHARED("../shared/scenes/cornell-box/CornellBox-Original.glb");
     Scene s;
     load_ok("../shared/scenes/cornell-box/CornellBox-Original.glb", &s);
     cr_expect_eq(s.ntris, 36);
@@ -340,8 +357,7 @@ Test(scene_shipped, cornell_glb_default_camera)
 /* The same bytes through the memory entry point (the fuzzer's). */
 Test(scene_shipped, glb_from_memory)
 {
-    if (!have_shared())
-        cr_skip_test("../shared/scenes is not there");
+    NEEDS_SHARED("../shared/scenes/cornell-box/CornellBox-Sphere.glb");
     FILE *f = fopen("../shared/scenes/cornell-box/CornellBox-Sphere.glb", "rb");
     cr_assert_not_null(f);
     unsigned char *data = malloc(1 << 20);
