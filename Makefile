@@ -31,15 +31,15 @@ LIB_SRC := $(ISA_SRC) $(ASM_SRC) $(SIM_SRC) $(SCN_SRC)
 # Two Criterion binaries: tests/io (image files, Embree, scene files: they link OpenImageIO,
 # Embree and tinygltf, whose ~270 shared libraries make every forked test process start slowly)
 # and tests/unit (everything else, linked --as-needed so it starts fast). unit runs last.
-TEST_SRC := $(wildcard tests/unit/*.c) tests/support/numerics.c
-IO_TEST_SRC := $(wildcard tests/io/*.c) tests/support/xcheck.c
+TEST_SRC := $(wildcard tests/unit/*.c) tests/support/numerics.c tests/support/shared.c
+IO_TEST_SRC := $(wildcard tests/io/*.c) tests/support/xcheck.c tests/support/shared.c
 LDAS    := -Wl,--as-needed
 
 ASMLIB_OBJ = $(patsubst %.c,$(BUILD)/obj/%.o,$(ISA_SRC) $(ASM_SRC))
 LIB_OBJ  = $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/obj/%.o,$(CXX_SRC))
 ASAN_OBJ = $(patsubst %.c,$(BUILD)/asan/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/asan/%.o,$(CXX_SRC))
 
-.PHONY: all deps run test test-asan test-unit test-hard fuzz fuzz-run bench validation docs check-docs clean run-built test-built help
+.PHONY: all deps install run test test-standalone test-asan test-unit test-hard fuzz fuzz-run bench validation docs check-docs clean run-built test-built help
 
 all: bin/sfasm bin/sfsim
 
@@ -47,10 +47,12 @@ help:
 	@echo "make run        install deps, build, run the example program"
 	@echo "make test       install deps, build, run the whole test suite"
 	@echo "make test-asan  the unit tests under AddressSanitizer + UBSan"
+	@echo "make test-standalone  make run and make test in a clone with no ../shared beside it"
 	@echo "make fuzz       build the libFuzzer targets, assembler and scene loader (clang);"
 	@echo "                make fuzz-run FUZZ_SECONDS=600 runs each for that long"
 	@echo "make bench      build and run the benchmarks in bench/ (core, functional and detailed speed, Embree)"
-	@echo "make docs       regenerate docs/isa.md from isa/opcodes.def"
+	@echo "make docs       regenerate docs/isa.md, the layout include and docs, the shipped Cornell box"
+	@echo "make install    install into PREFIX (default /usr/local; DESTDIR honoured): docs/install.md"
 
 deps:
 	@bash scripts/deps.sh
@@ -105,7 +107,13 @@ $(BUILD)/gen_layout: tools/gen_layout.c scenes/layout.def
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) tools/gen_layout.c -o $@
 
-docs: $(BUILD)/gen_isadoc $(BUILD)/gen_layout
+# The shipped Cornell box, from the published measurements (scenes/cornell/cornell-box.gltf).
+$(BUILD)/gen_cornell: tools/gen_cornell.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) tools/gen_cornell.c -o $@ $(CJSON) -lm
+
+docs: $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_cornell
+	$(BUILD)/gen_cornell scenes/cornell
 	$(BUILD)/gen_isadoc > docs/isa.md
 	$(BUILD)/gen_layout inc > kernels/lib/layout.inc
 	$(BUILD)/gen_layout md > docs/scene-memory.md
@@ -127,7 +135,7 @@ $(BUILD)/tests/io-asan: $(IO_TEST_SRC) $(BUILD)/libsfsim-asan.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(SAN) $(LDAS) $(IO_TEST_SRC) $(BUILD)/libsfsim-asan.a -o $@ $(CRIT) $(EMBREE) $(INIH) $(LDLIBS)
 
-HARD_TEST_SRC := $(wildcard tests/hard/*.c) tests/support/numerics.c
+HARD_TEST_SRC := $(wildcard tests/hard/*.c) tests/support/numerics.c tests/support/shared.c
 
 $(BUILD)/tests/hard: $(HARD_TEST_SRC) tests/support/numerics.h $(BUILD)/libsfsim.a
 	@mkdir -p $(dir $@)
@@ -136,23 +144,29 @@ $(BUILD)/tests/hard: $(HARD_TEST_SRC) tests/support/numerics.h $(BUILD)/libsfsim
 # The slow hard numerics cases (docs/numerics.md gives the run time).
 test-hard: deps
 	@$(MAKE) --no-print-directory all $(BUILD)/tests/hard
-	@$(TEST_ENV) $(BUILD)/tests/hard --jobs 2
+	@$(TEST_ENV) bash tests/run_criterion.sh $(BUILD)/tests/hard --jobs 2
 
 # CLI tests first, Criterion last: its synthesis line closes the run.
 TEST_ENV = SFSIM_BUILD=$(BUILD) SFSIM_GEN_ISADOC=$(BUILD)/gen_isadoc
 
-test-built: all $(BUILD)/tests/unit $(BUILD)/tests/io
+test-built: all $(BUILD)/tests/unit $(BUILD)/tests/io $(BUILD)/gen_cornell
 	@bash tests/cli/run.sh
 	@bash tests/cli/sweep.sh
-	@$(TEST_ENV) $(BUILD)/tests/io --jobs 2
-	@$(TEST_ENV) $(BUILD)/tests/unit --jobs 2
+	@SFSIM_GEN_CORNELL=$(BUILD)/gen_cornell bash tests/cli/standalone.sh
+	@$(TEST_ENV) bash tests/run_criterion.sh $(BUILD)/tests/io --jobs 2
+	@$(TEST_ENV) bash tests/run_criterion.sh $(BUILD)/tests/unit --jobs 2
+
+# A clone of the committed HEAD on its own (no ../shared): make run and make test pass, skipping
+# with reasons what needs ../shared. CI runs it (a few minutes).
+test-standalone: deps
+	@bash tests/standalone_clone.sh
 
 ASAN_ENV = ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp
 
 test-asan: deps
 	@$(MAKE) --no-print-directory $(BUILD)/tests/unit-asan $(BUILD)/tests/io-asan
-	@$(TEST_ENV) $(ASAN_ENV) $(BUILD)/tests/io-asan --jobs 2
-	@$(TEST_ENV) $(ASAN_ENV) $(BUILD)/tests/unit-asan --jobs 2
+	@$(TEST_ENV) $(ASAN_ENV) bash tests/run_criterion.sh $(BUILD)/tests/io-asan --jobs 2
+	@$(TEST_ENV) $(ASAN_ENV) bash tests/run_criterion.sh $(BUILD)/tests/unit-asan --jobs 2
 
 # ---- fuzzing (clang + libFuzzer) -------------------------------------------------------------
 FUZZ_SECONDS ?= 60
@@ -196,19 +210,19 @@ $(BUILD)/bench/core_speed: bench/core_speed.c $(BUILD)/libsfsim.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
 
-$(BUILD)/bench/embree_xcheck: bench/embree_xcheck.c tests/support/xcheck.c $(BUILD)/libsfsim.a
+$(BUILD)/bench/embree_xcheck: bench/embree_xcheck.c tests/support/xcheck.c tests/support/shared.c $(BUILD)/libsfsim.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $^ -o $@ $(EMBREE) $(INIH) $(LDLIBS)
 
-$(BUILD)/bench/functional_speed: bench/functional_speed.c $(BUILD)/libsfsim.a
+$(BUILD)/bench/functional_speed: bench/functional_speed.c tests/support/shared.c $(BUILD)/libsfsim.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
 
-$(BUILD)/bench/detailed_speed: bench/detailed_speed.c $(BUILD)/libsfsim.a
+$(BUILD)/bench/detailed_speed: bench/detailed_speed.c tests/support/shared.c $(BUILD)/libsfsim.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
 
-$(BUILD)/bench/speed_vs_error: bench/speed_vs_error.c $(BUILD)/libsfsim.a
+$(BUILD)/bench/speed_vs_error: bench/speed_vs_error.c tests/support/shared.c $(BUILD)/libsfsim.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
 
@@ -241,6 +255,30 @@ run-built: all
 	@echo "== outputs: out/frame.png (tone-mapped), out/frame.exr (linear), out/cost.png (cycles per pixel),"
 	@echo "==          out/report.txt (above), out/report.json (everything; docs/report.md)"
 	@grep -E '^cycles +[0-9]' out/report.txt | sed 's/^/== headline: /'
+
+# ---- installation (docs/install.md) ---------------------------------------------------------
+# PREFIX/bin: sfsim, sfasm; PREFIX/share/sfsim: kernels, configs, the default scene (sfsim finds
+# them from its own folder); PREFIX/share/doc/sfsim: README and docs.
+PREFIX  ?= /usr/local
+DATADIR := $(DESTDIR)$(PREFIX)/share/sfsim
+DOCDIR  := $(DESTDIR)$(PREFIX)/share/doc/sfsim
+SHIPPED_SCENES := scenes/cornell/scene.ini scenes/cornell/glossy.ini scenes/cornell/analytic.ini \
+                  scenes/cornell/cornell-box.gltf scenes/cornell/cornell-box.bin
+
+install: all
+	install -d $(DESTDIR)$(PREFIX)/bin $(DATADIR)/kernels/lib $(DATADIR)/kernels/bench $(DATADIR)/kernels/examples \
+	    $(DATADIR)/configs/sweeps $(DATADIR)/scenes/cornell $(DOCDIR)/docs
+	install -m 755 bin/sfsim bin/sfasm $(DESTDIR)$(PREFIX)/bin/
+	install -m 644 kernels/*.s $(DATADIR)/kernels/
+	install -m 644 kernels/lib/* $(DATADIR)/kernels/lib/
+	install -m 644 kernels/bench/* $(DATADIR)/kernels/bench/
+	install -m 644 kernels/examples/* $(DATADIR)/kernels/examples/
+	install -m 644 configs/*.ini $(DATADIR)/configs/
+	install -m 644 configs/sweeps/*.ini $(DATADIR)/configs/sweeps/
+	install -m 644 $(SHIPPED_SCENES) $(DATADIR)/scenes/cornell/
+	install -m 644 README.md $(DOCDIR)/
+	install -m 644 docs/*.md docs/*.png $(DOCDIR)/docs/
+	@echo "installed sfsim into $(DESTDIR)$(PREFIX) (data: $(PREFIX)/share/sfsim)"
 
 clean:
 	rm -rf $(BUILD) bin

@@ -19,6 +19,7 @@
 
 #include "../scenes/pack.h"
 #include "bench_args.h"
+#include "bench_scenes.h"
 #include "../scenes/scene.h"
 #include "../sim/config.h"
 #include "../sim/functional.h"
@@ -71,7 +72,13 @@ int main(int argc, char **argv)
     printf("%-34s %7s %11s %12s %9s %9s %10s %9s %9s\n", "scene", "threads", "mode", "sim instr", "seconds",
            "M instr/s", "M rays/s", "slowdown", "cycles");
     int rc = 0;
+    int skipped = 0;
     for (size_t i = 0; i < sizeof scenes / sizeof scenes[0]; i++) {
+        int ok = bench_scene_ok("detailed_speed", scenes[i], &skipped);
+        if (ok < 0)
+            return 1;
+        if (!ok)
+            continue;
         char err[65536];
         Scene s;
         PackedScene p;
@@ -105,5 +112,6 @@ int main(int argc, char **argv)
         pack_free(&p);
         scene_free(&s);
     }
+    bench_scenes_summary("detailed_speed", skipped, (int)(sizeof scenes / sizeof scenes[0]));
     return rc;
 }

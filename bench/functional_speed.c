@@ -19,6 +19,7 @@
 
 #include "../scenes/pack.h"
 #include "bench_args.h"
+#include "bench_scenes.h"
 #include "../scenes/scene.h"
 #include "../sim/config.h"
 #include "../sim/functional.h"
@@ -42,7 +43,13 @@ int main(int argc, char **argv)
     printf("%-34s %12s %10s %9s %9s %10s %10s %9s\n", "scene", "sim instr", "rays", "ref s", "func s", "M instr/s",
            "M rays/s", "slowdown");
     int rc = 0;
+    int skipped = 0;
     for (size_t i = 0; i < sizeof scenes / sizeof scenes[0]; i++) {
+        int ok = bench_scene_ok("functional_speed", scenes[i], &skipped);
+        if (ok < 0)
+            return 1;
+        if (!ok)
+            continue;
         char err[65536];
         Scene s;
         PackedScene p;
@@ -82,5 +89,6 @@ int main(int argc, char **argv)
         pack_free(&p);
         scene_free(&s);
     }
+    bench_scenes_summary("functional_speed", skipped, (int)(sizeof scenes / sizeof scenes[0]));
     return rc;
 }

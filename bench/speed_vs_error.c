@@ -28,6 +28,7 @@
 #include "../sim/config.h"
 #include "../sim/functional.h"
 #include "../sim/sampling.h"
+#include "bench_scenes.h"
 
 static double now(void)
 {
@@ -112,7 +113,13 @@ int main(int argc, char **argv)
                 "coverage (100 seeds) | interval (+-) |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
     fprintf(dat, "# scene rate speedup fps_error_pct util_error_pts covered coverage100 halfwidth_pct\n");
     int rc = 0;
+    int skipped = 0;
     for (int si = 0; si < 3; si++) {
+        int ok = bench_scene_ok("speed_vs_error", paths[si], &skipped);
+        if (ok < 0)
+            return 1;
+        if (!ok)
+            continue;
         char err[65536];
         Scene s;
         PackedScene p;
@@ -229,6 +236,7 @@ int main(int argc, char **argv)
     snprintf(cmd, sizeof cmd, "gnuplot '%s/speed_vs_error.gp'", outdir);
     if (system(cmd) != 0)
         fprintf(stderr, "speed_vs_error: gnuplot failed; the table and data are in %s\n", outdir);
+    bench_scenes_summary("speed_vs_error", skipped, 3);
     snprintf(path, sizeof path, "%s/speed_vs_error.md", outdir);
     FILE *in = fopen(path, "r");
     if (in) {

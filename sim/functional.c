@@ -20,6 +20,7 @@
 #include <unistd.h>
 
 #include "../asm/asm.h"
+#include "datadir.h"
 #include "ref_kd.h"
 
 const char *const func_kd_kind_keys[FUNC_KD_KINDS] = {"camera", "indirect", "shadow"};
@@ -33,17 +34,17 @@ const char *func_default_kernel(char *buf, size_t len)
         snprintf(buf, len, "%s", env);
         return buf;
     }
+    char err[PATH_MAX + 256];
+    if (datadir_path(DATADIR_KERNEL, buf, len, err, sizeof err))
+        return buf;
+    /* no data folder: name the file where a build tree keeps it, so the error names a path */
     char exe[PATH_MAX];
     ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-    if (n <= 0) {
-        snprintf(buf, len, "kernels/pathtrace.s");
-        return buf;
-    }
-    exe[n] = 0;
+    exe[n > 0 ? n : 0] = 0;
     char *slash = strrchr(exe, '/');
     if (slash)
         *slash = 0;
-    snprintf(buf, len, "%s/../kernels/pathtrace.s", exe);
+    snprintf(buf, len, "%s/../%s", n > 0 ? exe : ".", DATADIR_KERNEL);
     return buf;
 }
 

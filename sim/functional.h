@@ -110,7 +110,7 @@ int func_add_kd(PackedScene *p, const CfgMachine *cfg, FuncKdInfo *info, char *e
 /* `sfsim trace` through the kernel: fp->batch and fp->hits must be set. Same returns. */
 int func_trace(const PackedScene *p, const FuncParams *fp, FuncStats *st, char *err, size_t errlen);
 
-/* The kernel next to the executable: <dir of exe>/../kernels/pathtrace.s, or SFSIM_KERNEL. */
+/* The shipped kernel: $SFSIM_KERNEL, or kernels/pathtrace.s in the data folder (sim/datadir.h). */
 const char *func_default_kernel(char *buf, size_t len);
 
 #endif

@@ -14,6 +14,7 @@
 #include "../asm/object.h"
 #include "config.h"
 #include "core.h"
+#include "datadir.h"
 #include "img.h"
 #include "render.h"
 #include "sweep.h"
@@ -102,7 +103,8 @@ static void usage_run(FILE *out)
             "  reference   the golden model: a plain C path tracer over the packed scene memory\n"
             "\n"
             "options:\n"
-            "  -s, --scene FILE         scene (default: scenes/cornell/scene.ini)\n"
+            "  -s, --scene FILE         scene (default: the shipped Cornell box, scenes/cornell/scene.ini\n"
+            "                           in sfsim's data folder, found beside the binary: docs/install.md)\n"
             "  -o, --out DIR            output folder (default: out)\n"
             "  -c, --config FILE        machine config (stream.rays sets the tile: sqrt(M) pixels)\n"
             "  --set SECTION.KEY=VALUE  override a config key, or render.width, render.height,\n"
@@ -113,7 +115,7 @@ static void usage_run(FILE *out)
             "  --sample F               sampled mode: the fraction of tiles timed, (0, 1] (default 0.05)\n"
             "  --sample-seed S          sampled mode: which tiles (default 1)\n"
             "  --kernel FILE            kernel modes: the kernel source (default:\n"
-            "                           kernels/pathtrace.s beside the executable's folder, or $SFSIM_KERNEL)\n");
+            "                           kernels/pathtrace.s in the data folder, or $SFSIM_KERNEL)\n");
 }
 
 /* Config from -c/--set options, collected by the commands that take them. */
@@ -492,7 +494,7 @@ static int cmd_run(int argc, char **argv)
     ConfigArgs ca = {0};
     RenderOptions o;
     render_default_options(&o);
-    o.scene_path = "scenes/cornell/scene.ini";
+    o.scene_path = NULL; /* default: the shipped Cornell box, found beside the binary */
     o.out_dir = "out";
     o.progress = isatty(2);
     const char *mode = "detailed";
@@ -576,6 +578,15 @@ static int cmd_run(int argc, char **argv)
         return EXIT_USAGE;
     }
     o.mode = mode;
+    static char default_scene[4096];
+    if (!o.scene_path) {
+        char derr[8192];
+        if (!datadir_path(DATADIR_DEFAULT_SCENE, default_scene, sizeof default_scene, derr, sizeof derr)) {
+            fprintf(stderr, "sfsim run: no -s SCENE given and the default scene is missing: %s\n", derr);
+            return EXIT_INPUT;
+        }
+        o.scene_path = default_scene;
+    }
     CfgMachine cfg;
     if (build_config(&ca, &cfg))
         return EXIT_INPUT;

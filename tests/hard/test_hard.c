@@ -13,6 +13,7 @@
 #include "../../sim/functional.h"
 #include "../../sim/reference.h"
 #include "../support/numerics.h"
+#include "../support/shared.h"
 
 static uint64_t rng = 0x9E3779B97F4A7C15ull;
 static double urand(void)
@@ -25,6 +26,7 @@ static double urand(void)
 
 static void load_pack(const char *path, Scene *s, PackedScene *p)
 {
+    NEEDS_SCENE(path);
     char err[1024];
     cr_assert_eq(scene_load(path, s, err, sizeof err), 0, "%s", err);
     BvhParams bp;
@@ -339,6 +341,7 @@ static double self_intersection_rate(const Scene *s, uint32_t nrays)
 
 static void far_case(const char *path, double scale, double offset, int w, int h, int spp)
 {
+    NEEDS_SCENE(path);
     Scene base, moved;
     char err[1024];
     cr_assert_eq(scene_load(path, &base, err, sizeof err), 0, "%s", err);

@@ -11,6 +11,7 @@
 #include "../../scenes/scene.h"
 #include "../../sim/ref_kd.h"
 #include "../support/xcheck.h"
+#include "../support/shared.h"
 
 static void expect_tracer(const char *name, const char *tracer, const Scene *s, const PackedScene *p,
                           const XcheckTracer *tr, uint32_t ncam, uint32_t nrand)
@@ -87,6 +88,7 @@ Test(embree, random_triangle_soup)
  * the same distance (coplanar or duplicated geometry), which neither tracer is wrong about. */
 static void shared_scene(const char *path, int kd)
 {
+    NEEDS_SCENE(path);
     Scene s;
     char err[1024];
     cr_assert_eq(scene_load(path, &s, err, sizeof err), 0, "%s", err);

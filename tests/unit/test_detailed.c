@@ -18,11 +18,14 @@
 #include "../../sim/functional.h"
 #include "../../sim/timing.h"
 
+#include "../support/shared.h"
+
 static Scene scene;
 static PackedScene packed;
 
 static void load(const char *path, int w, int h, int spp)
 {
+    NEEDS_SCENE(path);
     char err[1024];
     cr_assert_eq(scene_load(path, &scene, err, sizeof err), 0, "%s: %s", path, err);
     scene.render.width = w;

@@ -18,6 +18,8 @@
 #include "../../sim/ref_kd.h"
 #include "../../sim/reference.h"
 
+#include "../support/shared.h"
+
 typedef struct Img {
     float *rgb;
     int w, h;
@@ -25,6 +27,7 @@ typedef struct Img {
 
 static void load_packed(const char *path, int w, int h, int spp, Scene *s, PackedScene *p)
 {
+    NEEDS_SCENE(path);
     char err[1024];
     cr_assert_eq(scene_load(path, s, err, sizeof err), 0, "%s: %s", path, err);
     s->render.width = w;

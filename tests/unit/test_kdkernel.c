@@ -18,6 +18,8 @@
 #include "../../sim/ref_kd.h"
 #include "../../sim/ref_trace.h"
 
+#include "../support/shared.h"
+
 static uint64_t rng_state;
 static float rnd(void)
 {
@@ -59,6 +61,7 @@ typedef struct Case {
 
 static void check_kernel(const char *path, uint32_t n, const Case *cases, int ncases)
 {
+    NEEDS_SCENE(path);
     Scene s;
     PackedScene p;
     char err[1024];
@@ -205,6 +208,7 @@ Test(kdkernel, conference_every_variant_matches_bvh_and_golden_counters, .timeou
  * BVH and with every kd-tree traversal (a small frame of the Cornell box and the conference room). */
 static void check_images(const char *path, int w, int h, int workload, int bounces)
 {
+    NEEDS_SCENE(path);
     Scene s;
     PackedScene p;
     char err[65536];
@@ -254,6 +258,10 @@ static void check_images(const char *path, int w, int h, int workload, int bounc
 Test(kdkernel, every_traversal_renders_the_bvh_image, .timeout = 600)
 {
     check_images("scenes/cornell/scene.ini", 48, 48, CFG_WORKLOAD_PATH, 0);
+}
+
+Test(kdkernel, every_traversal_renders_the_bvh_image_of_the_conference_room, .timeout = 600)
+{
     check_images("scenes/conference/scene.ini", 40, 32, CFG_WORKLOAD_PATH, 0);
 }
 

@@ -1,0 +1,126 @@
+#!/usr/bin/env bash
+# tests/cli/standalone.sh -- the repository on its own: the shipped Cornell box is what
+# tools/gen_cornell.c writes, bin/sfsim finds its kernel and default scene from any folder, and
+# `make install PREFIX=...` gives a tree whose sfsim works from any folder, with no source tree
+# and no ../shared. `make test` runs it (SFSIM_GEN_CORNELL names the generator it built).
+# Exit status: 0 when every case passed.
+set -u
+
+cd "$(dirname "$0")/../.." || exit 2
+ROOT=$(pwd)
+SFSIM=$ROOT/bin/sfsim
+T=$(mktemp -d "${TMPDIR:-/tmp}/sfsim-standalone.XXXXXX") || exit 2
+trap 'rm -rf "$T"' EXIT
+SMALL=(--set render.width=32 --set render.height=32 --set render.spp=1 --no-progress)
+
+pass=0
+fail=0
+name=""
+failed=0
+reasons=""
+rc=0
+begin() { name=$1; failed=0; reasons=""; }
+no() { failed=1; reasons="$reasons    - $*"$'\n'; }
+run() { "$@" >"$T/out" 2>"$T/err"; rc=$?; }
+want_rc() { [ "$rc" -eq "$1" ] || no "exit status $rc, expected $1"; }
+want_err() { grep -qiE -- "$1" "$T/err" || no "stderr does not match /$1/"; }
+end() {
+    if [ "$failed" -eq 0 ]; then
+        pass=$((pass + 1))
+    else
+        fail=$((fail + 1))
+        echo "FAIL: $name"
+        printf '%s' "$reasons"
+        [ -s "$T/out" ] && sed -n '1,10s/^/    stdout| /p' "$T/out"
+        [ -s "$T/err" ] && sed -n '1,10s/^/    stderr| /p' "$T/err"
+    fi
+}
+# scene_file DIR: the scene file a run's report.json names
+scene_file() { python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["scene"]["file"])' "$1/report.json" 2>/dev/null; }
+
+begin "the shipped Cornell box is what tools/gen_cornell.c writes (make docs)"
+if [ -x "${SFSIM_GEN_CORNELL:-}" ]; then
+    mkdir -p "$T/gen"
+    if "$SFSIM_GEN_CORNELL" "$T/gen" 2>"$T/err"; then
+        for f in cornell-box.gltf cornell-box.bin; do
+            cmp -s "$T/gen/$f" "scenes/cornell/$f" || no "scenes/cornell/$f is stale: run make docs"
+        done
+    else
+        no "gen_cornell failed"
+    fi
+else
+    no "SFSIM_GEN_CORNELL is not set to the built generator (make test sets it)"
+fi
+end
+
+begin "the shipped scenes need nothing outside the repository"
+for f in scenes/cornell/scene.ini scenes/cornell/glossy.ini scenes/cornell/analytic.ini; do
+    grep -q "shared/" "$f" && no "$f refers to ../shared"
+done
+end
+
+begin "bin/sfsim run with no -s renders the shipped Cornell box from /"
+run env -C / "$SFSIM" run -o "$T/from-root" "${SMALL[@]}"
+want_rc 0
+[ -s "$T/from-root/frame.png" ] || no "no frame.png"
+[ "$(scene_file "$T/from-root")" = "$ROOT/scenes/cornell/scene.ini" ] ||
+    no "report.json names scene '$(scene_file "$T/from-root")', expected $ROOT/scenes/cornell/scene.ini"
+end
+
+begin "bin/sfsim run --mode functional from another folder finds its kernel"
+mkdir -p "$T/elsewhere"
+run env -C "$T/elsewhere" "$SFSIM" run --mode functional -o out "${SMALL[@]}"
+want_rc 0
+[ -s "$T/elsewhere/out/frame.exr" ] || no "no frame.exr"
+end
+
+begin "make install PREFIX=... installs binaries, kernels, configs, the default scene and docs"
+run make --no-print-directory install PREFIX="$T/prefix"
+want_rc 0
+for f in bin/sfsim bin/sfasm share/sfsim/kernels/pathtrace.s share/sfsim/kernels/lib/layout.inc \
+    share/sfsim/configs/streamray.ini share/sfsim/configs/sweeps/width.ini share/sfsim/scenes/cornell/scene.ini \
+    share/sfsim/scenes/cornell/cornell-box.gltf share/sfsim/scenes/cornell/cornell-box.bin \
+    share/doc/sfsim/README.md share/doc/sfsim/docs/README.md; do
+    [ -s "$T/prefix/$f" ] || no "$f is not installed"
+done
+end
+
+begin "the installed sfsim renders the default scene from another folder, with its own files"
+mkdir -p "$T/user"
+run env -C "$T/user" "$T/prefix/bin/sfsim" run -o out "${SMALL[@]}"
+want_rc 0
+[ -s "$T/user/out/frame.png" ] || no "no frame.png"
+[ "$(scene_file "$T/user/out")" = "$T/prefix/share/sfsim/scenes/cornell/scene.ini" ] ||
+    no "report.json names scene '$(scene_file "$T/user/out")', not the installed one"
+end
+
+begin "the installed sfsim takes the installed machine config and a scene by path"
+run env -C "$T/user" "$T/prefix/bin/sfsim" run --mode reference -c "$T/prefix/share/sfsim/configs/streamray.ini" \
+    -s "$T/prefix/share/sfsim/scenes/cornell/glossy.ini" -o out2 "${SMALL[@]}"
+want_rc 0
+[ -s "$T/user/out2/frame.exr" ] || no "no frame.exr"
+end
+
+begin "the installed sfasm assembles an installed example"
+run "$T/prefix/bin/sfasm" "$T/prefix/share/sfsim/kernels/examples/filter_demo.s" -o "$T/user/demo.sfo"
+want_rc 0
+[ -s "$T/user/demo.sfo" ] || no "no object written"
+end
+
+begin "an sfsim without its data files says what is missing (exit 1), no crash"
+mkdir -p "$T/lonely/bin"
+cp "$SFSIM" "$T/lonely/bin/sfsim"
+run env -C "$T/lonely" "$T/lonely/bin/sfsim" run -o out "${SMALL[@]}"
+want_rc 1
+want_err "data files are missing|default scene is missing"
+[ -e "$T/lonely/out" ] && no "an output folder was left behind"
+end
+
+begin "SFSIM_DATA_DIR points sfsim at another data folder"
+run env -C "$T/lonely" SFSIM_DATA_DIR="$T/prefix/share/sfsim" "$T/lonely/bin/sfsim" run --mode reference -o out "${SMALL[@]}"
+want_rc 0
+[ -s "$T/lonely/out/frame.png" ] || no "no frame.png"
+end
+
+echo "standalone: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]
