@@ -14,6 +14,7 @@
 #include "../asm/object.h"
 #include "config.h"
 #include "core.h"
+#include "exitcodes.h"
 #include "img.h"
 #include "render.h"
 #include "sweep.h"
@@ -22,7 +23,7 @@
 
 #define SFSIM_VERSION "0.1"
 
-enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_USAGE = 2, EXIT_TRAP = 3 };
+enum { EXIT_TRAP = EXIT_PROGRAM }; /* this file's older name for it */
 
 static void usage(FILE *out)
 {
@@ -103,7 +104,8 @@ static void usage_run(FILE *out)
             "\n"
             "options:\n"
             "  -s, --scene FILE         scene (default: scenes/cornell/scene.ini)\n"
-            "  -o, --out DIR            output folder (default: out)\n"
+            "  -o, --out DIR            output folder (default: out): made when the outputs are written,\n"
+            "                           each file whole or not at all (exit 4 if not; docs/report.md)\n"
             "  -c, --config FILE        machine config (stream.rays sets the tile: sqrt(M) pixels)\n"
             "  --set SECTION.KEY=VALUE  override a config key, or render.width, render.height,\n"
             "                           render.spp, render.max_depth, render.seed\n"
@@ -587,7 +589,7 @@ static int cmd_run(int argc, char **argv)
     int rrc = render_run(&o, err, sizeof err);
     if (rrc != 0) {
         fprintf(stderr, "sfsim run: %s\n", err);
-        return rrc == -2 ? EXIT_TRAP : EXIT_INPUT;
+        return rrc == -2 ? EXIT_TRAP : rrc == -3 ? EXIT_IO : EXIT_INPUT;
     }
     printf("sfsim run: wrote %s/frame.png, frame.exr, report.txt, report.json%s\n", o.out_dir,
            !strcmp(mode, "detailed") || !strcmp(mode, "sampled") ? ", cost.png" : "");
@@ -670,7 +672,7 @@ static int cmd_trace(int argc, char **argv)
     int rc = trace_run(&o, &sum, err, sizeof err);
     if (rc != 0) {
         fprintf(stderr, "sfsim trace: %s\n", err);
-        return rc == -2 ? EXIT_TRAP : EXIT_INPUT;
+        return rc == -2 ? EXIT_TRAP : rc == -3 ? EXIT_IO : EXIT_INPUT;
     }
     printf("sfsim trace: %u rays (%s): %u hits, %u misses, %u occluded, %u clear, %u invalid; %.3f s",
            sum.rays, o.mode, sum.hits, sum.misses, sum.occluded, sum.clear, sum.invalid, sum.seconds);

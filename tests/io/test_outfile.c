@@ -1,6 +1,6 @@
 /* tests/io/test_outfile.c -- output files written whole or not at all (sim/outfile.h): every
  * operation that can fail on a full disk made to fail in turn (the fault hook, as SQLite tests
- * its I/O), for plain files and staged sets; the checks before work; the folders a run
+ * its I/O), for plain files, staged sets and images; the checks before work; the folders a run
  * makes and removes again. After each failure: the error names the file and says why, the final
  * name holds the old file or nothing, and no temporary file is left.
  */
@@ -13,6 +13,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "../../sim/heatmap.h"
+#include "../../sim/img.h"
 #include "../../sim/outfile.h"
 
 static char dir[64];
@@ -206,6 +208,41 @@ Test(outfile, a_set_goes_into_place_whole_or_leaves_no_mix, .init = mkdir_tmp, .
         cr_expect(olds == 3 || gone == 3, "k = %ld: %d old files beside %d removed ones", k, olds, gone);
         cr_expect_eq(olds, k <= 12 ? 3 : 0, "k = %ld: the old files stay unless a rename failed", k);
         cr_expect_eq(temporaries(dir), 0, "k = %ld: a temporary file is left", k);
+    }
+    outfile_fail_at(0);
+}
+
+Test(outfile, images_and_heat_maps_fail_whole, .init = mkdir_tmp, .fini = cleanup)
+{
+    float px[4 * 2 * 3];
+    double v[8];
+    for (int i = 0; i < 24; i++)
+        px[i] = 0.04f * (float)i;
+    for (int i = 0; i < 8; i++)
+        v[i] = i;
+    static const char *const names[] = {"a.exr", "a.png", "cost.png"};
+    for (int w = 0; w < 3; w++) {
+        char path[128], err[512];
+        snprintf(path, sizeof path, "%s/%s", dir, names[w]);
+        for (long k = 1; k <= 6; k++) {
+            unlink(path);
+            outfile_fail_at(k);
+            int rc = w == 0   ? img_write_linear(NULL, path, px, 4, 2, err, sizeof err)
+                     : w == 1 ? img_write_display(NULL, path, px, 4, 2, 1.0f, err, sizeof err)
+                              : heatmap_write(NULL, path, v, 4, 2, "t", "u", err, sizeof err);
+            if (k == 6) { /* create, write, fsync, close, rename */
+                cr_expect_eq(rc, 0, "%s: %s", names[w], err);
+                float *back;
+                int bw, bh;
+                cr_expect_eq(img_read(path, &back, &bw, &bh, err, sizeof err), 0, "%s", err);
+                free(back);
+                continue;
+            }
+            cr_expect_eq(rc, -1, "%s: operation %ld did not fail", names[w], k);
+            cr_expect(strncmp(err, path, strlen(path)) == 0 && strstr(err, "No space left on device"), "%s", err);
+            cr_expect_eq(access(path, F_OK), -1, "%s, k = %ld: a file is left", names[w], k);
+            cr_expect_eq(temporaries(dir), 0, "%s, k = %ld: a temporary file is left", names[w], k);
+        }
     }
     outfile_fail_at(0);
 }
