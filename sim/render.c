@@ -684,6 +684,9 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         snprintf(err, errlen, "--sample %g: expected a fraction of the tiles in (0, 1]", o->sample);
         return -1;
     }
+    /* Before any work: an output folder that cannot be made would fail the run only at its end. */
+    if (outfile_check_dir(o->out_dir, err, errlen) != 0)
+        return -3;
     SampleEstimate est_store, *est = NULL;
     double t0 = now();
     if (scene_load(o->scene_path, &s, err, errlen) != 0)

@@ -86,6 +86,9 @@ int trace_run(const TraceOptions *o, TraceSummary *sum, char *err, size_t errlen
     BatchHit *hits = NULL;
     memset(&p, 0, sizeof p);
     memset(&b, 0, sizeof b);
+    /* Before any work: a hit file that cannot be written would fail the run only at its end. */
+    if (outfile_check_file(o->out_path, err, errlen) != 0)
+        return -3;
     if (scene_load(o->scene_path, &s, err, errlen) != 0)
         return -1;
     int rc = -1;

@@ -600,6 +600,22 @@ done
 cmp -s "$T/fw/hits.txt" "$T/hits_f.txt" || no "the hit file differs from an ordinary run's"
 end
 
+begin "sfsim run -o naming a file fails before any work, naming it (exit 4)"
+: > "$T/fw/a_file"
+run "$SFSIM" run -s "$T/no_such_scene.ini" -o "$T/fw/a_file" "${TINY[@]}"
+want_rc 4; want_err "^sfsim run: $T/fw/a_file: exists and is not a folder"
+run "$SFSIM" run -s "$T/no_such_scene.ini" -o "$T/fw/a_file/sub" "${TINY[@]}"
+want_rc 4; want_err "^sfsim run: $T/fw/a_file/sub: $T/fw/a_file exists and is not a folder"
+[ ! -s "$T/fw/a_file" ] || no "the file was written to"
+end
+
+begin "sfsim trace -o naming a folder or a missing folder fails before any work (exit 4)"
+run "$SFSIM" trace -s "$T/no_such_scene.ini" --rays "$T/rays.txt" -o "$T/fw"
+want_rc 4; want_err "^sfsim trace: $T/fw: is a folder"
+run "$SFSIM" trace -s "$T/no_such_scene.ini" --rays "$T/rays.txt" -o "$T/fw/nowhere/hits.txt"
+want_rc 4; want_err "^sfsim trace: $T/fw/nowhere/hits.txt: .*No such file or directory"
+end
+
 begin "sfsim run with a kernel that does not assemble leaves no output folder behind (exit 1)"
 rm -rf "$T/fw/new"
 run "$SFSIM" run --mode functional --kernel "$T/bad_kernel.s" -s scenes/cornell/scene.ini -o "$T/fw/new/out" "${TINY[@]}"
