@@ -14,6 +14,7 @@
 #include <fcntl.h>
 #include <limits.h>
 #include <pthread.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -29,6 +30,7 @@ enum { OUT_BUF = 1 << 16, OUT_PATH_MAX = 4096 };
 static atomic_long fault_ops, fault_at;
 static pthread_once_t fault_once = PTHREAD_ONCE_INIT;
 static atomic_int fault_overridden;
+static void (*_Atomic op_hook)(long);
 
 static void fault_init(void)
 {
@@ -47,6 +49,9 @@ static int fault_point(void)
     pthread_once(&fault_once, fault_init);
     long n = atomic_fetch_add(&fault_ops, 1) + 1;
     long at = atomic_load(&fault_at);
+    void (*hook)(long) = atomic_load(&op_hook);
+    if (hook)
+        hook(n);
     if (at > 0 && n == at) {
         errno = ENOSPC;
         return -1;
@@ -60,6 +65,11 @@ void outfile_fail_at(long k)
     atomic_store(&fault_overridden, 1);
     atomic_store(&fault_at, k > 0 ? k : 0);
     atomic_store(&fault_ops, 0);
+}
+
+void outfile_set_hook(void (*hook)(long op))
+{
+    atomic_store(&op_hook, hook);
 }
 
 long outfile_ops(void)
@@ -358,7 +368,37 @@ int outset_count(const OutSet *s)
     return s ? s->n : 0;
 }
 
+/* A termination signal that arrives during the renames is held until they are done, so that ^C
+ * cannot leave some files of a run beside older ones (SIGKILL aside). */
+static volatile sig_atomic_t held_signal;
+static void hold_signal(int sig)
+{
+    held_signal = sig;
+}
+
+static const int held_signals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
+enum { NHELD = sizeof held_signals / sizeof held_signals[0] };
+
+static int commit(OutSet *s, char *err, size_t errlen);
+
 int outset_commit(OutSet *s, char *err, size_t errlen)
+{
+    struct sigaction sa, old[NHELD];
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = hold_signal;
+    sigemptyset(&sa.sa_mask);
+    held_signal = 0;
+    for (int i = 0; i < NHELD; i++)
+        sigaction(held_signals[i], &sa, &old[i]);
+    int rc = commit(s, err, errlen);
+    for (int i = 0; i < NHELD; i++)
+        sigaction(held_signals[i], &old[i], NULL);
+    if (held_signal)
+        raise(held_signal); /* now with the disposition the program had */
+    return rc;
+}
+
+static int commit(OutSet *s, char *err, size_t errlen)
 {
     for (int i = 0; i < s->n; i++) {
         Staged *f = &s->f[i];

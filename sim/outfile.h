@@ -59,7 +59,8 @@ int outfile_write_file(OutSet *set, const char *path, const void *data, size_t n
 OutSet *outset_new(void);
 /* Rename every staged file into place, in the order they were closed. If a rename fails, every
  * file of the set is removed, those renamed already and the older files of the same names not yet
- * replaced, so that the folder holds no mix of two runs' files; err names the file. */
+ * replaced, so that the folder holds no mix of two runs' files; err names the file. SIGINT,
+ * SIGTERM, SIGHUP and SIGQUIT arriving meanwhile are held and raised again once it is done. */
 int outset_commit(OutSet *s, char *err, size_t errlen);
 /* Remove the temporary files not committed, and free. NULL is harmless. */
 void outset_free(OutSet *s);
@@ -89,6 +90,8 @@ void outfile_keep_dirs(OutDirs *d);
 void outfile_fail_at(long k);
 /* Operations counted since the start or the last outfile_fail_at. */
 long outfile_ops(void);
+/* Test hook: call hook(n) before operation n runs (a signal sent there, say); NULL: none. */
+void outfile_set_hook(void (*hook)(long op));
 
 #ifdef __cplusplus
 }

@@ -7,10 +7,12 @@
 #include <criterion/criterion.h>
 #include <dirent.h>
 #include <errno.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "../../sim/heatmap.h"
@@ -210,6 +212,41 @@ Test(outfile, a_set_goes_into_place_whole_or_leaves_no_mix, .init = mkdir_tmp, .
         cr_expect_eq(temporaries(dir), 0, "k = %ld: a temporary file is left", k);
     }
     outfile_fail_at(0);
+}
+
+static long term_at;
+static void term_hook(long op)
+{
+    if (op == term_at)
+        raise(SIGTERM);
+}
+
+Test(outfile, a_signal_during_the_renames_waits_for_them, .init = mkdir_tmp, .fini = cleanup)
+{
+    char path[3][128], err[512];
+    for (int i = 0; i < 3; i++) {
+        snprintf(path[i], sizeof path[i], "%s/f%d.txt", dir, i);
+        put(path[i], "old\n");
+    }
+    pid_t pid = fork();
+    cr_assert_geq(pid, 0);
+    if (pid == 0) {
+        signal(SIGTERM, SIG_DFL);
+        OutSet *set = outset_new();
+        for (int i = 0; i < 3; i++)
+            if (outfile_write_file(set, path[i], "new\n", 4, err, sizeof err) != 0)
+                _exit(2);
+        term_at = outfile_ops() + 2; /* SIGTERM just before the second rename */
+        outfile_set_hook(term_hook);
+        outset_commit(set, err, sizeof err);
+        _exit(0); /* not reached: the held SIGTERM is raised again after the renames */
+    }
+    int st;
+    cr_assert_eq(waitpid(pid, &st, 0), pid);
+    cr_expect(WIFSIGNALED(st) && WTERMSIG(st) == SIGTERM, "the child was not ended by its SIGTERM (status %#x)", st);
+    for (int i = 0; i < 3; i++)
+        cr_expect(holds(path[i], "new\n", 4), "f%d.txt: the signal cut the renames short", i);
+    cr_expect_eq(temporaries(dir), 0);
 }
 
 Test(outfile, images_and_heat_maps_fail_whole, .init = mkdir_tmp, .fini = cleanup)
