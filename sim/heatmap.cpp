@@ -178,7 +178,7 @@ extern "C" void heatmap_set_font(const char *font_path)
     font_override = font_path ? font_path : "";
 }
 
-extern "C" int heatmap_write(const char *path, const double *values, int width, int height,
+extern "C" int heatmap_write(OutSet *set, const char *path, const double *values, int width, int height,
                              const char *title, const char *unit, char *err, size_t errlen)
 {
     if (width <= 0 || height <= 0 || width > MAX_SIDE || height > MAX_SIDE)
@@ -213,7 +213,7 @@ extern "C" int heatmap_write(const char *path, const double *values, int width, 
         std::vector<float> px((size_t)spec.width * spec.height * 3);
         if (!canvas.get_pixels(OIIO::ROI::All(), TypeDesc::FLOAT, px.data()))
             return fail(err, errlen, path, "drawing the heat map: " + canvas.geterror());
-        return img_write_rgb8(path, px.data(), spec.width, spec.height, err, errlen);
+        return img_write_rgb8(set, path, px.data(), spec.width, spec.height, err, errlen);
     } catch (const std::exception &e) {
         return fail(err, errlen, path, std::string("drawing the heat map: ") + e.what());
     }

@@ -31,6 +31,8 @@
 
 #include <stddef.h>
 
+#include "outfile.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -39,8 +41,9 @@ extern "C" {
  * as a heat-map PNG (or any 8-bit format the file name selects) laid out as above. title and
  * unit may be NULL or empty; keep unit short (about 8 characters fit the label column).
  * Returns 0, or -1 with "path: what was wrong" in err (the first pixel, in row-major order,
- * that is NaN, infinite or negative is named by its x and y; then no file is written). */
-int heatmap_write(const char *path, const double *values, int width, int height,
+ * that is NaN, infinite or negative is named by its x and y; then no file is written). The file
+ * goes through img_write_rgb8: set NULL writes it in place at once, a set stages it (img.h). */
+int heatmap_write(OutSet *set, const char *path, const double *values, int width, int height,
                   const char *title, const char *unit, char *err, size_t errlen);
 
 /* Test hook: use this font file instead of the search above; NULL restores the search. A path

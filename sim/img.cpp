@@ -2,6 +2,7 @@
 //
 // Owns: writing and reading image files through OpenImageIO. Must not: compute statistics or
 // tone-map beyond the display transfer documented in img.h (that stays in C where it is tested).
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <cmath>
@@ -12,6 +13,7 @@
 
 extern "C" {
 #include "img.h"
+#include "outfile.h"
 }
 
 namespace {
@@ -22,7 +24,11 @@ int fail(char *err, size_t errlen, const char *path, const std::string &why)
     return -1;
 }
 
-int write_image(const char *path, int w, int h, OIIO::TypeDesc type, const void *pixels,
+// Encoded in memory, then written by sim/outfile.c: OpenImageIO's PNG writer does not report a
+// failed write (a full disk left a 0-byte cost.png behind a "wrote" line), and outfile checks
+// every write, renames the file into place only when whole, and counts the writes for the fault
+// hook like every other output.
+int write_image(OutSet *set, const char *path, int w, int h, OIIO::TypeDesc type, const void *pixels,
                 char *err, size_t errlen)
 {
     if (w <= 0 || h <= 0)
@@ -30,12 +36,16 @@ int write_image(const char *path, int w, int h, OIIO::TypeDesc type, const void 
     auto out = OIIO::ImageOutput::create(path);
     if (!out)
         return fail(err, errlen, path, "no image writer for this file name: " + OIIO::geterror());
+    if (!out->supports("ioproxy"))
+        return fail(err, errlen, path, std::string("the ") + out->format_name() + " writer cannot encode in memory");
+    std::vector<unsigned char> bytes;
+    OIIO::Filesystem::IOVecOutput mem(bytes);
     OIIO::ImageSpec spec(w, h, 3, type);
-    if (!out->open(path, spec))
+    if (!out->set_ioproxy(&mem) || !out->open(path, spec))
         return fail(err, errlen, path, out->geterror());
     if (!out->write_image(type, pixels) || !out->close())
         return fail(err, errlen, path, out->geterror());
-    return 0;
+    return outfile_write_file(set, path, bytes.data(), bytes.size(), err, errlen);
 }
 
 float srgb_encode(float x)
@@ -45,13 +55,13 @@ float srgb_encode(float x)
 
 } // namespace
 
-extern "C" int img_write_linear(const char *path, const float *rgb, int width, int height,
+extern "C" int img_write_linear(OutSet *set, const char *path, const float *rgb, int width, int height,
                                 char *err, size_t errlen)
 {
-    return write_image(path, width, height, OIIO::TypeDesc::FLOAT, rgb, err, errlen);
+    return write_image(set, path, width, height, OIIO::TypeDesc::FLOAT, rgb, err, errlen);
 }
 
-extern "C" int img_write_display(const char *path, const float *rgb, int width, int height,
+extern "C" int img_write_display(OutSet *set, const char *path, const float *rgb, int width, int height,
                                  float exposure, char *err, size_t errlen)
 {
     std::vector<unsigned char> px((size_t)width * height * 3);
@@ -62,10 +72,10 @@ extern "C" int img_write_display(const char *path, const float *rgb, int width, 
             px[i + c] = (unsigned char)std::lround((bad ? v : srgb_encode(v)) * 255.0f);
         }
     }
-    return write_image(path, width, height, OIIO::TypeDesc::UINT8, px.data(), err, errlen);
+    return write_image(set, path, width, height, OIIO::TypeDesc::UINT8, px.data(), err, errlen);
 }
 
-extern "C" int img_write_rgb8(const char *path, const float *rgb, int width, int height,
+extern "C" int img_write_rgb8(OutSet *set, const char *path, const float *rgb, int width, int height,
                               char *err, size_t errlen)
 {
     std::vector<unsigned char> px((size_t)width * height * 3);
@@ -73,7 +83,7 @@ extern "C" int img_write_rgb8(const char *path, const float *rgb, int width, int
         float v = std::isfinite(rgb[i]) ? std::fmin(std::fmax(rgb[i], 0.0f), 1.0f) : 0.0f;
         px[i] = (unsigned char)std::lround(v * 255.0f);
     }
-    return write_image(path, width, height, OIIO::TypeDesc::UINT8, px.data(), err, errlen);
+    return write_image(set, path, width, height, OIIO::TypeDesc::UINT8, px.data(), err, errlen);
 }
 
 extern "C" int img_read(const char *path, float **rgb, int *width, int *height, char *err,

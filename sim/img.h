@@ -11,15 +11,20 @@
 
 #include <stddef.h>
 
+#include "outfile.h"
+
+/* The writers below encode in memory and write through sim/outfile.c: set NULL puts the file in
+ * place at once (whole, or not at all); a set stages it until outset_commit. Errors name path. */
+
 /* Write linear float RGB as-is (an EXR keeps full float precision). */
-int img_write_linear(const char *path, const float *rgb, int width, int height, char *err,
+int img_write_linear(OutSet *set, const char *path, const float *rgb, int width, int height, char *err,
                      size_t errlen);
 /* Write a display image (PNG, JPEG, ...): value x exposure, clamped to [0, 1], sRGB-encoded,
  * 8 bits per channel; NaN pixels become magenta so they cannot hide. */
-int img_write_display(const char *path, const float *rgb, int width, int height, float exposure,
+int img_write_display(OutSet *set, const char *path, const float *rgb, int width, int height, float exposure,
                       char *err, size_t errlen);
 /* Write already display-ready RGB in [0, 1] (a heat map, say) as 8-bit without any transfer. */
-int img_write_rgb8(const char *path, const float *rgb, int width, int height, char *err,
+int img_write_rgb8(OutSet *set, const char *path, const float *rgb, int width, int height, char *err,
                    size_t errlen);
 /* Read any format OpenImageIO knows into float RGB (*rgb malloc'ed; grey is replicated, alpha
  * dropped). Values are as stored: linear for EXR, encoded 0..1 for PNG. */

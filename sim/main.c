@@ -15,6 +15,7 @@
 #include "config.h"
 #include "core.h"
 #include "datadir.h"
+#include "exitcodes.h"
 #include "img.h"
 #include "render.h"
 #include "sweep.h"
@@ -23,7 +24,7 @@
 
 #define SFSIM_VERSION "0.1"
 
-enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_USAGE = 2, EXIT_TRAP = 3 };
+enum { EXIT_TRAP = EXIT_PROGRAM }; /* this file's older name for it */
 
 static void usage(FILE *out)
 {
@@ -105,7 +106,9 @@ static void usage_run(FILE *out)
             "options:\n"
             "  -s, --scene FILE         scene (default: the shipped Cornell box, scenes/cornell/scene.ini\n"
             "                           in sfsim's data folder, found beside the binary: docs/install.md)\n"
-            "  -o, --out DIR            output folder (default: out)\n"
+            "  -o, --out DIR            output folder (default: out): checked before any work, made when the\n"
+            "                           outputs are written, each file whole or not at all (exit 4 if not;\n"
+            "                           docs/report.md)\n"
             "  -c, --config FILE        machine config (stream.rays sets the tile: sqrt(M) pixels)\n"
             "  --set SECTION.KEY=VALUE  override a config key, or render.width, render.height,\n"
             "                           render.spp, render.max_depth, render.seed\n"
@@ -598,7 +601,7 @@ static int cmd_run(int argc, char **argv)
     int rrc = render_run(&o, err, sizeof err);
     if (rrc != 0) {
         fprintf(stderr, "sfsim run: %s\n", err);
-        return rrc == -2 ? EXIT_TRAP : EXIT_INPUT;
+        return rrc == -2 ? EXIT_TRAP : rrc == -3 ? EXIT_IO : EXIT_INPUT;
     }
     printf("sfsim run: wrote %s/frame.png, frame.exr, report.txt, report.json%s\n", o.out_dir,
            !strcmp(mode, "detailed") || !strcmp(mode, "sampled") ? ", cost.png" : "");
@@ -681,7 +684,7 @@ static int cmd_trace(int argc, char **argv)
     int rc = trace_run(&o, &sum, err, sizeof err);
     if (rc != 0) {
         fprintf(stderr, "sfsim trace: %s\n", err);
-        return rc == -2 ? EXIT_TRAP : EXIT_INPUT;
+        return rc == -2 ? EXIT_TRAP : rc == -3 ? EXIT_IO : EXIT_INPUT;
     }
     printf("sfsim trace: %u rays (%s): %u hits, %u misses, %u occluded, %u clear, %u invalid; %.3f s",
            sum.rays, o.mode, sum.hits, sum.misses, sum.occluded, sum.clear, sum.invalid, sum.seconds);

@@ -11,6 +11,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "outfile.h"
+
 void raybatch_free(RayBatch *b)
 {
     free(b->rays);
@@ -264,17 +266,16 @@ static void wr32(unsigned char *p, uint32_t v)
 int raybatch_write_hits(const char *path, const RayBatch *b, const BatchHit *hits, int binary, char *err,
                         size_t errlen)
 {
-    FILE *f = fopen(path, binary ? "wb" : "w");
-    if (!f) {
-        snprintf(err, errlen, "%s: cannot write: %s", path, strerror(errno));
+    /* Through sim/outfile.c: every write checked, and the file in place only once whole. */
+    OutFile f;
+    if (outfile_open(&f, path, err, errlen) != 0)
         return -1;
-    }
-    int ok = 1;
+    int ok;
     if (binary) {
         unsigned char h[16] = "SFHITS1";
         wr32(h + 8, b->count);
         wr32(h + 12, 0);
-        ok = fwrite(h, 1, 16, f) == 16;
+        ok = outfile_write(&f, h, 16, err, errlen) == 0;
         for (uint32_t i = 0; ok && i < b->count; i++) {
             unsigned char r[20];
             uint32_t status = hits[i].invalid ? 2u : b->rays[i].query == RAY_ANY ? hits[i].prim : hits[i].prim != UINT32_MAX;
@@ -287,25 +288,26 @@ int raybatch_write_hits(const char *path, const RayBatch *b, const BatchHit *hit
             wr32(r + 12, u);
             memcpy(&u, &hits[i].v, 4);
             wr32(r + 16, u);
-            ok = fwrite(r, 1, 20, f) == 20;
+            ok = outfile_write(&f, r, 20, err, errlen) == 0;
         }
     } else {
-        ok = fprintf(f, "# sfsim trace: ray  closest: t prim u v | miss ; any: occluded | clear ; invalid\n") > 0;
+        ok = outfile_printf(&f, err, errlen,
+                            "# sfsim trace: ray  closest: t prim u v | miss ; any: occluded | clear ; invalid\n") == 0;
         for (uint32_t i = 0; ok && i < b->count; i++) {
             if (hits[i].invalid)
-                ok = fprintf(f, "%u invalid\n", i) > 0;
+                ok = outfile_printf(&f, err, errlen, "%u invalid\n", i) == 0;
             else if (b->rays[i].query == RAY_ANY)
-                ok = fprintf(f, "%u %s\n", i, hits[i].prim ? "occluded" : "clear") > 0;
+                ok = outfile_printf(&f, err, errlen, "%u %s\n", i, hits[i].prim ? "occluded" : "clear") == 0;
             else if (hits[i].prim == UINT32_MAX)
-                ok = fprintf(f, "%u miss\n", i) > 0;
+                ok = outfile_printf(&f, err, errlen, "%u miss\n", i) == 0;
             else
-                ok = fprintf(f, "%u %.9g %u %.9g %.9g\n", i, (double)hits[i].t, hits[i].prim, (double)hits[i].u,
-                             (double)hits[i].v) > 0;
+                ok = outfile_printf(&f, err, errlen, "%u %.9g %u %.9g %.9g\n", i, (double)hits[i].t, hits[i].prim,
+                                    (double)hits[i].u, (double)hits[i].v) == 0;
         }
     }
-    if (fclose(f) != 0 || !ok) {
-        snprintf(err, errlen, "%s: write failed", path);
+    if (!ok) {
+        outfile_discard(&f);
         return -1;
     }
-    return 0;
+    return outfile_close(&f, NULL, err, errlen);
 }

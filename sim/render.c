@@ -3,6 +3,11 @@
  *
  * Owns: the output folder's files and their names. Must not: render, or decide anything the
  * renderer or the report's readers would need to know without reading the report.
+ *
+ * Outputs (docs/report.md): the folder is checked before any work and created only when there is
+ * something to write; every file is staged under a temporary name (sim/outfile.c) and the set is
+ * renamed into place only once all of them were written whole, so a failed run leaves no file of
+ * its own under a final name and no mix with an older run's files.
  */
 #include "render.h"
 
@@ -23,6 +28,7 @@
 #include "config.h"
 #include "functional.h"
 #include "heatmap.h"
+#include "outfile.h"
 #include "reference.h"
 #include "sampling.h"
 #include "timing.h"
@@ -55,31 +61,6 @@ static double now(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* mkdir -p */
-static int make_dirs(const char *path, char *err, size_t errlen)
-{
-    char buf[4096];
-    if (snprintf(buf, sizeof buf, "%s", path) >= (int)sizeof buf) {
-        snprintf(err, errlen, "%s: path too long", path);
-        return -1;
-    }
-    for (char *p = buf + 1; *p; p++) {
-        if (*p != '/')
-            continue;
-        *p = 0;
-        if (mkdir(buf, 0777) != 0 && errno != EEXIST) {
-            snprintf(err, errlen, "%s: cannot create folder: %s", buf, strerror(errno));
-            return -1;
-        }
-        *p = '/';
-    }
-    if (mkdir(buf, 0777) != 0 && errno != EEXIST) {
-        snprintf(err, errlen, "%s: cannot create folder: %s", buf, strerror(errno));
-        return -1;
-    }
-    return 0;
 }
 
 typedef struct Progress {
@@ -135,14 +116,24 @@ static int apply_overrides(const RenderOptions *o, Scene *s, char *err, size_t e
     return 0;
 }
 
-static int write_text(const char *path, const char *text, char *err, size_t errlen)
+/* The outputs of a run, and the names an earlier run may have left that this one does not write. */
+static const char *const run_outputs[] = {"frame.exr", "frame.png", "report.txt", "report.json", "cost.png",
+                                          "frame.partial.exr"};
+
+/* Remove dir's run outputs not in keep[] (NULL-terminated): a file an earlier run left would
+ * otherwise sit beside this run's as if it belonged to it. */
+static int remove_stale(const char *dir, const char *const *keep, char *err, size_t errlen)
 {
-    FILE *f = fopen(path, "w");
-    if (!f || fputs(text, f) < 0 || fclose(f) != 0) {
-        snprintf(err, errlen, "%s: cannot write: %s", path, strerror(errno));
-        if (f)
-            fclose(f);
-        return -1;
+    for (size_t i = 0; i < sizeof run_outputs / sizeof run_outputs[0]; i++) {
+        int kept = 0;
+        for (const char *const *k = keep; *k; k++)
+            kept |= !strcmp(*k, run_outputs[i]);
+        char path[4200];
+        snprintf(path, sizeof path, "%s/%s", dir, run_outputs[i]);
+        if (!kept && unlink(path) != 0 && errno != ENOENT) {
+            snprintf(err, errlen, "%s: cannot remove this file of an earlier run: %s", path, strerror(errno));
+            return -1;
+        }
     }
     return 0;
 }
@@ -585,8 +576,8 @@ static int timing_text(char *txt, size_t cap, const FuncStats *f, const CfgMachi
 
 /* Detailed and sampled modes: cost.png, simulated cycles per pixel of each tile (sampled mode:
  * tiles not sampled get the sample's cycles per instruction times their instructions). */
-static int write_cost_map(const char *dir, const FuncStats *f, const SampleEstimate *est, int width, int height,
-                          char *err, size_t errlen)
+static int write_cost_map(OutSet *set, const char *dir, const FuncStats *f, const SampleEstimate *est, int width,
+                          int height, char *err, size_t errlen)
 {
     /* One value per pixel; an image wider or taller than the heat map takes (8192) is drawn one
      * value per tile instead (the values are per tile either way). */
@@ -615,14 +606,63 @@ static int write_cost_map(const char *dir, const FuncStats *f, const SampleEstim
     snprintf(path, sizeof path, "%s/cost.png", dir);
     snprintf(title, sizeof title, "simulated cycles per pixel (tiles of %u x %u%s)", f->tile_w, f->tile_h,
              est ? "; unsampled tiles estimated" : "");
-    int rc = heatmap_write(path, v, width, height, title, "cycles", err, errlen);
+    int rc = heatmap_write(set, path, v, width, height, title, "cycles", err, errlen);
     free(v);
+    return rc;
+}
+
+/* A run whose kernel failed: frame.partial.exr (the finished tiles, the others black) and a
+ * report.json with "status": "failed" replace an earlier run's outputs, whose complete-looking
+ * files would now mislead (docs/kernel.md). 0, or -1 with werr saying what could not be written
+ * (then nothing of this run is in the folder). */
+static int write_partial(const RenderOptions *o, const float *rgb, int width, int height, const FuncStats *f,
+                         const char *why, char *werr, size_t werrlen)
+{
+    static const char *const keep[] = {"frame.partial.exr", "report.json", NULL};
+    OutDirs dirs = {0};
+    OutSet *set = outset_new();
+    cJSON *fr = cJSON_CreateObject();
+    char *text = NULL, path[4200];
+    int rc = -1;
+    if (!set || !fr) {
+        snprintf(werr, werrlen, "out of memory");
+        goto out;
+    }
+    if (outfile_make_dirs(o->out_dir, &dirs, werr, werrlen) != 0)
+        goto out;
+    snprintf(path, sizeof path, "%s/frame.partial.exr", o->out_dir);
+    if (img_write_linear(set, path, rgb, width, height, werr, werrlen) != 0)
+        goto out;
+    cJSON_AddStringToObject(fr, "mode", o->mode);
+    cJSON_AddStringToObject(fr, "status", "failed");
+    cJSON_AddStringToObject(fr, "error", why);
+    cJSON_AddNumberToObject(fr, "tiles_done", f->tiles_done);
+    cJSON_AddNumberToObject(fr, "tiles", f->ntiles);
+    cJSON_AddStringToObject(fr, "partial_image", "frame.partial.exr");
+    text = cJSON_Print(fr);
+    snprintf(path, sizeof path, "%s/report.json", o->out_dir);
+    if (!text) {
+        snprintf(werr, werrlen, "%s: out of memory", path);
+        goto out;
+    }
+    if (outfile_write_file(set, path, text, strlen(text), werr, werrlen) != 0 ||
+        remove_stale(o->out_dir, keep, werr, werrlen) != 0 || outset_commit(set, werr, werrlen) != 0)
+        goto out;
+    outfile_keep_dirs(&dirs);
+    rc = 0;
+out:
+    outset_free(set);
+    outfile_remove_dirs(&dirs);
+    cJSON_free(text);
+    cJSON_Delete(fr);
     return rc;
 }
 
 int render_run(const RenderOptions *o, char *err, size_t errlen)
 {
     int rc = -1;
+    OutDirs dirs = {0};
+    OutSet *set = NULL;
     Scene s;
     PackedScene p;
     float *rgb = NULL;
@@ -644,11 +684,14 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         snprintf(err, errlen, "--sample %g: expected a fraction of the tiles in (0, 1]", o->sample);
         return -1;
     }
+    /* Before any work: an output folder that cannot be made would fail the run only at its end. */
+    if (outfile_check_dir(o->out_dir, err, errlen) != 0)
+        return -3;
     SampleEstimate est_store, *est = NULL;
     double t0 = now();
     if (scene_load(o->scene_path, &s, err, errlen) != 0)
         return -1;
-    if (apply_overrides(o, &s, err, errlen) != 0 || make_dirs(o->out_dir, err, errlen) != 0)
+    if (apply_overrides(o, &s, err, errlen) != 0)
         goto out;
     BvhParams bp;
     bvh_default_params(&bp);
@@ -685,31 +728,14 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
                          .sample_seed = o->sample_seed};
         int frc = func_render(&p, &fp, rgb, &rs.f, err, errlen);
         if (frc == -2) {
-            /* The kernel failed in a tile: keep what the finished tiles rendered, marked partial;
-             * a previous run's complete outputs in this folder would now mislead, so they go. */
-            char path[4200], perr[512], text[8192];
-            static const char *const stale[] = {"frame.exr", "frame.png", "report.txt", "cost.png"};
-            for (size_t k = 0; k < sizeof stale / sizeof stale[0]; k++) {
-                snprintf(path, sizeof path, "%s/%s", o->out_dir, stale[k]);
-                unlink(path);
-            }
-            snprintf(path, sizeof path, "%s/frame.partial.exr", o->out_dir);
-            img_write_linear(path, rgb, s.render.width, s.render.height, perr, sizeof perr);
-            snprintf(path, sizeof path, "%s/report.json", o->out_dir);
-            cJSON *fr = cJSON_CreateObject();
-            cJSON_AddStringToObject(fr, "mode", o->mode);
-            cJSON_AddStringToObject(fr, "status", "failed");
-            cJSON_AddStringToObject(fr, "error", err);
-            cJSON_AddNumberToObject(fr, "tiles_done", rs.f.tiles_done);
-            cJSON_AddNumberToObject(fr, "tiles", rs.f.ntiles);
-            cJSON_AddStringToObject(fr, "partial_image", "frame.partial.exr");
-            char *ft = cJSON_Print(fr);
-            if (ft)
-                write_text(path, ft, perr, sizeof perr);
-            cJSON_free(ft);
-            cJSON_Delete(fr);
-            snprintf(text, sizeof text, "%s\n(%u of %u tiles finished: %s/frame.partial.exr; unfinished tiles are black)",
-                     err, rs.f.tiles_done, rs.f.ntiles, o->out_dir);
+            /* The kernel failed in a tile: keep what the finished tiles rendered, marked partial. */
+            char werr[4400], text[16384];
+            if (write_partial(o, rgb, s.render.width, s.render.height, &rs.f, err, werr, sizeof werr) == 0)
+                snprintf(text, sizeof text, "%s\n(%u of %u tiles finished: %s/frame.partial.exr; unfinished tiles are black)",
+                         err, rs.f.tiles_done, rs.f.ntiles, o->out_dir);
+            else
+                snprintf(text, sizeof text, "%s\n(%u of %u tiles finished; the partial image was not kept: %s)", err,
+                         rs.f.tiles_done, rs.f.ntiles, werr);
             snprintf(err, errlen, "%s", text);
         }
         if (frc != 0) {
@@ -773,12 +799,22 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     }
     double t_render = now();
 
+    /* From here on a failure is an output that could not be written (EXIT_IO); the folder is
+     * made now that there is something to write, and removed again if nothing is written. */
+    rc = -3;
+    set = outset_new();
+    if (!set) {
+        snprintf(err, errlen, "%s: out of memory", o->out_dir);
+        goto out;
+    }
+    if (outfile_make_dirs(o->out_dir, &dirs, err, errlen) != 0)
+        goto out;
     char path[4200];
     snprintf(path, sizeof path, "%s/frame.exr", o->out_dir);
-    if (img_write_linear(path, rgb, s.render.width, s.render.height, err, errlen) != 0)
+    if (img_write_linear(set, path, rgb, s.render.width, s.render.height, err, errlen) != 0)
         goto out;
     snprintf(path, sizeof path, "%s/frame.png", o->out_dir);
-    if (img_write_display(path, rgb, s.render.width, s.render.height, o->exposure, err, errlen) != 0)
+    if (img_write_display(set, path, rgb, s.render.width, s.render.height, o->exposure, err, errlen) != 0)
         goto out;
 
     long nonfinite = 0;
@@ -864,7 +900,11 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     }
     json_text = cJSON_Print(root);
     snprintf(path, sizeof path, "%s/report.json", o->out_dir);
-    if (!json_text || write_text(path, json_text, err, errlen) != 0)
+    if (!json_text) {
+        snprintf(err, errlen, "%s: out of memory", path);
+        goto out;
+    }
+    if (outfile_write_file(set, path, json_text, strlen(json_text), err, errlen) != 0)
         goto out;
 
     char txt[16384];
@@ -935,12 +975,27 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
                         secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, t_load - t0, t_pack - t_load);
     }
     snprintf(path, sizeof path, "%s/report.txt", o->out_dir);
-    if (write_text(path, txt, err, errlen) != 0)
+    if (outfile_write_file(set, path, txt, strlen(txt), err, errlen) != 0)
         goto out;
-    if ((detailed || sampled) && write_cost_map(o->out_dir, &rs.f, est, s.render.width, s.render.height, err, errlen) != 0)
+    if ((detailed || sampled) &&
+        write_cost_map(set, o->out_dir, &rs.f, est, s.render.width, s.render.height, err, errlen) != 0)
         goto out;
+    /* Every file is whole under its temporary name: the set goes into place, and what an earlier
+     * run left that this one does not write (cost.png, frame.partial.exr) goes away. */
+    static const char *const keep_timed[] = {"frame.exr", "frame.png", "report.txt", "report.json", "cost.png", NULL};
+    static const char *const keep_untimed[] = {"frame.exr", "frame.png", "report.txt", "report.json", NULL};
+    if (remove_stale(o->out_dir, detailed || sampled ? keep_timed : keep_untimed, err, errlen) != 0 ||
+        outset_commit(set, err, errlen) != 0)
+        goto out;
+    outfile_keep_dirs(&dirs);
     rc = 0;
 out:
+    if (rc == -3 && set) {
+        size_t n = strlen(err);
+        snprintf(err + n, errlen - n, " (no output of this run was kept in %s)", o->out_dir);
+    }
+    outset_free(set);
+    outfile_remove_dirs(&dirs);
     cJSON_free(json_text);
     cJSON_Delete(root);
     free(rgb);

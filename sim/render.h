@@ -2,7 +2,7 @@
  * report into the output folder.
  *
  * Owns: the orchestration of a run and the files it writes (frame.exr, frame.png, report.json,
- * report.txt). Must not: implement a renderer or parse the command line.
+ * report.txt, cost.png; frame.partial.exr when the kernel fails). Must not: implement a renderer or parse the command line.
  */
 #ifndef SFSIM_RENDER_H
 #define SFSIM_RENDER_H
@@ -12,7 +12,7 @@
 
 typedef struct RenderOptions {
     const char *scene_path;    /* .gltf/.glb or scene.ini */
-    const char *out_dir;       /* created if missing */
+    const char *out_dir;       /* created if missing, once there is something to write */
     int stream_rays;           /* M: 1024 or 4096; the tile is sqrt(M) x sqrt(M) pixels */
     uint32_t seed;
     int threads;               /* host threads; 0 = all cores */
@@ -40,7 +40,10 @@ void render_default_options(RenderOptions *o);
 
 /* A run in o->mode: "reference" (the golden model, sim/reference.c) or "functional" (the
  * kernel on functional cores, sim/functional.c). 0, or -1 with a message naming the file or
- * the setting at fault; -2 when the simulated program failed (trap, instruction limit). */
+ * the setting at fault; -2 when the simulated program failed (trap, instruction limit); -3 when
+ * an output could not be written (the folder checked before any work, a full disk, ...). Outputs
+ * are written whole or not at all (sim/outfile.h): after a failure no file of this run is left
+ * under a final name, except a kernel failure's frame.partial.exr and "failed" report.json. */
 int render_run(const RenderOptions *o, char *err, size_t errlen);
 
 #endif

@@ -11,6 +11,7 @@
 
 #include "../scenes/scene.h"
 #include "functional.h"
+#include "outfile.h"
 #include "ref_trace.h"
 
 static double now(void)
@@ -85,6 +86,9 @@ int trace_run(const TraceOptions *o, TraceSummary *sum, char *err, size_t errlen
     BatchHit *hits = NULL;
     memset(&p, 0, sizeof p);
     memset(&b, 0, sizeof b);
+    /* Before any work: a hit file that cannot be written would fail the run only at its end. */
+    if (outfile_check_file(o->out_path, err, errlen) != 0)
+        return -3;
     if (scene_load(o->scene_path, &s, err, errlen) != 0)
         return -1;
     int rc = -1;
@@ -112,7 +116,7 @@ int trace_run(const TraceOptions *o, TraceSummary *sum, char *err, size_t errlen
     sum->seconds = now() - t0;
     if (rc != 0)
         goto out;
-    rc = -1;
+    rc = -3; /* an output that could not be written */
     if (raybatch_write_hits(o->out_path, &b, hits, o->binary, err, errlen) != 0)
         goto out;
     sum->rays = b.count;

@@ -484,5 +484,184 @@ run "$SFSIM" trace -s scenes/cornell/scene.ini
 want_rc 2; want_err "required"
 end
 
+# ---- outputs: written whole or not at all (sim/outfile.h, docs/report.md) --------------------
+TINY=(--set render.width=32 --set render.height=32 --set render.spp=1 -j 2 --no-progress)
+TRAP=(--mode functional --kernel "$T/trap_kernel.s" -s scenes/cornell/scene.ini --set render.width=32 --set render.height=16
+      --set stream.rays=1024 --set core.simd_width=4 --set stream.mode=packet --set render.spp=1 -j 1 --no-progress)
+RUN_OUTPUTS="frame.exr frame.png report.txt report.json cost.png frame.partial.exr"
+
+# no_temporaries DIR: no temporary file of sim/outfile.c anywhere under DIR.
+no_temporaries() {
+    local left
+    left=$(find "$1" -name '.*.tmp-*' 2>/dev/null | head -3)
+    [ -z "$left" ] || no "temporary files left: $left"
+}
+
+# fail_each_write MODE DIR [FRESH]: run a tiny render with SFSIM_FAIL_WRITE=k for k = 1, 2, ...
+# until it succeeds; each failure must exit 4 naming a file and the reason, print no "wrote",
+# leave no temporary file, and leave DIR as it was: absent (FRESH) or holding the previous run's
+# files unchanged (or, when a rename into place failed, none of them). Sets $writes to the number of
+# operations and $named to the files the failures named.
+fail_each_write() {
+    local mode=$1 dir=$2 fresh=${3:-} k f olds gone
+    writes=0; named=""
+    for ((k = 1; k <= 80; k++)); do
+        [ -n "$fresh" ] && rm -rf "$dir"
+        run env SFSIM_FAIL_WRITE=$k "$SFSIM" run --mode "$mode" -s scenes/cornell/scene.ini -o "$dir" "${TINY[@]}"
+        if [ "$rc" -eq 0 ]; then writes=$((k - 1)); break; fi
+        if [ "$rc" -ne 4 ]; then no "k = $k: exit $rc, expected 4"; sed -n '1,3s/^/    stderr| /p' "$T/err"; break; fi
+        grep -qE "^sfsim run: $dir(/[a-z.]+)?: .*No space left on device" "$T/err" || no "k = $k: stderr does not name the file and the reason"
+        grep -q "wrote" "$T/out" && no "k = $k: a 'wrote' line after a failed write"
+        no_temporaries "$(dirname "$dir")"
+        f=$(grep -oE "$dir/[a-z.]+: " "$T/err" | head -1 | sed -E 's|.*/||; s|: $||')
+        case " $named " in *" ${f:-folder} "*) ;; *) named="$named ${f:-folder}" ;; esac
+        if [ -n "$fresh" ]; then
+            [ ! -e "$dir" ] || no "k = $k: the run left $dir behind ($(ls -A "$dir" | tr '\n' ' '))"
+        else
+            olds=0; gone=0
+            for f in $RUN_OUTPUTS; do
+                if [ ! -e "$dir/$f" ]; then gone=$((gone + 1))
+                elif cmp -s "$dir/$f" "$dir.before/$f"; then olds=$((olds + 1))
+                else no "k = $k: $f is neither the previous run's nor absent"
+                fi
+            done
+            [ "$olds" -eq 0 ] || [ "$olds" -eq "$(ls "$dir.before" | wc -l)" ] || no "k = $k: $olds of the previous run's files beside $gone removed ones"
+        fi
+        [ "$failed" -eq 0 ] || break
+    done
+    [ "$k" -le 80 ] || no "still failing at k = 80"
+}
+
+begin "sfsim run --mode functional: each output write fails in turn (SFSIM_FAIL_WRITE): exit 4, file named, nothing left"
+mkdir -p "$T/fw"
+fail_each_write functional "$T/fw/fun" fresh
+# the folder, then frame.exr, frame.png, report.json, report.txt: each created, written, synced,
+# closed, renamed into place
+[ "$writes" -ge 21 ] || no "only $writes output operations counted (SFSIM_FAIL_WRITE has no effect?)"
+for f in folder frame.exr frame.png report.json report.txt; do
+    case " $named " in *" $f "*) ;; *) no "no failure named $f (named:$named)" ;; esac
+done
+for f in frame.exr frame.png report.json report.txt; do [ -s "$T/fw/fun/$f" ] || no "the final run did not write $f"; done
+end
+
+begin "sfsim run (detailed): each write fails in turn over a previous run's outputs: they stay whole, no mix"
+"$SFSIM" run -s scenes/cornell/scene.ini -o "$T/fw/det" "${TINY[@]}" --set render.spp=2 >/dev/null 2>&1 \
+    || no "the previous run failed"
+"$SFSIM" run "${TRAP[@]}" -o "$T/fw/trap" >/dev/null 2>&1
+cp "$T/fw/trap/frame.partial.exr" "$T/fw/det/" 2>/dev/null || no "no frame.partial.exr from the trap kernel"
+rm -rf "$T/fw/det.before"; cp -a "$T/fw/det" "$T/fw/det.before"
+fail_each_write detailed "$T/fw/det"
+[ "$writes" -ge 25 ] || no "only $writes output operations counted"
+for f in frame.exr frame.png report.json report.txt cost.png; do
+    case " $named " in *" $f "*) ;; *) no "no failure named $f (named:$named)" ;; esac
+done
+for f in frame.exr frame.png report.json report.txt cost.png; do
+    [ -s "$T/fw/det/$f" ] && ! cmp -s "$T/fw/det/$f" "$T/fw/det.before/$f" || no "the final run did not replace $f"
+done
+[ ! -e "$T/fw/det/frame.partial.exr" ] || no "an earlier run's frame.partial.exr is left beside complete outputs"
+end
+
+begin "sfsim run --mode functional: a stale cost.png of an earlier detailed run is removed"
+cp "$T/fw/det/cost.png" "$T/fw/fun/cost.png"
+run "$SFSIM" run --mode functional -s scenes/cornell/scene.ini -o "$T/fw/fun" "${TINY[@]}"
+want_rc 0
+[ ! -e "$T/fw/fun/cost.png" ] || no "cost.png of another run is left beside this run's outputs"
+end
+
+begin "sfsim run: a kernel failure whose partial outputs cannot be written says so (exit 3, nothing claimed)"
+for ((k = 1; k <= 40; k++)); do
+    rm -rf "$T/fw/trap"
+    run env SFSIM_FAIL_WRITE=$k "$SFSIM" run "${TRAP[@]}" -o "$T/fw/trap"
+    want_rc 3
+    no_temporaries "$T/fw"
+    if grep -q "frame.partial.exr; unfinished tiles are black" "$T/err"; then
+        [ -s "$T/fw/trap/frame.partial.exr" ] || no "k = $k: frame.partial.exr claimed but missing"
+        break
+    fi
+    want_err "the partial image was not kept: .*No space left on device"
+    [ ! -e "$T/fw/trap" ] || no "k = $k: the run left $T/fw/trap behind"
+    [ "$failed" -eq 0 ] || break
+done
+[ "$k" -ge 10 ] || no "only $((k - 1)) operations failed before the partial outputs were written"
+end
+
+begin "sfsim trace: each write of the hit file fails in turn: exit 4, file named, no file, no temporary"
+for ((k = 1; k <= 20; k++)); do
+    rm -f "$T/fw/hits.txt"
+    run env SFSIM_FAIL_WRITE=$k "$SFSIM" trace -s scenes/cornell/scene.ini --rays "$T/rays.txt" -o "$T/fw/hits.txt"
+    [ "$rc" -eq 0 ] && break
+    want_rc 4; want_err "^sfsim trace: $T/fw/hits.txt: .*No space left on device"
+    grep -q "wrote" "$T/out" && no "k = $k: a 'wrote' line"
+    [ ! -e "$T/fw/hits.txt" ] || no "k = $k: a hit file is left"
+    no_temporaries "$T/fw"
+    [ "$failed" -eq 0 ] || break
+done
+[ "$k" -eq 6 ] || no "the hit file took $((k - 1)) failing operations, expected 5 (create, write, fsync, close, rename)"
+cmp -s "$T/fw/hits.txt" "$T/hits_f.txt" || no "the hit file differs from an ordinary run's"
+end
+
+begin "sfsim run -o naming a file fails before any work, naming it (exit 4)"
+: > "$T/fw/a_file"
+run "$SFSIM" run -s "$T/no_such_scene.ini" -o "$T/fw/a_file" "${TINY[@]}"
+want_rc 4; want_err "^sfsim run: $T/fw/a_file: exists and is not a folder"
+run "$SFSIM" run -s "$T/no_such_scene.ini" -o "$T/fw/a_file/sub" "${TINY[@]}"
+want_rc 4; want_err "^sfsim run: $T/fw/a_file/sub: $T/fw/a_file exists and is not a folder"
+[ ! -s "$T/fw/a_file" ] || no "the file was written to"
+end
+
+begin "sfsim trace -o naming a folder or a missing folder fails before any work (exit 4)"
+run "$SFSIM" trace -s "$T/no_such_scene.ini" --rays "$T/rays.txt" -o "$T/fw"
+want_rc 4; want_err "^sfsim trace: $T/fw: is a folder"
+run "$SFSIM" trace -s "$T/no_such_scene.ini" --rays "$T/rays.txt" -o "$T/fw/nowhere/hits.txt"
+want_rc 4; want_err "^sfsim trace: $T/fw/nowhere/hits.txt: .*No such file or directory"
+end
+
+begin "sfsim run with a kernel that does not assemble leaves no output folder behind (exit 1)"
+rm -rf "$T/fw/new"
+run "$SFSIM" run --mode functional --kernel "$T/bad_kernel.s" -s scenes/cornell/scene.ini -o "$T/fw/new/out" "${TINY[@]}"
+want_rc 1; want_err "bad_kernel.s:1:"
+[ ! -e "$T/fw/new" ] || no "$T/fw/new was created"
+end
+
+begin "sfsim run on a real full disk (a 64 KiB tmpfs, filled in steps): exit 0 with whole files, or 4 with nothing"
+mkdir -p "$T/tmpfs"
+if ! mount -t tmpfs -o size=64k tmpfs "$T/tmpfs" 2>"$T/err"; then
+    echo "note: cannot mount a tmpfs ($(head -1 "$T/err")): the fault hook above covers full disks alone"
+else
+    trap 'umount "$T/tmpfs" 2>/dev/null; rm -rf "$T"' EXIT
+    "$SFSIM" run -s scenes/cornell/scene.ini -o "$T/fw/ref" "${TINY[@]}" >/dev/null 2>&1 || no "reference run failed"
+    oks=0; fulls=0
+    for fill in 0 16 24 28 30 32 40 60; do
+        rm -rf "$T/tmpfs/"*
+        [ "$fill" -gt 0 ] && head -c $((fill * 1024)) /dev/zero > "$T/tmpfs/fill"
+        run "$SFSIM" run -s scenes/cornell/scene.ini -o "$T/tmpfs/out" "${TINY[@]}"
+        no_temporaries "$T/tmpfs"
+        if [ "$rc" -eq 0 ]; then
+            oks=$((oks + 1))
+            for f in frame.exr frame.png cost.png; do
+                "$SFSIM" compare "$T/tmpfs/out/$f" "$T/fw/ref/$f" 2>/dev/null | grep -qE "max diff +0$" \
+                    || no "$fill KiB full: $f claimed but not whole"
+            done
+            python3 -c 'import json,sys; json.load(open(sys.argv[1]))' "$T/tmpfs/out/report.json" 2>/dev/null \
+                || no "$fill KiB full: report.json claimed but not whole"
+            [ "$(wc -l < "$T/tmpfs/out/report.txt")" -eq "$(wc -l < "$T/fw/ref/report.txt")" ] \
+                && tail -1 "$T/tmpfs/out/report.txt" | grep -q "^host " \
+                || no "$fill KiB full: report.txt claimed but not whole"
+        elif [ "$rc" -eq 4 ]; then
+            fulls=$((fulls + 1))
+            grep -qE "^sfsim run: $T/tmpfs/out/[a-z.]+: .*No space left on device" "$T/err" \
+                || no "$fill KiB full: the message does not name the file and the reason"
+            grep -q "wrote" "$T/out" && no "$fill KiB full: a 'wrote' line"
+            [ ! -e "$T/tmpfs/out" ] || no "$fill KiB full: $(ls -A "$T/tmpfs/out" | tr '\n' ' ') left behind"
+        else
+            no "$fill KiB full: exit $rc"
+        fi
+    done
+    [ "$oks" -gt 0 ] && [ "$fulls" -gt 0 ] || no "$oks runs fit and $fulls did not: the test missed a case"
+    umount "$T/tmpfs" || no "cannot unmount $T/tmpfs"
+    trap 'rm -rf "$T"' EXIT
+fi
+end
+
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -30,7 +30,7 @@ static Image write_and_read(const char *name, const double *v, int w, int h, con
 {
     char path[128], err[256];
     snprintf(path, sizeof path, "%s/%s", dir, name);
-    cr_assert_eq(heatmap_write(path, v, w, h, title, unit, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(heatmap_write(NULL, path, v, w, h, title, unit, err, sizeof err), 0, "%s", err);
     Image im;
     cr_assert_eq(img_read(path, &im.rgb, &im.w, &im.h, err, sizeof err), 0, "%s", err);
     return im;
@@ -187,22 +187,22 @@ Test(heatmap, bad_values_name_the_first_bad_pixel, .init = mkdir_tmp)
     char path[128], err[256];
     snprintf(path, sizeof path, "%s/bad.png", dir);
     double v[4 * 3] = {1, 2, 3, 4, 5, 6, NAN, 8, -1, 10, 11, 12};
-    cr_expect_eq(heatmap_write(path, v, 4, 3, "t", "cycles", err, sizeof err), -1);
+    cr_expect_eq(heatmap_write(NULL, path, v, 4, 3, "t", "cycles", err, sizeof err), -1);
     cr_expect(strncmp(err, path, strlen(path)) == 0, "%s", err);
     cr_expect(strstr(err, "pixel (2, 1)") && strstr(err, "NaN"), "%s", err);
     cr_expect_neq(access(path, F_OK), 0, "nothing may be written");
 
     v[6] = 7;
-    cr_expect_eq(heatmap_write(path, v, 4, 3, "t", "cycles", err, sizeof err), -1);
+    cr_expect_eq(heatmap_write(NULL, path, v, 4, 3, "t", "cycles", err, sizeof err), -1);
     cr_expect(strstr(err, "pixel (0, 2)") && strstr(err, "negative"), "%s", err);
     v[8] = INFINITY;
-    cr_expect_eq(heatmap_write(path, v, 4, 3, "t", "cycles", err, sizeof err), -1);
+    cr_expect_eq(heatmap_write(NULL, path, v, 4, 3, "t", "cycles", err, sizeof err), -1);
     cr_expect(strstr(err, "pixel (0, 2)") && strstr(err, "infinite"), "%s", err);
     cr_expect_neq(access(path, F_OK), 0, "nothing may be written");
 
-    cr_expect_eq(heatmap_write(path, v, 0, 3, "t", "cycles", err, sizeof err), -1);
+    cr_expect_eq(heatmap_write(NULL, path, v, 0, 3, "t", "cycles", err, sizeof err), -1);
     cr_expect(strstr(err, "0 x 3"), "%s", err);
-    cr_expect_eq(heatmap_write(path, NULL, 4, 3, "t", "cycles", err, sizeof err), -1);
+    cr_expect_eq(heatmap_write(NULL, path, NULL, 4, 3, "t", "cycles", err, sizeof err), -1);
     cr_expect(strstr(err, "no values"), "%s", err);
 }
 
@@ -210,8 +210,8 @@ Test(heatmap, unwritable_paths_are_errors)
 {
     double v[2] = {1, 2};
     char err[256];
-    cr_expect_eq(heatmap_write("/nonexistent-dir/cost.png", v, 2, 1, "t", "u", err, sizeof err), -1);
+    cr_expect_eq(heatmap_write(NULL, "/nonexistent-dir/cost.png", v, 2, 1, "t", "u", err, sizeof err), -1);
     cr_expect(strncmp(err, "/nonexistent-dir/cost.png: ", 27) == 0, "%s", err);
-    cr_expect_eq(heatmap_write("/tmp/cost.unknownformat", v, 2, 1, "t", "u", err, sizeof err), -1);
+    cr_expect_eq(heatmap_write(NULL, "/tmp/cost.unknownformat", v, 2, 1, "t", "u", err, sizeof err), -1);
     cr_expect(strstr(err, "/tmp/cost.unknownformat: ") == err, "%s", err);
 }

@@ -23,7 +23,7 @@ Test(img_io, exr_round_trip_is_exact, .init = mkdir_tmp)
         px[i] = 0.1f * (float)i + 1e-7f * (float)(i * i) + (i == 5 ? 1000.5f : 0.0f);
     char path[128], err[256];
     snprintf(path, sizeof path, "%s/a.exr", dir);
-    cr_assert_eq(img_write_linear(path, px, 3, 2, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(img_write_linear(NULL, path, px, 3, 2, err, sizeof err), 0, "%s", err);
     float *back;
     int w, h;
     cr_assert_eq(img_read(path, &back, &w, &h, err, sizeof err), 0, "%s", err);
@@ -39,7 +39,7 @@ Test(img_io, png_is_clamped_srgb_and_marks_nan, .init = mkdir_tmp)
     float px[4 * 3] = {0, 0, 0, 0.5f, 0.5f, 0.5f, 2.0f, 2.0f, 2.0f, NAN, 0, 0};
     char path[128], err[256];
     snprintf(path, sizeof path, "%s/a.png", dir);
-    cr_assert_eq(img_write_display(path, px, 4, 1, 1.0f, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(img_write_display(NULL, path, px, 4, 1, 1.0f, err, sizeof err), 0, "%s", err);
     float *back;
     int w, h;
     cr_assert_eq(img_read(path, &back, &w, &h, err, sizeof err), 0, "%s", err);
@@ -58,9 +58,9 @@ Test(img_io, errors_name_the_file)
 {
     float px[3] = {0, 0, 0};
     char err[256];
-    cr_expect_eq(img_write_linear("/nonexistent-dir/x.exr", px, 1, 1, err, sizeof err), -1);
+    cr_expect_eq(img_write_linear(NULL, "/nonexistent-dir/x.exr", px, 1, 1, err, sizeof err), -1);
     cr_expect(strncmp(err, "/nonexistent-dir/x.exr: ", 24) == 0, "%s", err);
-    cr_expect_eq(img_write_linear("/tmp/x.unknownformat", px, 1, 1, err, sizeof err), -1);
+    cr_expect_eq(img_write_linear(NULL, "/tmp/x.unknownformat", px, 1, 1, err, sizeof err), -1);
     cr_expect(strstr(err, "/tmp/x.unknownformat: ") == err, "%s", err);
     float *back;
     int w, h;
