@@ -484,5 +484,24 @@ run "$SFSIM" trace -s scenes/cornell/scene.ini
 want_rc 2; want_err "required"
 end
 
+# ---- issue 14: exit codes, crashes and the smaller CLI defects -------------------------------------
+
+begin "sfsim trace of 0 rays (empty, comments only, binary n = 0) in every mode: empty valid hits, exit 0"
+: > "$T/rays0.txt"
+printf '# no rays here\n\n   # nor here\n' > "$T/rays0c.txt"
+printf 'SFRAYS1\0\0\0\0\0\0\0\0\0' > "$T/rays0.bin"
+for m in functional detailed reference; do
+    for f in rays0.txt rays0c.txt rays0.bin; do
+        run "$SFSIM" trace --mode "$m" -s scenes/cornell/scene.ini --rays "$T/$f" -o "$T/h0_${m}_$f.txt" -j 2
+        want_rc 0; want_out "0 rays \($m\): 0 hits, 0 misses"
+        [ "$(grep -vc '^#' "$T/h0_${m}_$f.txt" 2>/dev/null)" = 0 ] || no "$m $f: the text hit file is not empty"
+        run "$SFSIM" trace --mode "$m" -s scenes/cornell/scene.ini --rays "$T/$f" -o "$T/h0_${m}_$f.bin" --binary
+        want_rc 0
+        [ "$(od -An -c "$T/h0_${m}_$f.bin" 2>/dev/null | tr -d ' \n')" = 'SFHITS1\0\0\0\0\0\0\0\0\0' ] \
+            || no "$m $f: the binary hit file is not a header for 0 hits"
+    done
+done
+end
+
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
