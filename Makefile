@@ -178,7 +178,7 @@ $(BUILD)/fuzz/fuzz_rays: tests/fuzz/fuzz_rays.c sim/raybatch.c
 
 $(BUILD)/fuzz/fuzz_config: tests/fuzz/fuzz_config.c sim/config.c sim/timing.c sim/event.c sim/scenemem.c isa/isa.c
 	@mkdir -p $(dir $@)
-	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ $(INIH) -lm
+	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ $(INIH) $(CJSON) -lm
 
 fuzz: $(BUILD)/fuzz/fuzz_asm $(BUILD)/fuzz/fuzz_scene $(BUILD)/fuzz/fuzz_rays $(BUILD)/fuzz/fuzz_config
 

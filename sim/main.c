@@ -665,6 +665,7 @@ static int cmd_trace(int argc, char **argv)
     if (build_config(&ca, &cfg))
         return EXIT_INPUT;
     o.cfg = &cfg;
+    o.config_path = ca.path;
     static char err[65536];
     TraceSummary sum;
     int rc = trace_run(&o, &sum, err, sizeof err);
