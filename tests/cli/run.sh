@@ -503,5 +503,33 @@ for m in functional detailed reference; do
 done
 end
 
+begin "report.json's config holds every key that sfsim config --dump lists, with its value (every mode)"
+for m in detailed reference; do
+    run "$SFSIM" run --mode "$m" -s scenes/cornell/scene.ini -c configs/streamray.ini --set latency.vfma=7 \
+        --set render.width=16 --set render.height=16 --set render.spp=1 -o "$T/cfgblk_$m" -j 1 --no-progress
+    want_rc 0
+    "$SFSIM" config --dump -c configs/streamray.ini --set latency.vfma=7 >"$T/cfgdump_$m.ini" 2>>"$T/err" \
+        || no "sfsim config --dump failed"
+    python3 - "$T/cfgdump_$m.ini" "$T/cfgblk_$m/report.json" >"$T/cfgcheck" 2>&1 <<'PY' || no "$m: $(head -c 600 "$T/cfgcheck")"
+import json, re, sys
+dump, report = open(sys.argv[1]).read().splitlines(), json.load(open(sys.argv[2]))
+cfg, section, keys, bad = report["config"], None, 0, []
+for line in dump:
+    if re.match(r"^\[(.+)\]$", line):
+        section = line[1:-1]
+    elif re.match(r"^[a-z_0-9]+ = ", line):
+        key, value = line.split(" = ", 1)
+        keys += 1
+        got = cfg.get(section + "." + key)
+        if got is None:
+            bad.append("missing " + section + "." + key)
+        elif (str(got) if isinstance(got, str) else "%g" % got) != ("%g" % float(value) if re.match(r"^-?[0-9.e+]+$", value) else value):
+            bad.append("%s.%s = %r, config --dump says %s" % (section, key, got, value))
+if keys < 60 or bad or len(cfg) != keys or report.get("config_file") != "configs/streamray.ini":
+    sys.exit("%d keys dumped, %d in report.json; config_file %r; %s" % (keys, len(cfg), report.get("config_file"), "; ".join(bad)))
+PY
+done
+end
+
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
