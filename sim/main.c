@@ -439,8 +439,10 @@ static void usage_compare(FILE *out)
             "\n"
             "Compares two images of the same size (any format OpenImageIO reads; EXR compares linear\n"
             "radiance, PNG the stored 0..1 values) and prints RMSE, PSNR (peak 1), the largest channel\n"
-            "difference, both means and the NaN/Inf counts. Exit 0 when it could compare, 1 when an\n"
-            "image cannot be read or the sizes differ.\n");
+            "difference, both means and the NaN/Inf counts. The values are compared as stored, never\n"
+            "converted: a linear image (EXR, HDR, PFM) against a display image (PNG, JPEG) gets a warning\n"
+            "on stderr, since PNG's values are sRGB-encoded, exposure-scaled and clamped. Exit 0 when it\n"
+            "could compare, 1 when an image cannot be read or the sizes differ.\n");
 }
 
 static int cmd_compare(int argc, char **argv)
@@ -462,6 +464,13 @@ static int cmd_compare(int argc, char **argv)
     } else if (wa != wb || ha != hb) {
         fprintf(stderr, "sfsim compare: sizes differ: %s is %d x %d, %s is %d x %d\n", argv[0], wa, ha, argv[1], wb, hb);
     } else {
+        ImgEncoding ea = img_encoding(argv[0]), eb = img_encoding(argv[1]);
+        if (ea != eb && ea != IMG_ENC_UNKNOWN && eb != IMG_ENC_UNKNOWN)
+            fprintf(stderr,
+                    "sfsim compare: warning: %s holds %s and %s %s: the figures below compare different encodings, "
+                    "not the renders (compare frame.exr with frame.exr, or frame.png with frame.png)\n",
+                    argv[0], ea == IMG_ENC_LINEAR ? "linear radiance" : "display values (sRGB-encoded, clamped to 0..1)",
+                    argv[1], eb == IMG_ENC_LINEAR ? "linear radiance" : "display values (sRGB-encoded, clamped to 0..1)");
         ImgCompare c;
         img_compare(a, b, wa, ha, &c);
         printf("%s vs %s (%d x %d)\n", argv[0], argv[1], wa, ha);

@@ -531,5 +531,18 @@ PY
 done
 end
 
+begin "sfsim compare of a PNG with an EXR warns that they hold different encodings (exit 0); EXR with EXR does not"
+run "$SFSIM" run --mode reference -s scenes/cornell/scene.ini -o "$T/enc" --set render.width=16 \
+    --set render.height=16 --set render.spp=1 -j 1 --no-progress
+want_rc 0
+run "$SFSIM" compare "$T/enc/frame.png" "$T/enc/frame.exr"
+want_rc 0; want_out "RMSE"
+want_err "warning: .*frame.png holds display values \(sRGB-encoded.*frame.exr linear radiance"
+run "$SFSIM" compare "$T/enc/frame.exr" "$T/enc/frame.exr"
+want_rc 0; want_no_err
+run "$SFSIM" compare "$T/enc/frame.png" "$T/enc/frame.png"
+want_rc 0; want_no_err
+end
+
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
