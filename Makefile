@@ -50,7 +50,7 @@ help:
 	@echo "make fuzz       build the libFuzzer targets, assembler and scene loader (clang);"
 	@echo "                make fuzz-run FUZZ_SECONDS=600 runs each for that long"
 	@echo "make bench      build and run the benchmarks in bench/ (core, functional and detailed speed, Embree)"
-	@echo "make docs       regenerate docs/isa.md from isa/opcodes.def"
+	@echo "make docs       regenerate docs/isa.md from isa/opcodes.def, docs/exit-codes.md from sim/exitcodes.def"
 
 deps:
 	@bash scripts/deps.sh
@@ -101,17 +101,22 @@ bin/sfsim: $(BUILD)/obj/sim/main.o $(BUILD)/libsfsim.a
 $(BUILD)/gen_isadoc: tools/gen_isadoc.c $(BUILD)/libsfasm.a
 	$(CC) $(CFLAGS) $^ -o $@ -lm
 
+$(BUILD)/gen_exitdoc: tools/gen_exitdoc.c sim/exitcodes.def sim/exitcodes.h
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) tools/gen_exitdoc.c -o $@
+
 $(BUILD)/gen_layout: tools/gen_layout.c scenes/layout.def
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) tools/gen_layout.c -o $@
 
-docs: $(BUILD)/gen_isadoc $(BUILD)/gen_layout
+docs: $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_exitdoc
 	$(BUILD)/gen_isadoc > docs/isa.md
+	$(BUILD)/gen_exitdoc > docs/exit-codes.md
 	$(BUILD)/gen_layout inc > kernels/lib/layout.inc
 	$(BUILD)/gen_layout md > docs/scene-memory.md
 
 # ---- tests ----------------------------------------------------------------------------------
-$(BUILD)/tests/unit: $(TEST_SRC) $(BUILD)/libsfsim.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout
+$(BUILD)/tests/unit: $(TEST_SRC) $(BUILD)/libsfsim.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_exitdoc
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(LDAS) $(TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
 
@@ -119,7 +124,7 @@ $(BUILD)/tests/io: $(IO_TEST_SRC) $(BUILD)/libsfsim.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(LDAS) $(IO_TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(EMBREE) $(INIH) $(LDLIBS)
 
-$(BUILD)/tests/unit-asan: $(TEST_SRC) $(BUILD)/libsfsim-asan.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout
+$(BUILD)/tests/unit-asan: $(TEST_SRC) $(BUILD)/libsfsim-asan.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_exitdoc
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(SAN) $(LDAS) $(TEST_SRC) $(BUILD)/libsfsim-asan.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
 

@@ -112,7 +112,7 @@ int trace_run(const TraceOptions *o, TraceSummary *sum, char *err, size_t errlen
     sum->seconds = now() - t0;
     if (rc != 0)
         goto out;
-    rc = -1;
+    rc = -3;
     if (raybatch_write_hits(o->out_path, &b, hits, o->binary, err, errlen) != 0)
         goto out;
     sum->rays = b.count;

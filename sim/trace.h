@@ -40,7 +40,8 @@ int trace_batch_run(const PackedScene *p, uint32_t needs, const RayBatch *b, Bat
                     const CfgMachine *cfg, const char *kernel_path, int threads, uint64_t *sim_instructions,
                     TimingStats *timing, char *err, size_t errlen);
 
-/* The whole command: 0, -1 with a message naming the file or key, -2 when the kernel failed. */
+/* The whole command: 0, -1 with a message naming the file or key, -2 when the kernel failed,
+ * -3 when the hit file could not be written. */
 int trace_run(const TraceOptions *o, TraceSummary *sum, char *err, size_t errlen);
 
 #endif
