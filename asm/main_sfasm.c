@@ -197,5 +197,10 @@ int main(int argc, char **argv)
         rc = EXIT_OK;
     free(a.defines);
     free(a.include_dirs);
+    if (fflush(stdout) != 0 || ferror(stdout)) { /* --help, --version */
+        fprintf(stderr, "sfasm: cannot write to standard output\n");
+        if (rc == EXIT_OK)
+            rc = EXIT_IO;
+    }
     return rc;
 }

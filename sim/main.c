@@ -803,7 +803,7 @@ static int cmd_trace(int argc, char **argv)
     return EXIT_OK;
 }
 
-int main(int argc, char **argv)
+static int dispatch(int argc, char **argv)
 {
     if (argc < 2) {
         usage(stderr);
@@ -866,4 +866,17 @@ int main(int argc, char **argv)
     fprintf(stderr, "sfsim: unknown command '%s'\n\n", cmd);
     usage(stderr);
     return EXIT_USAGE;
+}
+
+int main(int argc, char **argv)
+{
+    int rc = dispatch(argc, argv);
+    /* What went to stdout (a config dump, help, registers, the summary) is an output too: a full
+     * disk or closed pipe must not pass for success. */
+    if (fflush(stdout) != 0 || ferror(stdout)) {
+        fprintf(stderr, "sfsim: cannot write to standard output: %s\n", strerror(errno ? errno : EIO));
+        if (rc == EXIT_OK)
+            rc = EXIT_IO;
+    }
+    return rc;
 }

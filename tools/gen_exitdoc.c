@@ -46,6 +46,7 @@ int main(void)
            "malformed (`--set render.width=0`, `--set core.simd_width=0`, `-j 0`, `--exposure inf`,\n"
            "`--mode fast`, `--dump-mem spad:2:1`) is bad input, `INPUT`, like a bad value in a file; an\n"
            "unknown command or option, a missing argument, or options that do not go together\n"
-           "(`--sample` without `--mode sampled`) are `USAGE`.\n");
+           "(`--sample` without `--mode sampled`) are `USAGE`. Every command that would otherwise exit `OK`\n"
+           "exits `IO` when its standard output could not be written (a full disk, `> /dev/full`).\n");
     return 0;
 }

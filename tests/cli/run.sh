@@ -621,6 +621,17 @@ run "$SFASM" -d "$T/no_such.sfo"
 want_rc 1
 end
 
+begin "standard output that cannot be written is an I/O failure (exit 4), not success"
+if [ -w /dev/full ]; then
+    for c in "config --markdown" "config --dump" "help exit-codes" "--help"; do
+        run bash -c "\"$SFSIM\" $c > /dev/full"
+        want_rc 4; want_err "cannot write to standard output"
+    done
+    run bash -c "\"$SFASM\" --help > /dev/full"
+    want_rc 4
+fi
+end
+
 begin "sfasm: a macro that calls itself twice gives one error naming it and its line, fast (was 125,000 lines)"
 printf '.macro m\n    m\n    m\n.endm\n    m\n' > "$T/bomb.s"
 run timeout 20 "$SFASM" "$T/bomb.s" -o "$T/bomb.sfo"
