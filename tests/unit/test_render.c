@@ -2,7 +2,8 @@
  * report.json and report.txt with accel.structure = kd, its figures per ray kind from the kernel's
  * counters (tests/unit/kd_stub.s stands in for the kd-tree kernel), and no kd section for the BVH;
  * the config block (every key), the files a report names, its tile and thread wording, and a
- * SAH cost that stays a number (or says why not) for a huge sphere.
+ * SAH cost that stays a number (or says why not) for a huge sphere; and the trace engine on a
+ * batch of 0 rays.
  */
 #include <cjson/cJSON.h>
 #include <criterion/criterion.h>
@@ -12,8 +13,11 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "../../scenes/pack.h"
+#include "../../scenes/scene.h"
 #include "../../sim/config.h"
 #include "../../sim/render.h"
+#include "../../sim/trace.h"
 
 static char *slurp(const char *path)
 {
@@ -276,4 +280,47 @@ Test(render, sah_cost_of_a_huge_sphere_is_a_number, .timeout = 120)
     cr_expect(isfinite(c->valuedouble) && c->valuedouble > 0.0, "sah_cost %g", c->valuedouble);
     free(txt);
     cJSON_Delete(j);
+}
+
+/* sfsim trace's engine on a batch of 0 rays, in every mode: 0, no hits, no instructions (the
+ * functional and detailed modes crashed: the thread pool capped its threads at the tile count, 0,
+ * and ran a worker with no job). The CLI test covers the files; this one runs under ASan. */
+Test(render, trace_of_zero_rays_in_every_mode, .timeout = 120)
+{
+    Scene s;
+    PackedScene p;
+    char err[4096];
+    cr_assert_eq(scene_load("scenes/cornell/scene.ini", &s, err, sizeof err), 0, "%s", err);
+    BvhParams bp;
+    bvh_default_params(&bp);
+    memset(&p, 0, sizeof p);
+    cr_assert_eq(pack_scene(&s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
+    CfgMachine cfg;
+    cfg_defaults(&cfg);
+    static const unsigned char header[16] = "SFRAYS1";
+    static const char *const sources[] = {"", "# comments only\n\n  # and blanks\n"};
+    static const char *const modes[] = {"functional", "detailed", "reference"};
+    for (int k = 0; k < 3; k++) {
+        RayBatch b;
+        memset(&b, 0, sizeof b);
+        const unsigned char *data = k < 2 ? (const unsigned char *)sources[k] : header;
+        size_t len = k < 2 ? strlen(sources[k]) : sizeof header;
+        cr_assert_eq(raybatch_parse("rays", data, len, &b, err, sizeof err), 0, "%s", err);
+        cr_assert_eq(b.count, 0u);
+        BatchHit hit;
+        for (int m = 0; m < 3; m++) {
+            uint64_t ninstr = 1;
+            TimingStats ts;
+            memset(&ts, 0xff, sizeof ts);
+            int rc = trace_batch_run(&p, s.needs, &b, &hit, modes[m], &cfg, "kernels/pathtrace.s", 2, &ninstr, &ts,
+                                     err, sizeof err);
+            cr_expect_eq(rc, 0, "input %d, %s: %s", k, modes[m], err);
+            cr_expect_eq(ninstr, 0u, "input %d, %s: %llu instructions", k, modes[m], (unsigned long long)ninstr);
+            if (m == 1)
+                cr_expect_eq(ts.cycles, 0u, "0 rays, %llu cycles", (unsigned long long)ts.cycles);
+        }
+        raybatch_free(&b);
+    }
+    pack_free(&p);
+    scene_free(&s);
 }
