@@ -51,7 +51,7 @@ help:
 	@echo "make fuzz       build the libFuzzer targets, assembler and scene loader (clang);"
 	@echo "                make fuzz-run FUZZ_SECONDS=600 runs each for that long"
 	@echo "make bench      build and run the benchmarks in bench/ (core, functional and detailed speed, Embree)"
-	@echo "make docs       regenerate docs/isa.md, the layout include and docs, the shipped Cornell box"
+	@echo "make docs       regenerate docs/isa.md, docs/exit-codes.md, the layout include and docs, the shipped Cornell box"
 	@echo "make install    install into PREFIX (default /usr/local; DESTDIR honoured): docs/install.md"
 
 deps:
@@ -103,6 +103,10 @@ bin/sfsim: $(BUILD)/obj/sim/main.o $(BUILD)/libsfsim.a
 $(BUILD)/gen_isadoc: tools/gen_isadoc.c $(BUILD)/libsfasm.a
 	$(CC) $(CFLAGS) $^ -o $@ -lm
 
+$(BUILD)/gen_exitdoc: tools/gen_exitdoc.c sim/exitcodes.def sim/exitcodes.h
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) tools/gen_exitdoc.c -o $@
+
 $(BUILD)/gen_layout: tools/gen_layout.c scenes/layout.def
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) tools/gen_layout.c -o $@
@@ -112,14 +116,15 @@ $(BUILD)/gen_cornell: tools/gen_cornell.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) tools/gen_cornell.c -o $@ $(CJSON) -lm
 
-docs: $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_cornell
+docs: $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_exitdoc $(BUILD)/gen_cornell
 	$(BUILD)/gen_cornell scenes/cornell
 	$(BUILD)/gen_isadoc > docs/isa.md
+	$(BUILD)/gen_exitdoc > docs/exit-codes.md
 	$(BUILD)/gen_layout inc > kernels/lib/layout.inc
 	$(BUILD)/gen_layout md > docs/scene-memory.md
 
 # ---- tests ----------------------------------------------------------------------------------
-$(BUILD)/tests/unit: $(TEST_SRC) $(BUILD)/libsfsim.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout
+$(BUILD)/tests/unit: $(TEST_SRC) $(BUILD)/libsfsim.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_exitdoc
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(LDAS) $(TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
 
@@ -127,7 +132,7 @@ $(BUILD)/tests/io: $(IO_TEST_SRC) $(BUILD)/libsfsim.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(LDAS) $(IO_TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(EMBREE) $(INIH) $(LDLIBS)
 
-$(BUILD)/tests/unit-asan: $(TEST_SRC) $(BUILD)/libsfsim-asan.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout
+$(BUILD)/tests/unit-asan: $(TEST_SRC) $(BUILD)/libsfsim-asan.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_exitdoc
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(SAN) $(LDAS) $(TEST_SRC) $(BUILD)/libsfsim-asan.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
 
@@ -192,7 +197,7 @@ $(BUILD)/fuzz/fuzz_rays: tests/fuzz/fuzz_rays.c sim/raybatch.c sim/outfile.c
 
 $(BUILD)/fuzz/fuzz_config: tests/fuzz/fuzz_config.c sim/config.c sim/timing.c sim/event.c sim/scenemem.c isa/isa.c
 	@mkdir -p $(dir $@)
-	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ $(INIH) -lm
+	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ $(INIH) $(CJSON) -lm
 
 fuzz: $(BUILD)/fuzz/fuzz_asm $(BUILD)/fuzz/fuzz_scene $(BUILD)/fuzz/fuzz_rays $(BUILD)/fuzz/fuzz_config
 

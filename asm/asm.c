@@ -110,8 +110,34 @@ static void add_expansions(const Asm *a, Msg *m, int exp)
     msg_add(m, ")");
 }
 
+/* Pass-2 messages are emitted after pass-1 ones; sorting by source line restores reading order
+ * (ties keep their order: stable). */
+static int diag_cmp(const void *x, const void *y)
+{
+    const AsmDiag *p = x, *q = y;
+    if (p->seq != q->seq)
+        return p->seq < q->seq ? -1 : 1;
+    return p->order < q->order ? -1 : p->order > q->order;
+}
+
+/* Keeps the first ASM_MAX_ERRORS_SHOWN diagnostics in reading order and frees the rest: a
+ * macro that fails in every one of its expansions would otherwise print (and hold) hundreds of
+ * thousands of lines. */
+static void trim_diags(Asm *a)
+{
+    if (a->ndiags <= ASM_MAX_ERRORS_SHOWN)
+        return;
+    qsort(a->diags, a->ndiags, sizeof *a->diags, diag_cmp);
+    for (size_t i = ASM_MAX_ERRORS_SHOWN; i < a->ndiags; i++)
+        free(a->diags[i].text);
+    a->diags_dropped += a->ndiags - ASM_MAX_ERRORS_SHOWN;
+    a->ndiags = ASM_MAX_ERRORS_SHOWN;
+}
+
 static void add_diag(Asm *a, uint64_t seq, char *text)
 {
+    if (a->ndiags >= 2 * ASM_MAX_ERRORS_SHOWN)
+        trim_diags(a);
     AsmDiag *nd = asm_grow(a->diags, &a->capdiags, a->ndiags + 1, sizeof *nd);
     if (!nd) { /* cannot keep it for ordering: say it now rather than lose it */
         fputs(text, a->opt->diag ? a->opt->diag : stderr);
@@ -119,7 +145,8 @@ static void add_diag(Asm *a, uint64_t seq, char *text)
         return;
     }
     a->diags = nd;
-    a->diags[a->ndiags] = (AsmDiag){seq, a->ndiags, text};
+    /* order counts every diagnostic so far, the trimmed ones too, so it only grows */
+    a->diags[a->ndiags] = (AsmDiag){seq, a->ndiags + a->diags_dropped, text};
     a->ndiags++;
 }
 
@@ -164,29 +191,24 @@ void asm_oom(Asm *a)
     a->fatal = 1;
 }
 
-/* Pass-2 messages are emitted after pass-1 ones; sorting by source line restores reading order
- * (ties keep their order: stable). */
-static int diag_cmp(const void *x, const void *y)
-{
-    const AsmDiag *p = x, *q = y;
-    if (p->seq != q->seq)
-        return p->seq < q->seq ? -1 : 1;
-    return p->order < q->order ? -1 : p->order > q->order;
-}
-
 static void flush_diags(Asm *a)
 {
     FILE *out = a->opt->diag ? a->opt->diag : stderr;
+    trim_diags(a);
     if (a->ndiags > 1)
         qsort(a->diags, a->ndiags, sizeof *a->diags, diag_cmp);
     for (size_t i = 0; i < a->ndiags; i++) {
         fputs(a->diags[i].text, out);
         free(a->diags[i].text);
     }
+    if (a->diags_dropped)
+        fprintf(out, "... and %zu more error%s (only the first %d are shown)\n", a->diags_dropped,
+                a->diags_dropped == 1 ? "" : "s", ASM_MAX_ERRORS_SHOWN);
     fflush(out);
     free(a->diags);
     a->diags = NULL;
     a->ndiags = a->capdiags = 0;
+    a->diags_dropped = 0;
 }
 
 /* ---- files ------------------------------------------------------------------------------------ */
@@ -669,8 +691,14 @@ void asm_macro_call(Asm *a, const AsmMacro *m, const AsmToken *t, int first_arg)
 {
     const AsmToken *name = &t[first_arg - 1];
     if (count_frames(a, 1) >= ASM_MAX_MACRO_DEPTH) {
-        asm_error_at(a, name->col, "macro '%s' nested too deeply (limit %d nested expansions)", m->name,
-                     ASM_MAX_MACRO_DEPTH);
+        /* Recursion without an end: one error, then stop, since the calls beside this one in
+         * every enclosing expansion would each hit the limit again (2^64 errors for a macro that
+         * calls itself twice). */
+        asm_error_at(a, name->col,
+                     "macro '%s' (defined at %s:%u) nested too deeply: more than %d nested expansions "
+                     "(does it call itself without an end?)",
+                     m->name, asm_file_name(a, m->file), m->line, ASM_MAX_MACRO_DEPTH);
+        a->fatal = 1;
         return;
     }
     if (m->nbody > ASM_MAX_EXPAND_LINES - a->expand_lines) {

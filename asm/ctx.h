@@ -32,6 +32,9 @@
 #define ASM_MAX_EXPAND_LINES   250000u                  /* all macro expansions together */
 #define ASM_MAX_EXPAND_BYTES   (16u << 20)
 #define ASM_MAX_DEFER_DEPTH    200                      /* chains of forward-defined constants */
+/* Diagnostics printed: the first ones in source order, then "... and N more errors". Every error
+ * still counts; at most twice this many are kept in memory at once. */
+#define ASM_MAX_ERRORS_SHOWN   50
 
 /* Where something is: file index, line, column (1-based), macro expansion (-1: none) and the
  * sequence number of the source line, which orders diagnostics. */
@@ -136,6 +139,7 @@ typedef struct Asm {
     int errors;
     int fatal;                   /* stop reading input (a limit was hit) */
     AsmDiag *diags;   size_t ndiags, capdiags;
+    size_t diags_dropped;        /* diagnostics beyond the first ASM_MAX_ERRORS_SHOWN, freed */
     char **files;     size_t nfiles, capfiles;
     AsmFrame *frames; size_t nframes, capframes;
     AsmCurLine cur;

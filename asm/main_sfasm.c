@@ -1,6 +1,7 @@
 /* asm/main_sfasm.c -- the sfasm command line: assemble a file, or disassemble an object.
  *
- * Owns: argument parsing, output naming and exit codes (0 ok, 1 assembly or I/O errors, 2 usage).
+ * Owns: argument parsing, output naming and exit codes (sim/exitcodes.def: EXIT_OK, EXIT_INPUT for
+ * errors in the source or object read, EXIT_USAGE, EXIT_IO when the output cannot be written).
  * Must not: assemble or format anything itself (asm/ does).
  */
 #include <errno.h>
@@ -9,6 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../sim/exitcodes.h"
+#include "../sim/exithelp.h"
 #include "asm.h"
 
 #define SFASM_VERSION "1.0"
@@ -37,8 +40,11 @@ static void usage(FILE *f)
             "  --help          this text\n"
             "  --version       the version\n"
             "\n"
-            "exit status: 0 success, 1 assembly or I/O errors, 2 usage errors\n"
-            "documentation: docs/assembler.md, docs/object-format.md\n");
+            "At most 50 errors are printed (in source order), then how many more there were.\n"
+            "\n"
+            "exit codes (shared by sfsim; sfasm returns 0, 1, 2 or 4; docs/exit-codes.md):\n");
+    exithelp_print(f);
+    fprintf(f, "\ndocumentation: docs/assembler.md, docs/object-format.md\n");
 }
 
 __attribute__((format(printf, 1, 2)))
@@ -50,7 +56,7 @@ static int usage_error(const char *fmt, ...)
     vfprintf(stderr, fmt, ap);
     fprintf(stderr, "\n(try 'sfasm --help')\n");
     va_end(ap);
-    return 2;
+    return EXIT_USAGE;
 }
 
 static int parse_define(Args *a, char *spec)
@@ -104,7 +110,7 @@ static int parse_args(int argc, char **argv, Args *a)
             if (!(val = opt_value(argc, argv, &i)))
                 return usage_error("option %s needs a value", arg);
             if (arg[1] == 'D' && parse_define(a, val) != 0)
-                return 2;
+                return EXIT_USAGE;
             if (arg[1] == 'I')
                 a->include_dirs[a->ninclude_dirs++] = val;
             if (arg[1] == 'o')
@@ -134,11 +140,15 @@ static int disassemble(const Args *a)
     char err[512];
     if (asm_object_read(a->disasm, &obj, err, sizeof err) < 0) {
         fprintf(stderr, "sfasm: %s\n", err);
-        return 1;
+        return EXIT_INPUT;
     }
     asm_disassemble(&obj, stdout, a->source);
     asm_object_free(&obj);
-    return fflush(stdout) == 0 ? 0 : 1;
+    if (fflush(stdout) != 0 || ferror(stdout)) {
+        fprintf(stderr, "sfasm: -d %s: cannot write the disassembly to stdout\n", a->disasm);
+        return EXIT_IO;
+    }
+    return EXIT_OK;
 }
 
 /* FILE.s -> FILE.sfo; any other name gets .sfo appended. */
@@ -162,7 +172,7 @@ static int assemble(const Args *a)
     int errors = asm_assemble_file(a->input, &opt, &obj);
     if (errors) {
         fprintf(stderr, "sfasm: %d error%s\n", errors, errors == 1 ? "" : "s");
-        return 1;
+        return EXIT_INPUT;
     }
     char *out = a->output ? NULL : default_output(a->input), err[512];
     int rc = -1;
@@ -174,7 +184,7 @@ static int assemble(const Args *a)
         fprintf(stderr, "sfasm: %s\n", err);
     free(out);
     asm_object_free(&obj);
-    return rc < 0 ? 1 : 0;
+    return rc < 0 ? EXIT_IO : EXIT_OK;
 }
 
 int main(int argc, char **argv)
@@ -184,8 +194,13 @@ int main(int argc, char **argv)
     if (rc == 0)
         rc = a.disasm ? disassemble(&a) : assemble(&a);
     else if (rc < 0)
-        rc = 0;
+        rc = EXIT_OK;
     free(a.defines);
     free(a.include_dirs);
+    if (fflush(stdout) != 0 || ferror(stdout)) { /* --help, --version */
+        fprintf(stderr, "sfasm: cannot write to standard output\n");
+        if (rc == EXIT_OK)
+            rc = EXIT_IO;
+    }
     return rc;
 }

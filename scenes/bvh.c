@@ -333,23 +333,28 @@ out:
     return rc;
 }
 
+/* Surface area in double: a box of finite floats has a finite area here (extents up to 7e38,
+ * products up to 5e77), where the float area overflows from extents of about 1e19 on (a sphere of
+ * radius 1e30 gave inf / inf = NaN as the cost). */
+static double node_area(const float *lo, const float *hi)
+{
+    double d[3];
+    for (int k = 0; k < 3; k++)
+        d[k] = hi[k] > lo[k] ? (double)hi[k] - (double)lo[k] : 0.0;
+    return 2.0 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]);
+}
+
 double bvh_sah_cost(const Bvh *b, const BvhParams *p)
 {
     if (b->nnodes == 0)
         return 0.0;
-    Box root;
-    memcpy(root.lo, b->nodes[0].bmin, sizeof root.lo);
-    memcpy(root.hi, b->nodes[0].bmax, sizeof root.hi);
-    double ra = box_area(&root);
+    double ra = node_area(b->nodes[0].bmin, b->nodes[0].bmax);
     if (!(ra > 0.0))
         ra = 1.0;
     double cost = 0.0;
     for (uint32_t i = 0; i < b->nnodes; i++) {
         const BvhNode *n = &b->nodes[i];
-        Box bx;
-        memcpy(bx.lo, n->bmin, sizeof bx.lo);
-        memcpy(bx.hi, n->bmax, sizeof bx.hi);
-        double a = box_area(&bx) / ra;
+        double a = node_area(n->bmin, n->bmax) / ra;
         cost += a * (n->count > 0 ? (double)p->cost_intersect * n->count : (double)p->cost_traversal);
     }
     return cost;

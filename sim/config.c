@@ -6,6 +6,7 @@
  */
 #include "config.h"
 
+#include <cjson/cJSON.h>
 #include <errno.h>
 #include <ini.h>
 #include <math.h>
@@ -476,5 +477,21 @@ void cfg_markdown(FILE *out)
         else
             fprintf(out, "| `%s.%s` | %s | %s | %s..%s | %s |\n", k->section, k->key, type_name(k->type), def, lo,
                     hi, k->help);
+    }
+}
+
+void cfg_json(const CfgMachine *cfg, struct cJSON *obj)
+{
+    for (size_t i = 0; i < NKEYS; i++) {
+        const CfgKeyInfo *k = &keys[i];
+        char name[128];
+        snprintf(name, sizeof name, "%s.%s", k->section, k->key);
+        double v = load(cfg, k);
+        if (k->type == CFG_ENUM) {
+            const char *n = cfg_enum_name(k->section, k->key, (int)v);
+            cJSON_AddStringToObject(obj, name, n ? n : "?");
+        } else {
+            cJSON_AddNumberToObject(obj, name, v);
+        }
     }
 }

@@ -60,5 +60,9 @@ const char *cfg_enum_name(const char *section, const char *key, int value);
 void cfg_dump(const CfgMachine *cfg, FILE *out);
 /* docs/config.md. */
 void cfg_markdown(FILE *out);
+/* Every key with its value in cfg, as "section.key" members of the JSON object obj (report.json's
+ * `config`): numbers for int, int64 and float keys, the value's name for enum keys. */
+struct cJSON;
+void cfg_json(const CfgMachine *cfg, struct cJSON *obj);
 
 #endif

@@ -812,9 +812,11 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
     atomic_init(&job->next_tile, 0u);
     atomic_init(&job->done_tiles, 0u);
     atomic_init(&job->failed, 0);
+    /* At most one thread per tile, but always the calling thread: with no tile (an empty ray
+     * batch) it finds no work and the run yields empty, valid results (docs/trace.md). */
     int nthreads = fp->threads < 1 ? 1 : fp->threads;
     if ((uint32_t)nthreads > job->ntiles)
-        nthreads = (int)job->ntiles;
+        nthreads = job->ntiles ? (int)job->ntiles : 1;
     ws = calloc((size_t)nthreads, sizeof *ws);
     th = calloc((size_t)nthreads, sizeof *th);
     if (!job->tiles || !ws || !th) {

@@ -41,4 +41,10 @@ typedef struct ImgCompare {
 /* Compare two images of the same size. */
 void img_compare(const float *a, const float *b, int width, int height, ImgCompare *out);
 
+/* What a file's values are, from its format's magic bytes: linear radiance (EXR, HDR, PFM),
+ * display-encoded (PNG, JPEG, GIF, BMP: sRGB transfer, clamped to 0..1), or unknown (TIFF and
+ * the rest, which may hold either; also unreadable files). */
+typedef enum ImgEncoding { IMG_ENC_UNKNOWN, IMG_ENC_LINEAR, IMG_ENC_DISPLAY } ImgEncoding;
+ImgEncoding img_encoding(const char *path);
+
 #endif

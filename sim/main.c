@@ -1,10 +1,12 @@
 /* sim/main.c -- the `sfsim` command line.
  *
  * Owns: argument parsing, exit codes and what is printed. Must not: simulate (it calls the
- * core, the config and the renderers). Exit codes: 0 ok, 1 input or config error, 2 usage,
- * 3 the simulated program trapped or hit its instruction limit.
+ * core, the config and the renderers). Exit codes: the EXIT_* of sim/exitcodes.def, nothing
+ * else; an option value out of range is bad input (EXIT_INPUT), an unknown option or a missing
+ * argument a usage error (EXIT_USAGE).
  */
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,6 +18,7 @@
 #include "core.h"
 #include "datadir.h"
 #include "exitcodes.h"
+#include "exithelp.h"
 #include "img.h"
 #include "render.h"
 #include "sweep.h"
@@ -23,8 +26,6 @@
 #include "trace.h"
 
 #define SFSIM_VERSION "0.1"
-
-enum { EXIT_TRAP = EXIT_PROGRAM }; /* this file's older name for it */
 
 static void usage(FILE *out)
 {
@@ -43,11 +44,31 @@ static void usage(FILE *out)
             "  trace    closest-hit / any-hit queries for a file of rays, through the kernel or the golden model\n"
             "  sweep    run a scene over many machine configs in parallel (sweep files, resumable; CSV, plots)\n"
             "  merge    build a sweep's CSV and plots from its point folders (after Slurm or GNU parallel)\n"
-            "  help     help on a command: sfsim help exec\n"
+            "  help     help on a command (sfsim help exec), or on the exit codes (sfsim help exit-codes)\n"
             "\n"
             "options everywhere: --help, --version\n"
-            "exit codes: 0 ok, 1 input or config error, 2 usage error, 3 program trapped or hit its limit\n"
-            "documentation: docs/README.md\n");
+            "\n"
+            "exit codes (every command; docs/exit-codes.md):\n");
+    exithelp_print(out);
+    fprintf(out, "\ndocumentation: docs/README.md\n");
+}
+
+static void usage_help(FILE *out)
+{
+    fprintf(out,
+            "usage: sfsim help [COMMAND | exit-codes]\n"
+            "\n"
+            "Prints the help of COMMAND (run, exec, config, compare, trace, sweep, merge, help), the exit\n"
+            "codes every command returns (exit-codes), or without an argument the list of commands.\n"
+            "`sfsim COMMAND --help` prints the same as `sfsim help COMMAND`.\n");
+}
+
+static void usage_exit_codes(FILE *out)
+{
+    fprintf(out,
+            "Exit codes of every sfsim and sfasm command (sim/exitcodes.def; docs/exit-codes.md):\n"
+            "\n");
+    exithelp_print(out);
 }
 
 static void usage_exec(FILE *out)
@@ -68,9 +89,15 @@ static void usage_exec(FILE *out)
             "  --width N                SIMD width, same as --set core.simd_width=N\n"
             "  --max-instructions N     instruction limit, same as --set sim.max_instructions=N\n"
             "  --dump-mem MEM:ADDR:WORDS  print WORDS words of MEM (rb0 rb1 idm spad scene fb) from\n"
-            "                           byte address ADDR after the run (repeatable)\n"
+            "                           byte address ADDR (a multiple of 4) after the run (repeatable)\n"
             "  -t, --timing             time the run on the machine of the config (detailed mode)\n"
-            "  -q, --quiet              print only the summary line (and the timing, with --timing)\n");
+            "  -q, --quiet              print only the summary line (and the timing, with --timing)\n"
+            "  --no-progress            no progress line: a run still going after 2 s otherwise says on\n"
+            "                           stderr, every 5 s, how many instructions it ran of the limit\n"
+            "\n"
+            "The --dump-mem specs are checked against the config's memory sizes before the program runs.\n"
+            "Exit codes: 0 halted, 1 bad input (config, object, --dump-mem spec), 2 usage, 3 trap or the\n"
+            "instruction limit (sfsim help exit-codes).\n");
 }
 
 static void usage_config(FILE *out)
@@ -171,41 +198,108 @@ static void print_float_of(uint32_t u, char *buf, size_t len)
     snprintf(buf, len, "%.9g", (double)f);
 }
 
-static int dump_mem(Core *c, const char *spec)
+/* One --dump-mem MEM:ADDR:WORDS, checked against the configured memory sizes before the program
+ * runs (a typo must not cost a long run). */
+typedef struct MemDump {
+    const char *spec;
+    CoreMem mem;
+    uint32_t addr, words;
+} MemDump;
+
+/* A number of a --dump-mem spec: decimal, 0x hex or 0 octal, nothing else after it but `stop`. */
+static int dump_number(const char *s, char stop, unsigned long long *out, const char **rest)
 {
-    char name[16];
-    long addr, words;
-    const char *colon = strchr(spec, ':');
-    if (!colon || (size_t)(colon - spec) >= sizeof name ||
-        sscanf(colon + 1, "%li:%li", &addr, &words) != 2 || addr < 0 || words < 0) {
-        fprintf(stderr, "sfsim: --dump-mem %s: expected MEM:ADDR:WORDS\n", spec);
+    char *end;
+    errno = 0;
+    if (*s == '-' || *s == '+' || *s == ' ')
+        return -1;
+    unsigned long long v = strtoull(s, &end, 0);
+    if (end == s || errno || *end != stop)
+        return -1;
+    *out = v;
+    *rest = end;
+    return 0;
+}
+
+static int dump_parse(const char *spec, const CoreParams *cp, MemDump *d)
+{
+    const char *colon = strchr(spec, ':'), *rest;
+    unsigned long long addr, words;
+    if (!colon || dump_number(colon + 1, ':', &addr, &rest) || dump_number(rest + 1, '\0', &words, &rest)) {
+        fprintf(stderr, "sfsim exec: --dump-mem %s: expected MEM:ADDR:WORDS, e.g. spad:0x40:8 (sfsim help exec)\n",
+                spec);
         return -1;
     }
-    memcpy(name, spec, (size_t)(colon - spec));
-    name[colon - spec] = 0;
     int m = -1;
     for (int i = 0; i < CORE_MEM_COUNT; i++)
-        if (strcmp(name, core_mem_names[i]) == 0)
+        if (strlen(core_mem_names[i]) == (size_t)(colon - spec) && !strncmp(spec, core_mem_names[i], (size_t)(colon - spec)))
             m = i;
     if (m < 0) {
-        fprintf(stderr, "sfsim: --dump-mem %s: unknown memory '%s' (rb0 rb1 idm spad scene fb)\n", spec, name);
+        fprintf(stderr, "sfsim exec: --dump-mem %s: unknown memory '%.*s' (rb0 rb1 idm spad scene fb)\n", spec,
+                (int)(colon - spec), spec);
         return -1;
     }
+    uint64_t size = cp->mem_bytes[m];
+    if (addr % 4) {
+        fprintf(stderr, "sfsim exec: --dump-mem %s: address 0x%llx is not a multiple of 4 (words are 4 bytes)\n",
+                spec, addr);
+        return -1;
+    }
+    if (addr > size || words > (size - addr) / 4) {
+        fprintf(stderr, "sfsim exec: --dump-mem %s: %llu word%s from 0x%llx end%s beyond %s (%llu bytes in this config)\n",
+                spec, words, words == 1 ? "" : "s", addr, words == 1 ? "s" : "", core_mem_names[m],
+                (unsigned long long)size);
+        return -1;
+    }
+    *d = (MemDump){spec, (CoreMem)m, (uint32_t)addr, (uint32_t)words};
+    return 0;
+}
+
+static void dump_print(Core *c, const MemDump *d)
+{
     uint32_t size;
-    uint8_t *mem = core_mem(c, (CoreMem)m, &size);
-    if (addr % 4 || addr > (long)size || words > ((long)size - addr) / 4) {
-        fprintf(stderr, "sfsim: --dump-mem %s: outside %s (%u bytes) or misaligned\n", spec, name, size);
-        return -1;
-    }
-    printf("%s from 0x%08lx:\n", name, addr);
-    for (long i = 0; i < words; i++) {
+    uint8_t *mem = core_mem(c, d->mem, &size);
+    printf("%s from 0x%08x:\n", core_mem_names[d->mem], d->addr);
+    for (uint32_t i = 0; i < d->words && d->addr + 4ull * i + 4 <= size; i++) {
         uint32_t w;
-        memcpy(&w, mem + addr + 4 * i, 4);
+        memcpy(&w, mem + d->addr + 4 * i, 4);
         char f[32];
         print_float_of(w, f, sizeof f);
-        printf("  [0x%08lx] 0x%08x %11d  %s\n", addr + 4 * i, w, (int32_t)w, f);
+        printf("  [0x%08x] 0x%08x %11d  %s\n", d->addr + 4 * i, w, (int32_t)w, f);
     }
-    return 0;
+}
+
+/* Run to halt, trap or the instruction limit in slices, so that a long run can say how far it is:
+ * after `after` seconds (SFSIM_PROGRESS_AFTER, default 2; 0 reports after every slice) and then
+ * every 5 s, one line on stderr. stdout is the same with or without it. */
+static CoreExit run_with_progress(Core *c, uint64_t limit, int progress)
+{
+    enum { SLICE = 1 << 20 };
+    double after = 2.0;
+    const char *env = getenv("SFSIM_PROGRESS_AFTER");
+    if (env && *env) {
+        char *end;
+        double v = strtod(env, &end);
+        if (!*end && v >= 0.0 && isfinite(v))
+            after = v;
+    }
+    double t0 = now(), next = t0 + after;
+    uint64_t done = 0;
+    for (;;) {
+        uint64_t slice = limit - done < SLICE ? limit - done : SLICE;
+        CoreExit ex = core_run(c, slice);
+        done += slice;
+        if (ex != CORE_EXIT_LIMIT || done >= limit)
+            return ex;
+        double t = now();
+        if (progress && t >= next) {
+            uint64_t n = core_instructions(c);
+            fprintf(stderr, "sfsim exec: still running after %.0f s: %llu instructions of the limit %llu "
+                    "(sim.max_instructions; --max-instructions N sets it)\n", t - t0, (unsigned long long)n,
+                    (unsigned long long)limit);
+            next = t + (after > 0.0 ? 5.0 : 0.0);
+        }
+    }
 }
 
 static void print_state(Core *c)
@@ -295,7 +389,7 @@ static int cmd_exec(int argc, char **argv)
 {
     ConfigArgs ca = {0};
     const char *prog = NULL, *dumps[64];
-    int ndumps = 0, quiet = 0, timed = 0;
+    int ndumps = 0, quiet = 0, timed = 0, progress = 1;
     char setbuf[2][64];
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
@@ -326,6 +420,8 @@ static int cmd_exec(int argc, char **argv)
             quiet = 1;
         } else if (!strcmp(a, "-t") || !strcmp(a, "--timing")) {
             timed = 1;
+        } else if (!strcmp(a, "--no-progress")) {
+            progress = 0;
         } else if (a[0] == '-') {
             fprintf(stderr, "sfsim exec: unknown option or missing value: %s (sfsim help exec)\n", a);
             return EXIT_USAGE;
@@ -343,14 +439,18 @@ static int cmd_exec(int argc, char **argv)
     CfgMachine cfg;
     if (build_config(&ca, &cfg))
         return EXIT_INPUT;
+    CoreParams cp;
+    cfg_core_params(&cfg, &cp);
+    MemDump dd[64];
+    for (int i = 0; i < ndumps; i++)
+        if (dump_parse(dumps[i], &cp, &dd[i]))
+            return EXIT_INPUT;
     AsmObject obj;
     char err[1024];
     if (asm_object_read(prog, &obj, err, sizeof err) != 0) {
         fprintf(stderr, "sfsim exec: %s\n", err);
         return EXIT_INPUT;
     }
-    CoreParams cp;
-    cfg_core_params(&cfg, &cp);
     Core *c = core_new(&cp, &obj, err, sizeof err);
     if (!c) {
         fprintf(stderr, "sfsim exec: %s: %s\n", prog, err);
@@ -371,7 +471,7 @@ static int cmd_exec(int argc, char **argv)
         core_set_hook(c, timing_hook, tm);
     }
     double t0 = now();
-    CoreExit ex = core_run(c, (uint64_t)cfg.sim_max_instructions);
+    CoreExit ex = run_with_progress(c, (uint64_t)cfg.sim_max_instructions, progress);
     double secs = now() - t0;
     if (tm)
         timing_end(tm);
@@ -383,16 +483,24 @@ static int cmd_exec(int argc, char **argv)
     if (!quiet)
         print_state(c);
     for (int i = 0; i < ndumps; i++)
-        if (dump_mem(c, dumps[i]))
-            rc = EXIT_USAGE;
+        dump_print(c, &dd[i]);
     if (tm) {
         if (print_timing(timing_stats(tm), timing_error(tm)))
-            rc = EXIT_TRAP;
+            rc = EXIT_PROGRAM;
         timing_free(tm);
     }
-    if (ex != CORE_EXIT_HALT) {
+    if (ex == CORE_EXIT_LIMIT) {
+        /* The core names the limit of its last slice; the run's limit is the configured one. */
+        const char *msg = core_trap_message(c), *tail = strstr(msg, " reached");
+        if (!strncmp(msg, "trap: instruction limit of ", 27) && tail)
+            fprintf(stderr, "sfsim exec: trap: instruction limit of %llu reached%s\n",
+                    (unsigned long long)cfg.sim_max_instructions, tail + 8);
+        else
+            fprintf(stderr, "sfsim exec: %s\n", msg);
+        rc = EXIT_PROGRAM;
+    } else if (ex != CORE_EXIT_HALT) {
         fprintf(stderr, "sfsim exec: %s\n", core_trap_message(c));
-        rc = EXIT_TRAP;
+        rc = EXIT_PROGRAM;
     }
     core_free(c);
     asm_object_free(&obj);
@@ -444,8 +552,10 @@ static void usage_compare(FILE *out)
             "\n"
             "Compares two images of the same size (any format OpenImageIO reads; EXR compares linear\n"
             "radiance, PNG the stored 0..1 values) and prints RMSE, PSNR (peak 1), the largest channel\n"
-            "difference, both means and the NaN/Inf counts. Exit 0 when it could compare, 1 when an\n"
-            "image cannot be read or the sizes differ.\n");
+            "difference, both means and the NaN/Inf counts. The values are compared as stored, never\n"
+            "converted: a linear image (EXR, HDR, PFM) against a display image (PNG, JPEG) gets a warning\n"
+            "on stderr, since PNG's values are sRGB-encoded, exposure-scaled and clamped. Exit 0 when it\n"
+            "could compare, 1 when an image cannot be read or the sizes differ.\n");
 }
 
 static int cmd_compare(int argc, char **argv)
@@ -467,6 +577,13 @@ static int cmd_compare(int argc, char **argv)
     } else if (wa != wb || ha != hb) {
         fprintf(stderr, "sfsim compare: sizes differ: %s is %d x %d, %s is %d x %d\n", argv[0], wa, ha, argv[1], wb, hb);
     } else {
+        ImgEncoding ea = img_encoding(argv[0]), eb = img_encoding(argv[1]);
+        if (ea != eb && ea != IMG_ENC_UNKNOWN && eb != IMG_ENC_UNKNOWN)
+            fprintf(stderr,
+                    "sfsim compare: warning: %s holds %s and %s %s: the figures below compare different encodings, "
+                    "not the renders (compare frame.exr with frame.exr, or frame.png with frame.png)\n",
+                    argv[0], ea == IMG_ENC_LINEAR ? "linear radiance" : "display values (sRGB-encoded, clamped to 0..1)",
+                    argv[1], eb == IMG_ENC_LINEAR ? "linear radiance" : "display values (sRGB-encoded, clamped to 0..1)");
         ImgCompare c;
         img_compare(a, b, wa, ha, &c);
         printf("%s vs %s (%d x %d)\n", argv[0], argv[1], wa, ha);
@@ -479,13 +596,14 @@ static int cmd_compare(int argc, char **argv)
     return rc;
 }
 
-static int parse_int(const char *opt, const char *s, long lo, long hi, long *out)
+/* An integer option value in lo..hi; a bad value is bad input (EXIT_INPUT), said by the caller. */
+static int parse_int(const char *cmd, const char *opt, const char *s, long lo, long hi, long *out)
 {
     char *end;
     errno = 0;
     long v = strtol(s, &end, 10);
     if (end == s || *end || errno || v < lo || v > hi) {
-        fprintf(stderr, "sfsim run: %s %s: expected an integer in %ld..%ld\n", opt, s, lo, hi);
+        fprintf(stderr, "sfsim %s: %s %s: expected an integer in %ld..%ld\n", cmd, opt, s, lo, hi);
         return -1;
     }
     *out = v;
@@ -518,15 +636,15 @@ static int cmd_run(int argc, char **argv)
         } else if (!strcmp(a, "--mode") && has_next) {
             mode = argv[++i];
         } else if ((!strcmp(a, "-j") || !strcmp(a, "--threads")) && has_next) {
-            if (parse_int(a, argv[++i], 1, 1024, &v))
-                return EXIT_USAGE;
+            if (parse_int("run", a, argv[++i], 1, 1024, &v))
+                return EXIT_INPUT;
             o.threads = (int)v;
         } else if (!strcmp(a, "--exposure") && has_next) {
             char *end;
             o.exposure = strtof(argv[++i], &end);
-            if (*end || !(o.exposure > 0.0f)) {
-                fprintf(stderr, "sfsim run: --exposure %s: expected a positive number\n", argv[i]);
-                return EXIT_USAGE;
+            if (end == argv[i] || *end || !isfinite(o.exposure) || !(o.exposure > 0.0f)) {
+                fprintf(stderr, "sfsim run: --exposure %s: expected a finite positive number (a float)\n", argv[i]);
+                return EXIT_INPUT;
             }
         } else if (!strcmp(a, "--sample") && has_next) {
             char *end;
@@ -534,12 +652,12 @@ static int cmd_run(int argc, char **argv)
             if (*end || !(o.sample > 0.0 && o.sample <= 1.0)) {
                 fprintf(stderr, "sfsim run: --sample %s: expected a fraction of the tiles in (0, 1], e.g. 0.05\n",
                         argv[i]);
-                return EXIT_USAGE;
+                return EXIT_INPUT;
             }
             sample_given = 1;
         } else if (!strcmp(a, "--sample-seed") && has_next) {
-            if (parse_int(a, argv[++i], 0, 4294967295L, &v))
-                return EXIT_USAGE;
+            if (parse_int("run", a, argv[++i], 0, 4294967295L, &v))
+                return EXIT_INPUT;
             o.sample_seed = (uint32_t)v;
         } else if (!strcmp(a, "--no-progress")) {
             o.progress = 0;
@@ -554,8 +672,8 @@ static int cmd_run(int argc, char **argv)
                     continue;
                 char opt[64];
                 snprintf(opt, sizeof opt, "--set %s =", render_keys[k].key);
-                if (parse_int(opt, s + kl + 1, (long)render_keys[k].lo, (long)render_keys[k].hi, &v))
-                    return EXIT_USAGE;
+                if (parse_int("run", opt, s + kl + 1, (long)render_keys[k].lo, (long)render_keys[k].hi, &v))
+                    return EXIT_INPUT;
                 if (k == RENDER_KEY_WIDTH) o.width = (int)v;
                 if (k == RENDER_KEY_HEIGHT) o.height = (int)v;
                 if (k == RENDER_KEY_SPP) o.spp = (int)v;
@@ -574,7 +692,7 @@ static int cmd_run(int argc, char **argv)
         strcmp(mode, "sampled") != 0) {
         fprintf(stderr, "sfsim run: --mode %s: expected detailed, sampled, functional or reference (sfsim help run)\n",
                 mode);
-        return EXIT_USAGE;
+        return EXIT_INPUT;
     }
     if (sample_given && strcmp(mode, "sampled") != 0) {
         fprintf(stderr, "sfsim run: --sample applies to --mode sampled only (sfsim help run)\n");
@@ -597,11 +715,13 @@ static int cmd_run(int argc, char **argv)
     o.bvh_leaf_size = cfg.bvh_leaf_size;
     o.bvh_bins = cfg.bvh_bins;
     o.cfg = &cfg;
+    o.config_path = ca.path;
     static char err[65536];
     int rrc = render_run(&o, err, sizeof err);
     if (rrc != 0) {
         fprintf(stderr, "sfsim run: %s\n", err);
-        return rrc == -2 ? EXIT_TRAP : rrc == -3 ? EXIT_IO : EXIT_INPUT;
+        /* -3: an output could not be written (trace_run's convention, for render_run's writers) */
+        return rrc == -2 ? EXIT_PROGRAM : rrc == -3 ? EXIT_IO : EXIT_INPUT;
     }
     printf("sfsim run: wrote %s/frame.png, frame.exr, report.txt, report.json%s\n", o.out_dir,
            !strcmp(mode, "detailed") || !strcmp(mode, "sampled") ? ", cost.png" : "");
@@ -655,8 +775,8 @@ static int cmd_trace(int argc, char **argv)
         } else if (!strcmp(a, "--binary")) {
             o.binary = 1;
         } else if ((!strcmp(a, "-j") || !strcmp(a, "--threads")) && has_next) {
-            if (parse_int(a, argv[++i], 1, 1024, &v))
-                return EXIT_USAGE;
+            if (parse_int("trace", a, argv[++i], 1, 1024, &v))
+                return EXIT_INPUT;
             o.threads = (int)v;
         } else if (!strcmp(a, "--kernel") && has_next) {
             o.kernel_path = argv[++i];
@@ -671,7 +791,7 @@ static int cmd_trace(int argc, char **argv)
     }
     if (strcmp(o.mode, "functional") != 0 && strcmp(o.mode, "reference") != 0 && strcmp(o.mode, "detailed") != 0) {
         fprintf(stderr, "sfsim trace: --mode %s: expected functional, detailed or reference\n", o.mode);
-        return EXIT_USAGE;
+        return EXIT_INPUT;
     }
     if (o.threads == 0)
         o.threads = (int)sysconf(_SC_NPROCESSORS_ONLN);
@@ -684,7 +804,7 @@ static int cmd_trace(int argc, char **argv)
     int rc = trace_run(&o, &sum, err, sizeof err);
     if (rc != 0) {
         fprintf(stderr, "sfsim trace: %s\n", err);
-        return rc == -2 ? EXIT_TRAP : rc == -3 ? EXIT_IO : EXIT_INPUT;
+        return rc == -2 ? EXIT_PROGRAM : rc == -3 ? EXIT_IO : EXIT_INPUT;
     }
     printf("sfsim trace: %u rays (%s): %u hits, %u misses, %u occluded, %u clear, %u invalid; %.3f s",
            sum.rays, o.mode, sum.hits, sum.misses, sum.occluded, sum.clear, sum.invalid, sum.seconds);
@@ -692,11 +812,11 @@ static int cmd_trace(int argc, char **argv)
         printf(", %llu simulated instructions", (unsigned long long)sum.sim_instructions);
     printf("; wrote %s\n", o.out_path);
     if (sum.timed && print_timing(&sum.timing, NULL))
-        return EXIT_TRAP;
+        return EXIT_PROGRAM;
     return EXIT_OK;
 }
 
-int main(int argc, char **argv)
+static int dispatch(int argc, char **argv)
 {
     if (argc < 2) {
         usage(stderr);
@@ -712,8 +832,16 @@ int main(int argc, char **argv)
         return EXIT_OK;
     }
     if (!strcmp(cmd, "help")) {
+        if (argc > 3) {
+            fprintf(stderr, "sfsim help: one topic at a time, not '%s %s' (sfsim help help)\n", argv[2], argv[3]);
+            return EXIT_USAGE;
+        }
         if (argc < 3)
             usage(stdout);
+        else if (!strcmp(argv[2], "help") || !strcmp(argv[2], "--help") || !strcmp(argv[2], "-h"))
+            usage_help(stdout);
+        else if (!strcmp(argv[2], "exit-codes"))
+            usage_exit_codes(stdout);
         else if (!strcmp(argv[2], "exec"))
             usage_exec(stdout);
         else if (!strcmp(argv[2], "config"))
@@ -729,7 +857,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[2], "merge"))
             merge_usage(stdout);
         else {
-            fprintf(stderr, "sfsim help: unknown command '%s'\n", argv[2]);
+            fprintf(stderr, "sfsim help: unknown command '%s' (sfsim help help)\n", argv[2]);
             return EXIT_USAGE;
         }
         return EXIT_OK;
@@ -751,4 +879,17 @@ int main(int argc, char **argv)
     fprintf(stderr, "sfsim: unknown command '%s'\n\n", cmd);
     usage(stderr);
     return EXIT_USAGE;
+}
+
+int main(int argc, char **argv)
+{
+    int rc = dispatch(argc, argv);
+    /* What went to stdout (a config dump, help, registers, the summary) is an output too: a full
+     * disk or closed pipe must not pass for success. */
+    if (fflush(stdout) != 0 || ferror(stdout)) {
+        fprintf(stderr, "sfsim: cannot write to standard output: %s\n", strerror(errno ? errno : EIO));
+        if (rc == EXIT_OK)
+            rc = EXIT_IO;
+    }
+    return rc;
 }

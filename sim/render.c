@@ -140,6 +140,26 @@ static int remove_stale(const char *dir, const char *const *keep, char *err, siz
 
 static double ratio(uint64_t a, uint64_t b) { return b ? (double)a / (double)b : 0.0; }
 
+/* A SAH cost for report.txt: "%.2f", or why there is none (a cost is a ratio of surface areas,
+ * undefined when the scene's bounds are not finite). */
+static const char *sah_text(double cost, char *buf, size_t len)
+{
+    if (isfinite(cost))
+        snprintf(buf, len, "%.2f", cost);
+    else
+        snprintf(buf, len, "n/a (the scene's bounding box is not finite)");
+    return buf;
+}
+
+/* The same for report.json: a number, or null (JSON has no NaN or infinity). */
+static void add_sah_json(cJSON *o, double cost)
+{
+    if (isfinite(cost))
+        cJSON_AddNumberToObject(o, "sah_cost", cost);
+    else
+        cJSON_AddNullToObject(o, "sah_cost");
+}
+
 /* Statistics of either mode, in the report's terms. */
 typedef struct RunStats {
     uint64_t primary, shadow, indirect, dropped;
@@ -199,7 +219,7 @@ static void add_kd_json(cJSON *root, const RunStats *rs, const CfgMachine *cfg)
     cJSON_AddNumberToObject(tr, "references", t->refs);
     cJSON_AddNumberToObject(tr, "references_per_primitive", ratio(t->refs, t->prims));
     cJSON_AddNumberToObject(tr, "largest_leaf", t->largest_leaf);
-    cJSON_AddNumberToObject(tr, "sah_cost", t->sah_cost);
+    add_sah_json(tr, t->sah_cost);
     cJSON_AddNumberToObject(tr, "build_seconds", t->build_seconds);
     uint64_t rays[FUNC_KD_KINDS], total[FUNC_KD_COUNTERS], all;
     kd_totals(f, rays, total, &all);
@@ -213,12 +233,13 @@ static int kd_text(char *txt, size_t cap, const RunStats *rs, const CfgMachine *
 {
     const FuncStats *f = &rs->f;
     const FuncKdInfo *t = &rs->kd;
+    char sah[64];
     int len = snprintf(txt, cap,
                        "kd-tree      %s traversal, stack depth %u; %u nodes, %u leaves (%u empty), depth %u, "
-                       "%.2f references per primitive, largest leaf %u, SAH cost %.2f; built in %.2f s\n"
+                       "%.2f references per primitive, largest leaf %u, SAH cost %s; built in %.2f s\n"
                        "kd per ray   %-8s",
                        cfg_enum_name("kd", "traversal", cfg->kd_traversal), f->kd_stack_depth, t->nodes, t->leaves,
-                       t->empty_leaves, t->depth, ratio(t->refs, t->prims), t->largest_leaf, t->sah_cost,
+                       t->empty_leaves, t->depth, ratio(t->refs, t->prims), t->largest_leaf, sah_text(t->sah_cost, sah, sizeof sah),
                        t->build_seconds, "");
     for (int c = 0; c < FUNC_KD_COUNTERS; c++)
         len += snprintf(txt + len, cap - (size_t)len, " %10s", func_kd_counter_keys[c]);
@@ -334,33 +355,6 @@ static void add_functional_json(cJSON *root, const RunStats *rs, const CfgMachin
         cJSON_AddNumberToObject(o, "rays", (double)f->tiles[t].rays);
         cJSON_AddItemToArray(tiles, o);
     }
-    cJSON *cf = cJSON_AddObjectToObject(root, "config");
-    cJSON_AddNumberToObject(cf, "core.simd_width", cfg->core_simd_width);
-    cJSON_AddNumberToObject(cf, "core.clock_mhz", cfg->core_clock_mhz);
-    cJSON_AddStringToObject(cf, "stream.mode", cfg_enum_name("stream", "mode", cfg->stream_mode));
-    cJSON_AddStringToObject(cf, "stream.order", cfg_enum_name("stream", "order", cfg->stream_order));
-    cJSON_AddNumberToObject(cf, "stream.rays", cfg->stream_rays);
-    cJSON_AddStringToObject(cf, "workload.kind", cfg_enum_name("workload", "kind", cfg->workload_kind));
-    cJSON_AddNumberToObject(cf, "workload.bounces", cfg->workload_bounces);
-    cJSON_AddNumberToObject(cf, "raybuf.size_kb", cfg->raybuf_size_kb);
-    cJSON_AddNumberToObject(cf, "raybuf.banks", cfg->raybuf_banks);
-    cJSON_AddNumberToObject(cf, "idm.size_kb", cfg->idm_size_kb);
-    cJSON_AddNumberToObject(cf, "spad.size_kb", cfg->spad_size_kb);
-    cJSON_AddNumberToObject(cf, "scene.size_mb", cfg->scene_size_mb);
-    cJSON_AddNumberToObject(cf, "fb.size_kb", cfg->fb_size_kb);
-    cJSON_AddNumberToObject(cf, "bvh.leaf_size", cfg->bvh_leaf_size);
-    cJSON_AddNumberToObject(cf, "bvh.bins", cfg->bvh_bins);
-    cJSON_AddStringToObject(cf, "accel.structure", cfg_enum_name("accel", "structure", cfg->accel_structure));
-    if (f->kd) {
-        cJSON_AddStringToObject(cf, "kd.traversal", cfg_enum_name("kd", "traversal", cfg->kd_traversal));
-        cJSON_AddNumberToObject(cf, "kd.stack_depth", cfg->kd_stack_depth);
-        cJSON_AddNumberToObject(cf, "kd.cost_traversal", cfg->kd_cost_traversal);
-        cJSON_AddNumberToObject(cf, "kd.cost_intersect", cfg->kd_cost_intersect);
-        cJSON_AddNumberToObject(cf, "kd.empty_bonus", cfg->kd_empty_bonus);
-        cJSON_AddNumberToObject(cf, "kd.max_depth", cfg->kd_max_depth);
-        cJSON_AddNumberToObject(cf, "kd.leaf_size", cfg->kd_leaf_size);
-    }
-    cJSON_AddNumberToObject(cf, "sim.max_instructions", (double)cfg->sim_max_instructions);
 }
 
 /* Active lanes of a stage over the timed tiles (all tiles in detailed mode, the sample in sampled
@@ -871,10 +865,13 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     cJSON_AddNumberToObject(bvh, "nodes", p.bvh.nnodes);
     cJSON_AddNumberToObject(bvh, "leaves", p.bvh.nleaves);
     cJSON_AddNumberToObject(bvh, "depth", p.bvh.depth);
-    cJSON_AddNumberToObject(bvh, "sah_cost", p.bvh.sah_cost);
+    add_sah_json(bvh, p.bvh.sah_cost);
     cJSON_AddNumberToObject(bvh, "leaf_size", bp.max_leaf_size);
     cJSON_AddNumberToObject(bvh, "bins", bp.bins);
     cJSON_AddNumberToObject(sc, "scene_memory_bytes", p.size);
+    /* The machine: every key of sim/config.def as used, in every mode (docs/report.md). */
+    cJSON_AddStringToObject(root, "config_file", o->config_path ? o->config_path : "built-in");
+    cfg_json(cfg, cJSON_AddObjectToObject(root, "config"));
     cJSON *ren = cJSON_AddObjectToObject(root, "render");
     cJSON_AddNumberToObject(ren, "width", s.render.width);
     cJSON_AddNumberToObject(ren, "height", s.render.height);
@@ -907,13 +904,28 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     if (outfile_write_file(set, path, json_text, strlen(json_text), err, errlen) != 0)
         goto out;
 
+    /* The tiles the image was cut into: a partial tile is said, since the tile size alone would
+     * suggest more pixels than there are. */
+    char tiles_txt[160], sah[64];
+    int tiles_x = (s.render.width + tile_w - 1) / tile_w, tiles_y = (s.render.height + tile_h - 1) / tile_h;
+    if (tiles_x * tiles_y == 1 && (s.render.width < tile_w || s.render.height < tile_h))
+        snprintf(tiles_txt, sizeof tiles_txt, "one partial tile (tiles are %d x %d pixels)", tile_w, tile_h);
+    else
+        snprintf(tiles_txt, sizeof tiles_txt, "%d tile%s of %d x %d pixels%s", tiles_x * tiles_y,
+                 tiles_x * tiles_y == 1 ? "" : "s", tile_w, tile_h,
+                 s.render.width % tile_w && s.render.height % tile_h ? ", the last column and row partial"
+                 : s.render.width % tile_w                           ? ", the last column partial"
+                 : s.render.height % tile_h                          ? ", the last row partial"
+                                                                     : "");
+    const char *thr = threads == 1 ? "thread" : "threads";
     char txt[16384];
     int len = snprintf(txt, sizeof txt,
              "sfsim report -- mode %s (%s)\n"
              "scene        %s\n"
              "             %u triangles, %u spheres, %u lights; needs: %s\n"
-             "             BVH %u nodes, %u leaves, depth %u, SAH cost %.2f; %u bytes of scene memory\n"
-             "image        %d x %d, %d spp, max depth %d, seed %u, tiles of %d x %d pixels\n"
+             "             BVH %u nodes, %u leaves, depth %u, SAH cost %s; %u bytes of scene memory\n"
+             "config       %s\n"
+             "image        %d x %d, %d spp, max depth %d, seed %u, %s\n"
              "             mean %.5f, non-finite values %ld\n"
              "rays         %llu total: %llu primary, %llu shadow, %llu indirect; %llu dropped\n",
              o->mode,
@@ -922,8 +934,9 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
              : functional ? "the kernel on the functional core: no timing"
                           : "golden model: no timing",
              o->scene_path, s.ntris, s.nspheres, p.nlights, needs[0] ? needs : "-", p.bvh.nnodes,
-             p.bvh.nleaves, p.bvh.depth, p.bvh.sah_cost, p.size, s.render.width, s.render.height,
-             s.render.spp, s.render.max_depth, o->seed, tile_w, tile_h, sum / (3.0 * (double)npx),
+             p.bvh.nleaves, p.bvh.depth, sah_text(p.bvh.sah_cost, sah, sizeof sah), p.size,
+             o->config_path ? o->config_path : "built-in (the defaults of sim/config.def)", s.render.width,
+             s.render.height, s.render.spp, s.render.max_depth, o->seed, tiles_txt, sum / (3.0 * (double)npx),
              nonfinite, (unsigned long long)total_rays, (unsigned long long)rs.primary,
              (unsigned long long)rs.shadow, (unsigned long long)rs.indirect, (unsigned long long)rs.dropped);
     if (functional) {
@@ -962,16 +975,16 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
             snprintf(isect_len, sizeof isect_len, "%.1f", ratio(f->isect_rays, f->isect_streams));
         len += snprintf(txt + len, sizeof txt - (size_t)len,
                         "streams      mean length: traversal %s, intersection %s, shading %.1f rays%s\n"
-                        "host         %.2f s on %d threads: %.2f M instructions/s, %.3f M rays/s; load %.2f s, BVH+pack %.2f s\n",
+                        "host         %.2f s on %d %s: %.2f M instructions/s, %.3f M rays/s; load %.2f s, BVH+pack %.2f s\n",
                         trav_len, isect_len, ratio(f->shade_rays, f->shade_streams),
-                        f->trav_streams ? "" : " (traversal one ray per lane: no stream filters)", secs, threads,
+                        f->trav_streams ? "" : " (traversal one ray per lane: no stream filters)", secs, threads, thr,
                         secs > 0 ? 1e-6 * (double)f->instructions / secs : 0.0,
                         secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, t_load - t0, t_pack - t_load);
     } else {
         len += snprintf(txt + len, sizeof txt - (size_t)len,
                         "traversal    %llu nodes visited, %llu primitive tests\n"
-                        "host         %.2f s rendering on %d threads (%.3f M rays/s); load %.2f s, BVH+pack %.2f s\n",
-                        (unsigned long long)rs.nodes_visited, (unsigned long long)rs.prims_tested, secs, threads,
+                        "host         %.2f s rendering on %d %s (%.3f M rays/s); load %.2f s, BVH+pack %.2f s\n",
+                        (unsigned long long)rs.nodes_visited, (unsigned long long)rs.prims_tested, secs, threads, thr,
                         secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, t_load - t0, t_pack - t_load);
     }
     snprintf(path, sizeof path, "%s/report.txt", o->out_dir);

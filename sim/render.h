@@ -22,6 +22,7 @@ typedef struct RenderOptions {
     int progress;              /* 1: progress bar on stderr (the CLI sets it when stderr is a tty) */
     const char *mode;          /* "detailed", "sampled", "functional" or "reference" */
     const struct CfgMachine *cfg; /* the machine (functional mode; NULL: defaults) */
+    const char *config_path;   /* the -c file as given, for the report; NULL: the built-in defaults */
     const char *kernel_path;   /* kernel modes: the kernel source (NULL: next to the binary) */
     double sample;             /* sampled mode: the fraction of tiles timed, (0, 1] */
     uint32_t sample_seed;      /* sampled mode: which tiles */

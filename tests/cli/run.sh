@@ -3,8 +3,9 @@
 # exit codes, messages that name file:line(:col), disassembly round trips, traps, configs.
 # `make test` runs it before the Criterion suite. Exit status: 0 when every test passed.
 #
-# Exit codes under test -- sfasm: 0 ok, 1 errors, 2 usage; sfsim: 0 ok, 1 input/config error,
-# 2 usage, 3 trap or instruction limit.
+# Exit codes under test: sim/exitcodes.def (sfsim help exit-codes) -- 0 ok, 1 bad input (also an
+# option value out of range), 2 usage (unknown option or command, missing argument), 3 trap or
+# instruction limit, 4 an output could not be written.
 set -u
 
 cd "$(dirname "$0")/../.." || exit 2
@@ -284,9 +285,9 @@ run "$SFSIM" compare "$T/ref1/frame.exr" "$T/ref4/frame.exr"
 want_rc 1; want_err "sizes differ"
 end
 
-begin "sfsim run with an unknown mode is a usage error (exit 2)"
+begin "sfsim run with an unknown mode is bad input (exit 1: a value out of range, docs/exit-codes.md)"
 run "$SFSIM" run --mode nonsense -o "$T/ref5"
-want_rc 2; want_err "nonsense"
+want_rc 1; want_err "nonsense"
 end
 
 # ---- sfsim run --mode functional: the kernel on the functional core ------------------------------
@@ -415,20 +416,20 @@ cs2=$(grep -E '^cycles +~' "$T/samp2/report.txt" 2>/dev/null | sed -E 's/^cycles
 [ -n "$cd4" ] && [ "$cs2" = "$cd4 $cd4 $cd4" ] || no "sampling every tile: '$cs2', detailed: '$cd4'"
 end
 
-begin "sfsim run: bad --sample values are usage errors (exit 2)"
+begin "sfsim run: bad --sample values are bad input (exit 1); --sample without sampled mode is a usage error (exit 2)"
 run "$SFSIM" run --mode sampled --sample 0 -o "$T/samp3"
-want_rc 2; want_err "--sample 0"
+want_rc 1; want_err "--sample 0"
 run "$SFSIM" run --mode sampled --sample 1.5 -o "$T/samp3"
-want_rc 2; want_err "\(0, 1\]"
+want_rc 1; want_err "\(0, 1\]"
 run "$SFSIM" run --sample 0.1 -o "$T/samp3"
 want_rc 2; want_err "--mode sampled only"
 end
 
-begin "sfsim run: a render key out of range names the key and its range (exit 2)"
+begin "sfsim run: a render key out of range names the key and its range (exit 1, as for machine keys)"
 run "$SFSIM" run --set render.spp=0 -o "$T/rk"
-want_rc 2; want_err "--set render.spp = 0: expected an integer in 1\.\.1048576"
+want_rc 1; want_err "--set render.spp = 0: expected an integer in 1\.\.1048576"
 run "$SFSIM" run --set render.max_depth=64 -o "$T/rk"
-want_rc 2; want_err "render.max_depth = 64: expected an integer in 0\.\.63"
+want_rc 1; want_err "render.max_depth = 64: expected an integer in 0\.\.63"
 end
 
 begin "sfsim exec --timing prints the cycles of a micro-benchmark (kernels/bench/branch.s: 10 cycles)"
@@ -661,6 +662,194 @@ else
     umount "$T/tmpfs" || no "cannot unmount $T/tmpfs"
     trap 'rm -rf "$T"' EXIT
 fi
+end
+
+
+# ---- issue 14: exit codes, crashes and the smaller CLI defects -------------------------------------
+
+begin "sfsim trace of 0 rays (empty, comments only, binary n = 0) in every mode: empty valid hits, exit 0"
+: > "$T/rays0.txt"
+printf '# no rays here\n\n   # nor here\n' > "$T/rays0c.txt"
+printf 'SFRAYS1\0\0\0\0\0\0\0\0\0' > "$T/rays0.bin"
+for m in functional detailed reference; do
+    for f in rays0.txt rays0c.txt rays0.bin; do
+        run "$SFSIM" trace --mode "$m" -s scenes/cornell/scene.ini --rays "$T/$f" -o "$T/h0_${m}_$f.txt" -j 2
+        want_rc 0; want_out "0 rays \($m\): 0 hits, 0 misses"
+        [ "$(grep -vc '^#' "$T/h0_${m}_$f.txt" 2>/dev/null)" = 0 ] || no "$m $f: the text hit file is not empty"
+        run "$SFSIM" trace --mode "$m" -s scenes/cornell/scene.ini --rays "$T/$f" -o "$T/h0_${m}_$f.bin" --binary
+        want_rc 0
+        [ "$(od -An -c "$T/h0_${m}_$f.bin" 2>/dev/null | tr -d ' \n')" = 'SFHITS1\0\0\0\0\0\0\0\0\0' ] \
+            || no "$m $f: the binary hit file is not a header for 0 hits"
+    done
+done
+end
+
+begin "report.json's config holds every key that sfsim config --dump lists, with its value (every mode)"
+for m in detailed reference; do
+    run "$SFSIM" run --mode "$m" -s scenes/cornell/scene.ini -c configs/streamray.ini --set latency.vfma=7 \
+        --set render.width=16 --set render.height=16 --set render.spp=1 -o "$T/cfgblk_$m" -j 1 --no-progress
+    want_rc 0
+    "$SFSIM" config --dump -c configs/streamray.ini --set latency.vfma=7 >"$T/cfgdump_$m.ini" 2>>"$T/err" \
+        || no "sfsim config --dump failed"
+    python3 - "$T/cfgdump_$m.ini" "$T/cfgblk_$m/report.json" >"$T/cfgcheck" 2>&1 <<'PY' || no "$m: $(head -c 600 "$T/cfgcheck")"
+import json, re, sys
+dump, report = open(sys.argv[1]).read().splitlines(), json.load(open(sys.argv[2]))
+cfg, section, keys, bad = report["config"], None, 0, []
+for line in dump:
+    if re.match(r"^\[(.+)\]$", line):
+        section = line[1:-1]
+    elif re.match(r"^[a-z_0-9]+ = ", line):
+        key, value = line.split(" = ", 1)
+        keys += 1
+        got = cfg.get(section + "." + key)
+        if got is None:
+            bad.append("missing " + section + "." + key)
+        elif (str(got) if isinstance(got, str) else "%g" % got) != ("%g" % float(value) if re.match(r"^-?[0-9.e+]+$", value) else value):
+            bad.append("%s.%s = %r, config --dump says %s" % (section, key, got, value))
+if keys < 60 or bad or len(cfg) != keys or report.get("config_file") != "configs/streamray.ini":
+    sys.exit("%d keys dumped, %d in report.json; config_file %r; %s" % (keys, len(cfg), report.get("config_file"), "; ".join(bad)))
+PY
+done
+end
+
+begin "sfsim compare of a PNG with an EXR warns that they hold different encodings (exit 0); EXR with EXR does not"
+run "$SFSIM" run --mode reference -s scenes/cornell/scene.ini -o "$T/enc" --set render.width=16 \
+    --set render.height=16 --set render.spp=1 -j 1 --no-progress
+want_rc 0
+run "$SFSIM" compare "$T/enc/frame.png" "$T/enc/frame.exr"
+want_rc 0; want_out "RMSE"
+want_err "warning: .*frame.png holds display values \(sRGB-encoded.*frame.exr linear radiance"
+run "$SFSIM" compare "$T/enc/frame.exr" "$T/enc/frame.exr"
+want_rc 0; want_no_err
+run "$SFSIM" compare "$T/enc/frame.png" "$T/enc/frame.png"
+want_rc 0; want_no_err
+end
+
+begin "exit codes: a value out of range is bad input (1) for render and machine keys alike; unknown options are usage (2)"
+run "$SFSIM" run --set render.width=0 -o "$T/ec"
+want_rc 1; want_err "render.width = 0"
+run "$SFSIM" run --set core.simd_width=0 -o "$T/ec"
+want_rc 1; want_err "core.simd_width"
+run "$SFSIM" run -j 0 -o "$T/ec"
+want_rc 1; want_err "sfsim run: -j 0: expected an integer in 1\.\.1024"
+run "$SFSIM" trace -s scenes/cornell/scene.ini --rays tests/fuzz/ray_seeds/cornell.txt -o "$T/ec.txt" -j 0
+want_rc 1; want_err "sfsim trace: -j 0"
+run "$SFSIM" trace -s scenes/cornell/scene.ini --rays tests/fuzz/ray_seeds/cornell.txt -o "$T/ec.txt" --mode fast
+want_rc 1; want_err "--mode fast"
+run "$SFSIM" exec "$T/ok.sfo" --width 0
+want_rc 1; want_err "core.simd_width"
+run "$SFSIM" config --dump --set render.width=5
+want_rc 1
+run "$SFSIM" run --no-such-option -o "$T/ec"
+want_rc 2; want_err "no-such-option"
+run "$SFSIM" run -o
+want_rc 2
+run "$SFSIM" exec
+want_rc 2
+run "$SFSIM" compare only_one.exr
+want_rc 2
+[ -e "$T/ec" ] && no "a refused run created its output folder"
+end
+
+begin "sfsim run --exposure refuses inf, nan, 0, negative, overflowing and non-numbers (exit 1)"
+for x in inf -inf nan 0 -1 1e39 abc "" 1x; do
+    run "$SFSIM" run --exposure "$x" -o "$T/ex"
+    want_rc 1; want_err "--exposure .*finite positive"
+done
+[ -e "$T/ex" ] && no "a refused run created its output folder"
+end
+
+begin "sfsim trace: a hit file that cannot be written exits 4 (EXIT_IO) naming it"
+run "$SFSIM" trace -s scenes/cornell/scene.ini --rays tests/fuzz/ray_seeds/cornell.txt -o "$T/no_such_dir/h.txt"
+want_rc 4; want_err "no_such_dir/h.txt"; grep -q "wrote" "$T/out" && no "claims to have written the hits"
+run "$SFSIM" trace -s scenes/cornell/scene.ini --rays tests/fuzz/ray_seeds/cornell.txt -o /dev/full
+want_rc 4; want_err "/dev/full"
+end
+
+begin "sfsim help knows itself and the exit codes; --help of sfsim and sfasm print every row of sim/exitcodes.def"
+run "$SFSIM" help help
+want_rc 0; want_out "usage: sfsim help"; want_no_err
+run "$SFSIM" help --help
+want_rc 0; want_out "usage: sfsim help"
+run "$SFSIM" help exit-codes
+want_rc 0; cp "$T/out" "$T/help_ec"
+run "$SFSIM" help no-such-topic
+want_rc 2; want_err "unknown command 'no-such-topic'"
+run "$SFSIM" --help
+cp "$T/out" "$T/help_sfsim"
+run "$SFASM" --help
+cp "$T/out" "$T/help_sfasm"
+rows=0
+while IFS= read -r line; do
+    [[ "$line" =~ ^EXITCODE\(([A-Z]+),\ *([0-9]+), ]] || continue
+    rows=$((rows + 1))
+    for f in help_ec help_sfsim help_sfasm; do
+        grep -qE "^ +${BASH_REMATCH[2]}\+? +${BASH_REMATCH[1]} " "$T/$f" || no "$f lacks the row ${BASH_REMATCH[2]} ${BASH_REMATCH[1]}"
+    done
+done < sim/exitcodes.def
+[ "$rows" -ge 7 ] || no "read only $rows rows of sim/exitcodes.def"
+end
+
+begin "sfasm exit codes: errors 1, usage 2, an object or disassembly that cannot be written 4"
+run "$SFASM" tests/cli/ok.s -o "$T/no_such_dir/ok.sfo"
+want_rc 4; want_err "no_such_dir/ok.sfo"
+if [ -w /dev/full ]; then
+    run bash -c "\"$SFASM\" -d \"$T/ok.sfo\" > /dev/full"
+    want_rc 4; want_err "cannot write the disassembly"
+fi
+run "$SFASM" -d "$T/no_such.sfo"
+want_rc 1
+end
+
+begin "standard output that cannot be written is an I/O failure (exit 4), not success"
+if [ -w /dev/full ]; then
+    for c in "config --markdown" "config --dump" "help exit-codes" "--help"; do
+        run bash -c "\"$SFSIM\" $c > /dev/full"
+        want_rc 4; want_err "cannot write to standard output"
+    done
+    run bash -c "\"$SFASM\" --help > /dev/full"
+    want_rc 4
+fi
+end
+
+begin "sfasm: a macro that calls itself twice gives one error naming it and its line, fast (was 125,000 lines)"
+printf '.macro m\n    m\n    m\n.endm\n    m\n' > "$T/bomb.s"
+run timeout 20 "$SFASM" "$T/bomb.s" -o "$T/bomb.sfo"
+want_rc 1; want_err "macro 'm' \(defined at .*bomb.s:1\) nested too deeply"
+[ "$(wc -l < "$T/err")" -le 2 ] || no "$(wc -l < "$T/err") lines of errors"
+end
+
+begin "sfasm prints at most 50 errors, then how many more (exit 1)"
+{ for i in $(seq 1 120); do echo "  frob$i r1"; done; } > "$T/many.s"
+run "$SFASM" "$T/many.s" -o "$T/many.sfo"
+want_rc 1
+[ "$(grep -c ": unknown instruction" "$T/err")" -eq 50 ] || no "$(grep -c ": unknown instruction" "$T/err") errors printed"
+want_err "many.s:50:3: unknown instruction 'frob50'"; want_err "^\.\.\. and 70 more errors"; want_err "sfasm: 120 errors"
+end
+
+begin "sfsim exec --dump-mem is checked before the program runs (a looping program: exit 1 at once)"
+for d in spad:2:1 spad:0x10000:1 spad:0xfffc:2 nosuch:0:1 spad:0 spad:-4:1 spad:0:1x; do
+    run timeout 10 "$SFSIM" exec "$T/loop.sfo" --dump-mem "$d"
+    want_rc 1; want_err "--dump-mem $d"
+    [ -s "$T/out" ] && no "$d: the program ran"
+done
+run "$SFSIM" exec "$T/ok.sfo" -q --dump-mem spad:0xfffc:1 --dump-mem scene:0:2
+want_rc 0; want_out "^spad from 0x0000fffc:"; want_out "^scene from 0x00000000:"
+end
+
+begin "sfsim exec: a long run says on stderr how far it is and the limit; stdout unchanged; --no-progress"
+run env SFSIM_PROGRESS_AFTER=0 "$SFSIM" exec "$T/loop.sfo" --max-instructions 3000000
+want_rc 3
+want_err "still running after [0-9]+ s: 1048576 instructions of the limit 3000000 \(sim.max_instructions"
+want_err "trap: instruction limit of 3000000 reached at pc [0-9]+ .*tests/cli/loop.s:[45]"
+grep -q "still running" "$T/out" && no "progress on stdout"
+sed -E 's/\([0-9.]+ s, [0-9.]+ M instructions\/s\)//' "$T/out" > "$T/prog_on"
+run env SFSIM_PROGRESS_AFTER=0 "$SFSIM" exec "$T/loop.sfo" --max-instructions 3000000 --no-progress
+want_rc 3
+grep -q "still running" "$T/err" && no "--no-progress still shows progress"
+sed -E 's/\([0-9.]+ s, [0-9.]+ M instructions\/s\)//' "$T/out" > "$T/prog_off"
+cmp -s "$T/prog_on" "$T/prog_off" || no "stdout differs with progress"
+want_err "trap: instruction limit of 3000000 reached"
 end
 
 echo "cli: $pass passed, $fail failed"

@@ -267,9 +267,86 @@ Test(asm_errors, macro_expansion_location)
 Test(asm_errors, macro_recursion_limit)
 {
     expect_diag(".macro r n\n r \\n\n.endm\n r 1\n",
-                "bad.s:2:2: macro 'r' nested too deeply (limit 64 nested expansions) (in expansion of"
+                "bad.s:2:2: macro 'r' (defined at bad.s:1) nested too deeply: more than 64 nested expansions"
+                " (does it call itself without an end?) (in expansion of"
                 " macro 'r' from bad.s:2; macro 'r' from bad.s:2; macro 'r' from bad.s:2; ... 60 more;"
                 " macro 'r' from bad.s:4)\n");
+}
+
+/* A macro that calls itself twice: one error naming it, not one per call of a binary tree of
+ * expansions (it printed 125,000 lines, 27 MB). */
+Test(asm_errors, macro_calling_itself_twice_is_one_error)
+{
+    expect_diag("  nop\n.macro m\n    m\n    m\n.endm\n    m\n",
+                "bad.s:3:5: macro 'm' (defined at bad.s:2) nested too deeply: more than 64 nested expansions"
+                " (does it call itself without an end?) (in expansion of"
+                " macro 'm' from bad.s:3; macro 'm' from bad.s:3; macro 'm' from bad.s:3; ... 60 more;"
+                " macro 'm' from bad.s:6)\n");
+}
+
+/* The text of n lines, each made by line(i). */
+static char *lines_of(int n, const char *(*line)(int i, char *buf, size_t len))
+{
+    size_t cap = (size_t)n * 64 + 1, used = 0;
+    char *src = malloc(cap), buf[64];
+    cr_assert_not_null(src);
+    src[0] = '\0';
+    for (int i = 0; i < n; i++)
+        used += (size_t)snprintf(src + used, cap - used, "%s", line(i, buf, sizeof buf));
+    return src;
+}
+
+static const char *call_bad(int i, char *buf, size_t len)
+{
+    snprintf(buf, len, "%s", i == 0 ? ".macro bad\n  frob r1\n.endm\n" : "  bad\n");
+    return buf;
+}
+
+/* At most 50 errors are printed, in source order, then how many more there were; all count. */
+Test(asm_errors, error_cap_50_then_how_many_more)
+{
+    char *src = lines_of(1 + 300, call_bad);   /* the macro, then 300 calls: 300 errors */
+    AsmObject obj;
+    int nerr;
+    char *diag = assemble(src, &obj, &nerr);
+    cr_assert_eq(nerr, 300);
+    int lines = 0;
+    for (const char *p = diag; *p; p++)
+        lines += *p == '\n';
+    cr_expect_eq(lines, 51, "%d lines:\n%s", lines, diag);
+    cr_expect(strstr(diag, "bad.s:2:3: unknown instruction 'frob' (in expansion of macro 'bad' from bad.s:4)\n")
+              == diag, "%.300s", diag);
+    cr_expect_not_null(strstr(diag, "(in expansion of macro 'bad' from bad.s:53)\n"
+                                    "... and 250 more errors (only the first 50 are shown)\n"), "%s", diag);
+    cr_expect_null(strstr(diag, "from bad.s:54)"), "the 51st error is printed");
+    free(diag);
+    free(src);
+}
+
+static const char *undefined_then_bogus(int i, char *buf, size_t len)
+{
+    if (i == 0)
+        snprintf(buf, len, "  li r1, nowhere\n");      /* found in pass 2, after all the others */
+    else
+        snprintf(buf, len, "  bogus%d r1\n", i);
+    return buf;
+}
+
+/* The cap keeps the first errors in reading order, not the first reported: a pass-2 error on
+ * line 1 comes first although it is found after 200 pass-1 errors. */
+Test(asm_errors, error_cap_keeps_reading_order)
+{
+    char *src = lines_of(201, undefined_then_bogus);
+    AsmObject obj;
+    int nerr;
+    char *diag = assemble(src, &obj, &nerr);
+    cr_assert_eq(nerr, 201);
+    cr_expect(strstr(diag, "bad.s:1:10: undefined symbol 'nowhere'\nbad.s:2:3: unknown instruction 'bogus1'\n") == diag,
+              "%.300s", diag);
+    cr_expect_not_null(strstr(diag, "bad.s:50:3: unknown instruction 'bogus49'\n"
+                                    "... and 151 more errors (only the first 50 are shown)\n"), "%s", diag);
+    free(diag);
+    free(src);
 }
 
 Test(asm_errors, include_recursion_limit)

@@ -1,16 +1,23 @@
 /* tests/unit/test_render.c -- the run report (sim/render.c, docs/report.md): the kd section of
  * report.json and report.txt with accel.structure = kd, its figures per ray kind from the kernel's
- * counters (tests/unit/kd_stub.s stands in for the kd-tree kernel), and no kd section for the BVH.
+ * counters (tests/unit/kd_stub.s stands in for the kd-tree kernel), and no kd section for the BVH;
+ * the config block (every key), the files a report names, its tile and thread wording, and a
+ * SAH cost that stays a number (or says why not) for a huge sphere; and the trace engine on a
+ * batch of 0 rays.
  */
 #include <cjson/cJSON.h>
 #include <criterion/criterion.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
+#include "../../scenes/pack.h"
+#include "../../scenes/scene.h"
 #include "../../sim/config.h"
 #include "../../sim/render.h"
+#include "../../sim/trace.h"
 
 static char *slurp(const char *path)
 {
@@ -26,32 +33,21 @@ static char *slurp(const char *path)
     return buf;
 }
 
-/* A functional run of the Cornell box, 128 x 64 pixels in 8 tiles of 32 x 32, into a fresh
- * folder; returns report.json parsed, *txt receives report.txt. */
-static cJSON *run(const CfgMachine *cfg, const char *kernel, char **txt)
+/* render_run(o) into a fresh folder (o->out_dir is set here); returns report.json parsed, *txt
+ * receives report.txt. */
+static cJSON *run_opts(RenderOptions *o, char **txt)
 {
     char dir[] = "/tmp/sfsim-report-XXXXXX";
     cr_assert_not_null(mkdtemp(dir));
-    RenderOptions o;
-    render_default_options(&o);
-    o.scene_path = "scenes/cornell/scene.ini";
-    o.out_dir = dir;
-    o.mode = "functional";
-    o.cfg = cfg;
-    o.kernel_path = kernel;
-    o.stream_rays = cfg->stream_rays;
-    o.width = 128;
-    o.height = 64;
-    o.spp = 1;
-    o.threads = 2;
+    o->out_dir = dir;
     char err[65536];
-    cr_assert_eq(render_run(&o, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(render_run(o, err, sizeof err), 0, "%s", err);
     char path[256];
     snprintf(path, sizeof path, "%s/report.json", dir);
     char *json = slurp(path);
     snprintf(path, sizeof path, "%s/report.txt", dir);
     *txt = slurp(path);
-    static const char *const files[] = {"report.json", "report.txt", "frame.exr", "frame.png"};
+    static const char *const files[] = {"report.json", "report.txt", "frame.exr", "frame.png", "cost.png"};
     for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
         snprintf(path, sizeof path, "%s/%s", dir, files[i]);
         unlink(path);
@@ -61,6 +57,24 @@ static cJSON *run(const CfgMachine *cfg, const char *kernel, char **txt)
     free(json);
     cr_assert(cJSON_IsObject(j), "report.json does not parse");
     return j;
+}
+
+/* A functional run of the Cornell box, 128 x 64 pixels in 8 tiles of 32 x 32, into a fresh
+ * folder; returns report.json parsed, *txt receives report.txt. */
+static cJSON *run(const CfgMachine *cfg, const char *kernel, char **txt)
+{
+    RenderOptions o;
+    render_default_options(&o);
+    o.scene_path = "scenes/cornell/scene.ini";
+    o.mode = "functional";
+    o.cfg = cfg;
+    o.kernel_path = kernel;
+    o.stream_rays = cfg->stream_rays;
+    o.width = 128;
+    o.height = 64;
+    o.spp = 1;
+    o.threads = 2;
+    return run_opts(&o, txt);
 }
 
 static double num(const cJSON *o, const char *a, const char *b)
@@ -140,8 +154,173 @@ Test(render, no_kd_section_for_the_bvh, .timeout = 120)
     cJSON *j = run(&cfg, "kernels/pathtrace.s", &txt);
     cr_expect_null(cJSON_GetObjectItemCaseSensitive(j, "kd"));
     cr_expect_str_eq(str(j, "config", "accel.structure"), "bvh");
-    cr_expect_null(cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(j, "config"), "kd.traversal"));
+    /* Every key is in the config block (docs/report.md), the kd keys too, with the values in force. */
+    cr_expect_str_eq(str(j, "config", "kd.traversal"), "stack");
+    cr_expect_eq(num(j, "config", "kd.stack_depth"), 3.0);
     cr_expect(strstr(txt, "kd-tree") == NULL, "%s", txt);
     free(txt);
     cJSON_Delete(j);
+}
+
+/* report.json's config block is every key of sim/config.def with the value in force: a changed
+ * timing key shows (the report names the machine its cycles come from). */
+Test(render, config_block_holds_every_key, .timeout = 120)
+{
+    CfgMachine cfg;
+    cfg_defaults(&cfg);
+    cfg.stream_rays = 1024;
+    CfgErrors errs = {0};
+    cr_assert_eq(cfg_set(&cfg, "latency.vfma=7", &errs), 0, "%s", errs.text ? errs.text : "");
+    cr_assert_eq(cfg_set(&cfg, "kd.empty_bonus=0.5", &errs), 0, "%s", errs.text ? errs.text : "");
+    cfg_errors_free(&errs);
+    char *txt;
+    cJSON *j = run(&cfg, "kernels/pathtrace.s", &txt);
+    const cJSON *cf = cJSON_GetObjectItemCaseSensitive(j, "config");
+    cr_assert(cJSON_IsObject(cf));
+    /* The keys cfg_dump lists, one "key = value" line each under its [section]. */
+    char *dump = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&dump, &len);
+    cr_assert_not_null(f);
+    cfg_dump(&cfg, f);
+    fclose(f);
+    char section[64] = "";
+    int keys = 0;
+    for (char *save = NULL, *line = strtok_r(dump, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
+        char key[64];
+        if (sscanf(line, "[%63[^]]]", section) == 1 || line[0] == ' ' || sscanf(line, "%63s =", key) != 1)
+            continue;
+        char full[160];
+        snprintf(full, sizeof full, "%s.%s", section, key);
+        cr_expect_not_null(cJSON_GetObjectItemCaseSensitive(cf, full), "report.json config lacks %s", full);
+        keys++;
+    }
+    free(dump);
+    cr_expect_geq(keys, 60, "cfg_dump listed only %d keys", keys);
+    cr_expect_eq(cJSON_GetArraySize(cf), keys, "config has %d members, the config %d keys", cJSON_GetArraySize(cf), keys);
+    cr_expect_eq(num(j, "config", "latency.vfma"), 7.0);
+    cr_expect_eq(num(j, "config", "kd.empty_bonus"), 0.5);
+    cr_expect_eq(num(j, "config", "stream.rays"), 1024.0);
+    cr_expect_str_eq(str(j, "config", "stream.mode"), "stream");
+    cr_expect_eq(num(j, "config", "sim.max_instructions"), 1e10);
+    free(txt);
+    cJSON_Delete(j);
+}
+
+/* The report names the config file (as given, or built-in) and the scene file; a 32 x 32 image
+ * is one partial tile of 64 x 64, not "tiles of 64 x 64"; one thread is "1 thread". */
+Test(render, report_names_files_tiles_and_threads, .timeout = 120)
+{
+    RenderOptions o;
+    render_default_options(&o);
+    o.scene_path = "scenes/cornell/scene.ini";
+    o.mode = "reference";
+    o.width = 32;
+    o.height = 32;
+    o.spp = 1;
+    o.threads = 1;
+    char *txt;
+    cJSON *j = run_opts(&o, &txt);
+    cr_expect(strstr(txt, "\nscene        scenes/cornell/scene.ini\n"), "%s", txt);
+    cr_expect(strstr(txt, "\nconfig       built-in"), "%s", txt);
+    cr_expect(strstr(txt, "one partial tile (tiles are 64 x 64 pixels)"), "%s", txt);
+    cr_expect(strstr(txt, "tiles of") == NULL, "%s", txt);
+    cr_expect(strstr(txt, " on 1 thread ("), "%s", txt);
+    cr_expect(strstr(txt, "1 threads") == NULL, "%s", txt);
+    const cJSON *cf = cJSON_GetObjectItemCaseSensitive(j, "config_file");
+    cr_expect(cJSON_IsString(cf) && !strcmp(cf->valuestring, "built-in"));
+    cr_expect_str_eq(str(j, "scene", "file"), "scenes/cornell/scene.ini");
+    /* The reference mode reports the machine too (its BVH keys shape the golden model's run). */
+    cr_expect_eq(num(j, "config", "bvh.leaf_size"), 4.0);
+    free(txt);
+    cJSON_Delete(j);
+
+    o.config_path = "configs/streamray.ini";
+    o.width = 100;
+    o.height = 64;
+    o.threads = 2;
+    j = run_opts(&o, &txt);
+    cr_expect(strstr(txt, "\nconfig       configs/streamray.ini\n"), "%s", txt);
+    cr_expect(strstr(txt, "2 tiles of 64 x 64 pixels, the last column partial"), "%s", txt);
+    cr_expect(strstr(txt, " on 2 threads ("), "%s", txt);
+    cf = cJSON_GetObjectItemCaseSensitive(j, "config_file");
+    cr_expect(cJSON_IsString(cf) && !strcmp(cf->valuestring, "configs/streamray.ini"));
+    free(txt);
+    cJSON_Delete(j);
+}
+
+/* A sphere of radius 1e30: the BVH's surface areas overflow single precision; the SAH cost must
+ * still be a number in report.txt and report.json (it was "-nan" and null). */
+Test(render, sah_cost_of_a_huge_sphere_is_a_number, .timeout = 120)
+{
+    char dir[] = "/tmp/sfsim-huge-XXXXXX", scene[128];
+    cr_assert_not_null(mkdtemp(dir));
+    snprintf(scene, sizeof scene, "%s/scene.ini", dir);
+    FILE *f = fopen(scene, "w");
+    cr_assert_not_null(f);
+    fputs("[camera]\nposition = 0 0 5\nlook_at = 0 0 0\n[render]\nwidth = 16\nheight = 16\nspp = 1\n"
+          "[material.m]\nroughness = 0.5\n[sphere.huge]\ncenter = 0 0 0\nradius = 1e30\nmaterial = m\n"
+          "[sphere.small]\ncenter = 0 0 -2\nradius = 1\nmaterial = m\n"
+          "[light.sun]\ntype = directional\ndirection = -1 -1 -1\nintensity = 2\n", f);
+    fclose(f);
+    RenderOptions o;
+    render_default_options(&o);
+    o.scene_path = scene;
+    o.mode = "reference";
+    o.threads = 1;
+    char *txt;
+    cJSON *j = run_opts(&o, &txt);
+    unlink(scene);
+    rmdir(dir);
+    cr_expect(strstr(txt, "nan") == NULL && strstr(txt, "inf") == NULL, "%s", txt);
+    cr_expect(strstr(txt, "SAH cost n/a") == NULL, "%s", txt);
+    const cJSON *bvh = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(j, "scene"), "bvh");
+    const cJSON *c = cJSON_GetObjectItemCaseSensitive(bvh, "sah_cost");
+    cr_assert(cJSON_IsNumber(c), "scene.bvh.sah_cost is not a number");
+    cr_expect(isfinite(c->valuedouble) && c->valuedouble > 0.0, "sah_cost %g", c->valuedouble);
+    free(txt);
+    cJSON_Delete(j);
+}
+
+/* sfsim trace's engine on a batch of 0 rays, in every mode: 0, no hits, no instructions (the
+ * functional and detailed modes crashed: the thread pool capped its threads at the tile count, 0,
+ * and ran a worker with no job). The CLI test covers the files; this one runs under ASan. */
+Test(render, trace_of_zero_rays_in_every_mode, .timeout = 120)
+{
+    Scene s;
+    PackedScene p;
+    char err[4096];
+    cr_assert_eq(scene_load("scenes/cornell/scene.ini", &s, err, sizeof err), 0, "%s", err);
+    BvhParams bp;
+    bvh_default_params(&bp);
+    memset(&p, 0, sizeof p);
+    cr_assert_eq(pack_scene(&s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
+    CfgMachine cfg;
+    cfg_defaults(&cfg);
+    static const unsigned char header[16] = "SFRAYS1";
+    static const char *const sources[] = {"", "# comments only\n\n  # and blanks\n"};
+    static const char *const modes[] = {"functional", "detailed", "reference"};
+    for (int k = 0; k < 3; k++) {
+        RayBatch b;
+        memset(&b, 0, sizeof b);
+        const unsigned char *data = k < 2 ? (const unsigned char *)sources[k] : header;
+        size_t len = k < 2 ? strlen(sources[k]) : sizeof header;
+        cr_assert_eq(raybatch_parse("rays", data, len, &b, err, sizeof err), 0, "%s", err);
+        cr_assert_eq(b.count, 0u);
+        BatchHit hit;
+        for (int m = 0; m < 3; m++) {
+            uint64_t ninstr = 1;
+            TimingStats ts;
+            memset(&ts, 0xff, sizeof ts);
+            int rc = trace_batch_run(&p, s.needs, &b, &hit, modes[m], &cfg, "kernels/pathtrace.s", 2, &ninstr, &ts,
+                                     err, sizeof err);
+            cr_expect_eq(rc, 0, "input %d, %s: %s", k, modes[m], err);
+            cr_expect_eq(ninstr, 0u, "input %d, %s: %llu instructions", k, modes[m], (unsigned long long)ninstr);
+            if (m == 1)
+                cr_expect_eq(ts.cycles, 0u, "0 rays, %llu cycles", (unsigned long long)ts.cycles);
+        }
+        raybatch_free(&b);
+    }
+    pack_free(&p);
+    scene_free(&s);
 }
