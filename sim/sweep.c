@@ -23,7 +23,6 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/file.h>
 #include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/types.h>
@@ -37,8 +36,6 @@
 #include "ini.h"
 #include "render.h"
 #include "timing.h"
-
-enum { SW_EXIT_OK = 0, SW_EXIT_INPUT = 1, SW_EXIT_USAGE = 2 };
 
 /* The one limit: more points than this is an error that says so. */
 #define SW_MAX_POINTS 100000
@@ -1137,19 +1134,63 @@ static int dir_foreign(const char *dir)
     return foreign;
 }
 
+/* The folder's lock, DIR/.sweep.lock: a whole sweep and merge hold it exclusively, --point tasks
+ * shared, so that merge never writes sweep.csv under a running sweep, and a sweep never starts
+ * under another. A POSIX record lock (fcntl) rather than flock: a refusal can then name the
+ * holder's pid (F_GETLK), and it also works on NFS. The lock belongs to this process (not to the
+ * points it forks) until *fd is closed. EXIT_OK, or an exit code after saying why. */
+static int sweep_lock(const char *dir, int exclusive, const char *cmd, int *fd)
+{
+    char *path = xasprintf("%s/.sweep.lock", dir);
+    int rc = EXIT_IO;
+    *fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (*fd < 0) {
+        fprintf(stderr, "sfsim %s: %s: cannot create: %s\n", cmd, path, strerror(errno));
+        goto out;
+    }
+    struct flock fl;
+    memset(&fl, 0, sizeof fl);
+    fl.l_type = exclusive ? F_WRLCK : F_RDLCK;
+    fl.l_whence = SEEK_SET; /* l_start = l_len = 0: the whole file */
+    if (fcntl(*fd, F_SETLK, &fl) == 0) {
+        rc = EXIT_OK;
+        goto out;
+    }
+    if (errno == EACCES || errno == EAGAIN) {
+        struct flock q = fl;
+        char holder[128] = "another sfsim sweep";
+        if (fcntl(*fd, F_GETLK, &q) == 0 && q.l_type == F_RDLCK)
+            snprintf(holder, sizeof holder, "sfsim sweep --point tasks (pid %ld, perhaps others)", (long)q.l_pid);
+        else if (q.l_type == F_WRLCK)
+            snprintf(holder, sizeof holder, "another sfsim sweep or merge (pid %ld)", (long)q.l_pid);
+        if (!strcmp(cmd, "merge"))
+            fprintf(stderr, "sfsim merge: %s is in use by %s: merge when it has ended\n", dir, holder);
+        else
+            fprintf(stderr, "sfsim sweep: %s is in use by %s (wait for it or stop it)\n", dir, holder);
+        close(*fd);
+        *fd = -1;
+        goto out;
+    }
+    fprintf(stderr, "sfsim %s: warning: %s: cannot lock (%s); make sure no other sweep runs in %s\n", cmd, path,
+            strerror(errno), dir);
+    rc = EXIT_OK;
+out:
+    free(path);
+    return rc;
+}
+
 /* Open the sweep folder `dir` for the sweep in cur: create it and write sweep.json, or check
  * the one there is the same sweep. Takes the folder's lock (exclusive for a whole sweep, shared
- * for one point). On success *dir_abs is the folder's absolute path and the lock stays held in
- * *lock_fd. */
+ * for one point). EXIT_OK with *dir_abs the folder's absolute path and the lock held in
+ * *lock_fd, or an exit code after saying why. */
 static int sweep_dir_open(const char *dir, const Plan *cur, int exclusive, int *lock_fd, char **dir_abs)
 {
     char err[PATH_MAX + 256];
     *lock_fd = -1;
     *dir_abs = NULL;
     char *manifest = xasprintf("%s/sweep.json", dir);
-    char *lock = xasprintf("%s/.sweep.lock", dir);
     char *points = xasprintf("%s/points", dir);
-    int rc = -1;
+    int rc = EXIT_IO;
     struct stat st;
     if (stat(dir, &st) == 0) {
         if (!S_ISDIR(st.st_mode)) {
@@ -1159,6 +1200,7 @@ static int sweep_dir_open(const char *dir, const Plan *cur, int exclusive, int *
         if (!file_exists(manifest) && dir_foreign(dir)) {
             fprintf(stderr, "sfsim sweep: %s is not empty and holds no sweep.json: not a sweep folder "
                             "(choose another -o DIR)\n", dir);
+            rc = EXIT_INPUT;
             goto out;
         }
     }
@@ -1166,20 +1208,9 @@ static int sweep_dir_open(const char *dir, const Plan *cur, int exclusive, int *
         fprintf(stderr, "sfsim sweep: %s\n", err);
         goto out;
     }
-    *lock_fd = open(lock, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (*lock_fd < 0) {
-        fprintf(stderr, "sfsim sweep: %s: cannot create: %s\n", lock, strerror(errno));
+    if ((rc = sweep_lock(dir, exclusive, "sweep", lock_fd)) != EXIT_OK)
         goto out;
-    }
-    if (flock(*lock_fd, (exclusive ? LOCK_EX : LOCK_SH) | LOCK_NB) != 0) {
-        if (errno == EWOULDBLOCK) {
-            fprintf(stderr, "sfsim sweep: %s is in use by another sfsim sweep%s (wait for it or stop it)\n", dir,
-                    exclusive ? "" : " running all its points");
-            goto out;
-        }
-        fprintf(stderr, "sfsim sweep: warning: %s: cannot lock (%s); make sure no other sweep runs in %s\n", lock,
-                strerror(errno), dir);
-    }
+    rc = EXIT_INPUT; /* a manifest that is not this sweep's is the arguments' fault */
     if (file_exists(manifest)) {
         size_t len;
         char *text = file_read(manifest, &len, err, sizeof err);
@@ -1223,9 +1254,11 @@ static int sweep_dir_open(const char *dir, const Plan *cur, int exclusive, int *
         buf_free(&b);
         if (w) {
             fprintf(stderr, "sfsim sweep: %s\n", err);
+            rc = EXIT_IO;
             goto out;
         }
     }
+    rc = EXIT_IO;
     if (mkdir_p(points, err, sizeof err)) {
         fprintf(stderr, "sfsim sweep: %s\n", err);
         goto out;
@@ -1235,14 +1268,13 @@ static int sweep_dir_open(const char *dir, const Plan *cur, int exclusive, int *
         fprintf(stderr, "sfsim sweep: %s: %s\n", dir, strerror(errno));
         goto out;
     }
-    rc = 0;
+    rc = EXIT_OK;
 out:
     if (rc && *lock_fd >= 0) {
         close(*lock_fd);
         *lock_fd = -1;
     }
     free(manifest);
-    free(lock);
     free(points);
     return rc;
 }
@@ -2610,7 +2642,7 @@ static int emit_scripts(const Plan *pl, const Args *a, const char *exe, const ch
     if (rc) {
         fprintf(stderr, "sfsim sweep: %s\n", err);
         free(path);
-        return SW_EXIT_INPUT;
+        return EXIT_IO;
     }
     if (slurm)
         printf("sweep: wrote %s, a Slurm array job of %d tasks, one per point (the folder must be on storage the "
@@ -2621,7 +2653,7 @@ static int emit_scripts(const Plan *pl, const Args *a, const char *exe, const ch
                "      (or parallel -S host1,host2 ... with %s on storage the hosts share)\n"
                "  sfsim merge %s      # then: sweep.csv and plots\n", path, pl->npoints, a->jobs, path, dir, dir);
     free(path);
-    return SW_EXIT_OK;
+    return EXIT_OK;
 }
 
 /* ---- the commands --------------------------------------------------------------------------- */
@@ -2654,8 +2686,10 @@ void sweep_usage(FILE *out)
             "                           command per point for GNU parallel); run nothing\n"
             "  --point K                run point K alone (0-based), as those tasks do; no CSV\n"
             "\n"
-            "exit: 0 every point done, 1 an input error or a failed point (the others still run),\n"
-            "2 usage, 130/143 stopped by SIGINT/SIGTERM (run the same command again to resume)\n");
+            "exit: 0 every point done, 1 an input error (nothing is run), 2 usage, 4 an output could\n"
+            "not be written or DIR is in use by another sweep or merge, 5 a point failed (the others\n"
+            "still run), 128 + signal: 130/143 stopped by SIGINT/SIGTERM (run the same command again\n"
+            "to resume)\n");
 }
 
 void merge_usage(FILE *out)
@@ -2665,8 +2699,10 @@ void merge_usage(FILE *out)
             "\n"
             "Builds DIR/sweep.csv and DIR/plots/ from DIR/sweep.json and the point folders, after the\n"
             "points ran as Slurm or GNU parallel tasks (sfsim sweep --emit), and says how many points\n"
-            "are done, failed and unfinished. Exit 0 when every point is done, 1 otherwise (the CSV is\n"
-            "written all the same, with rows of status failed or unfinished). docs/sweep.md.\n");
+            "are done, failed and unfinished. Exit 0 when every point is done, 5 otherwise (the CSV is\n"
+            "written all the same, with rows of status failed or unfinished); 1 when DIR holds no\n"
+            "sweep; 4 when the CSV cannot be written, or while a sweep or its --point tasks run in DIR\n"
+            "(merge refuses, naming the pid that holds DIR's lock). docs/sweep.md.\n");
 }
 
 static int parse_int_opt(const char *opt, const char *s, long lo, long hi, int *out)
@@ -2770,7 +2806,7 @@ static void print_resume(int argc, char **argv)
 
 static int signal_exit(int sig)
 {
-    return 128 + sig;
+    return EXIT_SIGNAL + sig;
 }
 
 static const char *signal_name(int sig)
@@ -2806,9 +2842,9 @@ int sweep_main(int argc, char **argv)
     int prc = args_parse(argc, argv, &a);
     if (prc) {
         free(a.sets);
-        return prc > 0 ? SW_EXIT_OK : SW_EXIT_USAGE;
+        return prc > 0 ? EXIT_OK : EXIT_USAGE;
     }
-    int rc = SW_EXIT_INPUT, lock_fd = -1;
+    int rc = EXIT_INPUT, lock_fd = -1;
     char *dir = NULL;
     int *todo = NULL;
     Runner r;
@@ -2827,8 +2863,9 @@ int sweep_main(int argc, char **argv)
         fprintf(stderr, "sfsim sweep: --point %d: the sweep has points 0..%d\n", a.point, pl.npoints - 1);
         goto out;
     }
-    if (sweep_dir_open(a.out, &pl, a.point < 0, &lock_fd, &dir))
+    if ((rc = sweep_dir_open(a.out, &pl, a.point < 0, &lock_fd, &dir)) != EXIT_OK)
         goto out;
+    rc = EXIT_INPUT;
     ssize_t n = readlink("/proc/self/exe", r.exe, sizeof r.exe - 1);
     if (n <= 0) {
         fprintf(stderr, "sfsim sweep: cannot find this program (/proc/self/exe): %s\n", strerror(errno));
@@ -2851,7 +2888,7 @@ int sweep_main(int argc, char **argv)
         if (s == PS_DONE || (s == PS_FAILED && !a.retry)) {
             fprintf(stderr, "sweep: %s %s already%s\n", label, s == PS_DONE ? "is done" : "failed",
                     s == PS_DONE ? "" : " (--retry-failed runs it again)");
-            rc = s == PS_DONE ? SW_EXIT_OK : SW_EXIT_INPUT;
+            rc = s == PS_DONE ? EXIT_OK : EXIT_POINTS;
             free(label);
             goto out;
         }
@@ -2866,7 +2903,9 @@ int sweep_main(int argc, char **argv)
             rc = signal_exit(got);
         } else if (got == 0) {
             fprintf(stderr, "sweep: %s %s\n", label, r.done ? "done" : "failed");
-            rc = r.done ? SW_EXIT_OK : SW_EXIT_INPUT;
+            rc = r.done ? EXIT_OK : EXIT_POINTS;
+        } else {
+            rc = EXIT_IO; /* its folder or marker could not be written (said) */
         }
         free(label);
         goto out;
@@ -2888,6 +2927,8 @@ int sweep_main(int argc, char **argv)
                     signal_name(got), r.done, pl.npoints, r.failed, left);
             print_resume(argc, argv);
             rc = signal_exit(got);
+        } else {
+            rc = EXIT_IO; /* a point folder or marker could not be written (said) */
         }
         goto out;
     }
@@ -2897,7 +2938,7 @@ int sweep_main(int argc, char **argv)
     fmt_duration(now() - r.t0, d, sizeof d);
     fprintf(stderr, "sweep: %d/%d done, %d failed, %d unfinished (%d run now in %s, -j %d)\n", nd, pl.npoints, nf, nu,
             r.started, d, r.jobs);
-    rc = nd == pl.npoints && !csv_bad ? SW_EXIT_OK : SW_EXIT_INPUT;
+    rc = csv_bad ? EXIT_IO : nd == pl.npoints ? EXIT_OK : EXIT_POINTS;
 out:
     if (lock_fd >= 0)
         close(lock_fd);
@@ -2916,18 +2957,18 @@ int merge_main(int argc, char **argv)
 {
     if (argc == 1 && (!strcmp(argv[0], "--help") || !strcmp(argv[0], "-h"))) {
         merge_usage(stdout);
-        return SW_EXIT_OK;
+        return EXIT_OK;
     }
     if (argc != 1 || argv[0][0] == '-') {
         merge_usage(stderr);
-        return SW_EXIT_USAGE;
+        return EXIT_USAGE;
     }
     const char *dir = argv[0];
     char err[PATH_MAX + 256];
     char *manifest = xasprintf("%s/sweep.json", dir);
     size_t len;
     char *text = file_read(manifest, &len, err, sizeof err);
-    int rc = SW_EXIT_INPUT;
+    int rc = EXIT_INPUT, lock_fd = -1;
     Plan pl;
     memset(&pl, 0, sizeof pl);
     if (!text) {
@@ -2943,11 +2984,17 @@ int merge_main(int argc, char **argv)
         fprintf(stderr, "sfsim merge: %s: %s\n", manifest, err);
         goto out;
     }
+    /* Not under a running sweep or its tasks: they write the markers this reads and a whole
+     * sweep writes sweep.csv itself at its end. */
+    if ((rc = sweep_lock(dir, 1, "merge", &lock_fd)) != EXIT_OK)
+        goto out;
     int nd, nf, nu;
     int csv_bad = outputs_write(&pl, dir, "merge", &nd, &nf, &nu);
     printf("merge: %s: %d points: %d done, %d failed, %d unfinished\n", dir, pl.npoints, nd, nf, nu);
-    rc = nd == pl.npoints && !csv_bad ? SW_EXIT_OK : SW_EXIT_INPUT;
+    rc = csv_bad ? EXIT_IO : nd == pl.npoints ? EXIT_OK : EXIT_POINTS;
 out:
+    if (lock_fd >= 0)
+        close(lock_fd);
     if (pl.json)
         plan_free(&pl);
     free(text);

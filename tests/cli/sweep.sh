@@ -163,9 +163,9 @@ for d in $done_before; do
 done
 end
 
-begin "merge of the stopped sweep: exit 1, a row per point, unfinished ones say so"
+begin "merge of the stopped sweep: exit 5 (EXIT_POINTS), a row per point, unfinished ones say so"
 run "$SFSIM" merge "$T/kill"
-want_rc 1
+want_rc 5
 want_out "$nbefore done, 0 failed, $((8 - nbefore)) unfinished"
 [ "$(rows "$T/kill/sweep.csv")" -eq 8 ] || no "sweep.csv has $(rows "$T/kill/sweep.csv") rows, expected 8"
 [ "$(col "$T/kill/sweep.csv" status | grep -c unfinished)" -eq $((8 - nbefore)) ] || no "unfinished rows miscounted"
@@ -191,14 +191,36 @@ for c in $(col "$csv" cycles); do
 done
 end
 
+begin "merge refuses while a sweep runs in the folder (exit 4, names the folder and the sweep's pid), then works"
+printf '[sweep]\ncore.simd_width = 4, 8, 12, 16\nrender.seed = 1, 2, 3, 4\n' >"$T/live.ini"
+cmdline="$SFSIM sweep --sweep $T/live.ini -o $T/live & (then merge $T/live)"
+"$SFSIM" sweep --sweep "$T/live.ini" -o "$T/live" -j 1 "${TINY[@]}" >"$T/live.out" 2>"$T/live.err" &
+bg_pid=$!
+for _ in $(seq 1 600); do
+    [ -d "$T/live/points/000" ] && break
+    sleep 0.05
+done
+run "$SFSIM" merge "$T/live"
+want_rc 4
+want_err "merge: .*/live is in use by another sfsim sweep or merge \(pid $bg_pid\)"
+[ -e "$T/live/sweep.csv" ] && no "merge wrote sweep.csv under the running sweep"
+[ -d "$T/live/plots" ] && no "merge drew plots under the running sweep"
+kill -TERM "$bg_pid" 2>/dev/null
+wait "$bg_pid"
+bg_pid=""
+run "$SFSIM" merge "$T/live"
+want_rc 5
+[ "$(rows "$T/live/sweep.csv")" -eq 16 ] || no "after the sweep stopped, merge wrote no complete sweep.csv"
+end
+
 # ---- 3: a failing point ---------------------------------------------------------------------
 
 printf '[point.ok1]\ncore.simd_width = 8\n\n[point.small-buffer]\nraybuf.size_kb = 64\n\n[point.ok2]\ncore.simd_width = 16\n' \
     >"$T/fail.ini"
 
-begin "a point that sfsim run rejects is recorded failed, the others run, exit 1"
+begin "a point that sfsim run rejects is recorded failed, the others run, exit 5 (EXIT_POINTS)"
 run "$SFSIM" sweep --sweep "$T/fail.ini" -o "$T/fail" -j 2 "${TINY[@]}"
-want_rc 1
+want_rc 5
 want_err "small-buffer.*failed.*raybuf.size_kb"
 csv="$T/fail/sweep.csv"
 [ "$(col "$csv" point | tr '\n' ' ')" = "ok1 small-buffer ok2 " ] || no "point column: $(col "$csv" point | tr '\n' ' ')"
@@ -212,10 +234,10 @@ end
 
 begin "failed points are finished: a restart runs nothing; --retry-failed runs them again"
 run "$SFSIM" sweep --sweep "$T/fail.ini" -o "$T/fail" -j 2 "${TINY[@]}"
-want_rc 1
+want_rc 5
 want_err "\(0 run now"
 run "$SFSIM" sweep --sweep "$T/fail.ini" -o "$T/fail" -j 2 "${TINY[@]}" --retry-failed
-want_rc 1
+want_rc 5
 want_err "\(1 run now"
 end
 
