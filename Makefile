@@ -186,7 +186,7 @@ $(BUILD)/fuzz/gltf_shim.o: scenes/gltf_shim.cpp scenes/gltf.h scenes/scene.h
 	$(CLANG)++ -std=c++17 -g -O1 -fsanitize=fuzzer-no-link,address,undefined -isystem /usr/include/stb \
 	    -DSFSIM_TINYGLTF_IMPLEMENTATION -c $< -o $@
 
-$(BUILD)/fuzz/fuzz_scene: tests/fuzz/fuzz_scene.c scenes/scene.c scenes/scene_file.c $(BUILD)/fuzz/gltf_shim.o
+$(BUILD)/fuzz/fuzz_scene: tests/fuzz/fuzz_scene.c scenes/scene.c scenes/scene_file.c sim/ini.c $(BUILD)/fuzz/gltf_shim.o
 	@mkdir -p $(dir $@)
 	$(CLANG)++ -x c -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined \
 	    $(filter %.c,$^) -x none $(filter %.o,$^) -o $@ -linih -lm
@@ -195,7 +195,7 @@ $(BUILD)/fuzz/fuzz_rays: tests/fuzz/fuzz_rays.c sim/raybatch.c sim/outfile.c
 	@mkdir -p $(dir $@)
 	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ -lm
 
-$(BUILD)/fuzz/fuzz_config: tests/fuzz/fuzz_config.c sim/config.c sim/timing.c sim/event.c sim/scenemem.c isa/isa.c
+$(BUILD)/fuzz/fuzz_config: tests/fuzz/fuzz_config.c sim/config.c sim/ini.c sim/timing.c sim/event.c sim/scenemem.c isa/isa.c
 	@mkdir -p $(dir $@)
 	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ $(INIH) $(CJSON) -lm
 

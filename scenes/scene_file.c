@@ -5,34 +5,24 @@
  * 'section.key': message" (or "section [name]: message"), all of them in one run. Must not:
  * finish the scene (scene_finish) or read glTF itself (gltf_shim.cpp).
  *
- * inih does the splitting into sections, keys and values; a reader callback sees every line
- * first, to know line numbers and section headers, to report every syntax error (inih reports
- * only the first), and to strip indentation, which inih would otherwise take for a continuation
- * of the previous value.
+ * The syntax (comments, sections, keys, a section or key given twice, a UTF-8 BOM, size and line
+ * limits) is sim/ini.c's, the INI reader of every sfsim file (docs/ini.md); this file knows the
+ * sections and keys of a scene.
  */
 #include "scene_file.h"
 
 #include <ctype.h>
 #include <errno.h>
-#include <ini.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
+#include "../sim/ini.h"
 #include "gltf.h"
 
-typedef struct Entry {
-    char *section, *key, *value;
-    int line;
-} Entry;
-
-typedef struct Section {
-    char *name;
-    int line;
-} Section;
+typedef IniEntry Entry;
 
 typedef struct Diag {
     int line;   /* the messages come out in line order, */
@@ -41,19 +31,14 @@ typedef struct Diag {
 } Diag;
 
 typedef struct Parse {
-    FILE *f;
     const char *path;
-    int line;
-    Entry *e;
-    size_t n, cap;
-    Section *sec;
-    size_t nsec, capsec;
-    int oom;
+    IniFile ini; /* the sections and keys, each once */
     Diag *d;
     size_t nd, capd;
     int nerr;
 } Parse;
 
+static void diag_keep(Parse *p, int line, char *text);
 static void diag(Parse *p, int line, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 static void diag(Parse *p, int line, const char *fmt, ...)
 {
@@ -68,6 +53,12 @@ static void diag(Parse *p, int line, const char *fmt, ...)
     free(msg);
     if (n < 0)
         return; /* out of memory: counted, not shown */
+    diag_keep(p, line, text);
+}
+
+/* Keep a message made elsewhere (the INI reader's), already "FILE:LINE: ...". */
+static void diag_keep(Parse *p, int line, char *text)
+{
     if (p->nd == p->capd) {
         size_t cap = p->capd ? 2 * p->capd : 16;
         Diag *d = realloc(p->d, cap * sizeof *d);
@@ -116,139 +107,6 @@ static void write_diags(Parse *p, char *err, size_t errlen)
     if (shown < p->nerr && used < errlen)
         snprintf(err + used, errlen - used, "%s... and %d more error%s", used ? "\n" : "", p->nerr - shown,
                  p->nerr - shown == 1 ? "" : "s");
-}
-
-/* ---- lines ----------------------------------------------------------------------------------- */
-
-static int add_section(Parse *p, const char *name, size_t len)
-{
-    if (p->nsec == p->capsec) {
-        size_t cap = p->capsec ? 2 * p->capsec : 16;
-        Section *s = realloc(p->sec, cap * sizeof *s);
-        if (!s)
-            return -1;
-        p->sec = s;
-        p->capsec = cap;
-    }
-    char *copy = strndup(name, len);
-    if (!copy)
-        return -1;
-    p->sec[p->nsec].name = copy;
-    p->sec[p->nsec].line = p->line;
-    p->nsec++;
-    return 0;
-}
-
-static int is_comment(const char *s) { return *s == ';' || *s == '#'; }
-
-/* Checks one line; a bad line is reported and handed to inih as an empty one. */
-static void check_line(Parse *p, char *str)
-{
-    char *s = str;
-    if (p->line == 1 && (unsigned char)s[0] == 0xEF && (unsigned char)s[1] == 0xBB && (unsigned char)s[2] == 0xBF)
-        s += 3; /* UTF-8 byte order mark */
-    while (*s == ' ' || *s == '\t')
-        s++;
-    if (s != str)
-        memmove(str, s, strlen(s) + 1);
-    size_t len = strlen(str);
-    while (len && (str[len - 1] == '\n' || str[len - 1] == '\r' || str[len - 1] == ' ' || str[len - 1] == '\t'))
-        len--;
-    if (len == 0 || is_comment(str))
-        return;
-    if (str[0] == '[') {
-        char *close = memchr(str, ']', len);
-        char *after = close ? close + 1 : NULL;
-        while (after && (*after == ' ' || *after == '\t'))
-            after++;
-        if (!close || (after < str + len && !is_comment(after))) {
-            diag(p, p->line, "syntax error: a section header is '[name]' alone on its line");
-            str[0] = '\n', str[1] = 0;
-            return;
-        }
-        const char *a = str + 1, *b = close;
-        while (a < b && isspace((unsigned char)*a))
-            a++;
-        while (b > a && isspace((unsigned char)b[-1]))
-            b--;
-        if (a == b) {
-            diag(p, p->line, "syntax error: empty section name");
-            str[0] = '\n', str[1] = 0;
-            return;
-        }
-        if (add_section(p, a, (size_t)(b - a)) != 0)
-            p->oom = 1;
-        return;
-    }
-    char *eq = memchr(str, '=', len);
-    if (!eq || eq == str) {
-        diag(p, p->line, "syntax error: expected 'key = value' or '[section]', got '%.*s'",
-             (int)(len > 60 ? 60 : len), str);
-        str[0] = '\n', str[1] = 0;
-        return;
-    }
-    if (memchr(str, ':', (size_t)(eq - str))) {
-        /* inih would split "a: b = c" at the colon */
-        diag(p, p->line, "syntax error: ':' in key '%.*s'", (int)(eq - str), str);
-        str[0] = '\n', str[1] = 0;
-        return;
-    }
-    if (p->nsec == 0) {
-        const char *k = eq;
-        while (k > str && (k[-1] == ' ' || k[-1] == '\t'))
-            k--;
-        diag(p, p->line, "key '%.*s': outside any section", (int)(k - str), str);
-        str[0] = '\n', str[1] = 0;
-    }
-}
-
-static char *reader(char *str, int num, void *stream)
-{
-    Parse *p = stream;
-    if (!fgets(str, num, p->f))
-        return NULL;
-    p->line++;
-    size_t len = strlen(str);
-    if (len > 0 && str[len - 1] != '\n' && !feof(p->f)) {
-        diag(p, p->line, "line longer than %d characters", num - 2);
-        int ch;
-        while ((ch = fgetc(p->f)) != EOF && ch != '\n')
-            ;
-        str[0] = '\n';
-        str[1] = 0;
-        return str;
-    }
-    check_line(p, str);
-    return str;
-}
-
-static int on_entry(void *user, const char *section, const char *key, const char *value)
-{
-    Parse *p = user;
-    if (p->n == p->cap) {
-        size_t cap = p->cap ? 2 * p->cap : 32;
-        Entry *e = realloc(p->e, cap * sizeof *e);
-        if (!e) {
-            p->oom = 1;
-            return 1;
-        }
-        p->e = e;
-        p->cap = cap;
-    }
-    Entry *e = &p->e[p->n];
-    e->section = strdup(section);
-    e->key = strdup(key);
-    e->value = strdup(value);
-    e->line = p->line;
-    if (!e->section || !e->key || !e->value) {
-        free(e->section);
-        free(e->key);
-        free(e->value);
-        p->oom = 1;
-        return 1;
-    }
-    p->n++;
-    return 1;
 }
 
 /* ---- values ---------------------------------------------------------------------------------- */
@@ -375,21 +233,14 @@ static const char *named(const char *section, const char *kind)
 
 static int section_line(const Parse *p, const char *name)
 {
-    for (size_t i = 0; i < p->nsec; i++)
-        if (!strcmp(p->sec[i].name, name))
-            return p->sec[i].line;
-    return 0;
+    const IniSection *s = inifile_section(&p->ini, name);
+    return s ? s->line : 0;
 }
 
-/* The (first) entry of `key` in `section`, or NULL. */
+/* The entry of `key` in `section` (each is there once, but for [scene] gltf), or NULL. */
 static const Entry *get(const Parse *p, const char *section, const char *key)
 {
-    for (size_t i = 0; i < p->n; i++) {
-        const Entry *e = &p->e[i];
-        if (!strcmp(e->section, section) && !strcmp(e->key, key))
-            return e;
-    }
-    return NULL;
+    return inifile_get(&p->ini, section, key);
 }
 
 static void missing(Parse *p, const char *section, const char *key, const char *why)
@@ -825,48 +676,33 @@ static const char *keys_of(const char *kind)
 
 int scene_file_load(const char *path, Scene *s, char *err, size_t errlen)
 {
+    static const char *const repeatable[] = {"scene.gltf", NULL};
+    const IniOptions opt = {0, 0, repeatable};
     Parse p;
     memset(&p, 0, sizeof p);
     p.path = path;
-    struct stat st;
-    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
-        snprintf(err, errlen, "%s: not a regular file", path);
-        return -1;
+    inifile_load(&p.ini, path, &opt);
+    /* The reader's messages join this file's, all sorted by line in the end. */
+    p.nerr += p.ini.nerrors;
+    for (int i = 0; i < p.ini.nmessages; i++) {
+        diag_keep(&p, p.ini.messages[i].line, p.ini.messages[i].text);
+        p.ini.messages[i].text = NULL;
     }
-    p.f = fopen(path, "r");
-    if (!p.f) {
-        snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
-        return -1;
-    }
-    int rc = ini_parse_stream(reader, &p, on_entry, &p);
-    fclose(p.f);
-    if (rc > 0 && p.nerr == 0) /* check_line passes only what inih accepts; a safety net */
-        diag(&p, rc, "syntax error");
-    if (rc < 0 || p.oom) {
-        diag(&p, 0, "out of memory");
-        goto done;
-    }
+    if (p.ini.nerrors && !p.ini.nsections)
+        goto done; /* not read at all, or nothing to check */
 
-    /* Section names: known kinds, each once. */
-    for (size_t i = 0; i < p.nsec; i++) {
-        const char *name = p.sec[i].name;
-        if (!section_kind(name)) {
-            diag(&p, p.sec[i].line,
+    /* Section names: known kinds (each is there once: the reader says so). */
+    for (int i = 0; i < p.ini.nsections; i++) {
+        const char *name = p.ini.sections[i].name;
+        if (!section_kind(name))
+            diag(&p, p.ini.sections[i].line,
                  "unknown section [%s] (expected scene, camera, render, gltf.NAME, light.NAME, sphere.NAME or "
                  "material.NAME)",
                  name);
-            continue;
-        }
-        for (size_t j = 0; j < i; j++)
-            if (!strcmp(p.sec[j].name, name)) {
-                diag(&p, p.sec[i].line, "section [%s] appears twice (first at line %d)", name,
-                     p.sec[j].line);
-                break;
-            }
     }
-    /* Keys: known for their section, each once (except [scene] gltf, which may repeat). */
-    for (size_t i = 0; i < p.n; i++) {
-        const Entry *e = &p.e[i];
+    /* Keys: known for their section, on one line. */
+    for (int i = 0; i < p.ini.nentries; i++) {
+        Entry *e = &p.ini.entries[i];
         const char *kind = section_kind(e->section);
         if (!kind)
             continue; /* its section is reported */
@@ -886,32 +722,32 @@ int scene_file_load(const char *path, Scene *s, char *err, size_t errlen)
                  !strcmp(kind, e->section) ? e->section : kind, keys);
             continue;
         }
-        if (strcmp(e->section, "scene") != 0)
-            for (size_t j = 0; j < i; j++)
-                if (!strcmp(p.e[j].section, e->section) && !strcmp(p.e[j].key, e->key)) {
-                    diag(&p, e->line, "key '%s.%s': given twice (first at line %d)", e->section, e->key,
-                         p.e[j].line);
-                    break;
-                }
+        char *nl = strchr(e->value, '\n');
+        if (nl) {
+            diag(&p, e->line, "key '%s.%s': continued on an indented line: the value must be on one line",
+                 e->section, e->key);
+            /* Reported once: what follows sees blanks, so that no message spans lines. */
+            for (char *c = nl; *c; c++)
+                if (*c == '\n')
+                    *c = ' ';
+        }
     }
 
     /* glTF files in the order they appear: [scene] gltf lines, then [gltf.NAME] sections. */
     int gltf_failed = 0;
-    for (size_t i = 0; i < p.n; i++) {
-        const Entry *e = &p.e[i];
+    for (int i = 0; i < p.ini.nentries; i++) {
+        const Entry *e = &p.ini.entries[i];
         if (!strcmp(e->section, "scene") && !strcmp(e->key, "gltf"))
             gltf_failed |= load_gltf(&p, s, e, NULL) != 0;
     }
-    for (size_t i = 0; i < p.nsec; i++)
-        if (named(p.sec[i].name, "gltf") && section_line(&p, p.sec[i].name) == p.sec[i].line)
-            gltf_failed |= gltf_section(&p, s, p.sec[i].name) != 0;
+    for (int i = 0; i < p.ini.nsections; i++)
+        if (named(p.ini.sections[i].name, "gltf"))
+            gltf_failed |= gltf_section(&p, s, p.ini.sections[i].name) != 0;
 
     /* Then what refers to the glTF files' materials by name: materials, spheres; then lights. */
     for (int pass = 0; pass < 3; pass++)
-        for (size_t i = 0; i < p.nsec; i++) {
-            const char *sec = p.sec[i].name, *name;
-            if (section_line(&p, sec) != p.sec[i].line)
-                continue; /* a repeated section, reported above */
+        for (int i = 0; i < p.ini.nsections; i++) {
+            const char *sec = p.ini.sections[i].name, *name;
             if (pass == 0 && (name = named(sec, "material")))
                 material_section(&p, s, sec, name);
             else if (pass == 1 && (name = named(sec, "sphere")))
@@ -924,15 +760,7 @@ int scene_file_load(const char *path, Scene *s, char *err, size_t errlen)
     render_section(&p, s);
 
 done:
-    for (size_t i = 0; i < p.n; i++) {
-        free(p.e[i].section);
-        free(p.e[i].key);
-        free(p.e[i].value);
-    }
-    free(p.e);
-    for (size_t i = 0; i < p.nsec; i++)
-        free(p.sec[i].name);
-    free(p.sec);
+    inifile_free(&p.ini);
     int nerr = p.nerr;
     write_diags(&p, err, errlen);
     return nerr ? -1 : 0;

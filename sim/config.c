@@ -1,5 +1,5 @@
-/* sim/config.c -- machine-config keys from sim/config.def: defaults, INI reading through inih,
- * --set overrides, checks, listings.
+/* sim/config.c -- machine-config keys from sim/config.def: defaults, INI reading (through
+ * sim/ini.c, the INI reader of every file: docs/ini.md), --set overrides, checks, listings.
  *
  * Owns: turning text into CfgMachine values and saying precisely what is wrong with bad text.
  * Must not: exit, or interpret what a key means for the machine.
@@ -8,11 +8,12 @@
 
 #include <cjson/cJSON.h>
 #include <errno.h>
-#include <ini.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "ini.h"
 
 typedef enum CfgType { CFG_INT, CFG_I64, CFG_FLOAT, CFG_ENUM } CfgType;
 
@@ -221,105 +222,64 @@ static const char *parse_value(const CfgKeyInfo *k, const char *text, CfgValue *
     return NULL;
 }
 
-typedef struct Reader {
-    FILE *f;
-    const char *path;
-    int line;
-    int last_syntax_error;  /* line of the last syntax error this reader reported */
-    CfgMachine *cfg;
-    CfgErrors *errs;
-} Reader;
-
-/* inih reports only the first malformed line; check each line here so all are reported. A
- * line is fine when blank, a comment, a [section], an indented continuation, or has = or :. */
-static int syntax_ok(const char *line)
+/* Check every key of a parsed file against the table and store the good ones; the messages
+ * (the reader's and these, in line order) go to errs. */
+static int load_file(CfgMachine *cfg, IniFile *f, CfgErrors *errs)
 {
-    if (*line == ' ' || *line == '\t')
-        return 1;
-    if (*line == 0 || *line == '\n' || *line == '\r' || *line == ';' || *line == '#')
-        return 1;
-    if (*line == '[')
-        return strchr(line, ']') != NULL;
-    return strchr(line, '=') != NULL || strchr(line, ':') != NULL;
-}
-
-/* fgets for inih that counts lines, so the handler knows where it is, and catches lines longer
- * than inih's buffer instead of letting them be split silently. */
-static char *reader(char *str, int num, void *stream)
-{
-    Reader *r = stream;
-    if (!fgets(str, num, r->f))
-        return NULL;
-    size_t len = strlen(str);
-    int complete = (len > 0 && str[len - 1] == '\n') || feof(r->f);
-    if (complete) {
-        r->line++;
-        if (!syntax_ok(str)) {
-            add_error(r->errs, "%s:%d: syntax error (expected [section] or key = value)", r->path, r->line);
-            r->last_syntax_error = r->line;
-            str[0] = '\n';
-            str[1] = 0;
+    for (int i = 0; i < f->nentries; i++) {
+        const IniEntry *e = &f->entries[i];
+        const CfgKeyInfo *k = find(e->section, e->key);
+        if (!k) {
+            if (!section_known(e->section))
+                inifile_error(f, e->line, "key '%s.%s': unknown section [%s]", e->section, e->key, e->section);
+            else
+                inifile_error(f, e->line, "key '%s.%s': unknown key", e->section, e->key);
+            continue;
         }
-        return str;
+        CfgValue v;
+        char buf[256];
+        /* An indented line below a key continues its value (docs/ini.md); no machine key takes
+         * more than one line. */
+        const char *msg = strchr(e->value, '\n') ? "continued on an indented line: the value must be on one line"
+                                                  : parse_value(k, e->value, &v, buf, sizeof buf);
+        if (msg) {
+            inifile_error(f, e->line, "key '%s.%s': %s", e->section, e->key, msg);
+            continue;
+        }
+        store(cfg, k, v);
     }
-    /* Too long: report, then skip the rest of the line and hand inih an empty one. */
-    r->line++;
-    add_error(r->errs, "%s:%d: line longer than %d characters", r->path, r->line, num - 1);
-    int ch;
-    while ((ch = fgetc(r->f)) != EOF && ch != '\n')
-        ;
-    str[0] = '\n';
-    str[1] = 0;
-    return str;
+    int n, before = errs->count, count = f->nerrors;
+    const IniMessage *m = inifile_messages(f, &n);
+    for (int i = 0; i < n; i++)
+        add_error(errs, "%s", m[i].text);
+    errs->count = before + count; /* a last "... and N more errors" line stands for N */
+    inifile_free(f);
+    return count;
 }
 
-static int handler(void *user, const char *section, const char *name, const char *value)
-{
-    Reader *r = user;
-    const CfgKeyInfo *k = find(section, name);
-    if (!k) {
-        if (!section[0])
-            add_error(r->errs, "%s:%d: key '%s' is not in a [section]", r->path, r->line, name);
-        else if (!section_known(section))
-            add_error(r->errs, "%s:%d: key '%s.%s': unknown section [%s]", r->path, r->line, section, name, section);
-        else
-            add_error(r->errs, "%s:%d: key '%s.%s': unknown key", r->path, r->line, section, name);
-        return 1;
-    }
-    CfgValue v;
-    char buf[256];
-    const char *msg = parse_value(k, value, &v, buf, sizeof buf);
-    if (msg) {
-        add_error(r->errs, "%s:%d: key '%s.%s': %s", r->path, r->line, section, name, msg);
-        return 1;
-    }
-    store(r->cfg, k, v);
-    return 1;
-}
+/* A section may appear again in a machine config (sfsim config --dump writes [raybuf] twice:
+ * config.def keeps a unit's timing keys together); a key still appears once. */
+static const IniOptions cfg_ini = {1, 0, NULL};
 
 int cfg_load_stream(CfgMachine *cfg, FILE *f, const char *name, CfgErrors *errs)
 {
-    int before = errs->count;
-    Reader r = {f, name, 0, 0, cfg, errs};
-    int rc = ini_parse_stream(reader, &r, handler, &r);
-    if (rc > 0 && rc != r.last_syntax_error)
-        add_error(errs, "%s:%d: syntax error (expected [section] or key = value)", name, rc);
-    else if (rc < 0)
-        add_error(errs, "%s: cannot read", name);
-    return errs->count - before;
+    IniFile ini;
+    inifile_load_stream(&ini, f, name, &cfg_ini);
+    return load_file(cfg, &ini, errs);
+}
+
+int cfg_load_text(CfgMachine *cfg, const char *text, size_t len, const char *name, CfgErrors *errs)
+{
+    IniFile ini;
+    inifile_parse(&ini, name, text, len, &cfg_ini);
+    return load_file(cfg, &ini, errs);
 }
 
 int cfg_load(CfgMachine *cfg, const char *path, CfgErrors *errs)
 {
-    int before = errs->count;
-    FILE *f = fopen(path, "r");
-    if (!f) {
-        add_error(errs, "%s: cannot open: %s", path, strerror(errno));
-        return errs->count - before;
-    }
-    cfg_load_stream(cfg, f, path, errs);
-    fclose(f);
-    return errs->count - before;
+    IniFile ini;
+    inifile_load(&ini, path, &cfg_ini);
+    return load_file(cfg, &ini, errs);
 }
 
 int cfg_set(CfgMachine *cfg, const char *assignment, CfgErrors *errs)
@@ -457,7 +417,10 @@ void cfg_markdown(FILE *out)
     fprintf(out, "# Machine configuration\n\n"
                  "<!-- GENERATED by `bin/sfsim config --markdown` from sim/config.def; do not edit. -->\n\n"
                  "A machine config is an INI file (`configs/streamray.ini` is the machine of Gribble & Ramani\n"
-                 "2008, Sec. 3.3). Every key has a type, a default and a range; a key left out takes its\n"
+                 "2008, Sec. 3.3), read by the reader of every sfsim INI file with its rules ([ini.md](ini.md):\n"
+                 "comments, a key once per section, a UTF-8 BOM, a regular file of at most 16 MiB, lines of at\n"
+                 "most 198 characters). A section may appear more than once (`config --dump` repeats some); a value is on\n"
+                 "one line. Every key has a type, a default and a range; a key left out takes its\n"
                  "default. `--set section.key=value` overrides any key on the command line, and\n"
                  "`bin/sfsim config --dump [-c FILE] [--set ...]` prints the values in force. Unknown sections\n"
                  "and keys, values that are not numbers, and values out of range are errors naming the file,\n"

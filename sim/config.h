@@ -1,5 +1,5 @@
 /* sim/config.h -- the machine configuration: the keys of sim/config.def as a struct, INI parsing
- * (inih), --set overrides, checks, and the dump/markdown listings.
+ * (sim/ini.h, the rules of docs/ini.md), --set overrides, checks, and the dump/markdown listings.
  *
  * Owns: every machine-config key's type, default, range and help. Must not: interpret keys
  * (the simulator's parts read the struct).
@@ -32,10 +32,13 @@ typedef struct CfgErrors {
 
 void cfg_defaults(CfgMachine *cfg);
 /* Read an INI file over cfg. Every problem is reported as "FILE:LINE: key 'sec.key': message"
- * (or "FILE:LINE: message" for syntax), all of them. */
+ * (or "FILE:LINE: message" for syntax, "FILE: message" for a file that cannot be read: a
+ * directory, a device or FIFO, more than 16 MiB), all of them, in line order. */
 int cfg_load(CfgMachine *cfg, const char *path, CfgErrors *errs);
-/* The same from an open stream; name is used in the messages. */
+/* The same from an open stream (at most 16 MiB of it is read) or from text in memory; name is
+ * used in the messages. */
 int cfg_load_stream(CfgMachine *cfg, FILE *f, const char *name, CfgErrors *errs);
+int cfg_load_text(CfgMachine *cfg, const char *text, size_t len, const char *name, CfgErrors *errs);
 /* Apply "section.key=value"; errors name the option: "--set core.simd_width=999: ...". */
 int cfg_set(CfgMachine *cfg, const char *assignment, CfgErrors *errs);
 /* Cross-key consistency (e.g. a 4096-ray stream of 128-byte records must fit a ray buffer). */

@@ -15,7 +15,6 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <ftw.h>
-#include <ini.h>
 #include <limits.h>
 #include <math.h>
 #include <poll.h>
@@ -24,7 +23,6 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/file.h>
 #include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/types.h>
@@ -33,11 +31,12 @@
 #include <unistd.h>
 
 #include "config.h"
+#include "datadir.h"
+#include "exitcodes.h"
 #include "functional.h"
+#include "ini.h"
 #include "render.h"
 #include "timing.h"
-
-enum { SW_EXIT_OK = 0, SW_EXIT_INPUT = 1, SW_EXIT_USAGE = 2 };
 
 /* The one limit: more points than this is an error that says so. */
 #define SW_MAX_POINTS 100000
@@ -436,8 +435,18 @@ static int key_known(const char *key)
     return !unknown;
 }
 
-/* "A..B" or "A..B step S" (inclusive) appended to out as value texts; -1 with msg. */
-static int range_expand(const char *item, StrList *out, char *msg, size_t len)
+/* A range "A..B" or "A..B step S" (inclusive; S defaults to 1): integers exactly, floats with a
+ * little slack so that 0..1 step 0.1 ends at 1. */
+typedef struct Range {
+    int ints;
+    long long a, s;  /* integers */
+    double af, sf;   /* floats */
+    double count;    /* values it gives; may be huge, never computed by making them */
+} Range;
+
+/* -1 with msg when item is no good range. Overflow-safe: the count of a range of integers is
+ * computed in unsigned arithmetic, of floats in double (inf is "too many"). */
+static int range_parse(const char *item, Range *r, char *msg, size_t len)
 {
     const char *dots = strstr(item, "..");
     char *a = xstrndup(item, (size_t)(dots - item));
@@ -456,25 +465,30 @@ static int range_expand(const char *item, StrList *out, char *msg, size_t len)
     double av, bv, sv;
     int ai, bi, si, rc = -1;
     long long aii, bii, sii;
+    memset(r, 0, sizeof *r);
     if (parse_number(trim(a), &av, &ai, &aii) || parse_number(b, &bv, &bi, &bii) || parse_number(s, &sv, &si, &sii)) {
         snprintf(msg, len, "bad range '%s': expected A..B or A..B step S, with numbers", item);
     } else if (!(sv > 0)) {
         snprintf(msg, len, "bad range '%s': the step must be > 0", item);
-    } else if (bv < av) {
+    } else if (ai && bi && si ? bii < aii : bv < av) {
         snprintf(msg, len, "bad range '%s': its end is below its start", item);
     } else {
-        int ints = ai && bi && si;
-        /* Integers exactly; floats with a little slack so 0..1 step 0.1 ends at 1. */
-        double count = ints ? (double)((bii - aii) / sii + 1) : floor((bv - av) / sv * (1 + 1e-12) + 1e-9) + 1;
-        if (count > SW_MAX_POINTS) {
-            snprintf(msg, len, "range '%s' gives %.0f values, more than %d", item, count, SW_MAX_POINTS);
+        r->ints = ai && bi && si;
+        if (r->ints) {
+            r->a = aii;
+            r->s = sii;
+            r->count = (double)(((unsigned long long)bii - (unsigned long long)aii) / (unsigned long long)sii) + 1;
         } else {
-            for (long long i = 0; i < (long long)count; i++) {
-                if (ints)
-                    sl_push(out, xasprintf("%lld", aii + i * sii));
-                else
-                    sl_push(out, xasprintf("%.10g", av + (double)i * sv));
-            }
+            r->af = av;
+            r->sf = sv;
+            r->count = floor((bv - av) / sv * (1 + 1e-12) + 1e-9) + 1;
+        }
+        if (!(r->count <= SW_MAX_POINTS)) {
+            if (r->count < 1e15)
+                snprintf(msg, len, "range '%s' gives %.0f values, more than %d", item, r->count, SW_MAX_POINTS);
+            else
+                snprintf(msg, len, "range '%s' gives more than %d values", item, SW_MAX_POINTS);
+        } else {
             rc = 0;
         }
     }
@@ -483,44 +497,25 @@ static int range_expand(const char *item, StrList *out, char *msg, size_t len)
     return rc;
 }
 
-/* Two value texts that mean the same value ("8" and "8.0"). */
-static int same_value(const char *x, const char *y)
+/* Value i of a range (i < r->count). a + i s stays within [A, B]: no overflow. */
+static char *range_value(const Range *r, long long i)
 {
-    double a, b;
-    if (is_number(x, &a) && is_number(y, &b))
-        return a == b;
-    return strcmp(x, y) == 0;
+    if (r->ints)
+        return xasprintf("%lld", (long long)((unsigned long long)r->a + (unsigned long long)i * (unsigned long long)r->s));
+    return xasprintf("%.10g", r->af + (double)i * r->sf);
 }
 
 /* ---- the sweep file ------------------------------------------------------------------------- */
 
+/* The syntax is sim/ini.c's (docs/ini.md); this part knows [sweep] and [point.NAME] and their keys. */
+
 typedef struct SfKey {
-    char *name;
-    int line;
-    Buf raw;      /* the value text, with its continuation lines */
-    StrList vals; /* the values, once the key is complete */
+    const IniEntry *e;
+    StrList items;  /* a [sweep] key: its list's items (values or ranges) */
+    double count;   /* the values they give */
+    int bad;        /* reported */
+    StrList vals;   /* the values, once checked */
 } SfKey;
-
-typedef struct SfSection {
-    char *point; /* NAME of [point.NAME]; NULL for [sweep] */
-    int line;
-    SfKey *keys;
-    int nkeys;
-} SfSection;
-
-typedef struct SweepFile {
-    const char *path; /* as the user wrote it: the messages name it */
-    FILE *f;
-    int line, last_syntax_error;
-    SfSection *secs;
-    int nsecs;
-    int cur;            /* section receiving keys; -1: a bad section (reported), -2: none yet */
-    int pend;           /* key of section cur that continuation lines extend; -1 none */
-    int pend_ignored;   /* the last key was dropped (reported): drop its continuation lines too */
-    int cont;           /* the line inih is handling continues the pending key */
-    int sweep_line, point_line;
-    Errs *errs;
-} SweepFile;
 
 static int point_name_ok(const char *s)
 {
@@ -533,360 +528,291 @@ static int point_name_ok(const char *s)
     return 1;
 }
 
-/* A value without an inline comment (" ; ..." or " # ...") and surrounding blanks. */
-static char *sf_value(const char *value)
+/* Split a [sweep] key's list into items and count its values (without making them). A list
+ * continues on indented lines: a line break is a comma, and a comma may end the line before. */
+static void sf_list_count(IniFile *f, SfKey *k)
 {
-    char *v = xstrdup(value);
-    for (char *c = v; *c; c++)
-        if ((*c == ';' || *c == '#') && (c == v || c[-1] == ' ' || c[-1] == '\t')) {
-            *c = 0;
-            break;
+    const IniEntry *e = k->e;
+    Buf joined = {0};
+    for (const char *p = e->value; *p;) {
+        size_t n = strcspn(p, "\n");
+        char *line = xstrndup(p, n);
+        char *t = trim(line);
+        size_t tl = strlen(t);
+        if (tl && t[tl - 1] == ',')
+            t[--tl] = 0;
+        if (tl) {
+            if (joined.len)
+                buf_puts(&joined, ",");
+            buf_puts(&joined, t);
         }
-    char *t = trim(v);
-    memmove(v, t, strlen(t) + 1);
-    return v;
-}
-
-/* The values of a [sweep] key: a comma-separated list whose items are values or ranges. */
-static void sf_list(SweepFile *sf, SfKey *k)
-{
-    StrList items = {0};
+        free(line);
+        p += n + (p[n] == '\n');
+    }
     int empty = 0;
-    for (const char *p = buf_str(&k->raw);;) {
+    for (const char *p = buf_str(&joined);;) {
         size_t n = strcspn(p, ",");
         char *item = xstrndup(p, n);
         char *t = trim(item);
         memmove(item, t, strlen(t) + 1);
         empty += !*item;
-        sl_push(&items, item);
+        sl_push(&k->items, item);
         if (!p[n])
             break;
         p += n + 1;
     }
-    if (empty == items.n)
-        err_add(sf->errs, "%s:%d: key '%s': empty list", sf->path, k->line, k->name);
-    else if (empty)
-        err_add(sf->errs, "%s:%d: key '%s': an empty item in the list", sf->path, k->line, k->name);
+    buf_free(&joined);
+    if (empty) {
+        inifile_error(f, e->line, "key '%s': %s", e->key, empty == k->items.n ? "empty list" : "an empty item in the list");
+        k->bad = 1;
+        return;
+    }
     char msg[512];
-    for (int i = 0; i < items.n && !empty; i++) {
-        const char *item = items.v[i];
-        StrList vals = {0};
-        if (strstr(item, "..") && range_expand(item, &vals, msg, sizeof msg)) {
-            err_add(sf->errs, "%s:%d: key '%s': %s", sf->path, k->line, k->name, msg);
-            sl_free(&vals);
-            continue;
+    k->count = 0;
+    for (int i = 0; i < k->items.n; i++) {
+        Range r;
+        if (!strstr(k->items.v[i], "..")) {
+            k->count += 1;
+        } else if (range_parse(k->items.v[i], &r, msg, sizeof msg) == 0) {
+            k->count += r.count;
+        } else {
+            inifile_error(f, e->line, "key '%s': %s", e->key, msg);
+            k->bad = 1;
         }
-        if (!strstr(item, ".."))
-            sl_push(&vals, xstrdup(item));
-        for (int j = 0; j < vals.n; j++) {
+    }
+}
+
+/* For the duplicate check: a value as a number (8 and 8.0 are one value) or as text. */
+typedef struct SfVal {
+    int is_num;
+    double num;
+    const char *text;
+    int pos;
+} SfVal;
+
+static int sfval_cmp(const void *a, const void *b)
+{
+    const SfVal *x = a, *y = b;
+    if (x->is_num != y->is_num)
+        return x->is_num ? -1 : 1;
+    int c = x->is_num ? (x->num < y->num ? -1 : x->num > y->num) : strcmp(x->text, y->text);
+    return c ? c : (x->pos > y->pos) - (x->pos < y->pos);
+}
+
+/* Make and check the values of a [sweep] key whose items are good: each value as `--set`
+ * checks it, and no value twice (sorted, so a long list costs n log n). */
+static void sf_list_values(IniFile *f, SfKey *k)
+{
+    const IniEntry *e = k->e;
+    char msg[512];
+    for (int i = 0; i < k->items.n; i++) {
+        const char *item = k->items.v[i];
+        Range r;
+        int is_range = strstr(item, "..") != NULL;
+        long long n = 1;
+        if (is_range) {
+            range_parse(item, &r, msg, sizeof msg); /* good: sf_list_count said so */
+            n = (long long)r.count;
+        }
+        for (long long j = 0; j < n; j++) {
+            char *v = is_range ? range_value(&r, j) : xstrdup(item);
             int unknown;
-            if (value_check(k->name, vals.v[j], &unknown, msg, sizeof msg)) {
-                if (vals.n > 1)
-                    err_add(sf->errs, "%s:%d: key '%s': in %s: %s", sf->path, k->line, k->name, item, msg);
+            if (value_check(e->key, v, &unknown, msg, sizeof msg)) {
+                if (is_range)
+                    inifile_error(f, e->line, "key '%s': in %s: %s", e->key, item, msg);
                 else
-                    err_add(sf->errs, "%s:%d: key '%s': %s", sf->path, k->line, k->name, msg);
+                    inifile_error(f, e->line, "key '%s': %s", e->key, msg);
+                k->bad = 1;
+                free(v);
                 break;
             }
-            int dup = 0;
-            for (int m = 0; m < k->vals.n && !dup; m++)
-                dup = same_value(k->vals.v[m], vals.v[j]);
-            if (dup) {
-                err_add(sf->errs, "%s:%d: key '%s': value %s appears twice in the list", sf->path, k->line, k->name,
-                        vals.v[j]);
-                break;
-            }
-            sl_push(&k->vals, vals.v[j]);
-            vals.v[j] = NULL;
+            sl_push(&k->vals, v);
         }
-        sl_free(&vals);
     }
-    sl_free(&items);
-}
-
-/* The pending key is complete (the next key, section or the end came): check its values. */
-static void sf_flush(SweepFile *sf)
-{
-    if (sf->pend >= 0) {
-        SfSection *s = &sf->secs[sf->cur];
-        SfKey *k = &s->keys[sf->pend];
-        const char *v = buf_str(&k->raw);
-        char msg[512];
-        int unknown;
-        msg[0] = 0;
-        if (!key_known(k->name))
-            value_check(k->name, "0", &unknown, msg, sizeof msg);
-        else if (!s->point)
-            sf_list(sf, k);
-        else if (!*v)
-            snprintf(msg, sizeof msg, "empty value");
-        else if (strchr(v, ','))
-            snprintf(msg, sizeof msg, "a point takes one value, not a list ('%s')", v);
-        else if (strstr(v, ".."))
-            snprintf(msg, sizeof msg, "a point takes one value, not a range ('%s')", v);
-        else if (value_check(k->name, v, &unknown, msg, sizeof msg) == 0)
-            sl_push(&k->vals, xstrdup(v));
-        if (msg[0])
-            err_add(sf->errs, "%s:%d: key '%s': %s", sf->path, k->line, k->name, msg);
+    if (k->vals.n < 2)
+        return;
+    SfVal *sv = xrealloc(NULL, (size_t)k->vals.n * sizeof *sv);
+    for (int i = 0; i < k->vals.n; i++) {
+        sv[i].text = k->vals.v[i];
+        sv[i].pos = i;
+        sv[i].is_num = is_number(k->vals.v[i], &sv[i].num);
     }
-    sf->pend = -1;
-    sf->pend_ignored = 0;
-}
-
-/* A section that ended without keys. */
-static void sf_check_keys(SweepFile *sf)
-{
-    /* A section whose lines were bad was reported already. */
-    if (sf->cur >= 0 && !sf->secs[sf->cur].nkeys && sf->last_syntax_error < sf->secs[sf->cur].line)
-        err_add(sf->errs, "%s:%d: [%s%s] has no keys", sf->path, sf->secs[sf->cur].line,
-                sf->secs[sf->cur].point ? "point." : "sweep", sf->secs[sf->cur].point ? sf->secs[sf->cur].point : "");
-}
-
-static void sf_section(SweepFile *sf, const char *line)
-{
-    const char *close = strchr(line, ']');
-    char *name = xstrndup(line + 1, (size_t)(close - line - 1));
-    char *n = trim(name);
-    sf_check_keys(sf);
-    sf->cur = -1;
-    int is_sweep = !strcmp(n, "sweep"), is_point = !strncmp(n, "point.", 6);
-    if ((is_sweep && sf->point_line && !sf->sweep_line) || (is_point && sf->sweep_line && !sf->point_line))
-        err_add(sf->errs, "%s:%d: [%s] in a file with %s (line %d): a sweep file has a [sweep] section or "
-                "[point.NAME] sections, not both", sf->path, sf->line, n, is_sweep ? "[point.NAME] sections" : "[sweep]",
-                is_sweep ? sf->point_line : sf->sweep_line);
-    if (is_sweep && sf->sweep_line) {
-        err_add(sf->errs, "%s:%d: a second [sweep] section (the first is at line %d)", sf->path, sf->line,
-                sf->sweep_line);
-    } else if (is_point && !point_name_ok(n + 6)) {
-        err_add(sf->errs, "%s:%d: section [%s]: a point's name is letters, digits, '-' and '_'", sf->path, sf->line, n);
-    } else if (!is_sweep && !is_point) {
-        err_add(sf->errs, "%s:%d: unknown section [%s] (a sweep file has a [sweep] section or [point.NAME] sections)",
-                sf->path, sf->line, n);
-    } else {
-        for (int i = 0; i < sf->nsecs; i++)
-            if (is_point && sf->secs[i].point && !strcmp(sf->secs[i].point, n + 6)) {
-                err_add(sf->errs, "%s:%d: [%s] again (the first is at line %d)", sf->path, sf->line, n,
-                        sf->secs[i].line);
-                free(name);
-                return;
-            }
-        if (is_sweep)
-            sf->sweep_line = sf->line;
-        else if (!sf->point_line)
-            sf->point_line = sf->line;
-        sf->secs = xrealloc(sf->secs, (size_t)(sf->nsecs + 1) * sizeof *sf->secs);
-        SfSection *s = &sf->secs[sf->nsecs];
-        memset(s, 0, sizeof *s);
-        s->point = is_point ? xstrdup(n + 6) : NULL;
-        s->line = sf->line;
-        sf->cur = sf->nsecs++;
-    }
-    free(name);
-}
-
-/* A line is fine when blank, a comment, a [section] or has = or : (as sim/config.c). */
-static int sf_syntax_ok(const char *line)
-{
-    if (*line == 0 || *line == '\n' || *line == '\r' || *line == ';' || *line == '#')
-        return 1;
-    if (*line == '[')
-        return strchr(line, ']') != NULL;
-    return strchr(line, '=') != NULL || strchr(line, ':') != NULL;
-}
-
-/* fgets for inih that counts lines, follows sections (inih does not call the handler for a
- * section without keys) and reports every bad line. An indented line without '=' continues the
- * list of the key above it (inih's multi-line values: a long list need not exceed inih's line
- * length); any other indented line is a line of its own. */
-static char *sf_reader(char *str, int num, void *stream)
-{
-    SweepFile *sf = stream;
-    if (!fgets(str, num, sf->f))
-        return NULL;
-    size_t len = strlen(str);
-    int complete = (len > 0 && str[len - 1] == '\n') || feof(sf->f);
-    sf->line++;
-    sf->cont = 0;
-    if (!complete) {
-        err_add(sf->errs, "%s:%d: line longer than %d characters (continue a long list on indented lines below "
-                "its key)", sf->path, sf->line, num - 2);
-        sf->last_syntax_error = sf->line;
-        int ch;
-        while ((ch = fgetc(sf->f)) != EOF && ch != '\n')
-            ;
-        strcpy(str, "\n");
-        return str;
-    }
-    if (sf->line == 1 && !strncmp(str, "\xEF\xBB\xBF", 3)) {
-        memmove(str, str + 3, len - 2);
-        len -= 3;
-    }
-    size_t indent = strspn(str, " \t");
-    const char *body = str + indent;
-    if (!*body || strchr(";#\r\n", *body))
-        return str; /* blank or comment */
-    if (indent && *body != '[' && !strchr(body, '=') && !strchr(body, ':')) {
-        if (sf->pend >= 0) {
-            sf->cont = 1;
-            return str;
+    qsort(sv, (size_t)k->vals.n, sizeof *sv, sfval_cmp);
+    /* Each value given more than once; say the one repeated first, and how many others are. */
+    int first = -1, repeated = 0;
+    for (int i = 1; i < k->vals.n; i++) {
+        const SfVal *x = &sv[i - 1], *y = &sv[i];
+        int same = x->is_num == y->is_num && (x->is_num ? x->num == y->num : !strcmp(x->text, y->text));
+        int group_start = i < 2 || !(sv[i - 2].is_num == x->is_num &&
+                                     (x->is_num ? sv[i - 2].num == x->num : !strcmp(sv[i - 2].text, x->text)));
+        if (same && group_start) { /* y is the group's second occurrence */
+            repeated++;
+            if (first < 0 || y->pos < sv[first].pos)
+                first = i;
         }
-        if (!sf->pend_ignored) {
-            err_add(sf->errs, "%s:%d: an indented line continues a key's list, but no key comes before it", sf->path,
-                    sf->line);
-            sf->last_syntax_error = sf->line;
-        }
-        strcpy(str, "\n");
-        return str;
     }
-    sf_flush(sf);
-    memmove(str, body, len - indent + 1);
-    if (!sf_syntax_ok(str)) {
-        err_add(sf->errs, "%s:%d: syntax error (expected [section] or key = value)", sf->path, sf->line);
-        sf->last_syntax_error = sf->line;
-        strcpy(str, "\n");
-    } else if (str[0] == '[') {
-        sf_section(sf, str);
+    if (repeated) {
+        inifile_error(f, e->line, "key '%s': value %s appears twice in the list%s", e->key, sv[first].text,
+                      repeated > 1 ? " (and other values too)" : "");
+        k->bad = 1;
     }
-    return str;
+    free(sv);
 }
 
-static int sf_handler(void *user, const char *section, const char *name, const char *value)
+/* A [point.NAME] key: one value. */
+static void sf_point_value(IniFile *f, SfKey *k)
 {
-    (void)section; /* sf_reader follows the sections; it also sees those without keys */
-    SweepFile *sf = user;
-    char *v = sf_value(value);
-    if (sf->cont) {
-        /* "4, 8," + "12" and "4, 8" + "12" both continue the list. */
-        Buf *raw = &sf->secs[sf->cur].keys[sf->pend].raw;
-        if (*v) {
-            size_t n = raw->len;
-            while (n && (raw->s[n - 1] == ' ' || raw->s[n - 1] == '\t'))
-                n--;
-            buf_puts(raw, !n || raw->s[n - 1] == ',' ? " " : ", ");
-            buf_puts(raw, v);
-        }
-        free(v);
-        return 1;
+    const IniEntry *e = k->e;
+    const char *v = e->value;
+    char msg[512];
+    int unknown;
+    msg[0] = 0;
+    if (!*v)
+        snprintf(msg, sizeof msg, "empty value");
+    else if (strchr(v, ',') || strchr(v, '\n'))
+        snprintf(msg, sizeof msg, "a point takes one value, not a list ('%.*s')", (int)strcspn(v, "\n"), v);
+    else if (strstr(v, ".."))
+        snprintf(msg, sizeof msg, "a point takes one value, not a range ('%s')", v);
+    else if (value_check(e->key, v, &unknown, msg, sizeof msg) == 0)
+        sl_push(&k->vals, xstrdup(v));
+    if (msg[0]) {
+        inifile_error(f, e->line, "key '%s': %s", e->key, msg);
+        k->bad = 1;
     }
-    free(v);
-    sf->pend_ignored = 1;
-    if (sf->cur == -2) {
-        err_add(sf->errs, "%s:%d: key '%s' before any section ([sweep] or [point.NAME])", sf->path, sf->line, name);
-        return 1;
-    }
-    if (sf->cur < 0)
-        return 1;
-    SfSection *s = &sf->secs[sf->cur];
-    for (int i = 0; i < s->nkeys; i++)
-        if (!strcmp(s->keys[i].name, name)) {
-            err_add(sf->errs, "%s:%d: key '%s': a second time in this section (the first is at line %d)", sf->path,
-                    sf->line, name, s->keys[i].line);
-            return 1;
-        }
-    s->keys = xrealloc(s->keys, (size_t)(s->nkeys + 1) * sizeof *s->keys);
-    SfKey *k = &s->keys[s->nkeys];
-    memset(k, 0, sizeof *k);
-    k->name = xstrdup(name);
-    k->line = sf->line;
-    v = sf_value(value);
-    buf_puts(&k->raw, v);
-    free(v);
-    sf->pend = s->nkeys++;
-    sf->pend_ignored = 0;
-    return 1;
-}
-
-static void sf_free(SweepFile *sf)
-{
-    for (int i = 0; i < sf->nsecs; i++) {
-        for (int j = 0; j < sf->secs[i].nkeys; j++) {
-            free(sf->secs[i].keys[j].name);
-            buf_free(&sf->secs[i].keys[j].raw);
-            sl_free(&sf->secs[i].keys[j].vals);
-        }
-        free(sf->secs[i].keys);
-        free(sf->secs[i].point);
-    }
-    free(sf->secs);
 }
 
 /* The points of a sweep file (its text, read once) as the manifest's "points" array, or NULL
- * after adding every problem to errs. */
+ * after adding every problem to errs. The number of points is known, and refused beyond
+ * SW_MAX_POINTS, before any value is made. */
 static cJSON *sweep_points(const char *path, const char *text, size_t len, Errs *errs, int *explicit_points)
 {
-    SweepFile sf = {0};
-    sf.path = path;
-    sf.cur = -2;
-    sf.pend = -1;
-    sf.errs = errs;
-    int before = errs->count;
+    IniFile f;
+    const IniOptions opt = {0, 1, NULL};
+    inifile_parse(&f, path, text, len, &opt);
     cJSON *points = NULL;
-    if (strlen(text) != len) {
-        err_add(errs, "%s: holds a NUL byte: not a text file", path);
-        return NULL;
-    }
-    if (len > 0) {
-        sf.f = fmemopen((void *)text, len, "r");
-        if (!sf.f) {
-            err_add(errs, "%s: cannot read: %s", path, strerror(errno));
-            return NULL;
+    int nsec = f.nsections, sweep_line = 0, point_line = 0, npoints = 0;
+    char *sec_ok = xrealloc(NULL, (size_t)nsec + 1);
+    for (int i = 0; i < nsec; i++) {
+        const IniSection *s = &f.sections[i];
+        int is_sweep = !strcmp(s->name, "sweep"), is_point = !strncmp(s->name, "point.", 6);
+        sec_ok[i] = 0;
+        if (!is_sweep && !is_point) {
+            inifile_error(&f, s->line, "unknown section [%s] (a sweep file has a [sweep] section or [point.NAME] "
+                                       "sections)", s->name);
+            continue;
         }
-        int rc = ini_parse_stream(sf_reader, &sf, sf_handler, &sf);
-        fclose(sf.f);
-        if (rc > 0 && rc != sf.last_syntax_error)
-            err_add(errs, "%s:%d: syntax error (expected [section] or key = value)", path, rc);
-        else if (rc < 0)
-            err_add(errs, "%s: cannot read", path);
+        if (is_point && !point_name_ok(s->name + 6)) {
+            inifile_error(&f, s->line, "section [%s]: a point's name is letters, digits, '-' and '_'", s->name);
+            continue;
+        }
+        if ((is_sweep && point_line) || (is_point && sweep_line && !point_line))
+            inifile_error(&f, s->line, "[%s] in a file with %s (line %d): a sweep file has a [sweep] section or "
+                          "[point.NAME] sections, not both", s->name, is_sweep ? "[point.NAME] sections" : "[sweep]",
+                          is_sweep ? point_line : sweep_line);
+        if (is_sweep)
+            sweep_line = s->line;
+        else if (!point_line)
+            point_line = s->line;
+        npoints += is_point;
+        sec_ok[i] = 1;
+        if (!s->nkeys && !s->nbad)
+            inifile_error(&f, s->line, "[%s] has no keys", s->name);
     }
-    sf_flush(&sf);
-    sf_check_keys(&sf);
-    if (!sf.sweep_line && !sf.point_line)
-        err_add(errs, "%s: no [sweep] section and no [point.NAME] section", path);
-    if (errs->count > before)
+    if (!sweep_line && !point_line && (f.nsections || !f.nerrors)) /* (not for a binary file) */
+        inifile_error(&f, 0, "no [sweep] section and no [point.NAME] section");
+    if (npoints > SW_MAX_POINTS)
+        inifile_error(&f, 0, "%d points, more than %d (split the sweep)", npoints, SW_MAX_POINTS);
+
+    /* The keys: known ones, then a [sweep] key's list counted, a point's value checked. */
+    SfKey *keys = xrealloc(NULL, ((size_t)f.nentries + 1) * sizeof *keys);
+    memset(keys, 0, ((size_t)f.nentries + 1) * sizeof *keys);
+    double total = 1;
+    int nlists = 0;
+    char factors[256] = "";
+    for (int i = 0; i < f.nentries; i++) {
+        SfKey *k = &keys[i];
+        k->e = &f.entries[i];
+        k->bad = 1;
+        if (!sec_ok[k->e->sec])
+            continue; /* its section is reported */
+        char msg[512];
+        int unknown;
+        if (!key_known(k->e->key)) {
+            value_check(k->e->key, "0", &unknown, msg, sizeof msg);
+            inifile_error(&f, k->e->line, "key '%s': %s", k->e->key, msg);
+            continue;
+        }
+        k->bad = 0;
+        if (!strcmp(k->e->section, "sweep")) {
+            sf_list_count(&f, k);
+            if (!k->bad) {
+                total *= k->count;
+                size_t fl = strlen(factors);
+                if (fl + 40 < sizeof factors)
+                    snprintf(factors + fl, sizeof factors - fl, "%s%.0f", nlists ? " x " : "", k->count);
+                else if (!strstr(factors, "..."))
+                    strcat(factors, " x ...");
+                nlists++;
+            }
+        } else if (npoints <= SW_MAX_POINTS) {
+            sf_point_value(&f, k);
+        }
+    }
+    if (sweep_line && !point_line && total > SW_MAX_POINTS) {
+        if (total < 1e15)
+            inifile_error(&f, sweep_line, "[sweep]: %.0f points (%s values), more than %d (split the sweep)", total,
+                          factors, SW_MAX_POINTS);
+        else
+            inifile_error(&f, sweep_line, "[sweep]: more than %d points (%s values; split the sweep)", SW_MAX_POINTS,
+                          factors);
+    } else {
+        for (int i = 0; i < f.nentries; i++)
+            if (!keys[i].bad && !strcmp(keys[i].e->section, "sweep"))
+                sf_list_values(&f, &keys[i]);
+    }
+    int n;
+    const IniMessage *m = inifile_messages(&f, &n);
+    for (int i = 0; i < n; i++)
+        err_add(errs, "%s", m[i].text);
+    errs->count += f.nerrors - n; /* a last "... and N more errors" line stands for N */
+    if (f.nerrors)
         goto out;
 
-    *explicit_points = sf.point_line != 0;
+    *explicit_points = point_line != 0;
     points = cJSON_CreateArray();
     if (*explicit_points) {
-        for (int i = 0; i < sf.nsecs; i++) {
+        int e = 0;
+        for (int i = 0; i < nsec; i++) {
             cJSON *p = cJSON_CreateObject(), *set = cJSON_CreateObject();
-            cJSON_AddStringToObject(p, "name", sf.secs[i].point);
-            for (int j = 0; j < sf.secs[i].nkeys; j++)
-                cJSON_AddStringToObject(set, sf.secs[i].keys[j].name, sf.secs[i].keys[j].vals.v[0]);
+            cJSON_AddStringToObject(p, "name", f.sections[i].name + 6);
+            for (; e < f.nentries && keys[e].e->sec == i; e++)
+                cJSON_AddStringToObject(set, keys[e].e->key, keys[e].vals.v[0]);
             cJSON_AddItemToObject(p, "settings", set);
             cJSON_AddItemToArray(points, p);
-        }
-        if (sf.nsecs > SW_MAX_POINTS) {
-            err_add(errs, "%s: %d points, more than %d (split the sweep)", path, sf.nsecs, SW_MAX_POINTS);
-            cJSON_Delete(points);
-            points = NULL;
         }
         goto out;
     }
     /* The cross product, the first key varying slowest. */
-    SfSection *s = &sf.secs[0];
-    long long total = 1;
-    for (int j = 0; j < s->nkeys; j++) {
-        total *= s->keys[j].vals.n;
-        if (total > SW_MAX_POINTS) {
-            err_add(errs, "%s: the sweep has more than %d points (split it)", path, SW_MAX_POINTS);
-            cJSON_Delete(points);
-            points = NULL;
-            goto out;
-        }
-    }
-    for (long long p = 0; p < total; p++) {
+    long long ntotal = (long long)total;
+    for (long long p = 0; p < ntotal; p++) {
         cJSON *pt = cJSON_CreateObject(), *set = cJSON_CreateObject();
-        long long rest = p, stride = total;
-        for (int j = 0; j < s->nkeys; j++) {
-            stride /= s->keys[j].vals.n;
-            cJSON_AddStringToObject(set, s->keys[j].name, s->keys[j].vals.v[rest / stride]);
+        long long rest = p, stride = ntotal;
+        for (int j = 0; j < f.nentries; j++) {
+            stride /= keys[j].vals.n;
+            cJSON_AddStringToObject(set, keys[j].e->key, keys[j].vals.v[rest / stride]);
             rest %= stride;
         }
         cJSON_AddItemToObject(pt, "settings", set);
         cJSON_AddItemToArray(points, pt);
     }
 out:
-    sf_free(&sf);
+    for (int i = 0; i < f.nentries; i++) {
+        sl_free(&keys[i].items);
+        sl_free(&keys[i].vals);
+    }
+    free(keys);
+    free(sec_ok);
+    inifile_free(&f);
     return points;
 }
 
@@ -1054,25 +980,18 @@ static cJSON *manifest_build(const Args *a)
     cJSON *points = NULL, *m = NULL;
     int explicit_points = 0;
 
+    /* The config and the sweep file are INI files: read as sim/ini.c reads every one (a regular
+     * file of at most 16 MiB), and their text kept in the manifest. */
     if (a->config) {
-        config = realpath(a->config, NULL);
-        if (!config)
-            err_add(&errs, "%s: cannot open: %s", a->config, strerror(errno));
-        else if (!(config_text = file_read(config, &config_len, err, sizeof err)))
+        if (inifile_read(a->config, &config_text, &config_len, err, sizeof err))
             err_add(&errs, "%s", err);
-        else if (strlen(config_text) != config_len)
-            err_add(&errs, "%s: holds a NUL byte: not a text file", a->config);
-        else if (config_len > 0) {
+        else if (!(config = realpath(a->config, NULL)))
+            err_add(&errs, "%s: cannot open: %s", a->config, strerror(errno));
+        else {
             CfgMachine cfg;
             CfgErrors ce = {0};
             cfg_defaults(&cfg);
-            FILE *f = fmemopen(config_text, config_len, "r");
-            if (!f) {
-                err_add(&errs, "%s: cannot read: %s", a->config, strerror(errno));
-            } else {
-                cfg_load_stream(&cfg, f, a->config, &ce);
-                fclose(f);
-            }
+            cfg_load_text(&cfg, config_text, config_len, a->config, &ce);
             if (ce.count)
                 buf_puts(&errs.text, ce.text);
             errs.count += ce.count;
@@ -1095,11 +1014,10 @@ static cJSON *manifest_build(const Args *a)
     scene = realpath(a->scene, NULL);
     if (!scene)
         err_add(&errs, "scene %s: cannot open: %s", a->scene, strerror(errno));
-    sweep = realpath(a->sweep, NULL);
-    if (!sweep)
-        err_add(&errs, "%s: cannot open: %s", a->sweep, strerror(errno));
-    else if (!(sweep_text = file_read(sweep, &sweep_len, err, sizeof err)))
+    if (inifile_read(a->sweep, &sweep_text, &sweep_len, err, sizeof err))
         err_add(&errs, "%s", err);
+    else if (!(sweep = realpath(a->sweep, NULL)))
+        err_add(&errs, "%s: cannot open: %s", a->sweep, strerror(errno));
     else
         points = sweep_points(a->sweep, sweep_text, sweep_len, &errs, &explicit_points);
     if (errs.count) {
@@ -1217,19 +1135,63 @@ static int dir_foreign(const char *dir)
     return foreign;
 }
 
+/* The folder's lock, DIR/.sweep.lock: a whole sweep and merge hold it exclusively, --point tasks
+ * shared, so that merge never writes sweep.csv under a running sweep, and a sweep never starts
+ * under another. A POSIX record lock (fcntl) rather than flock: a refusal can then name the
+ * holder's pid (F_GETLK), and it also works on NFS. The lock belongs to this process (not to the
+ * points it forks) until *fd is closed. EXIT_OK, or an exit code after saying why. */
+static int sweep_lock(const char *dir, int exclusive, const char *cmd, int *fd)
+{
+    char *path = xasprintf("%s/.sweep.lock", dir);
+    int rc = EXIT_IO;
+    *fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (*fd < 0) {
+        fprintf(stderr, "sfsim %s: %s: cannot create: %s\n", cmd, path, strerror(errno));
+        goto out;
+    }
+    struct flock fl;
+    memset(&fl, 0, sizeof fl);
+    fl.l_type = exclusive ? F_WRLCK : F_RDLCK;
+    fl.l_whence = SEEK_SET; /* l_start = l_len = 0: the whole file */
+    if (fcntl(*fd, F_SETLK, &fl) == 0) {
+        rc = EXIT_OK;
+        goto out;
+    }
+    if (errno == EACCES || errno == EAGAIN) {
+        struct flock q = fl;
+        char holder[128] = "another sfsim sweep";
+        if (fcntl(*fd, F_GETLK, &q) == 0 && q.l_type == F_RDLCK)
+            snprintf(holder, sizeof holder, "sfsim sweep --point tasks (pid %ld, perhaps others)", (long)q.l_pid);
+        else if (q.l_type == F_WRLCK)
+            snprintf(holder, sizeof holder, "another sfsim sweep or merge (pid %ld)", (long)q.l_pid);
+        if (!strcmp(cmd, "merge"))
+            fprintf(stderr, "sfsim merge: %s is in use by %s: merge when it has ended\n", dir, holder);
+        else
+            fprintf(stderr, "sfsim sweep: %s is in use by %s (wait for it or stop it)\n", dir, holder);
+        close(*fd);
+        *fd = -1;
+        goto out;
+    }
+    fprintf(stderr, "sfsim %s: warning: %s: cannot lock (%s); make sure no other sweep runs in %s\n", cmd, path,
+            strerror(errno), dir);
+    rc = EXIT_OK;
+out:
+    free(path);
+    return rc;
+}
+
 /* Open the sweep folder `dir` for the sweep in cur: create it and write sweep.json, or check
  * the one there is the same sweep. Takes the folder's lock (exclusive for a whole sweep, shared
- * for one point). On success *dir_abs is the folder's absolute path and the lock stays held in
- * *lock_fd. */
+ * for one point). EXIT_OK with *dir_abs the folder's absolute path and the lock held in
+ * *lock_fd, or an exit code after saying why. */
 static int sweep_dir_open(const char *dir, const Plan *cur, int exclusive, int *lock_fd, char **dir_abs)
 {
     char err[PATH_MAX + 256];
     *lock_fd = -1;
     *dir_abs = NULL;
     char *manifest = xasprintf("%s/sweep.json", dir);
-    char *lock = xasprintf("%s/.sweep.lock", dir);
     char *points = xasprintf("%s/points", dir);
-    int rc = -1;
+    int rc = EXIT_IO;
     struct stat st;
     if (stat(dir, &st) == 0) {
         if (!S_ISDIR(st.st_mode)) {
@@ -1239,6 +1201,7 @@ static int sweep_dir_open(const char *dir, const Plan *cur, int exclusive, int *
         if (!file_exists(manifest) && dir_foreign(dir)) {
             fprintf(stderr, "sfsim sweep: %s is not empty and holds no sweep.json: not a sweep folder "
                             "(choose another -o DIR)\n", dir);
+            rc = EXIT_INPUT;
             goto out;
         }
     }
@@ -1246,20 +1209,9 @@ static int sweep_dir_open(const char *dir, const Plan *cur, int exclusive, int *
         fprintf(stderr, "sfsim sweep: %s\n", err);
         goto out;
     }
-    *lock_fd = open(lock, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (*lock_fd < 0) {
-        fprintf(stderr, "sfsim sweep: %s: cannot create: %s\n", lock, strerror(errno));
+    if ((rc = sweep_lock(dir, exclusive, "sweep", lock_fd)) != EXIT_OK)
         goto out;
-    }
-    if (flock(*lock_fd, (exclusive ? LOCK_EX : LOCK_SH) | LOCK_NB) != 0) {
-        if (errno == EWOULDBLOCK) {
-            fprintf(stderr, "sfsim sweep: %s is in use by another sfsim sweep%s (wait for it or stop it)\n", dir,
-                    exclusive ? "" : " running all its points");
-            goto out;
-        }
-        fprintf(stderr, "sfsim sweep: warning: %s: cannot lock (%s); make sure no other sweep runs in %s\n", lock,
-                strerror(errno), dir);
-    }
+    rc = EXIT_INPUT; /* a manifest that is not this sweep's is the arguments' fault */
     if (file_exists(manifest)) {
         size_t len;
         char *text = file_read(manifest, &len, err, sizeof err);
@@ -1303,9 +1255,11 @@ static int sweep_dir_open(const char *dir, const Plan *cur, int exclusive, int *
         buf_free(&b);
         if (w) {
             fprintf(stderr, "sfsim sweep: %s\n", err);
+            rc = EXIT_IO;
             goto out;
         }
     }
+    rc = EXIT_IO;
     if (mkdir_p(points, err, sizeof err)) {
         fprintf(stderr, "sfsim sweep: %s\n", err);
         goto out;
@@ -1315,14 +1269,13 @@ static int sweep_dir_open(const char *dir, const Plan *cur, int exclusive, int *
         fprintf(stderr, "sfsim sweep: %s: %s\n", dir, strerror(errno));
         goto out;
     }
-    rc = 0;
+    rc = EXIT_OK;
 out:
     if (rc && *lock_fd >= 0) {
         close(*lock_fd);
         *lock_fd = -1;
     }
     free(manifest);
-    free(lock);
     free(points);
     return rc;
 }
@@ -2690,7 +2643,7 @@ static int emit_scripts(const Plan *pl, const Args *a, const char *exe, const ch
     if (rc) {
         fprintf(stderr, "sfsim sweep: %s\n", err);
         free(path);
-        return SW_EXIT_INPUT;
+        return EXIT_IO;
     }
     if (slurm)
         printf("sweep: wrote %s, a Slurm array job of %d tasks, one per point (the folder must be on storage the "
@@ -2701,7 +2654,7 @@ static int emit_scripts(const Plan *pl, const Args *a, const char *exe, const ch
                "      (or parallel -S host1,host2 ... with %s on storage the hosts share)\n"
                "  sfsim merge %s      # then: sweep.csv and plots\n", path, pl->npoints, a->jobs, path, dir, dir);
     free(path);
-    return SW_EXIT_OK;
+    return EXIT_OK;
 }
 
 /* ---- the commands --------------------------------------------------------------------------- */
@@ -2722,7 +2675,8 @@ void sweep_usage(FILE *out)
             "  --sweep FILE             the sweep file (required)\n"
             "  -o, --out DIR            the sweep folder (required)\n"
             "  -c, --config FILE        machine config every point starts from (default: the built-in one)\n"
-            "  -s, --scene FILE         scene (default: scenes/cornell/scene.ini)\n"
+            "  -s, --scene FILE         scene (default: the shipped Cornell box, scenes/cornell/scene.ini in\n"
+            "                           sfsim's data folder beside the binary: docs/install.md)\n"
             "  -j, --jobs N             points run at once (default: the number of cores)\n"
             "  --mode MODE              detailed (default), functional or sampled, for every run\n"
             "  --sample F               sampled mode: the fraction of tiles timed, for every run\n"
@@ -2734,8 +2688,10 @@ void sweep_usage(FILE *out)
             "                           command per point for GNU parallel); run nothing\n"
             "  --point K                run point K alone (0-based), as those tasks do; no CSV\n"
             "\n"
-            "exit: 0 every point done, 1 an input error or a failed point (the others still run),\n"
-            "2 usage, 130/143 stopped by SIGINT/SIGTERM (run the same command again to resume)\n");
+            "exit: 0 every point done, 1 an input error (nothing is run), 2 usage, 4 an output could\n"
+            "not be written or DIR is in use by another sweep or merge, 5 a point failed (the others\n"
+            "still run), 128 + signal: 130/143 stopped by SIGINT/SIGTERM (run the same command again\n"
+            "to resume)\n");
 }
 
 void merge_usage(FILE *out)
@@ -2745,8 +2701,10 @@ void merge_usage(FILE *out)
             "\n"
             "Builds DIR/sweep.csv and DIR/plots/ from DIR/sweep.json and the point folders, after the\n"
             "points ran as Slurm or GNU parallel tasks (sfsim sweep --emit), and says how many points\n"
-            "are done, failed and unfinished. Exit 0 when every point is done, 1 otherwise (the CSV is\n"
-            "written all the same, with rows of status failed or unfinished). docs/sweep.md.\n");
+            "are done, failed and unfinished. Exit 0 when every point is done, 5 otherwise (the CSV is\n"
+            "written all the same, with rows of status failed or unfinished); 1 when DIR holds no\n"
+            "sweep; 4 when the CSV cannot be written, or while a sweep or its --point tasks run in DIR\n"
+            "(merge refuses, naming the pid that holds DIR's lock). docs/sweep.md.\n");
 }
 
 static int parse_int_opt(const char *opt, const char *s, long lo, long hi, int *out)
@@ -2762,11 +2720,11 @@ static int parse_int_opt(const char *opt, const char *s, long lo, long hi, int *
     return 0;
 }
 
-/* 0 ok, 1 --help printed, -1 usage error printed. */
+/* 0 ok, 1 --help printed, -1 usage error printed, -2 an option's value is bad (printed). */
 static int args_parse(int argc, char **argv, Args *a)
 {
     memset(a, 0, sizeof *a);
-    a->scene = "scenes/cornell/scene.ini";
+    a->scene = NULL; /* the shipped Cornell box in sfsim's data folder, below */
     a->mode = "detailed";
     a->threads = 1;
     a->point = -1;
@@ -2788,7 +2746,7 @@ static int args_parse(int argc, char **argv, Args *a)
             a->out = argv[++i];
         } else if ((!strcmp(o, "-j") || !strcmp(o, "--jobs")) && has) {
             if (parse_int_opt(o, argv[++i], 1, 4096, &a->jobs))
-                return -1;
+                return -2;
         } else if (!strcmp(o, "--mode") && has) {
             a->mode = argv[++i];
         } else if (!strcmp(o, "--sample") && has) {
@@ -2798,14 +2756,14 @@ static int args_parse(int argc, char **argv, Args *a)
             a->sets[a->nsets++] = argv[++i];
         } else if (!strcmp(o, "--threads-per-point") && has) {
             if (parse_int_opt(o, argv[++i], 1, 1024, &a->threads))
-                return -1;
+                return -2;
         } else if (!strcmp(o, "--retry-failed")) {
             a->retry = 1;
         } else if (!strcmp(o, "--emit") && has) {
             a->emit = argv[++i];
         } else if (!strcmp(o, "--point") && has) {
             if (parse_int_opt(o, argv[++i], 0, SW_MAX_POINTS - 1, &a->point))
-                return -1;
+                return -2;
         } else {
             fprintf(stderr, "sfsim sweep: unknown option or missing value: %s (sfsim help sweep)\n", o);
             return -1;
@@ -2817,20 +2775,29 @@ static int args_parse(int argc, char **argv, Args *a)
     }
     if (strcmp(a->mode, "detailed") && strcmp(a->mode, "functional") && strcmp(a->mode, "sampled")) {
         fprintf(stderr, "sfsim sweep: --mode %s: expected detailed, functional or sampled\n", a->mode);
-        return -1;
+        return -2;
     }
     double f;
     if (a->sample && (!is_number(a->sample, &f) || !(f > 0 && f <= 1))) {
         fprintf(stderr, "sfsim sweep: --sample %s: expected a fraction in (0, 1]\n", a->sample);
-        return -1;
+        return -2;
     }
     if (a->emit && strcmp(a->emit, "slurm") && strcmp(a->emit, "parallel")) {
         fprintf(stderr, "sfsim sweep: --emit %s: expected slurm or parallel\n", a->emit);
-        return -1;
+        return -2;
     }
     if (a->emit && a->point >= 0) {
         fprintf(stderr, "sfsim sweep: --emit and --point do not go together\n");
         return -1;
+    }
+    if (!a->scene) {
+        static char scene[4096];
+        char err[8192];
+        if (!datadir_path(DATADIR_DEFAULT_SCENE, scene, sizeof scene, err, sizeof err)) {
+            fprintf(stderr, "sfsim sweep: no -s SCENE given and the default scene is missing: %s\n", err);
+            return -2;
+        }
+        a->scene = scene;
     }
     return 0;
 }
@@ -2850,7 +2817,7 @@ static void print_resume(int argc, char **argv)
 
 static int signal_exit(int sig)
 {
-    return 128 + sig;
+    return EXIT_SIGNAL + sig;
 }
 
 static const char *signal_name(int sig)
@@ -2886,9 +2853,9 @@ int sweep_main(int argc, char **argv)
     int prc = args_parse(argc, argv, &a);
     if (prc) {
         free(a.sets);
-        return prc > 0 ? SW_EXIT_OK : SW_EXIT_USAGE;
+        return prc > 0 ? EXIT_OK : prc == -2 ? EXIT_INPUT : EXIT_USAGE;
     }
-    int rc = SW_EXIT_INPUT, lock_fd = -1;
+    int rc = EXIT_INPUT, lock_fd = -1;
     char *dir = NULL;
     int *todo = NULL;
     Runner r;
@@ -2907,8 +2874,9 @@ int sweep_main(int argc, char **argv)
         fprintf(stderr, "sfsim sweep: --point %d: the sweep has points 0..%d\n", a.point, pl.npoints - 1);
         goto out;
     }
-    if (sweep_dir_open(a.out, &pl, a.point < 0, &lock_fd, &dir))
+    if ((rc = sweep_dir_open(a.out, &pl, a.point < 0, &lock_fd, &dir)) != EXIT_OK)
         goto out;
+    rc = EXIT_INPUT;
     ssize_t n = readlink("/proc/self/exe", r.exe, sizeof r.exe - 1);
     if (n <= 0) {
         fprintf(stderr, "sfsim sweep: cannot find this program (/proc/self/exe): %s\n", strerror(errno));
@@ -2931,7 +2899,7 @@ int sweep_main(int argc, char **argv)
         if (s == PS_DONE || (s == PS_FAILED && !a.retry)) {
             fprintf(stderr, "sweep: %s %s already%s\n", label, s == PS_DONE ? "is done" : "failed",
                     s == PS_DONE ? "" : " (--retry-failed runs it again)");
-            rc = s == PS_DONE ? SW_EXIT_OK : SW_EXIT_INPUT;
+            rc = s == PS_DONE ? EXIT_OK : EXIT_POINTS;
             free(label);
             goto out;
         }
@@ -2946,7 +2914,9 @@ int sweep_main(int argc, char **argv)
             rc = signal_exit(got);
         } else if (got == 0) {
             fprintf(stderr, "sweep: %s %s\n", label, r.done ? "done" : "failed");
-            rc = r.done ? SW_EXIT_OK : SW_EXIT_INPUT;
+            rc = r.done ? EXIT_OK : EXIT_POINTS;
+        } else {
+            rc = EXIT_IO; /* its folder or marker could not be written (said) */
         }
         free(label);
         goto out;
@@ -2968,6 +2938,8 @@ int sweep_main(int argc, char **argv)
                     signal_name(got), r.done, pl.npoints, r.failed, left);
             print_resume(argc, argv);
             rc = signal_exit(got);
+        } else {
+            rc = EXIT_IO; /* a point folder or marker could not be written (said) */
         }
         goto out;
     }
@@ -2977,7 +2949,7 @@ int sweep_main(int argc, char **argv)
     fmt_duration(now() - r.t0, d, sizeof d);
     fprintf(stderr, "sweep: %d/%d done, %d failed, %d unfinished (%d run now in %s, -j %d)\n", nd, pl.npoints, nf, nu,
             r.started, d, r.jobs);
-    rc = nd == pl.npoints && !csv_bad ? SW_EXIT_OK : SW_EXIT_INPUT;
+    rc = csv_bad ? EXIT_IO : nd == pl.npoints ? EXIT_OK : EXIT_POINTS;
 out:
     if (lock_fd >= 0)
         close(lock_fd);
@@ -2996,18 +2968,18 @@ int merge_main(int argc, char **argv)
 {
     if (argc == 1 && (!strcmp(argv[0], "--help") || !strcmp(argv[0], "-h"))) {
         merge_usage(stdout);
-        return SW_EXIT_OK;
+        return EXIT_OK;
     }
     if (argc != 1 || argv[0][0] == '-') {
         merge_usage(stderr);
-        return SW_EXIT_USAGE;
+        return EXIT_USAGE;
     }
     const char *dir = argv[0];
     char err[PATH_MAX + 256];
     char *manifest = xasprintf("%s/sweep.json", dir);
     size_t len;
     char *text = file_read(manifest, &len, err, sizeof err);
-    int rc = SW_EXIT_INPUT;
+    int rc = EXIT_INPUT, lock_fd = -1;
     Plan pl;
     memset(&pl, 0, sizeof pl);
     if (!text) {
@@ -3023,11 +2995,17 @@ int merge_main(int argc, char **argv)
         fprintf(stderr, "sfsim merge: %s: %s\n", manifest, err);
         goto out;
     }
+    /* Not under a running sweep or its tasks: they write the markers this reads and a whole
+     * sweep writes sweep.csv itself at its end. */
+    if ((rc = sweep_lock(dir, 1, "merge", &lock_fd)) != EXIT_OK)
+        goto out;
     int nd, nf, nu;
     int csv_bad = outputs_write(&pl, dir, "merge", &nd, &nf, &nu);
     printf("merge: %s: %d points: %d done, %d failed, %d unfinished\n", dir, pl.npoints, nd, nf, nu);
-    rc = nd == pl.npoints && !csv_bad ? SW_EXIT_OK : SW_EXIT_INPUT;
+    rc = csv_bad ? EXIT_IO : nd == pl.npoints ? EXIT_OK : EXIT_POINTS;
 out:
+    if (lock_fd >= 0)
+        close(lock_fd);
     if (pl.json)
         plan_free(&pl);
     free(text);

@@ -11,8 +11,9 @@
 
 #include <stdio.h>
 
-/* The commands; argv excludes "sfsim sweep" / "sfsim merge". Exit codes as sim/main.c:
- * 0 ok, 1 input error or a failed point, 2 usage. */
+/* The commands; argv excludes "sfsim sweep" / "sfsim merge". They return the EXIT_* codes of
+ * sim/exitcodes.h: OK, INPUT, USAGE, IO (an output not written, the folder in use), POINTS (a
+ * point failed or is unfinished), SIGNAL + the signal. */
 int sweep_main(int argc, char **argv);
 int merge_main(int argc, char **argv);
 void sweep_usage(FILE *out);

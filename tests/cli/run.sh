@@ -850,6 +850,76 @@ grep -q "still running" "$T/err" && no "--no-progress still shows progress"
 sed -E 's/\([0-9.]+ s, [0-9.]+ M instructions\/s\)//' "$T/out" > "$T/prog_off"
 cmp -s "$T/prog_on" "$T/prog_off" || no "stdout differs with progress"
 want_err "trap: instruction limit of 3000000 reached"
+
+# ---- INI files: machine configs and scene.ini, one reader, one set of rules (docs/ini.md) ------
+
+begin "-c DIRECTORY is refused by run, trace, exec and config: 'is a directory' (exit 1)"
+mkdir -p "$T/confdir"
+printf '0 1 3.5 0 0 -1\n' >"$T/ini-rays.txt"
+run "$SFSIM" run -c "$T/confdir" -o "$T/confdir-run" --set render.width=8 --set render.height=8 --set render.spp=1
+want_rc 1; want_err "confdir: is a directory"
+run "$SFSIM" trace -c "$T/confdir" -s scenes/cornell/scene.ini --rays "$T/ini-rays.txt" -o "$T/confdir-hits.txt"
+want_rc 1; want_err "confdir: is a directory"
+run "$SFSIM" exec "$T/ok.sfo" -c "$T/confdir"
+want_rc 1; want_err "confdir: is a directory"
+run "$SFSIM" config --dump -c "$T/confdir"
+want_rc 1; want_err "confdir: is a directory"
+end
+
+begin "-c /dev/zero and -c FIFO are refused at once, not read forever (exit 1)"
+run timeout 20 "$SFSIM" exec "$T/ok.sfo" -c /dev/zero
+want_rc 1; want_err "/dev/zero: not a regular file \(a character device\)"
+mkfifo "$T/conf.fifo"
+run timeout 20 "$SFSIM" config --dump -c "$T/conf.fifo"
+want_rc 1; want_err "conf.fifo: not a regular file \(a FIFO\)"
+end
+
+begin "an INI file over 16 MiB or with a line over 198 characters is refused, naming the limit (exit 1)"
+truncate -s 17M "$T/huge.ini"
+run timeout 20 "$SFSIM" config --dump -c "$T/huge.ini"
+want_rc 1; want_err "huge.ini: larger than 16 MiB"
+printf '[core]\n; %0200d\nsimd_width = 8\n' 0 >"$T/longline.ini"
+run "$SFSIM" config --dump -c "$T/longline.ini"
+want_rc 1; want_err "longline.ini:2: line longer than 198 characters"
+end
+
+begin "a machine config with a UTF-8 BOM and CRLF line ends loads (exit 0)"
+printf '\xef\xbb\xbf; written on Windows\r\n[core]\r\nsimd_width = 8\r\n' >"$T/bom.ini"
+run "$SFSIM" config --dump -c "$T/bom.ini"
+want_rc 0; want_out "^simd_width = 8"
+end
+
+begin "a machine key given twice is refused naming both lines, also across a repeated section (exit 1)"
+printf '[core]\nsimd_width = 8\n\nsimd_width = 4\n' >"$T/twice.ini"
+run "$SFSIM" exec "$T/ok.sfo" -c "$T/twice.ini"
+want_rc 1; want_err "twice.ini:4: key 'core.simd_width': given twice \(first at line 2\)"
+printf '[core]\nsimd_width = 8\n[stream]\nrays = 1024\n[core]\nsimd_width = 4\n' >"$T/twice-sec.ini"
+run "$SFSIM" config --dump -c "$T/twice-sec.ini"
+want_rc 1; want_err "twice-sec.ini:6: key 'core.simd_width': given twice \(first at line 2\)"
+printf '[core]\nsimd_width = 8\n    4\n' >"$T/cont.ini"
+run "$SFSIM" config --dump -c "$T/cont.ini"
+want_rc 1; want_err "cont.ini:2: key 'core.simd_width': continued on an indented line"
+end
+
+begin "a machine config may repeat a section (as config --dump does): its keys join (exit 0)"
+printf '[core]\nsimd_width = 8\n[stream]\nrays = 1024\n[core]\nclock_mhz = 400\n' >"$T/again.ini"
+run "$SFSIM" config --dump -c "$T/again.ini"
+want_rc 0; want_out "^simd_width = 8"; want_out "^clock_mhz = 400"; want_out "^rays = 1024"
+end
+
+# A scene of one emitting sphere: no glTF file, so it can live in $T.
+SPHERE_SCENE='[camera]\nposition = 0 0 5\nlook_at = 0 0 0\n[material.glow]\nemission = 1 1 1\n[sphere.s]\ncenter = 0 0 0\nradius = 1\nmaterial = glow\n[render]\nwidth = 8\nheight = 8\nspp = 1\n'
+
+begin "scene.ini follows the same rules: a BOM is fine; a directory, a device, a key twice are refused"
+printf "\xef\xbb\xbf$SPHERE_SCENE" >"$T/bom-scene.ini"
+run "$SFSIM" run --mode reference -s "$T/bom-scene.ini" -o "$T/bom-scene" -j 1 --no-progress
+want_rc 0
+mkdir -p "$T/dir-scene.ini"
+run "$SFSIM" run --mode reference -s "$T/dir-scene.ini" -o "$T/dir-scene" -j 1 --no-progress
+want_rc 1; want_err "dir-scene.ini: is a directory"
+printf "${SPHERE_SCENE}width = 16\n" >"$T/twice-scene.ini"
+run "$SFSIM" run --mode reference -s "$T/twice-scene.ini" -o "$T/twice-scene" -j 1 --no-progress
+want_rc 1; want_err "twice-scene.ini:14: key 'render.width': given twice \(first at line 11\)"
 end
 
 echo "cli: $pass passed, $fail failed"

@@ -74,6 +74,14 @@ want_rc 0
 [ -s "$T/elsewhere/out/frame.exr" ] || no "no frame.exr"
 end
 
+begin "bin/sfsim sweep with no -s sweeps the shipped Cornell box from another folder"
+printf '[sweep]\ncore.simd_width = 8, 16\n' > "$T/elsewhere/two.ini"
+run env -C "$T/elsewhere" "$SFSIM" sweep --sweep two.ini -o sw -j 2 --mode functional \
+    --set render.width=32 --set render.height=32 --set render.spp=1
+want_rc 0
+[ "$(grep -c . "$T/elsewhere/sw/sweep.csv" 2>/dev/null)" = 3 ] || no "sweep.csv does not hold a header and 2 points"
+end
+
 begin "make install PREFIX=... installs binaries, kernels, configs, the default scene and docs"
 run make --no-print-directory install PREFIX="$T/prefix"
 want_rc 0

@@ -1,7 +1,8 @@
 /* tests/fuzz/fuzz_config.c -- libFuzzer target for the machine-config INI reader (sim/config.c,
- * through inih): any bytes must load into a config or produce messages that name the file and
- * line, never a crash, a leak, or a value outside its key's range. A config that passes its
- * checks must also build the timing model (sim/timing.c) and time a short program on it. */
+ * through sim/ini.c and inih): any bytes must load into a config or produce messages that name
+ * the file and line, never a crash, a leak, or a value outside its key's range. A config that
+ * passes its checks must also build the timing model (sim/timing.c) and time a short program on
+ * it. */
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -29,7 +30,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (n && (!errs.text || strncmp(errs.text, "fuzz.ini", 8) != 0))
         __builtin_trap(); /* every message names the file */
     if (cfg.core_simd_width < 1 || cfg.core_simd_width > 64 || (cfg.stream_rays != 1024 && cfg.stream_rays != 4096) ||
-        cfg.stream_mode < 0 || cfg.stream_mode > 1 || cfg.workload_kind < 0 || cfg.workload_kind > 2)
+        cfg.stream_mode < 0 || cfg.stream_mode > 1 || cfg.workload_kind < 0 || cfg.workload_kind > CFG_WORKLOAD_PHONG)
         __builtin_trap(); /* a value escaped its range */
     int bad = cfg_check(&cfg, &errs);
     cfg_errors_free(&errs);
