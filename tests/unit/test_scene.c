@@ -896,6 +896,70 @@ Test(scene_gltf_errors, nan_vertex)
     load_fails(put_gltf("inf.gltf", gl_json(&g)), 1, "inf.gltf: mesh 0 'tri' primitive 0 POSITION: vertex 2");
 }
 
+/* ---- sparse accessors (glTF 2.0 Sec. 3.6.2.3) -------------------------------------------- */
+
+/* A triangle whose POSITION accessor (0, 0, 0), (1, 0, 0), (0, 1, 0) carries a sparse part that
+ * replaces vertices i0 and i1 by (5, 0, 0) and (0, 7, 0). Without a base bufferView (base = 0)
+ * the accessor starts from zeros; vbytes is the sparse values' view length (24 = whole). */
+static char *sparse_json(unsigned i0, unsigned i1, int base, int vbytes)
+{
+    unsigned char buf[64];
+    const float p[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0}, v[6] = {5, 0, 0, 0, 7, 0};
+    const uint16_t idx[2] = {(uint16_t)i0, (uint16_t)i1};
+    memcpy(buf, p, 36);
+    memcpy(buf + 36, idx, 4);
+    memcpy(buf + 40, v, 24);
+    char *data = b64(buf, sizeof buf), *json = NULL;
+    cr_assert_gt(asprintf(&json,
+                          "{\"asset\": {\"version\": \"2.0\"}, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],\n"
+                          " \"meshes\": [{\"name\": \"tri\", \"primitives\": [{\"attributes\": {\"POSITION\": 0}}]}],\n"
+                          " \"accessors\": [{%s\"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\",\n"
+                          "   \"sparse\": {\"count\": 2, \"indices\": {\"bufferView\": 1, \"componentType\": 5123},\n"
+                          "              \"values\": {\"bufferView\": 2}}}],\n"
+                          " \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 36}, {\"buffer\": 0, \"byteOffset\": 36, "
+                          "\"byteLength\": 4},\n"
+                          "                 {\"buffer\": 0, \"byteOffset\": 40, \"byteLength\": %d}],\n"
+                          " \"buffers\": [{\"byteLength\": 64, \"uri\": \"data:application/octet-stream;base64,%s\"}]}\n",
+                          base ? "\"bufferView\": 0, " : "", vbytes, data),
+                 0);
+    free(data);
+    return json;
+}
+
+Test(scene_geometry, sparse_accessor_substitutes_values)
+{
+    for (int base = 1; base >= 0; base--) {
+        Scene s;
+        load_ok(put_gltf(base ? "sp.gltf" : "sp0.gltf", sparse_json(1, 2, base, 24)), &s);
+        cr_assert_eq(s.ntris, 1);
+        static const float want[9] = {0, 0, 0, 5, 0, 0, 0, 7, 0};
+        for (int k = 0; k < 9; k++)
+            cr_expect_eq(s.pos[k], want[k], "base %d: coordinate %d is %g, expected %g", base, k, (double)s.pos[k],
+                         (double)want[k]);
+        scene_free(&s);
+    }
+    /* only vertex 0 replaced: the others keep the base view's values */
+    Scene s;
+    load_ok(put_gltf("sp1.gltf", sparse_json(0, 2, 1, 24)), &s);
+    expect_near(s.pos[0], 5.0f, 0.0f);
+    expect_near(s.pos[3], 1.0f, 0.0f);
+    expect_near(s.pos[7], 7.0f, 0.0f);
+    scene_free(&s);
+}
+
+Test(scene_gltf_errors, sparse_accessor_checked)
+{
+    load_fails(put_gltf("sd.gltf", sparse_json(2, 1, 1, 24)), 3, "sd.gltf: mesh 0 'tri' primitive 0 POSITION: accessor 0",
+               "sparse index 1 is 1, not greater than the one before (2)", "increase strictly");
+    load_fails(put_gltf("se.gltf", sparse_json(1, 1, 1, 24)), 2, "se.gltf: mesh 0 'tri' primitive 0 POSITION: accessor 0",
+               "sparse index 1 is 1, not greater");
+    load_fails(put_gltf("so.gltf", sparse_json(1, 3, 0, 24)), 2, "so.gltf: mesh 0 'tri' primitive 0 POSITION: accessor 0",
+               "sparse index 1 is 3, out of range (accessor count 3)");
+    load_fails(put_gltf("sv.gltf", sparse_json(1, 2, 1, 20)), 2,
+               "sv.gltf: mesh 0 'tri' primitive 0 POSITION: accessor 0: sparse values",
+               "2 elements at offset 0 run past the end of the bufferView");
+}
+
 Test(scene_gltf_errors, broken_hierarchy)
 {
     Gl g = tri();
