@@ -371,6 +371,7 @@ struct Loader {
     // makes them count (Scene.ntris), so a failed file leaves the Scene as it was, with larger
     // arrays. Materials, textures and lights wait here until commit().
     size_t old = 0, cur = 0, cap = 0; // triangles: the Scene's, this file's so far, room for
+    uint32_t primitives = 0, skipped[4] = {0, 0, 0, 0}; // primitives met; skipped by mode (POINTS..LINE_STRIP)
     std::vector<SceneMaterial> mats;
     std::vector<SceneTexture> texs;
     std::vector<SceneLight> lights;
@@ -926,10 +927,14 @@ bool load_primitive(Loader &L, const Mat4 &full, int mesh, int pi)
     const auto &p = gm.primitives[(size_t)pi];
     std::string where = elem("mesh", mesh, gm.name) + " primitive " + std::to_string(pi);
     int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+    L.primitives++;
+    // Points and lines have no area for a ray to hit: skipped, counted, and reported (commit).
+    if (mode >= TINYGLTF_MODE_POINTS && mode <= TINYGLTF_MODE_LINE_STRIP) {
+        L.skipped[mode]++;
+        return true;
+    }
     if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN)
-        return L.fail(where + ": mode " + std::to_string(mode) + " (" + mode_name(mode) +
-                      ") is not a triangle primitive; only TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN can be "
-                      "ray traced");
+        return L.fail(where + ": mode " + std::to_string(mode) + " is not a glTF primitive mode (0 to 6)");
     auto pa = p.attributes.find("POSITION");
     if (pa == p.attributes.end())
         return L.fail(where + ": no POSITION attribute");
@@ -1296,6 +1301,17 @@ bool commit(Loader &L)
     if (!append(s->materials, s->nmaterials, L.mats) || !append(s->textures, s->ntextures, L.texs) ||
         !append(s->lights, s->nlights, L.lights))
         return L.fail("out of memory");
+    uint32_t skipped = L.skipped[0] + L.skipped[1] + L.skipped[2] + L.skipped[3];
+    if (skipped) {
+        std::string by;
+        for (int k = 0; k < 4; k++)
+            if (L.skipped[k])
+                by += std::string(by.empty() ? "" : ", ") + std::to_string(L.skipped[k]) + " " + mode_name(k);
+        if (scene_warn(s, "%s: skipped %u of %u primitives: not triangles (%s); only triangles are ray traced",
+                       L.file.c_str(), skipped, L.primitives, by.c_str()) != 0)
+            return L.fail("out of memory");
+        s->skipped_primitives += skipped;
+    }
     s->ntris = (uint32_t)(L.old + L.cur);
     s->nmaterials += (uint32_t)L.mats.size();
     s->ntextures += (uint32_t)L.texs.size();
@@ -1334,8 +1350,10 @@ size_t count_triangles(const Loader &L, const std::vector<int> &roots)
             size_t cnt = a.count, tris;
             if (p.mode == TINYGLTF_MODE_TRIANGLES || p.mode < 0)
                 tris = cnt / 3;
-            else // strips and fans; other modes fail later
+            else if (p.mode == TINYGLTF_MODE_TRIANGLE_STRIP || p.mode == TINYGLTF_MODE_TRIANGLE_FAN)
                 tris = cnt >= 2 ? cnt - 2 : 0;
+            else // points and lines are skipped; other modes fail later
+                continue;
             // An accessor cannot hold more elements than its buffer has bytes.
             if (a.bufferView < 0 || (size_t)a.bufferView >= m.bufferViews.size())
                 continue;

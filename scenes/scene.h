@@ -126,6 +126,11 @@ typedef struct Scene {
     float bounds_min[3], bounds_max[3];  /* of triangles and spheres */
     uint32_t needs;           /* SCENE_NEED_* */
     char *source;             /* the file the scene was loaded from */
+    /* What the loaders left out: glTF primitives that are not triangles (POINTS, LINES,
+     * LINE_LOOP, LINE_STRIP), skipped; and one line per thing left out or approximated, each
+     * naming the file and the feature, for the caller to print (library code prints nothing). */
+    uint32_t skipped_primitives;
+    char **warnings;          uint32_t nwarnings;
 } Scene;
 
 /* Load a scene: a .gltf/.glb file, or a scene.ini that names one. Fills every field (defaults,
@@ -139,6 +144,9 @@ void scene_free(Scene *s);
  * default camera, needs; an error for a scene without geometry). */
 void scene_init(Scene *s, const char *source);
 int scene_finish(Scene *s, char *err, size_t errlen);
+
+/* For loaders: adds a warning line (printf format). 0, or -1 when out of memory. */
+int scene_warn(Scene *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 /* Writes the needs as a comma-separated list ("lambert,area_lights"). */
 void scene_needs_string(uint32_t needs, char *buf, size_t len);

@@ -648,6 +648,8 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     double t0 = now();
     if (scene_load(o->scene_path, &s, err, errlen) != 0)
         return -1;
+    for (uint32_t i = 0; i < s.nwarnings; i++) /* what the scene left out (docs/scenes.md) */
+        fprintf(stderr, "sfsim run: warning: %s\n", s.warnings[i]);
     if (apply_overrides(o, &s, err, errlen) != 0 || make_dirs(o->out_dir, err, errlen) != 0)
         goto out;
     BvhParams bp;
@@ -839,6 +841,10 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     cJSON_AddNumberToObject(bvh, "leaf_size", bp.max_leaf_size);
     cJSON_AddNumberToObject(bvh, "bins", bp.bins);
     cJSON_AddNumberToObject(sc, "scene_memory_bytes", p.size);
+    cJSON_AddNumberToObject(sc, "skipped_primitives", s.skipped_primitives);
+    cJSON *warn = cJSON_AddArrayToObject(sc, "warnings");
+    for (uint32_t i = 0; i < s.nwarnings; i++)
+        cJSON_AddItemToArray(warn, cJSON_CreateString(s.warnings[i]));
     cJSON *ren = cJSON_AddObjectToObject(root, "render");
     cJSON_AddNumberToObject(ren, "width", s.render.width);
     cJSON_AddNumberToObject(ren, "height", s.render.height);
@@ -886,6 +892,11 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
              s.render.spp, s.render.max_depth, o->seed, tile_w, tile_h, sum / (3.0 * (double)npx),
              nonfinite, (unsigned long long)total_rays, (unsigned long long)rs.primary,
              (unsigned long long)rs.shadow, (unsigned long long)rs.indirect, (unsigned long long)rs.dropped);
+    if (s.skipped_primitives)
+        len += snprintf(txt + len, sizeof txt - (size_t)len, "skipped      %u glTF primitives that are not triangles\n",
+                        s.skipped_primitives);
+    for (uint32_t i = 0; i < s.nwarnings && len < (int)sizeof txt; i++)
+        len += snprintf(txt + len, sizeof txt - (size_t)len, "warning      %s\n", s.warnings[i]);
     if (functional) {
         const FuncStats *f = &rs.f;
         uint64_t opsum[ISA_C_COUNT] = {0}, all = 0;

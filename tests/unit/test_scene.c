@@ -860,14 +860,29 @@ Test(scene_gltf_errors, indices_not_whole_triangles)
     load_fails(put_gltf("w.gltf", gl_json(&g)), 2, "w.gltf: mesh 0 'tri' primitive 0", "not a multiple of 3");
 }
 
+/* Points and lines are skipped and counted (one warning per file); a file of nothing else has no
+ * geometry; a mode outside glTF's 0..6 is an error. */
 Test(scene_gltf_errors, non_triangle_primitive)
 {
     Gl g = tri();
-    g.prim = "\"mode\": 1";
-    load_fails(put_gltf("lines.gltf", gl_json(&g)), 2, "lines.gltf: mesh 0 'tri' primitive 0: mode 1 (LINES)",
-               "is not a triangle primitive");
-    g.prim = "\"mode\": 0";
-    load_fails(put_gltf("points.gltf", gl_json(&g)), 1, "points.gltf: mesh 0 'tri' primitive 0: mode 0 (POINTS)");
+    Scene s;
+    load_ok(put_gltf("mixed.gltf",
+                     edit(gl_json(&g), "{\"attributes\": {\"POSITION\": 0}}",
+                          "{\"attributes\": {\"POSITION\": 0}, \"mode\": 1}, {\"attributes\": {\"POSITION\": 0}},"
+                          " {\"attributes\": {\"POSITION\": 0}, \"mode\": 0}, {\"attributes\": {\"POSITION\": 0}, "
+                          "\"mode\": 1}")),
+            &s);
+    cr_expect_eq(s.ntris, 1);
+    cr_expect_eq(s.skipped_primitives, 3);
+    cr_assert_eq(s.nwarnings, 1);
+    cr_expect_not_null(strstr(s.warnings[0], "mixed.gltf: skipped 3 of 4 primitives: not triangles (1 POINTS, 2 LINES)"),
+                       "%s", s.warnings[0]);
+    scene_free(&s);
+    g.prim = "\"mode\": 3";
+    load_fails(put_gltf("lines.gltf", gl_json(&g)), 2, "lines.gltf: the scene has no geometry",
+               "its 1 glTF primitives that are not triangles were skipped");
+    g.prim = "\"mode\": 9";
+    load_fails(put_gltf("nine.gltf", gl_json(&g)), 1, "nine.gltf: mesh 0 'tri' primitive 0: mode 9 is not a glTF primitive mode");
 }
 
 Test(scene_gltf_errors, unsupported_required_extension)
@@ -1344,10 +1359,10 @@ Test(scene_ini_errors, missing_gltf_file)
 Test(scene_ini_errors, broken_gltf_inside)
 {
     Gl g = tri();
-    g.prim = "\"mode\": 3";
-    put_gltf("lines.gltf", gl_json(&g));
-    ini_fails("[scene]\ngltf = lines.gltf\n", 2, ":2: key 'scene.gltf': ",
-              "lines.gltf: mesh 0 'tri' primitive 0: mode 3 (LINE_STRIP) is not a triangle primitive");
+    g.prim = "\"mode\": 9";
+    put_gltf("nine.gltf", gl_json(&g));
+    ini_fails("[scene]\ngltf = nine.gltf\n", 2, ":2: key 'scene.gltf': ",
+              "nine.gltf: mesh 0 'tri' primitive 0: mode 9 is not a glTF primitive mode");
 }
 
 /* A directory is not a scene file (tinygltf would size it as 2^63 bytes; found by fuzzing). */
