@@ -31,6 +31,8 @@
 
 #include <sys/stat.h>
 
+#include <cjson/cJSON.h>
+
 extern "C" {
 #include "gltf.h"
 }
@@ -1277,10 +1279,43 @@ bool visit(Loader &L, int node, const Mat4 &parent, int depth)
     return true;
 }
 
-// Required extensions this loader honours. Everything else that a file requires is an error;
-// extensions that are only used are ignored (docs/scenes.md lists them).
+// Required extensions this loader honours, the one list: everything else that a file requires is
+// refused by name; extensions that are only used are ignored (docs/scenes.md lists them).
 const char *const supported_required[] = {"KHR_materials_emissive_strength", "KHR_materials_transmission",
                                           "KHR_materials_ior", "KHR_lights_punctual", "KHR_mesh_quantization"};
+
+bool supported_extension(const std::string &ext)
+{
+    for (const char *k : supported_required)
+        if (ext == k)
+            return true;
+    return false;
+}
+
+void refuse_extension(const char *name, const std::string &ext, char *err, size_t errlen)
+{
+    std::snprintf(err, errlen, "%s: requires extension %s, which sfsim does not support", name, ext.c_str());
+}
+
+// extensionsRequired, read from the JSON before tinygltf parses the rest: tinygltf fails on what
+// such an extension changes (a Draco-compressed accessor has no bufferView) before the model it
+// would hand back says which extension that was. Broken JSON is left to tinygltf to report.
+bool check_required_first(const unsigned char *json, size_t len, const char *name, char *err, size_t errlen)
+{
+    cJSON *doc = cJSON_ParseWithLength((const char *)json, len);
+    const cJSON *req = cJSON_GetObjectItemCaseSensitive(doc, "extensionsRequired");
+    if (!cJSON_IsArray(req))
+        req = nullptr;
+    const cJSON *e = nullptr;
+    bool ok = true;
+    cJSON_ArrayForEach(e, req)
+        if (ok && cJSON_IsString(e) && !supported_extension(e->valuestring)) {
+            refuse_extension(name, e->valuestring, err, errlen);
+            ok = false;
+        }
+    cJSON_Delete(doc);
+    return ok;
+}
 
 template <class T> bool append(T *&arr, uint32_t n, const std::vector<T> &more)
 {
@@ -1379,15 +1414,11 @@ int load(bool ok, const std::string &gerr, const std::string &warn, const tinygl
         std::snprintf(err, errlen, "%s: %s", name, e.c_str());
         return -1;
     }
-    for (const auto &ext : model.extensionsRequired) {
-        bool known = false;
-        for (const char *k : supported_required)
-            known |= ext == k;
-        if (!known) {
-            std::snprintf(err, errlen, "%s: required extension %s is not supported", name, ext.c_str());
+    for (const auto &ext : model.extensionsRequired)
+        if (!supported_extension(ext)) {
+            refuse_extension(name, ext, err, errlen);
             return -1;
         }
-    }
     Loader L(model, name, s);
     if (xf)
         std::memcpy(L.pre.m, xf, sizeof L.pre.m);
@@ -1512,6 +1543,8 @@ int load_memory(const unsigned char *data, size_t len, const char *name, const s
         std::snprintf(err, errlen, "%s: JSON nested deeper than %d levels", name, MAX_JSON_DEPTH);
         return -1;
     }
+    if (!check_required_first(json, json_len, name, err, errlen))
+        return -1;
     tinygltf::Model model;
     tinygltf::TinyGLTF loader;
     Stash stash;
