@@ -348,10 +348,18 @@ struct EmitMap {
     }
 };
 
+// Where a texture reads its coordinates: the TEXCOORD_<set> attribute through the affine map of
+// KHR_texture_transform, u' = m0 u + m1 v + m2, v' = m3 u + m4 v + m5 (identity without one).
+struct UvMap {
+    int set = 0;
+    double m[6] = {1, 0, 0, 0, 1, 0};
+};
+
 struct MatInfo {
     int index = -1;      // SceneMaterial index (absolute) of the material as loaded
     int emit_twin = -1;  // the emitting part when an emissive texture only partly emits, else -1
-    int emit_texcoord = 0;
+    bool emit_tex = false; // an emissive texture is sampled (by the material or its twin)
+    UvMap base_uv, emit_uv;
     const EmitMap *map = nullptr;
 };
 
@@ -374,6 +382,8 @@ struct Loader {
     // arrays. Materials, textures and lights wait here until commit().
     size_t old = 0, cur = 0, cap = 0; // triangles: the Scene's, this file's so far, room for
     uint32_t primitives = 0, skipped[4] = {0, 0, 0, 0}; // primitives met; skipped by mode (POINTS..LINE_STRIP)
+    std::vector<char> wrap_seen;  // by glTF texture: its sampler's wrap modes were looked at
+    uint32_t not_repeat = 0;      // used textures whose sampler does not repeat (not applied)
     std::vector<SceneMaterial> mats;
     std::vector<SceneTexture> texs;
     std::vector<SceneLight> lights;
@@ -616,6 +626,16 @@ bool texture_index(Loader &L, int t, const std::string &where, int &out)
     int img = m.textures[(size_t)t].source;
     if (img < 0)
         return true; // no source image (e.g. only an extension's): no texture
+    // Textures always repeat (docs/scenes.md): a sampler that asks for clamping or mirroring is
+    // counted for a warning.
+    if (L.wrap_seen.size() != m.textures.size())
+        L.wrap_seen.assign(m.textures.size(), 0);
+    int smp = m.textures[(size_t)t].sampler;
+    if (!L.wrap_seen[(size_t)t] && smp >= 0 && (size_t)smp < m.samplers.size() &&
+        (m.samplers[(size_t)smp].wrapS != TINYGLTF_TEXTURE_WRAP_REPEAT ||
+         m.samplers[(size_t)smp].wrapT != TINYGLTF_TEXTURE_WRAP_REPEAT))
+        L.not_repeat++;
+    L.wrap_seen[(size_t)t] = 1;
     if ((size_t)img >= m.images.size())
         return L.fail(where + ": texture " + std::to_string(t) + " names missing image " + std::to_string(img));
     if (L.image_to_tex[(size_t)img] >= 0) {
@@ -718,6 +738,51 @@ bool uv_emits(const EmitMap &em, const double *uv)
     return false;
 }
 
+// The coordinates texture info `ti` samples with: texCoord, and KHR_texture_transform's offset,
+// rotation and scale (and its texCoord, which overrides the other), composed as the extension
+// says: translation x rotation x scale.
+bool uv_map(Loader &L, const tinygltf::TextureInfo &ti, const std::string &where, UvMap &out)
+{
+    out = UvMap();
+    out.set = ti.texCoord;
+    auto it = ti.extensions.find("KHR_texture_transform");
+    if (it != ti.extensions.end() && it->second.IsObject()) {
+        const tinygltf::Value &x = it->second;
+        std::string w = where + ": KHR_texture_transform";
+        double off[2] = {0, 0}, sc[2] = {1, 1}, rot = 0;
+        const char *pairs[2] = {"offset", "scale"};
+        double *dst[2] = {off, sc};
+        for (int k = 0; k < 2; k++) {
+            if (!x.Has(pairs[k]))
+                continue;
+            const tinygltf::Value &a = x.Get(pairs[k]);
+            if (!a.IsArray() || a.ArrayLen() != 2 || !a.Get(0).IsNumber() || !a.Get(1).IsNumber())
+                return L.fail(w + ": " + pairs[k] + " is not 2 numbers");
+            dst[k][0] = a.Get(0).GetNumberAsDouble();
+            dst[k][1] = a.Get(1).GetNumberAsDouble();
+        }
+        if (x.Has("rotation")) {
+            if (!x.Get("rotation").IsNumber())
+                return L.fail(w + ": rotation is not a number");
+            rot = x.Get("rotation").GetNumberAsDouble();
+        }
+        if (x.Has("texCoord")) {
+            if (!x.Get("texCoord").IsInt())
+                return L.fail(w + ": texCoord is not an integer");
+            out.set = x.Get("texCoord").GetNumberAsInt();
+        }
+        if (!std::isfinite(off[0]) || !std::isfinite(off[1]) || !std::isfinite(sc[0]) || !std::isfinite(sc[1]) ||
+            !std::isfinite(rot))
+            return L.fail(w + ": a value is not finite");
+        double c = std::cos(rot), sn = std::sin(rot);
+        double m[6] = {c * sc[0], sn * sc[1], off[0], -sn * sc[0], c * sc[1], off[1]};
+        std::memcpy(out.m, m, sizeof m);
+    }
+    if (out.set < 0)
+        return L.fail(where + ": texCoord " + std::to_string(out.set) + " is negative");
+    return true;
+}
+
 // glTF materials -> SceneMaterial (ARCHITECTURE.md Sec. 1 mapping).
 bool load_materials(Loader &L)
 {
@@ -768,12 +833,17 @@ bool load_materials(Loader &L)
         sm.alpha_cutoff = (float)gm.alphaCutoff;
         sm.double_sided = gm.doubleSided ? 1 : 0;
         int tex;
+        MatInfo &info = L.minfo[i];
         if (!texture_index(L, pbr.baseColorTexture.index, where + " baseColorTexture", tex))
+            return false;
+        if (tex >= 0 && !uv_map(L, pbr.baseColorTexture, where + " baseColorTexture", info.base_uv))
             return false;
         sm.base_texture = tex;
         sm.emissive_texture = -1;
         bool emits = sm.emission[0] > 0.0f || sm.emission[1] > 0.0f || sm.emission[2] > 0.0f;
         if (emits && !texture_index(L, gm.emissiveTexture.index, where + " emissiveTexture", tex))
+            return false;
+        if (emits && tex >= 0 && !uv_map(L, gm.emissiveTexture, where + " emissiveTexture", info.emit_uv))
             return false;
         if (emits)
             sm.emissive_texture = tex;
@@ -781,8 +851,9 @@ bool load_materials(Loader &L)
         if (!sm.name)
             return L.fail("out of memory");
         L.mats.push_back(sm);
-        MatInfo &mi = L.minfo[i];
+        MatInfo &mi = info;
         mi.index = (int)(L.mat_base + L.mats.size() - 1);
+        mi.emit_tex = emits && tex >= 0;
         if (emits && tex >= 0) {
             // An emissive texture that is black in places: the triangles that only see black texels
             // do not emit. The material splits into a non-emitting part (this one) and an emitting
@@ -795,6 +866,7 @@ bool load_materials(Loader &L)
                 for (int k = 0; k < 3; k++)
                     me.emission[k] = 0.0f;
                 me.emissive_texture = -1;
+                mi.emit_tex = false;
             } else if (!all) {
                 SceneMaterial twin = me;
                 twin.name = strdup(me.name);
@@ -805,7 +877,6 @@ bool load_materials(Loader &L)
                     return L.fail("out of memory");
                 L.mats.push_back(twin);
                 L.minfo[i].emit_twin = (int)(L.mat_base + L.mats.size() - 1);
-                L.minfo[i].emit_texcoord = gm.emissiveTexture.texCoord;
                 L.minfo[i].map = &em;
             }
         }
@@ -858,6 +929,20 @@ void geometric_normals(const float *pos, float *nrm, size_t from, size_t to)
     }
 }
 
+// The Scene's optional per-triangle arrays (NULL until a file has the attribute): the address of
+// the pointer, floats per triangle, and the value earlier triangles get (normals: their
+// geometric normal instead).
+struct TriArray {
+    float **p;
+    size_t per;
+    float fill;
+};
+
+std::vector<TriArray> tri_arrays(Scene *s)
+{
+    return {{&s->nrm, 9, 0.0f}, {&s->uv, 6, 0.0f}, {&s->uv_emit, 6, 0.0f}, {&s->col, 9, 1.0f}};
+}
+
 // Room for `more` triangles after the ones written so far (the counting pass in load() usually
 // reserved everything at once).
 bool reserve(Loader &L, size_t more)
@@ -875,36 +960,33 @@ bool reserve(Loader &L, size_t more)
     uint32_t *tm = pos ? (uint32_t *)std::realloc(s->tri_material, sizeof(uint32_t) * cap) : nullptr;
     if (tm)
         s->tri_material = tm;
-    float *nrm = tm && s->nrm ? (float *)std::realloc(s->nrm, sizeof(float) * 9 * cap) : nullptr;
-    if (nrm)
-        s->nrm = nrm;
-    float *uv = tm && s->uv ? (float *)std::realloc(s->uv, sizeof(float) * 6 * cap) : nullptr;
-    if (uv)
-        s->uv = uv;
-    if (!pos || !tm || (s->nrm && !nrm) || (s->uv && !uv))
+    bool ok = pos && tm;
+    for (const TriArray &a : tri_arrays(s))
+        if (ok && *a.p) {
+            float *r = (float *)std::realloc(*a.p, sizeof(float) * a.per * cap);
+            if (r)
+                *a.p = r;
+            ok = r != nullptr;
+        }
+    if (!ok)
         return L.fail("out of memory for " + std::to_string(need) + " triangles");
     L.cap = cap;
     return true;
 }
 
-// The first vertex normals of the scene: every earlier triangle gets its geometric normal.
-bool add_normals(Loader &L)
+// The first per-triangle array `a` of the scene: every earlier triangle gets a.fill (normals:
+// the geometric normal).
+bool add_array(Loader &L, const TriArray &a)
 {
-    float *n = (float *)std::malloc(sizeof(float) * 9 * (L.cap ? L.cap : 1));
-    if (!n)
-        return L.fail("out of memory for normals");
-    geometric_normals(L.s->pos, n, 0, L.old + L.cur);
-    L.s->nrm = n;
-    return true;
-}
-
-// The first texture coordinates of the scene: zero for every earlier triangle.
-bool add_uvs(Loader &L)
-{
-    float *t = (float *)std::calloc(6 * (L.cap ? L.cap : 1), sizeof(float));
+    size_t n = a.per * (L.cap ? L.cap : 1);
+    float *t = (float *)std::malloc(sizeof(float) * n);
     if (!t)
-        return L.fail("out of memory for texture coordinates");
-    L.s->uv = t;
+        return L.fail("out of memory for per-vertex data");
+    for (size_t i = 0; i < n; i++)
+        t[i] = a.fill;
+    if (a.p == &L.s->nrm)
+        geometric_normals(L.s->pos, t, 0, L.old + L.cur);
+    *a.p = t;
     return true;
 }
 
@@ -920,6 +1002,44 @@ bool check_float_or_quantized(Loader &L, const View &v, const std::string &what,
     return L.fail(what + ": component type " + ctype_name(v.ctype) + (v.normalized ? " (normalized)" : "") +
                   " is not allowed here" +
                   (allow_normalized ? " (FLOAT or normalized UNSIGNED_BYTE/SHORT)" : " (FLOAT)"));
+}
+
+// The TEXCOORD_<map.set> of primitive p through map's transform, 2 floats per vertex into out;
+// has = false (out empty) when the primitive has no such attribute.
+bool read_uvs(Loader &L, const tinygltf::Primitive &p, const std::string &where, const UvMap &map, size_t nverts,
+              std::vector<float> &out, bool &has)
+{
+    std::string attr = "TEXCOORD_" + std::to_string(map.set);
+    auto ta = p.attributes.find(attr);
+    has = ta != p.attributes.end();
+    out.clear();
+    if (!has)
+        return true;
+    View vt;
+    std::string an = where + " " + attr + ": accessor " + std::to_string(ta->second);
+    if (!accessor_view(L, ta->second, where + " " + attr, vt))
+        return false;
+    if (vt.ncomp != 2 || vt.count != nverts)
+        return L.fail(an + " must be VEC2 with " + std::to_string(nverts) + " elements (has " +
+                      std::to_string(vt.ncomp) + " components, " + std::to_string(vt.count) + " elements)");
+    if (!check_float_or_quantized(L, vt, an, true))
+        return false;
+    out.resize(2 * nverts);
+    const double *m = map.m;
+    for (size_t v = 0; v < nverts; v++) {
+        double u = vt.get(v, 0), w = vt.get(v, 1);
+        double t[2] = {m[0] * u + m[1] * w + m[2], m[3] * u + m[4] * w + m[5]};
+        for (int k = 0; k < 2; k++) {
+            if (!std::isfinite(t[k]) || std::fabs(t[k]) > 1e30)
+                return L.fail(where + " " + attr + ": vertex " + std::to_string(v) + " is not finite" +
+                              (map.m[0] == 1 && map.m[1] == 0 && map.m[2] == 0 && map.m[3] == 0 && map.m[4] == 1 &&
+                                       map.m[5] == 0
+                                   ? ""
+                                   : " after KHR_texture_transform"));
+            out[2 * v + (size_t)k] = (float)t[k];
+        }
+    }
+    return true;
 }
 
 bool load_primitive(Loader &L, const Mat4 &full, int mesh, int pi)
@@ -940,7 +1060,7 @@ bool load_primitive(Loader &L, const Mat4 &full, int mesh, int pi)
     auto pa = p.attributes.find("POSITION");
     if (pa == p.attributes.end())
         return L.fail(where + ": no POSITION attribute");
-    View vp, vn, vt, vi;
+    View vp, vn, vc, vi;
     if (!accessor_view(L, pa->second, where + " POSITION", vp))
         return false;
     if (vp.ncomp != 3)
@@ -959,17 +1079,21 @@ bool load_primitive(Loader &L, const Mat4 &full, int mesh, int pi)
         if (!check_float_or_quantized(L, vn, where + " NORMAL: accessor " + std::to_string(na->second), false))
             return false;
     }
-    auto ta = p.attributes.find("TEXCOORD_0");
-    bool has_t = ta != p.attributes.end();
-    if (has_t) {
-        if (!accessor_view(L, ta->second, where + " TEXCOORD_0", vt))
+    // Vertex colours: COLOR_0 multiplies the base colour (glTF 2.0 Sec. 3.7.2.1; alpha ignored).
+    auto ca = p.attributes.find("COLOR_0");
+    bool has_c = ca != p.attributes.end();
+    if (has_c) {
+        std::string an = where + " COLOR_0: accessor " + std::to_string(ca->second);
+        if (!accessor_view(L, ca->second, where + " COLOR_0", vc))
             return false;
-        if (vt.ncomp != 2 || vt.count != vp.count)
-            return L.fail(where + " TEXCOORD_0: accessor " + std::to_string(ta->second) + " must be VEC2 with " +
-                          std::to_string(vp.count) + " elements (has " + std::to_string(vt.ncomp) + " components, " +
-                          std::to_string(vt.count) + " elements)");
-        if (!check_float_or_quantized(L, vt, where + " TEXCOORD_0: accessor " + std::to_string(ta->second), true))
-            return false;
+        if ((vc.ncomp != 3 && vc.ncomp != 4) || vc.count != vp.count)
+            return L.fail(an + " must be VEC3 or VEC4 with " + std::to_string(vp.count) + " elements (has " +
+                          std::to_string(vc.ncomp) + " components, " + std::to_string(vc.count) + " elements)");
+        if (vc.ctype != TINYGLTF_COMPONENT_TYPE_FLOAT &&
+            !(vc.normalized && (vc.ctype == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                                vc.ctype == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT)))
+            return L.fail(an + ": component type " + ctype_name(vc.ctype) + (vc.normalized ? " (normalized)" : "") +
+                          " is not allowed here (FLOAT or normalized UNSIGNED_BYTE/SHORT)");
     }
     // Indices: any unsigned integer type, each below the vertex count.
     std::vector<uint32_t> idx;
@@ -1019,6 +1143,7 @@ bool load_primitive(Loader &L, const Mat4 &full, int mesh, int pi)
     }
     int mat, twin = -1;
     const MatInfo *mi = nullptr;
+    static const MatInfo no_material;
     if (p.material >= 0) {
         if ((size_t)p.material >= m.materials.size())
             return L.fail(where + ": material " + std::to_string(p.material) + " does not exist");
@@ -1027,12 +1152,21 @@ bool load_primitive(Loader &L, const Mat4 &full, int mesh, int pi)
         twin = mi->emit_twin;
     } else if ((mat = default_material(L)) < 0) {
         return L.fail("out of memory");
+    } else {
+        mi = &no_material;
     }
+    // Texture coordinates, per texture: the base-colour texture's set through its transform (a
+    // material without one: TEXCOORD_0 as it is), the emissive texture's likewise.
+    std::vector<float> wt, we;
+    bool has_t, has_e = false;
+    if (!read_uvs(L, p, where, mi->base_uv, vp.count, wt, has_t) ||
+        (mi->emit_tex && !read_uvs(L, p, where, mi->emit_uv, vp.count, we, has_e)))
+        return false;
     double nm[9];
     bool nm_ok = normal_matrix(full, nm);
     bool flip = det3(full) < 0.0; // a mirroring transform reverses the winding (glTF 2.0 Sec. 3.7.4)
     // Every vertex once.
-    std::vector<float> wp(3 * vp.count), wn(has_n ? 3 * vp.count : 0), wt(has_t ? 2 * vp.count : 0);
+    std::vector<float> wp(3 * vp.count), wn(has_n ? 3 * vp.count : 0), wc(has_c ? 3 * vp.count : 0);
     for (size_t v = 0; v < vp.count; v++) {
         double in[3] = {vp.get(v, 0), vp.get(v, 1), vp.get(v, 2)}, out[3];
         xform_point(full, in, out);
@@ -1055,21 +1189,28 @@ bool load_primitive(Loader &L, const Mat4 &full, int mesh, int pi)
             for (int k = 0; k < 3; k++)
                 wn[3 * v + (size_t)k] = (float)o[k];
         }
-        if (has_t)
-            for (int k = 0; k < 2; k++) {
-                double t = vt.get(v, k);
-                if (!std::isfinite(t) || std::fabs(t) > 1e30)
-                    return L.fail(where + " TEXCOORD_0: vertex " + std::to_string(v) + " is not finite");
-                wt[2 * v + (size_t)k] = (float)t;
+        if (has_c)
+            for (int k = 0; k < 3; k++) {
+                double c = vc.get(v, k);
+                if (!std::isfinite(c) || c < 0.0)
+                    return L.fail(where + " COLOR_0: vertex " + std::to_string(v) + " component " + std::to_string(k) +
+                                  " is negative or not finite (" + std::to_string(c) + ")");
+                wc[3 * v + (size_t)k] = (float)c;
             }
     }
     size_t nt = tri.size() / 3;
-    if (!reserve(L, nt) || (has_n && !L.s->nrm && !add_normals(L)) || (has_t && !L.s->uv && !add_uvs(L)))
+    Scene *S = L.s;
+    if (!reserve(L, nt) || (has_n && !S->nrm && !add_array(L, tri_arrays(S)[0])) ||
+        (has_t && !S->uv && !add_array(L, tri_arrays(S)[1])) ||
+        (mi->emit_tex && !S->uv_emit && !add_array(L, tri_arrays(S)[2])) ||
+        (has_c && !S->col && !add_array(L, tri_arrays(S)[3])))
         return false;
-    float *P = L.s->pos + 9 * (L.old + L.cur), *N = L.s->nrm ? L.s->nrm + 9 * (L.old + L.cur) : nullptr;
-    float *T = L.s->uv ? L.s->uv + 6 * (L.old + L.cur) : nullptr;
-    uint32_t *M = L.s->tri_material + L.old + L.cur;
-    bool twin_uv = twin >= 0 && has_t && mi->emit_texcoord == 0;
+    size_t at = L.old + L.cur;
+    float *P = S->pos + 9 * at, *N = S->nrm ? S->nrm + 9 * at : nullptr;
+    float *T = S->uv ? S->uv + 6 * at : nullptr, *E = S->uv_emit ? S->uv_emit + 6 * at : nullptr;
+    float *C = S->col ? S->col + 9 * at : nullptr;
+    uint32_t *M = S->tri_material + at;
+    bool twin_uv = twin >= 0 && has_e;
     for (size_t t = 0; t < nt; t++) {
         uint32_t c3[3] = {tri[3 * t], tri[3 * t + 1], tri[3 * t + 2]};
         if (flip)
@@ -1101,10 +1242,15 @@ bool load_primitive(Loader &L, const Mat4 &full, int mesh, int pi)
                     *N++ = usable ? vn3[k] : (float)gn[k];
             for (int k = 0; k < 2; k++) {
                 float u = has_t ? wt[2 * (size_t)c3[c] + (size_t)k] : 0.0f;
+                float e = has_e ? we[2 * (size_t)c3[c] + (size_t)k] : 0.0f;
                 if (T)
                     *T++ = u;
-                tuv[2 * c + k] = u;
+                if (E)
+                    *E++ = e;
+                tuv[2 * c + k] = e;
             }
+            for (int k = 0; C && k < 3; k++)
+                *C++ = has_c ? wc[3 * (size_t)c3[c] + (size_t)k] : 1.0f;
         }
         uint32_t tm = (uint32_t)mat;
         if (twin >= 0 && (!twin_uv || uv_emits(*mi->map, tuv)))
@@ -1347,6 +1493,9 @@ bool commit(Loader &L)
             return L.fail("out of memory");
         s->skipped_primitives += skipped;
     }
+    if (L.not_repeat && scene_warn(s, "%s: %u textures ask for CLAMP_TO_EDGE or MIRRORED_REPEAT wrapping, which is not "
+                                      "applied: every texture repeats", L.file.c_str(), L.not_repeat) != 0)
+        return L.fail("out of memory");
     s->ntris = (uint32_t)(L.old + L.cur);
     s->nmaterials += (uint32_t)L.mats.size();
     s->ntextures += (uint32_t)L.texs.size();

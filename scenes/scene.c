@@ -179,6 +179,8 @@ void scene_free(Scene *s)
     free(s->pos);
     free(s->nrm);
     free(s->uv);
+    free(s->uv_emit);
+    free(s->col);
     free(s->tri_material);
     free(s->materials);
     free(s->textures);

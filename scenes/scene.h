@@ -112,7 +112,12 @@ typedef struct Scene {
     uint32_t ntris;
     float *pos;               /* ntris * 9: v0 v1 v2 */
     float *nrm;               /* ntris * 9 shading normals, or NULL when the file has none */
-    float *uv;                /* ntris * 6 texture coordinates, or NULL */
+    float *uv;                /* ntris * 6 texture coordinates of the base-colour texture (its
+                                 TEXCOORD set through its KHR_texture_transform), or NULL */
+    float *uv_emit;           /* ntris * 6 texture coordinates of the emissive texture, the same
+                                 way; NULL when no material samples one */
+    float *col;               /* ntris * 9 vertex colours (COLOR_0 rgb, linear; 1 where a file has
+                                 none), or NULL */
     uint32_t *tri_material;   /* ntris material indices */
 
     SceneMaterial *materials; uint32_t nmaterials;

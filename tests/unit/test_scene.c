@@ -530,6 +530,120 @@ Test(scene_materials, base_colour_texture_srgb_to_linear)
     scene_free(&s);
 }
 
+/* KHR_texture_transform and texCoord are applied to the coordinates at load time, per texture:
+ * the base-colour texture reads TEXCOORD_1 through offset (0.5, 0.25), rotation pi/2, scale
+ * (2, 3) -- u' = 2 cos(r) u + 3 sin(r) v + 0.5, v' = -2 sin(r) u + 3 cos(r) v + 0.25 -- while
+ * the emissive texture reads the same set through its own offset. */
+Test(scene_materials, texture_transform_and_texcoord_per_texture)
+{
+    static const float uv[6] = {0, 0, 1, 0, 0, 1};
+    Gl g = tri();
+    g.uv = uv;
+    g.material = "{\"pbrMetallicRoughness\": {\"metallicFactor\": 0, \"baseColorTexture\": {\"index\": 0, \"texCoord\": 1,"
+                 " \"extensions\": {\"KHR_texture_transform\": {\"offset\": [0.5, 0.25], \"rotation\": 1.5707963267948966,"
+                 " \"scale\": [2, 3]}}}}, \"emissiveFactor\": [1, 1, 1], \"emissiveTexture\": {\"index\": 0, \"extensions\":"
+                 " {\"KHR_texture_transform\": {\"offset\": [0.125, 0], \"texCoord\": 1}}}}";
+    g.top = "\"extensionsUsed\": [\"KHR_texture_transform\"], \"textures\": [{\"source\": 0}],"
+            " \"images\": [{\"uri\": \"data:image/png;base64," PNG_2X2 "\"}]";
+    Scene s;
+    load_ok(put_gltf("tt.gltf", edit(gl_json(&g), "\"TEXCOORD_0\"", "\"TEXCOORD_1\"")), &s);
+    cr_assert_not_null(s.uv);
+    static const float want[6] = {0.5f, 0.25f, 0.5f, -1.75f, 3.5f, 0.25f};
+    for (int k = 0; k < 6; k++)
+        expect_near(s.uv[k], want[k], 1e-6f);
+    cr_assert_not_null(s.uv_emit, "the emissive texture's own coordinates");
+    static const float want_e[6] = {0.125f, 0, 1.125f, 0, 0.125f, 1};
+    for (int k = 0; k < 6; k++)
+        expect_near(s.uv_emit[k], want_e[k], 0.0f);
+    scene_free(&s);
+    /* a texture reading a set the primitive does not have has no coordinates (not applied) */
+    g.material = "{\"pbrMetallicRoughness\": {\"metallicFactor\": 0, \"baseColorTexture\": {\"index\": 0, \"texCoord\": 1}}}";
+    load_ok(put_gltf("t0.gltf", gl_json(&g)), &s);
+    cr_expect_null(s.uv);
+    cr_expect_null(s.uv_emit);
+    cr_expect_str_eq(needs_of(&s), "lambert");
+    scene_free(&s);
+    /* dequantization, as gltfpack writes it: integer coordinates scaled by the transform */
+    g.material = "{\"pbrMetallicRoughness\": {\"metallicFactor\": 0, \"baseColorTexture\": {\"index\": 0,"
+                 " \"extensions\": {\"KHR_texture_transform\": {\"scale\": [0.001, 0.002]}}}}}";
+    static const float big[6] = {0, 0, 1000, 0, 0, 500};
+    g.uv = big;
+    load_ok(put_gltf("tq.gltf", gl_json(&g)), &s);
+    expect_near(s.uv[2], 1.0f, 1e-6f);
+    expect_near(s.uv[5], 1.0f, 1e-6f);
+    scene_free(&s);
+}
+
+/* Textures repeat: a sampler asking for clamping is not applied, and a warning says so. */
+Test(scene_materials, clamped_sampler_warns)
+{
+    static const float uv[6] = {0, 0, 1, 0, 0, 1};
+    Gl g = tri();
+    g.uv = uv;
+    g.material = "{\"pbrMetallicRoughness\": {\"metallicFactor\": 0, \"baseColorTexture\": {\"index\": 0}}}";
+    g.top = "\"textures\": [{\"source\": 0, \"sampler\": 0}], \"samplers\": [{\"wrapS\": 33071, \"wrapT\": 10497}],"
+            " \"images\": [{\"uri\": \"data:image/png;base64," PNG_2X2 "\"}]";
+    Scene s;
+    load_ok(put_gltf("cl.gltf", gl_json(&g)), &s);
+    cr_assert_eq(s.nwarnings, 1);
+    cr_expect_not_null(strstr(s.warnings[0], "cl.gltf: 1 textures ask for CLAMP_TO_EDGE or MIRRORED_REPEAT wrapping, "
+                                             "which is not applied: every texture repeats"), "%s", s.warnings[0]);
+    scene_free(&s);
+    g.top = "\"textures\": [{\"source\": 0, \"sampler\": 0}], \"samplers\": [{}],"
+            " \"images\": [{\"uri\": \"data:image/png;base64," PNG_2X2 "\"}]";
+    load_ok(put_gltf("rp.gltf", gl_json(&g)), &s);
+    cr_expect_eq(s.nwarnings, 0);
+    scene_free(&s);
+}
+
+Test(scene_gltf_errors, texture_transform_checked)
+{
+    static const float uv[6] = {0, 0, 1, 0, 0, 1};
+    Gl g = tri();
+    g.uv = uv;
+    g.top = "\"textures\": [{\"source\": 0}], \"images\": [{\"uri\": \"data:image/png;base64," PNG_2X2 "\"}]";
+    g.material = "{\"name\": \"m\", \"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0, \"extensions\":"
+                 " {\"KHR_texture_transform\": {\"scale\": [1]}}}}}";
+    load_fails(put_gltf("tx1.gltf", gl_json(&g)), 1,
+               "tx1.gltf: material 0 'm' baseColorTexture: KHR_texture_transform: scale is not 2 numbers");
+    g.material = "{\"name\": \"m\", \"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0, \"extensions\":"
+                 " {\"KHR_texture_transform\": {\"scale\": [1e300, 1e300]}}}}}";
+    load_fails(put_gltf("tx2.gltf", gl_json(&g)), 1,
+               "tx2.gltf: mesh 0 'tri' primitive 0 TEXCOORD_0: vertex 1 is not finite after KHR_texture_transform");
+}
+
+/* COLOR_0 (VEC3 or VEC4, float or normalized integers) is kept per vertex; triangles of a file
+ * without it get white. */
+Test(scene_materials, vertex_colours)
+{
+    static const float col[9] = {1, 0, 0, 0, 0.5f, 0, 0, 0, 0.25f};
+    Gl g = tri();
+    g.nrm = col;
+    Scene s;
+    load_ok(put_gltf("vc.gltf", edit(gl_json(&g), "\"NORMAL\"", "\"COLOR_0\"")), &s);
+    cr_assert_not_null(s.col);
+    for (int k = 0; k < 9; k++)
+        expect_near(s.col[k], col[k], 0.0f);
+    cr_expect_null(s.nrm);
+    scene_free(&s);
+    /* a second file without colours: white */
+    put_gltf("a.gltf", edit(gl_json(&g), "\"NORMAL\"", "\"COLOR_0\""));
+    g.nrm = NULL;
+    put_gltf("b.gltf", gl_json(&g));
+    load_ok(put_file("s.ini", "[scene]\ngltf = b.gltf\ngltf = a.gltf\n"), &s);
+    cr_assert_eq(s.ntris, 2);
+    cr_assert_not_null(s.col);
+    for (int k = 0; k < 9; k++) {
+        expect_near(s.col[k], 1.0f, 0.0f);
+        expect_near(s.col[9 + k], col[k], 0.0f);
+    }
+    scene_free(&s);
+    float neg[9] = {1, 0, 0, 0, -0.5f, 0, 0, 0, 0.25f};
+    g.nrm = neg;
+    load_fails(put_gltf("vn.gltf", edit(gl_json(&g), "\"NORMAL\"", "\"COLOR_0\"")), 1,
+               "vn.gltf: mesh 0 'tri' primitive 0 COLOR_0: vertex 1 component 1 is negative or not finite");
+}
+
 /* An emissive texture that is black in places: only triangles that see lit texels emit. */
 Test(scene_materials, emissive_texture_lights_only_lit_parts)
 {
