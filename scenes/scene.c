@@ -121,8 +121,13 @@ int scene_finish(Scene *s, char *err, size_t errlen)
         if (!used[i])
             continue;
         const SceneMaterial *m = &s->materials[i];
-        if (m->emission[0] + m->emission[1] + m->emission[2] > 0.0f)
-            continue; /* a light: shaded by the hit-light filter, not a material shader */
+        if (m->emission[0] + m->emission[1] + m->emission[2] > 0.0f) {
+            /* a light: shaded by the hit-light filter, not a material shader -- unless its
+             * emissive texture makes it partly dark, when it is also shaded (docs/scenes.md) */
+            if (m->emissive_texture < 0 || !s->uv_emit)
+                continue;
+            needs |= SCENE_NEED_EMISSIVE_TEXTURES;
+        }
         needs |= m->kind == SCENE_MAT_LAMBERT ? SCENE_NEED_LAMBERT
                : m->kind == SCENE_MAT_GLOSSY ? SCENE_NEED_GLOSSY : SCENE_NEED_DIELECTRIC;
         if (m->base_texture >= 0 && s->uv)
@@ -131,6 +136,8 @@ int scene_finish(Scene *s, char *err, size_t errlen)
             needs |= SCENE_NEED_ALPHA;
     }
     free(used);
+    if (s->col && s->ntris)
+        needs |= SCENE_NEED_VERTEX_COLORS;
     if (s->nspheres)
         needs |= SCENE_NEED_SPHERES;
     if (s->nemissive)

@@ -98,14 +98,17 @@ enum {
     SCENE_NEED_PUNCTUAL    = 1u << 6,  /* point, spot or directional lights */
     SCENE_NEED_ALPHA       = 1u << 7,  /* alpha mask or blend materials in use */
     SCENE_NEED_BACKGROUND  = 1u << 8,  /* non-zero background radiance */
-    SCENE_NEED_AMBIENT     = 1u << 9   /* constant ambient term */
+    SCENE_NEED_AMBIENT     = 1u << 9,  /* constant ambient term */
+    SCENE_NEED_EMISSIVE_TEXTURES = 1u << 10, /* an emitting material with an emissive texture */
+    SCENE_NEED_VERTEX_COLORS = 1u << 11     /* COLOR_0 on some triangles */
 };
 #define SCENE_NEED_LIST(X) \
     X(SCENE_NEED_LAMBERT, "lambert") X(SCENE_NEED_GLOSSY, "glossy") \
     X(SCENE_NEED_DIELECTRIC, "dielectric") X(SCENE_NEED_TEXTURES, "textures") \
     X(SCENE_NEED_SPHERES, "spheres") X(SCENE_NEED_AREA_LIGHTS, "area_lights") \
     X(SCENE_NEED_PUNCTUAL, "punctual_lights") X(SCENE_NEED_ALPHA, "alpha") \
-    X(SCENE_NEED_BACKGROUND, "background") X(SCENE_NEED_AMBIENT, "ambient")
+    X(SCENE_NEED_BACKGROUND, "background") X(SCENE_NEED_AMBIENT, "ambient") \
+    X(SCENE_NEED_EMISSIVE_TEXTURES, "emissive_textures") X(SCENE_NEED_VERTEX_COLORS, "vertex_colors")
 
 typedef struct Scene {
     /* Triangles, flattened to world space. */

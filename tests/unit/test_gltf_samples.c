@@ -6,6 +6,7 @@
 #include <cjson/cJSON.h>
 #include <criterion/criterion.h>
 #include <criterion/redirect.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -128,4 +129,250 @@ Test(gltf_report, nothing_skipped)
     cr_expect_null(strstr(txt, "warning"), "%s", txt);
     free(txt);
     cJSON_Delete(j);
+}
+
+/* ---- the kernel against the golden model --------------------------------------------------- */
+
+typedef struct Frame {
+    float *rgb;
+    int w, h;
+} Frame;
+
+static void load_packed(const char *path, Scene *s, PackedScene *p)
+{
+    char err[4096];
+    cr_assert_eq(scene_load(path, s, err, sizeof err), 0, "%s", err);
+    BvhParams bp;
+    bvh_default_params(&bp);
+    cr_assert_eq(pack_scene(s, &bp, 0, p, err, sizeof err), 0, "%s: %s", path, err);
+}
+
+static Frame golden(const Scene *s, const PackedScene *p, RefWorkload wl, int bounces)
+{
+    Frame f = {calloc(3 * (size_t)s->render.width * s->render.height, sizeof(float)), s->render.width,
+               s->render.height};
+    char err[1024];
+    RefParams rp = {.tile = 64, .seed = 1, .threads = 2, .workload = wl, .bounces = bounces};
+    cr_assert_eq(ref_render(p, &rp, f.rgb, NULL, err, sizeof err), 0, "%s", err);
+    return f;
+}
+
+static Frame kernel(const Scene *s, const PackedScene *p, const CfgMachine *cfg, FuncStats *st)
+{
+    Frame f = {calloc(3 * (size_t)s->render.width * s->render.height, sizeof(float)), s->render.width,
+               s->render.height};
+    static char err[65536];
+    FuncParams fp = {.cfg = cfg, .kernel_path = "kernels/pathtrace.s", .needs = s->needs, .seed = 1, .threads = 2};
+    cr_assert_eq(func_render(p, &fp, f.rgb, st, err, sizeof err), 0, "%s", err);
+    return f;
+}
+
+static int same_bits(const Frame *a, const Frame *b)
+{
+    return memcmp(a->rgb, b->rgb, sizeof(float) * 3 * (size_t)a->w * a->h) == 0;
+}
+
+static double mean(const Frame *f)
+{
+    double m = 0.0;
+    for (size_t i = 0; i < 3 * (size_t)f->w * f->h; i++)
+        m += f->rgb[i];
+    return m / (3.0 * f->w * f->h);
+}
+
+/* Emissive textures (on their own coordinates, through a texture transform), vertex colours,
+ * a sphere in a textured emitter's material: the kernel's image has the golden model's bits for
+ * several machines and both traversals, and in the Phong workload, and it was built with the
+ * shader parts these features need. */
+Test(gltf_kernel, emissive_textures_and_vertex_colours_match_the_golden_model, .timeout = 300)
+{
+    Scene s;
+    PackedScene p;
+    load_packed("tests/scenes/ok_emissive_texture.ini", &s, &p);
+    char needs[256];
+    scene_needs_string(s.needs, needs, sizeof needs);
+    cr_expect_str_eq(needs, "lambert,glossy,textures,spheres,area_lights,emissive_textures,vertex_colors");
+    Frame g = golden(&s, &p, REF_WORKLOAD_PATH, 0);
+    cr_expect_gt(mean(&g), 0.0);
+    static const struct { int lanes, rays, packet; } m[] = {{16, 4096, 0}, {8, 1024, 0}, {16, 4096, 1}};
+    for (size_t i = 0; i < sizeof m / sizeof m[0]; i++) {
+        CfgMachine cfg;
+        cfg_defaults(&cfg);
+        cfg.core_simd_width = m[i].lanes;
+        cfg.stream_rays = m[i].rays;
+        cfg.stream_mode = m[i].packet ? CFG_STREAM_MODE_PACKET : CFG_STREAM_MODE_STREAM;
+        FuncStats st;
+        Frame k = kernel(&s, &p, &cfg, &st);
+        cr_expect(same_bits(&k, &g), "N = %d, M = %d%s: the kernel's image differs from the golden model's",
+                  m[i].lanes, m[i].rays, m[i].packet ? ", packets" : "");
+        cr_expect(strstr(st.defines, "HAS_EMISSIVE_TEX=1") && strstr(st.defines, "HAS_COLORS=1"), "%s", st.defines);
+        free(k.rgb);
+        func_stats_free(&st);
+    }
+    free(g.rgb);
+    /* the Phong workload samples each light once per hit: textured triangle lights at their centroid */
+    g = golden(&s, &p, REF_WORKLOAD_PHONG, 1);
+    CfgMachine cfg;
+    cfg_defaults(&cfg);
+    cfg.workload_kind = CFG_WORKLOAD_PHONG;
+    cfg.workload_bounces = 1;
+    FuncStats st;
+    Frame k = kernel(&s, &p, &cfg, &st);
+    cr_expect(same_bits(&k, &g), "phong: the kernel's image differs from the golden model's");
+    free(k.rgb);
+    free(g.rgb);
+    func_stats_free(&st);
+    pack_free(&p);
+    scene_free(&s);
+}
+
+/* A scene.ini over tests/scenes/ok_emissive_texture.gltf (absolute path), with the given camera
+ * and render sections; returns the ini's path. */
+static const char *emissive_ini(char *dir, const char *sections)
+{
+    static char path[512];
+    char cwd[256];
+    cr_assert_not_null(getcwd(cwd, sizeof cwd));
+    snprintf(path, sizeof path, "%s/s.ini", dir);
+    FILE *f = fopen(path, "w");
+    cr_assert_not_null(f);
+    fprintf(f, "[scene]\ngltf = %s/tests/scenes/ok_emissive_texture.gltf\n%s", cwd, sections);
+    fclose(f);
+    return path;
+}
+
+/* The golden model, looking straight at the emissive panel of ok_emissive_texture.gltf (x -1..1,
+ * y 0..1.5 at z = -1; emissive coordinates u' = 2 u + 0.25 into 8 black, then 8 blue texels
+ * (0, 64, 255); emission (1, 0.8, 0.6) x 4): the camera rays see (0, 3.2 x 0.0513, 2.4) plus a
+ * little reflection where the texel is blue (x in [-0.75, -0.25) and [0.25, 0.75)), and almost
+ * nothing where it is black. Without the emissive texture the whole panel glowed (4, 3.2, 2.4). */
+Test(gltf_kernel, emission_follows_the_emissive_texture)
+{
+    char dir[] = "/tmp/sfsim-emit-XXXXXX";
+    cr_assert_not_null(mkdtemp(dir));
+    const char *ini = emissive_ini(dir, "[camera]\nposition = 0 0.75 2\nlook_at = 0 0.75 -1\nfov_y = 18.92\n"
+                                        "[render]\nwidth = 32\nheight = 16\nspp = 1\nmax_depth = 0\n");
+    Scene s;
+    PackedScene p;
+    load_packed(ini, &s, &p);
+    Frame g = golden(&s, &p, REF_WORKLOAD_PATH, 0);
+    int lit = 0, dark = 0;
+    for (int y = 4; y < 12; y++)
+        for (int x = 0; x < 32; x++) {
+            const float *px = &g.rgb[3 * (y * 32 + x)];
+            double cx = (x + 0.5) / 16.0 - 1.0; /* the pixel's centre on the panel */
+            int blue = (cx > -0.7 && cx < -0.3) || (cx > 0.3 && cx < 0.7);
+            int black = (cx > -0.2 && cx < 0.2) || cx < -0.8 || cx > 0.8;
+            if (blue) {
+                cr_expect(px[2] >= 2.4f && px[2] < 2.9f && px[0] < 0.5f && px[1] > 0.1f && px[1] < 0.6f,
+                          "pixel (%d, %d) on a blue texel: %g %g %g", x, y, (double)px[0], (double)px[1],
+                          (double)px[2]);
+                lit++;
+            } else if (black) {
+                cr_expect(px[2] < 0.5f, "pixel (%d, %d) on a black texel: blue %g", x, y, (double)px[2]);
+                dark++;
+            }
+        }
+    cr_expect_gt(lit, 40);
+    cr_expect_gt(dark, 40);
+    free(g.rgb);
+    pack_free(&p);
+    scene_free(&s);
+    unlink(ini);
+    rmdir(dir);
+}
+
+/* Light sampling sees the texture too: a white floor lit only by the panel's emitting triangles,
+ * through shadow rays (max_depth 0), takes the blue of the texels (red 0); sampled with the
+ * emission factor alone it would be warm, red above blue. */
+Test(gltf_kernel, light_sampling_follows_the_emissive_texture)
+{
+    char dir[] = "/tmp/sfsim-nee-XXXXXX";
+    cr_assert_not_null(mkdtemp(dir));
+    const char *ini = emissive_ini(dir, "[camera]\nposition = 0 2 2\nlook_at = 0 0 0\nfov_y = 40\n"
+                                        "[render]\nwidth = 16\nheight = 16\nspp = 16\nmax_depth = 0\n");
+    Scene s;
+    PackedScene p;
+    load_packed(ini, &s, &p);
+    cr_assert_not_null(s.col);
+    for (size_t i = 0; i < 9 * (size_t)s.ntris; i++)
+        s.col[i] = 1.0f; /* a white floor */
+    pack_free(&p);
+    BvhParams bp;
+    bvh_default_params(&bp);
+    char err[256];
+    cr_assert_eq(pack_scene(&s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
+    Frame g = golden(&s, &p, REF_WORKLOAD_PATH, 0);
+    double r = 0, b = 0;
+    for (int y = 10; y < 16; y++) /* the lower rows: floor */
+        for (int x = 0; x < 16; x++) {
+            r += g.rgb[3 * (y * 16 + x)];
+            b += g.rgb[3 * (y * 16 + x) + 2];
+        }
+    cr_expect(b > 0.0 && r < 0.01 * b, "the floor: red %g, blue %g", r, b);
+    free(g.rgb);
+    pack_free(&p);
+    scene_free(&s);
+    unlink(ini);
+    rmdir(dir);
+}
+
+/* COLOR_0 multiplies the base colour. Seen from above with direct light only (max_depth 0), a
+ * pixel's radiance is linear in the base colour and its random numbers do not depend on it, so
+ * the image over the image of the same scene with white vertex colours is, channel by channel,
+ * the colour interpolated at the pixel: red at (-1, 1), green at (1, 1), blue at (1, -1), white
+ * at (-1, -1) (the floor of ok_emissive_texture.gltf, two triangles split along x + z = 0). */
+Test(gltf_kernel, vertex_colours_tint_the_base_colour)
+{
+    char dir[] = "/tmp/sfsim-col-XXXXXX";
+    cr_assert_not_null(mkdtemp(dir));
+    const char *ini = emissive_ini(dir, "[camera]\nposition = 0 3 0\nlook_at = 0 0 0\nup = 0 0 -1\nfov_y = 40\n"
+                                        "[render]\nwidth = 16\nheight = 16\nspp = 4\nmax_depth = 0\n"
+                                        "[light.top]\ntype = quad\nposition = -2 4 -2\nedge_u = 4 0 0\nedge_v = 0 0 4\n"
+                                        "intensity = 2\n");
+    Scene s;
+    PackedScene p;
+    load_packed(ini, &s, &p);
+    cr_assert_not_null(s.col);
+    Frame a = golden(&s, &p, REF_WORKLOAD_PATH, 0);
+    pack_free(&p);
+    for (size_t i = 0; i < 9 * (size_t)s.ntris; i++)
+        s.col[i] = 1.0f;
+    BvhParams bp;
+    bvh_default_params(&bp);
+    char err[256];
+    cr_assert_eq(pack_scene(&s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
+    Frame b = golden(&s, &p, REF_WORKLOAD_PATH, 0);
+    static const float vc[4][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}};
+    static const float vx[4] = {-1, 1, 1, -1}, vz[4] = {1, 1, -1, -1};
+    double half = 3.0 * tan(20.0 * M_PI / 180.0);
+    int checked = 0;
+    for (int y = 0; y < 16; y++)
+        for (int x = 0; x < 16; x++) {
+            double wx = ((x + 0.5) / 16.0 - 0.5) * 2.0 * half, wz = ((y + 0.5) / 16.0 - 0.5) * 2.0 * half;
+            if (fabs(wx) > 0.9 || fabs(wz) > 0.9 || fabs(wx + wz) < 0.2)
+                continue;
+            /* barycentrics in the triangle (0, 1, 2) or (0, 2, 3) */
+            int t[3] = {0, wx + wz > 0 ? 1 : 2, wx + wz > 0 ? 2 : 3};
+            double x0 = vx[t[0]], z0 = vz[t[0]], x1 = vx[t[1]] - x0, z1 = vz[t[1]] - z0, x2 = vx[t[2]] - x0,
+                   z2 = vz[t[2]] - z0, d = x1 * z2 - x2 * z1;
+            double u = ((wx - x0) * z2 - x2 * (wz - z0)) / d, v = (x1 * (wz - z0) - (wx - x0) * z1) / d;
+            const float *pa = &a.rgb[3 * (y * 16 + x)], *pb = &b.rgb[3 * (y * 16 + x)];
+            if (!(pb[0] > 1e-3f && pb[1] > 1e-3f && pb[2] > 1e-3f))
+                continue; /* in shadow, or the light was not seen */
+            for (int k = 0; k < 3; k++) {
+                double want = (1 - u - v) * vc[t[0]][k] + u * vc[t[1]][k] + v * vc[t[2]][k];
+                cr_expect(fabs(pa[k] / pb[k] - want) < 0.08, "pixel (%d, %d) at (%.2f, %.2f), channel %d: %g, expected %g",
+                          x, y, wx, wz, k, (double)(pa[k] / pb[k]), want);
+            }
+            checked++;
+        }
+    printf("vertex colours: %d pixels checked\n", checked);
+    cr_expect_gt(checked, 100);
+    free(a.rgb);
+    free(b.rgb);
+    pack_free(&p);
+    scene_free(&s);
+    unlink(ini);
+    rmdir(dir);
 }

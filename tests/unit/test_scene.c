@@ -264,7 +264,8 @@ Test(scene_shipped, glass_vase_flowers)
 Test(scene_shipped, lights_punctual_lamp)
 {
     check_shipped("scenes/lights-punctual-lamp/scene.ini", 6000,
-                  "glossy,dielectric,textures,area_lights,punctual_lights,alpha,background", SCENE_CAMERA_FILE);
+                  "glossy,dielectric,textures,area_lights,punctual_lights,alpha,background,emissive_textures",
+                  SCENE_CAMERA_FILE);
 }
 Test(scene_shipped, sponza)
 {
@@ -273,14 +274,14 @@ Test(scene_shipped, sponza)
 }
 Test(scene_shipped, toy_car)
 {
-    check_shipped("scenes/toy-car/scene.ini", 108936, "lambert,glossy,dielectric,textures,area_lights,background",
-                  SCENE_CAMERA_FILE);
+    check_shipped("scenes/toy-car/scene.ini", 108936,
+                  "lambert,glossy,dielectric,textures,area_lights,background,emissive_textures", SCENE_CAMERA_FILE);
 }
 Test(scene_shipped, transmission_test)
 {
     /* no [camera]: the file's own */
     check_shipped("scenes/transmission-test/scene.ini", 128775,
-                  "glossy,dielectric,textures,area_lights,alpha,background", SCENE_CAMERA_GLTF);
+                  "glossy,dielectric,textures,area_lights,alpha,background,emissive_textures", SCENE_CAMERA_GLTF);
 }
 Test(scene_shipped, stanford_bunny)
 {
@@ -288,8 +289,8 @@ Test(scene_shipped, stanford_bunny)
 }
 Test(scene_shipped, lamborghini, .timeout = 60)
 {
-    check_shipped("scenes/lamborghini/scene.ini", 145917, "lambert,glossy,textures,area_lights,alpha,background",
-                  SCENE_CAMERA_FILE);
+    check_shipped("scenes/lamborghini/scene.ini", 145917,
+                  "lambert,glossy,textures,area_lights,alpha,background,vertex_colors", SCENE_CAMERA_FILE);
 }
 Test(scene_shipped, lost_empire, .timeout = 60)
 {
@@ -669,7 +670,9 @@ Test(scene_materials, emissive_texture_lights_only_lit_parts)
     cr_expect_eq(s.tri_material[1], 1);
     cr_assert_eq(s.nemissive, 1);
     cr_expect_eq(s.emissive_tris[0], 1);
-    cr_expect_str_eq(needs_of(&s), "lambert,area_lights");
+    /* the lit part samples its texture, and is shaded too (its texture may be dark in places) */
+    cr_expect_str_eq(needs_of(&s), "lambert,area_lights,emissive_textures");
+    cr_assert_not_null(s.uv_emit);
     scene_free(&s);
 }
 
@@ -1569,6 +1572,8 @@ Test(scene_needs, string)
     scene_needs_string(0x3FF, buf, sizeof buf);
     cr_expect_str_eq(buf,
                      "lambert,glossy,dielectric,textures,spheres,area_lights,punctual_lights,alpha,background,ambient");
+    scene_needs_string(SCENE_NEED_EMISSIVE_TEXTURES | SCENE_NEED_VERTEX_COLORS, buf, sizeof buf);
+    cr_expect_str_eq(buf, "emissive_textures,vertex_colors");
     scene_needs_string(0x3FF, buf, 10); /* truncates, terminated */
     cr_expect_eq(strlen(buf), 9);
 }
@@ -1619,6 +1624,7 @@ Test(scene_files, everything)
     cr_expect_eq(s.ntextures, 2);
     cr_expect_eq(s.camera.source, SCENE_CAMERA_GLTF);
     cr_expect_eq(s.nemissive, 1, "one of the two lamp triangles sees lit texels");
-    cr_expect_str_eq(needs_of(&s), "lambert,glossy,dielectric,textures,area_lights,punctual_lights,alpha");
+    cr_expect_str_eq(needs_of(&s), "lambert,glossy,dielectric,textures,area_lights,punctual_lights,alpha,"
+                                   "emissive_textures");
     scene_free(&s);
 }
