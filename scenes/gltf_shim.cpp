@@ -30,6 +30,7 @@
 #include <vector>
 
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cjson/cJSON.h>
 
@@ -287,14 +288,85 @@ bool no_write(std::string *err, const std::string &, const std::vector<unsigned 
 
 // Loading from a file: external buffers and images are read by tinygltf, but through this reader,
 // which refuses what is not a regular file (tinygltf sizes a file by seeking to its end, and a
-// directory or device answers with nonsense such as 2^63 bytes).
-bool regular_file_exists(const std::string &path, void *)
+// directory or device answers with nonsense such as 2^63 bytes), and what lies outside the glTF
+// file's folder (a uri such as ../../etc/passwd) unless SFSIM_ALLOW_OUTSIDE_URIS=1 says otherwise.
+struct FsContext {
+    std::string base;     // the glTF file's folder as tinygltf joins uris to it ("" or "dir/")
+    std::string root;     // the same, absolute and normalized, ending in '/'
+    std::string real;     // the same through realpath (symbolic links resolved), ending in '/'
+    bool allow_outside = false;
+    std::string refused;  // the first uri refused, as the file wrote it
+};
+
+// path made absolute (from the working directory) with "." and ".." resolved by name alone.
+std::string lexical_path(const std::string &path)
 {
+    std::string full = path;
+    if (full.empty() || full[0] != '/') {
+        char cwd[4096];
+        if (!getcwd(cwd, sizeof cwd))
+            return std::string();
+        full = std::string(cwd) + "/" + full;
+    }
+    std::vector<std::string> parts;
+    size_t i = 0;
+    while (i <= full.size()) {
+        size_t j = full.find('/', i);
+        if (j == std::string::npos)
+            j = full.size();
+        std::string part = full.substr(i, j - i);
+        if (part == "..") {
+            if (!parts.empty())
+                parts.pop_back();
+        } else if (!part.empty() && part != ".") {
+            parts.push_back(part);
+        }
+        i = j + 1;
+    }
+    std::string out;
+    for (const auto &part : parts)
+        out += "/" + part;
+    return out.empty() ? "/" : out;
+}
+
+bool under(const std::string &path, const std::string &dir) { return path.compare(0, dir.size(), dir) == 0; }
+
+// Whether `path` stays inside the folder: by name, and, when it exists, through symbolic links.
+bool inside_folder(const FsContext &c, const std::string &path)
+{
+    if (!under(lexical_path(path), c.root))
+        return false;
+    char *r = realpath(path.c_str(), nullptr);
+    if (!r)
+        return true; // does not exist: the read reports it
+    bool in = under(std::string(r), c.real);
+    std::free(r);
+    return in;
+}
+
+bool regular_file_exists(const std::string &path, void *user)
+{
+    const FsContext *c = static_cast<const FsContext *>(user);
+    if (c && !c->allow_outside && !inside_folder(*c, path))
+        // tinygltf tries the file's folder, then the working directory. A uri that leaves the
+        // folder "exists", so the read below refuses it whether or not it does (its existence is
+        // not revealed); the working-directory fallback is simply not searched.
+        return c->base.empty() || under(path, c->base);
     struct stat st;
     return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
-bool read_regular_file(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *)
+
+bool read_regular_file(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *user)
 {
+    FsContext *c = static_cast<FsContext *>(user);
+    if (c && !c->allow_outside && !inside_folder(*c, path)) {
+        std::string uri = under(path, c->base) ? path.substr(c->base.size()) : path;
+        if (c->refused.empty())
+            c->refused = uri;
+        if (err)
+            *err += "'" + uri + "' lies outside the glTF file's folder\n";
+        return false;
+    }
     struct stat st;
     if (stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) {
         if (err)
@@ -1725,14 +1797,32 @@ extern "C" int gltf_append(const char *path, const double *xf, Scene *s, char *e
         }
         std::vector<unsigned char> data;
         std::string rerr;
-        if (!read_regular_file(&data, &rerr, path, nullptr)) {
+        if (!read_regular_file(&data, &rerr, path, nullptr)) { // (the file named by the user: no folder check)
             std::snprintf(err, errlen, "%s: %s", path, one_line(rerr).c_str());
             return -1;
         }
         const char *slash = std::strrchr(path, '/');
         std::string base_dir = slash ? std::string(path, (size_t)(slash - path) + 1) : std::string();
-        tinygltf::FsCallbacks fs = {regular_file_exists, same_path, read_regular_file, no_write, nullptr};
-        return load_memory(data.data(), data.size(), path, base_dir, fs, xf, s, err, errlen);
+        FsContext ctx;
+        ctx.base = base_dir;
+        ctx.root = lexical_path(base_dir.empty() ? "." : base_dir);
+        char *real = realpath(base_dir.empty() ? "." : base_dir.c_str(), nullptr);
+        ctx.real = real ? real : ctx.root;
+        std::free(real);
+        if (ctx.root.empty() || ctx.root.back() != '/')
+            ctx.root += "/";
+        if (ctx.real.back() != '/')
+            ctx.real += "/";
+        const char *allow = std::getenv("SFSIM_ALLOW_OUTSIDE_URIS");
+        ctx.allow_outside = allow && std::strcmp(allow, "1") == 0;
+        tinygltf::FsCallbacks fs = {regular_file_exists, same_path, read_regular_file, no_write, &ctx};
+        int rc = load_memory(data.data(), data.size(), path, base_dir, fs, xf, s, err, errlen);
+        if (rc != 0 && !ctx.refused.empty())
+            std::snprintf(err, errlen,
+                          "%s: uri '%s' leads outside the folder of the glTF file, which sfsim does not read (set "
+                          "SFSIM_ALLOW_OUTSIDE_URIS=1 to allow it)",
+                          path, ctx.refused.c_str());
+        return rc;
     } catch (const std::exception &e) {
         std::snprintf(err, errlen, "%s: %s", path, e.what());
         return -1;

@@ -1044,6 +1044,96 @@ Test(scene_gltf_errors, unsupported_required_extension)
     scene_free(&s);
 }
 
+/* Buffer and image uris stay inside the glTF file's folder: '../b.bin' is refused whether or not
+ * it exists (neither its existence nor its size is told), a link inside the folder that points
+ * out is refused too, a subfolder is fine, and SFSIM_ALLOW_OUTSIDE_URIS=1 lets the file out. */
+Test(scene_gltf_errors, uris_stay_in_the_folder)
+{
+    char a[128], sub[128], bin[160], link[160], inner[160];
+    snprintf(a, sizeof a, "%s/a", g_dir);
+    snprintf(sub, sizeof sub, "%s/a/sub", g_dir);
+    cr_assert_eq(mkdir(a, 0700), 0);
+    cr_assert_eq(mkdir(sub, 0700), 0);
+    snprintf(bin, sizeof bin, "%s/b.bin", g_dir);
+    FILE *f = fopen(bin, "wb");
+    cr_assert_not_null(f);
+    fwrite(tri_pos, 1, sizeof tri_pos, f);
+    fclose(f);
+    snprintf(inner, sizeof inner, "%s/a/sub/c.bin", g_dir);
+    f = fopen(inner, "wb");
+    cr_assert_not_null(f);
+    fwrite(tri_pos, 1, sizeof tri_pos, f);
+    fclose(f);
+    snprintf(link, sizeof link, "%s/a/link.bin", g_dir);
+    cr_assert_eq(symlink("../b.bin", link), 0);
+    static const char *const uris[] = {"../b.bin", "../nothere.bin", "link.bin", "sub/../../b.bin", "sub/c.bin"};
+    unsetenv("SFSIM_ALLOW_OUTSIDE_URIS");
+    for (int i = 0; i < 5; i++) {
+        Gl g = tri();
+        char *j = gl_json(&g), *uri = strstr(j, "data:application"), *end = strchr(uri, '"');
+        char *json = NULL;
+        cr_assert_gt(asprintf(&json, "%.*s%s%s", (int)(uri - j), j, uris[i], end), 0);
+        free(j);
+        char path[192], err[1024];
+        snprintf(path, sizeof path, "%s/a/x.gltf", g_dir);
+        f = fopen(path, "w");
+        fputs(json, f);
+        fclose(f);
+        free(json);
+        Scene s;
+        int rc = scene_load(path, &s, err, sizeof err);
+        if (i == 4) {
+            cr_expect_eq(rc, 0, "%s: %s", uris[i], err);
+            if (rc == 0)
+                scene_free(&s);
+        } else {
+            char want[512];
+            snprintf(want, sizeof want,
+                     "%s: uri '%s' leads outside the folder of the glTF file, which sfsim does not read (set "
+                     "SFSIM_ALLOW_OUTSIDE_URIS=1 to allow it)", path, uris[i]);
+            cr_expect_eq(rc, -1, "%s loaded", uris[i]);
+            cr_expect_str_eq(err, want);
+        }
+        /* allowed explicitly: the file outside is read (the missing one is then not found) */
+        setenv("SFSIM_ALLOW_OUTSIDE_URIS", "1", 1);
+        rc = scene_load(path, &s, err, sizeof err);
+        unsetenv("SFSIM_ALLOW_OUTSIDE_URIS");
+        if (i == 1) {
+            cr_expect_eq(rc, -1);
+            cr_expect_not_null(strstr(err, "nothere.bin"), "%s", err);
+        } else {
+            cr_expect_eq(rc, 0, "%s with SFSIM_ALLOW_OUTSIDE_URIS=1: %s", uris[i], err);
+            if (rc == 0) {
+                cr_expect_eq(s.ntris, 1);
+                scene_free(&s);
+            }
+        }
+        unlink(path);
+    }
+    /* an image uri: the same rule */
+    static const float uv[6] = {0, 0, 1, 0, 0, 1};
+    Gl g = tri();
+    g.uv = uv;
+    g.material = "{\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0}}}";
+    g.top = "\"textures\": [{\"source\": 0}], \"images\": [{\"uri\": \"../../b.png\"}]";
+    char path[192], err[1024];
+    snprintf(path, sizeof path, "%s/a/img.gltf", g_dir);
+    char *json = gl_json(&g);
+    f = fopen(path, "w");
+    fputs(json, f);
+    fclose(f);
+    free(json);
+    Scene s;
+    cr_expect_neq(scene_load(path, &s, err, sizeof err), 0);
+    cr_expect_not_null(strstr(err, "img.gltf: uri '../../b.png' leads outside the folder of the glTF file"), "%s", err);
+    unlink(path);
+    unlink(link);
+    unlink(inner);
+    unlink(bin);
+    rmdir(sub);
+    rmdir(a);
+}
+
 Test(scene_gltf_errors, nan_vertex)
 {
     float pos[9] = {0, 0, 0, NAN, 0, 0, 0, 1, 0};
