@@ -150,6 +150,14 @@ const char *ctype_name(int ctype)
     }
 }
 
+// A number for messages, as printf's %g writes it (1e+30, 0.5, inf).
+std::string num(double x)
+{
+    char b[32];
+    std::snprintf(b, sizeof b, "%g", x);
+    return b;
+}
+
 // One line from tinygltf's multi-line error and warning text.
 std::string one_line(std::string s)
 {
@@ -1102,7 +1110,7 @@ bool read_uvs(Loader &L, const tinygltf::Primitive &p, const std::string &where,
         double u = vt.get(v, 0), w = vt.get(v, 1);
         double t[2] = {m[0] * u + m[1] * w + m[2], m[3] * u + m[4] * w + m[5]};
         for (int k = 0; k < 2; k++) {
-            if (!std::isfinite(t[k]) || std::fabs(t[k]) > 1e30)
+            if (!std::isfinite((float)t[k]))
                 return L.fail(where + " " + attr + ": vertex " + std::to_string(v) + " is not finite" +
                               (map.m[0] == 1 && map.m[1] == 0 && map.m[2] == 0 && map.m[3] == 0 && map.m[4] == 1 &&
                                        map.m[5] == 0
@@ -1239,16 +1247,25 @@ bool load_primitive(Loader &L, const Mat4 &full, int mesh, int pi)
     bool flip = det3(full) < 0.0; // a mirroring transform reverses the winding (glTF 2.0 Sec. 3.7.4)
     // Every vertex once.
     std::vector<float> wp(3 * vp.count), wn(has_n ? 3 * vp.count : 0), wc(has_c ? 3 * vp.count : 0);
+    std::string pw = where + " POSITION: accessor " + std::to_string(pa->second) + ": vertex ";
     for (size_t v = 0; v < vp.count; v++) {
         double in[3] = {vp.get(v, 0), vp.get(v, 1), vp.get(v, 2)}, out[3];
-        xform_point(full, in, out);
+        // What the file holds first, then where the node transforms put it: each error says which.
         for (int k = 0; k < 3; k++) {
             if (!std::isfinite(in[k]))
-                return L.fail(where + " POSITION: vertex " + std::to_string(v) + " coordinate " + std::to_string(k) +
-                              " is not finite (" + std::to_string(in[k]) + ")");
-            if (!std::isfinite(out[k]) || std::fabs(out[k]) > 1e30)
-                return L.fail(where + " POSITION: vertex " + std::to_string(v) +
-                              " is not finite after the node transforms");
+                return L.fail(pw + std::to_string(v) + " coordinate " + std::to_string(k) + " is not finite (" +
+                              std::to_string(in[k]) + ")");
+            if (std::fabs(in[k]) > SCENE_COORD_LIMIT)
+                return L.fail(pw + std::to_string(v) + " coordinate " + std::to_string(k) + " is " + num(in[k]) +
+                              ", beyond the limit of " + num(SCENE_COORD_LIMIT) +
+                              " on scene coordinates (docs/scenes.md, Limits)");
+        }
+        xform_point(full, in, out);
+        for (int k = 0; k < 3; k++) {
+            if (!std::isfinite(out[k]) || std::fabs(out[k]) > SCENE_COORD_LIMIT)
+                return L.fail(pw + std::to_string(v) + " is (" + num(out[0]) + ", " + num(out[1]) + ", " + num(out[2]) +
+                              ") after the node transforms, beyond the limit of " + num(SCENE_COORD_LIMIT) +
+                              " on scene coordinates (docs/scenes.md, Limits)");
             wp[3 * v + (size_t)k] = (float)out[k];
         }
         if (has_n) {

@@ -141,6 +141,12 @@ typedef struct Scene {
     char **warnings;          uint32_t nwarnings;
 } Scene;
 
+/* The largest magnitude of a triangle vertex coordinate in the world (after all transforms). The
+ * renderers multiply coordinates pairwise in binary32 (edge functions, cross products, box areas),
+ * which stay finite up to about 1e18 (1e36 < FLT_MAX; docs/numerics.md); beyond, hits would be
+ * lost to inf and NaN without a word, so the loader refuses such vertices (docs/scenes.md). */
+#define SCENE_COORD_LIMIT 1e18
+
 /* Load a scene: a .gltf/.glb file, or a scene.ini that names one. Fills every field (defaults,
  * camera framing the bounds when none is given, needs). 0, or -1 with a message naming the file
  * and the element ("scene.glb: accessor 3: index 812 out of range (count 500)"). */
