@@ -6,6 +6,7 @@
 #include <cjson/cJSON.h>
 #include <criterion/criterion.h>
 #include <criterion/redirect.h>
+#include <dirent.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -375,4 +376,100 @@ Test(gltf_kernel, vertex_colours_tint_the_base_colour)
     scene_free(&s);
     unlink(ini);
     rmdir(dir);
+}
+
+/* ---- ../shared/scenes/gltf-samples: every folder renders or is refused by name -------------- */
+
+#define SAMPLES "../shared/scenes/gltf-samples"
+
+/* The folders that must be refused, and the message (after the scene.ini's "FILE:LINE: key
+ * 'scene.gltf': ") naming the file and the feature. Every other folder must render. */
+static const struct {
+    const char *dir, *refusal;
+} refused[] = {
+    {"box-draco", "/Box.gltf: requires extension KHR_draco_mesh_compression, which sfsim does not support"},
+    {"unlit-required", "/UnlitTest.glb: requires extension KHR_materials_unlit, which sfsim does not support"},
+};
+
+static const char *expected_refusal(const char *dir)
+{
+    for (size_t i = 0; i < sizeof refused / sizeof refused[0]; i++)
+        if (!strcmp(refused[i].dir, dir))
+            return refused[i].refusal;
+    return NULL;
+}
+
+/* Each folder's scene.ini at its own size: the kernel on the functional core (N = 16, M = 4096)
+ * gives the golden model's image bit for bit, or the load fails with the expected message. */
+Test(gltf_samples, every_sample_renders_as_the_golden_model_or_is_refused_by_name, .timeout = 300)
+{
+    struct stat st;
+    if (stat(SAMPLES, &st) != 0 || !S_ISDIR(st.st_mode))
+        cr_skip_test("needs ../shared/scenes (absent)");
+    struct dirent **names;
+    int n = scandir(SAMPLES, &names, NULL, alphasort);
+    cr_assert_gt(n, 0, "cannot list " SAMPLES);
+    int rendered = 0, refusals = 0;
+    for (int i = 0; i < n; i++) {
+        const char *dir = names[i]->d_name;
+        char ini[512];
+        snprintf(ini, sizeof ini, SAMPLES "/%s/scene.ini", dir);
+        if (dir[0] == '.' || stat(ini, &st) != 0) {
+            free(names[i]);
+            continue;
+        }
+        const char *want = expected_refusal(dir);
+        Scene s;
+        char err[4096];
+        int rc = scene_load(ini, &s, err, sizeof err);
+        if (want) {
+            cr_expect_neq(rc, 0, "%s: loaded, but must be refused", dir);
+            if (rc == 0) {
+                scene_free(&s);
+            } else {
+                char full[512];
+                snprintf(full, sizeof full, SAMPLES "/%s%s", dir, want);
+                cr_expect_not_null(strstr(err, full), "%s: the message does not name the file and the feature:\n%s",
+                                   dir, err);
+                printf("gltf-samples %-22s refused: %s\n", dir, err);
+                refusals++;
+            }
+            free(names[i]);
+            continue;
+        }
+        cr_expect_eq(rc, 0, "%s: %s", dir, err);
+        if (rc != 0) {
+            free(names[i]);
+            continue;
+        }
+        PackedScene p;
+        BvhParams bp;
+        bvh_default_params(&bp);
+        cr_assert_eq(pack_scene(&s, &bp, 0, &p, err, sizeof err), 0, "%s: %s", dir, err);
+        Frame g = golden(&s, &p, REF_WORKLOAD_PATH, 0);
+        CfgMachine cfg;
+        cfg_defaults(&cfg);
+        FuncStats fs;
+        Frame k = kernel(&s, &p, &cfg, &fs);
+        char needs[256];
+        scene_needs_string(s.needs, needs, sizeof needs);
+        int same = same_bits(&k, &g);
+        cr_expect(same, "%s: the kernel's image differs from the golden model's", dir);
+        cr_expect_gt(mean(&g), 0.0, "%s: black image", dir);
+        cr_expect_eq(fs.rays_camera, (uint64_t)s.render.width * s.render.height * s.render.spp, "%s", dir);
+        printf("gltf-samples %-22s %dx%d %d spp, %u triangles, mean %.5f, %s  [%s]%s\n", dir, s.render.width,
+               s.render.height, s.render.spp, s.ntris, mean(&g), same ? "kernel = golden" : "DIFFERENT", needs,
+               s.nwarnings ? " (with warnings)" : "");
+        rendered++;
+        free(g.rgb);
+        free(k.rgb);
+        func_stats_free(&fs);
+        pack_free(&p);
+        scene_free(&s);
+        free(names[i]);
+    }
+    free(names);
+    printf("gltf-samples: %d rendered, %d refused\n", rendered, refusals);
+    cr_expect_eq(refusals, (int)(sizeof refused / sizeof refused[0]), "every expected refusal was seen");
+    cr_expect_geq(rendered + refusals, 26, "the folder holds 26 samples");
 }
