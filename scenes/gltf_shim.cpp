@@ -1,10 +1,13 @@
 // scenes/gltf_shim.cpp -- glTF 2.0 through tinygltf (Debian's libtinygltf 2.7), behind a C API.
 //
-// Owns: walking a glTF document (default scene, node transforms, meshes, accessors, materials,
-// base-colour and emissive textures, KHR_lights_punctual, the first camera) and validating
-// everything it reads, so a malformed file gives an error naming the file and the element instead
-// of a crash. Must not: pick scene defaults, compute bounds or needs (scenes/scene.c), build
-// acceleration structures, or print anything.
+// Owns: walking a glTF document (default scene, node transforms, meshes, accessors with their
+// sparse substitution, materials, base-colour and emissive textures with their texture
+// coordinates and KHR_texture_transform, vertex colours, KHR_lights_punctual, the first camera)
+// and validating everything it reads, so a malformed file gives an error naming the file and the
+// element instead of a crash; what it leaves out (points, lines, sampler wrap modes) becomes a
+// warning line in the Scene; external files are read only inside the glTF file's folder. Must
+// not: pick scene defaults, compute bounds or needs (scenes/scene.c), build acceleration
+// structures, or print anything.
 //
 // The only C++ in the project besides the OpenImageIO shim (ARCHITECTURE.md Sec. 2). Exceptions
 // never cross the C boundary.

@@ -897,6 +897,8 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
                         s.skipped_primitives);
     for (uint32_t i = 0; i < s.nwarnings && len < (int)sizeof txt; i++)
         len += snprintf(txt + len, sizeof txt - (size_t)len, "warning      %s\n", s.warnings[i]);
+    if (len >= (int)sizeof txt) /* (truncated: the writes below stay inside txt) */
+        len = (int)sizeof txt - 1;
     if (functional) {
         const FuncStats *f = &rs.f;
         uint64_t opsum[ISA_C_COUNT] = {0}, all = 0;
