@@ -189,7 +189,7 @@ $(BUILD)/fuzz/gltf_shim.o: scenes/gltf_shim.cpp scenes/gltf.h scenes/scene.h
 $(BUILD)/fuzz/fuzz_scene: tests/fuzz/fuzz_scene.c scenes/scene.c scenes/scene_file.c sim/ini.c $(BUILD)/fuzz/gltf_shim.o
 	@mkdir -p $(dir $@)
 	$(CLANG)++ -x c -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined \
-	    $(filter %.c,$^) -x none $(filter %.o,$^) -o $@ -linih -lm
+	    $(filter %.c,$^) -x none $(filter %.o,$^) -o $@ -linih -lcjson -lm
 
 $(BUILD)/fuzz/fuzz_rays: tests/fuzz/fuzz_rays.c sim/raybatch.c sim/outfile.c
 	@mkdir -p $(dir $@)

@@ -9,7 +9,8 @@
 ; docs/kernel.md describes the structure, registers and memories.
 ;
 ; Assembled by the host with -D RAYS=M and one -D per scene feature (docs/kernel.md):
-;   HAS_GLOSSY, HAS_DIELECTRIC, HAS_LAMBERT, HAS_NORMALS, HAS_BACKGROUND, HAS_AMBIENT; and
+;   HAS_GLOSSY, HAS_DIELECTRIC, HAS_LAMBERT, HAS_NORMALS, HAS_BACKGROUND, HAS_AMBIENT,
+;   HAS_EMISSIVE_TEX, HAS_COLORS; and
 ;   WORKLOAD (with BOUNCES) for the utilization workloads instead of the material shaders.
 
         .include "abi.inc"
@@ -890,7 +891,8 @@ fd\@:
 ; light), wi := it normalized, e1 := le, the radiance it brings x geometry, e2 := the shading
 ; normal, vt3 := cos at it; m2 := the m1 lanes that receive light and see it from both
 ; normals (nf facing the ray). sample_light and shade_direct of sim/reference.c, operation
-; for operation. Aliases of LIGHT_ALIASES; clobbers m3-m7, nl, vt, vt2, r1, r7.
+; for operation. Aliases of LIGHT_ALIASES; clobbers m3-m7, nl, vt, vt2, r1, r7 (and, with
+; HAS_EMISSIVE_TEX, p: the emissive texel of a textured triangle light).
 .macro  LIGHT_SAMPLE
         ldg     lk, la, SM_LIGHT_KIND @m1
         ; light kinds: m4 area (quad, triangle), m5 spot, m6 directional, m7 point
@@ -915,6 +917,29 @@ fd\@:
         vfmul   vt2, vt, vt2 @m2
         vfmul   lv, vt, lv @m2
         vmov    lu, vt2 @m2
+.ifdef HAS_EMISSIVE_TEX
+        ; triangles with an emissive texture (LIGHT TEX >= 0; m3): p := the texel's colour at
+        ; the sampled point (emissive coordinates at barycentrics (1 - c1 - c2, c1, c2)), which
+        ; scales le below; 1 on the other lanes
+        vli     px, 1.0 @m1
+        vli     py, 1.0 @m1
+        vli     pz, 1.0 @m1
+        ldg     e2x, la, SM_LIGHT_TEX @m2
+        vilt    m3, e2x, vz @m2
+        mandn   m3, m2, m3
+        bmz     m3, ls_notex\@
+        ldg     e1x, la, SM_LIGHT_SRC @m3
+        vmuli   e1x, e1x, 24 @m3
+        ldb     vt, r0, SM_HDR_EMIT_UVS @m3
+        vadd    e1x, e1x, vt @m3        ; the three emissive uv pairs
+        vli     vt3, 1.0 @m3
+        vfsub   vt3, vt3, lu @m3
+        vfsub   vt3, vt3, lv @m3
+        BARY    e1y, e1x, 0, 8, vt3, lu, lv, vt, m3
+        BARY    e1z, e1x, 4, 8, vt3, lu, lv, vt, m3
+        TEXEL3  p, e2x, e1y, e1z, e1x, vt, vt2, m3, m2
+ls_notex\@:
+.endif
         ldg     lpx, la, SM_LIGHT_P @m1
         ldg     lpy, la, SM_LIGHT_P + 4 @m1
         ldg     lpz, la, SM_LIGHT_P + 8 @m1
@@ -997,6 +1022,11 @@ ls_nodir\@:
         ldg     e1y, la, SM_LIGHT_RADIANCE + 4 @m2
         ldg     e1z, la, SM_LIGHT_RADIANCE + 8 @m2
         SCALE3  e1, vt2, m2             ; le
+.ifdef HAS_EMISSIVE_TEX
+        vfmul   e1x, e1x, px @m2        ; x the emissive texel (1 for other lights)
+        vfmul   e1y, e1y, py @m2
+        vfmul   e1z, e1z, pz @m2
+.endif
         vflt    m2, vz, vt2 @m2         ; scale > 0
         ; both normals must see the light
         DOT3    vt, wi, nf, vt3, m2
@@ -1007,6 +1037,67 @@ ls_nodir\@:
         vfle    m3, vt, vz @m2
         mandn   m2, m2, m3
         DOT3    vt3, e2, wi, vt, m2     ; cosi = ns . wi
+.endm
+
+; d := w a[off] + u a[off + stride] + v a[off + 2 stride] (per lane at address a): one
+; attribute interpolated at barycentrics (w, u, v), as sim/reference.c writes it. t scratch.
+.macro  BARY d, a, off, stride, w, u, v, t, k
+        ldg     \d, \a, \off @\k
+        vfmul   \d, \w, \d @\k
+        ldg     \t, \a, \off + \stride @\k
+        vfmul   \t, \u, \t @\k
+        vfadd   \d, \d, \t @\k
+        ldg     \t, \a, \off + 2 * \stride @\k
+        vfmul   \t, \v, \t @\k
+        vfadd   \d, \d, \t @\k
+.endm
+
+; d := the texel index along one axis at coordinate t (clobbered) of a texture `size` texels
+; long: repeat wrapping (t - floor t), scaled, truncated, clamped to [0, size - 1]; texel() of
+; sim/reference.c. s and the mask mt scratch.
+.macro  TEXIDX d, t, size, s, k, mt
+        vffloor \s, \t @\k
+        vfsub   \t, \t, \s @\k        ; fractional part
+        vcvtif  \s, \size @\k
+        vfmul   \t, \t, \s @\k
+        vcvtfi  \d, \t @\k
+        vilt    \mt, \d, vz @\k          ; (integer compare with 0)
+        vli     \d, 0 @\mt
+        vilt    \mt, \d, \size @\k
+        mandn   \mt, \k, \mt
+        vaddi   \d, \size, -1 @\mt
+.endm
+
+; d := channel `shift` / 8 of the RGBA8 texel words, sRGB-decoded through the table at lut. s scratch.
+.macro  TEXCH d, texel, shift, lut, s, k
+        vshri   \s, \texel, \shift @\k
+        vandi   \s, \s, 255 @\k
+        vshli   \s, \s, 2 @\k
+        vadd    \s, \s, \lut @\k
+        ldg     \d, \s, 0 @\k
+.endm
+
+; o := the linear colour of texture `tex` (index per lane; clobbered) at (tu, tv) (clobbered):
+; the nearest texel with repeat wrapping, sRGB-decoded -- texel() and texel_channel() of
+; sim/reference.c. a, t, t2 and the mask mt scratch.
+.macro  TEXEL3 o, tex, tu, tv, a, t, t2, k, mt
+        vshli   \a, \tex, 4 @\k           ; SM_TEX_BYTES = 16
+        ldb     \t, r0, SM_HDR_TEXS @\k
+        vadd    \a, \a, \t @\k            ; texture record
+        ldg     \t, \a, SM_TEX_WIDTH @\k
+        ldg     \t2, \a, SM_TEX_HEIGHT @\k
+        TEXIDX  \o\()x, \tu, \t, \o\()z, \k, \mt  ; ix
+        TEXIDX  \o\()y, \tv, \t2, \o\()z, \k, \mt ; iy
+        vmul    \o\()y, \o\()y, \t @\k
+        vadd    \o\()y, \o\()y, \o\()x @\k
+        vshli   \o\()y, \o\()y, 2 @\k
+        ldg     \a, \a, SM_TEX_TEXELS @\k
+        vadd    \o\()y, \o\()y, \a @\k
+        ldg     \tex, \o\()y, 0 @\k         ; RGBA8 texel
+        ldb     \t, r0, SM_HDR_SRGB_LUT @\k
+        TEXCH   \o\()x, \tex, 0, \t, \a, \k
+        TEXCH   \o\()y, \tex, 8, \t, \a, \k
+        TEXCH   \o\()z, \tex, 16, \t, \a, \k
 .endm
 
 shade:
@@ -1250,14 +1341,7 @@ surf_nosphere:
         vbcast  vt2, r9 @m6
         vadd    vt, vt, vt2 @m6         ; address of the three normals
 .macro  NINTERP d, off
-        ldg     \d, vt, \off @m6
-        vfmul   \d, w0, \d @m6
-        ldg     vt2, vt, \off + 12 @m6
-        vfmul   vt2, bu, vt2 @m6
-        vfadd   \d, \d, vt2 @m6
-        ldg     vt2, vt, \off + 24 @m6
-        vfmul   vt2, bv, vt2 @m6
-        vfadd   \d, \d, vt2 @m6
+        BARY    \d, vt, \off, 12, w0, bu, bv, vt2, m6
 .endm
         NINTERP ax, 0
         NINTERP ay, 4
@@ -1306,28 +1390,12 @@ surf_nosphere:
         vbcast  vt2, r11 @m3
         vadd    fx, fx, vt2 @m3         ; the three uv pairs
 .macro  UVINTERP d, off
-        ldg     \d, fx, \off @m3
-        vfmul   \d, w0, \d @m3
-        ldg     vt2, fx, \off + 8 @m3
-        vfmul   vt2, bu, vt2 @m3
-        vfadd   \d, \d, vt2 @m3
-        ldg     vt2, fx, \off + 16 @m3
-        vfmul   vt2, bv, vt2 @m3
-        vfadd   \d, \d, vt2 @m3
+        BARY    \d, fx, \off, 8, w0, bu, bv, vt2, m3
 .endm
         UVINTERP fy, 0                  ; tu
         UVINTERP fz, 4                  ; tv
 .macro  TEXCOORD d, t, size
-        vffloor vt2, \t @m3
-        vfsub   \t, \t, vt2 @m3        ; fractional part
-        vcvtif  vt2, \size @m3
-        vfmul   \t, \t, vt2 @m3
-        vcvtfi  \d, \t @m3
-        vilt    m4, \d, vz @m3          ; (integer compare with 0)
-        vli     \d, 0 @m4
-        vilt    m4, \d, \size @m3
-        mandn   m4, m3, m4
-        vaddi   \d, \size, -1 @m4
+        TEXIDX  \d, \t, \size, vt2, m3, m4
 .endm
         ldg     gx, vt, SM_TEX_WIDTH @m3
         ldg     gy, vt, SM_TEX_HEIGHT @m3
@@ -1353,6 +1421,23 @@ surf_nosphere:
         TEXMUL  ez, 16
 surf_notex:
 .endif
+.ifdef HAS_COLORS
+        ; vertex colours (COLOR_0): base x (w0 c0 + u c1 + v c2), on triangles
+        mmov    m3, m1
+.ifdef HAS_SPHERES
+        mandn   m3, m1, m5
+.endif
+        ldg     fx, pa, SM_PRIM_SRC @m3
+        vmuli   fx, fx, 36 @m3
+        ldb     vt, r0, SM_HDR_COLORS @m3
+        vadd    fx, fx, vt @m3          ; the three colours
+        BARY    fy, fx, 0, 12, w0, bu, bv, vt2, m3
+        vfmul   ex, ex, fy @m3
+        BARY    fy, fx, 4, 12, w0, bu, bv, vt2, m3
+        vfmul   ey, ey, fy @m3
+        BARY    fy, fx, 8, 12, w0, bu, bv, vt2, m3
+        vfmul   ez, ez, fy @m3
+.endif
         rsct    ex, vid, r0, F_BASER @m1
         rsct    ey, vid, r0, F_BASEG @m1
         rsct    ez, vid, r0, F_BASEB @m1
@@ -1376,7 +1461,39 @@ surf_notex:
 .if WORKLOAD == WL_SPECULAR || WORKLOAD == WL_DIFFUSE
         mclr    m2                      ; (these utilization workloads treat emitters as surfaces)
 .endif
+.ifdef HAS_EMISSIVE_TEX
+        ; emitters with an emissive texture (MATX EMIT_TEX >= 0; m3): the texel at the hit's
+        ; emissive coordinates scales the emission (triangles: spheres have none), and they stay
+        ; in the stream to be shaded as well; only the others end their paths here
+        ldb     vt, r0, SM_HDR_MATS @m2
+        vsub    vt, mat, vt @m2
+        vshri   vt, vt, 2 @m2           ; SM_MAT_BYTES / SM_MATX_BYTES = 4
+        ldb     vt2, r0, SM_HDR_MATX @m2
+        vadd    vt, vt, vt2 @m2
+        ldg     gx, vt, SM_MATX_EMIT_TEX @m2
+        vilt    m3, gx, vz @m2
+        mandn   m3, m2, m3
+        mmov    m4, m3
+.ifdef HAS_SPHERES
+        mandn   m4, m3, m5
+.endif
+        bmz     m4, surf_noemtex
+        ldg     fx, pa, SM_PRIM_SRC @m4
+        vmuli   fx, fx, 24 @m4
+        ldb     vt, r0, SM_HDR_EMIT_UVS @m4
+        vadd    fx, fx, vt @m4          ; the three emissive uv pairs
+        BARY    fy, fx, 0, 8, w0, bu, bv, vt2, m4
+        BARY    fz, fx, 4, 8, w0, bu, bv, vt2, m4
+        TEXEL3  e, gx, fy, fz, fx, vt, vt2, m4, m6
+        vfmul   ax, ax, ex @m4
+        vfmul   ay, ay, ey @m4
+        vfmul   az, az, ez @m4
+surf_noemtex:
+        mandn   m4, m2, m3
+        pmask   m4
+.else
         pmask   m2
+.endif
         ; emission counts for camera rays and after delta bounces
         beq     r18, r0, surf_add
         rgat    vt, vid, r0, F_SPEC @m2

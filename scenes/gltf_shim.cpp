@@ -1,10 +1,13 @@
 // scenes/gltf_shim.cpp -- glTF 2.0 through tinygltf (Debian's libtinygltf 2.7), behind a C API.
 //
-// Owns: walking a glTF document (default scene, node transforms, meshes, accessors, materials,
-// base-colour and emissive textures, KHR_lights_punctual, the first camera) and validating
-// everything it reads, so a malformed file gives an error naming the file and the element instead
-// of a crash. Must not: pick scene defaults, compute bounds or needs (scenes/scene.c), build
-// acceleration structures, or print anything.
+// Owns: walking a glTF document (default scene, node transforms, meshes, accessors with their
+// sparse substitution, materials, base-colour and emissive textures with their texture
+// coordinates and KHR_texture_transform, vertex colours, KHR_lights_punctual, the first camera)
+// and validating everything it reads, so a malformed file gives an error naming the file and the
+// element instead of a crash; what it leaves out (points, lines, sampler wrap modes) becomes a
+// warning line in the Scene; external files are read only inside the glTF file's folder. Must
+// not: pick scene defaults, compute bounds or needs (scenes/scene.c), build acceleration
+// structures, or print anything.
 //
 // The only C++ in the project besides the OpenImageIO shim (ARCHITECTURE.md Sec. 2). Exceptions
 // never cross the C boundary.
@@ -19,6 +22,7 @@
 #include <tiny_gltf.h>
 
 #include <cerrno>
+#include <deque>
 #include <algorithm>
 #include <climits>
 #include <cmath>
@@ -29,6 +33,9 @@
 #include <vector>
 
 #include <sys/stat.h>
+#include <unistd.h>
+
+#include <cjson/cJSON.h>
 
 extern "C" {
 #include "gltf.h"
@@ -144,6 +151,14 @@ const char *ctype_name(int ctype)
     case TINYGLTF_COMPONENT_TYPE_FLOAT: return "FLOAT";
     default: return "unknown";
     }
+}
+
+// A number for messages, as printf's %g writes it (1e+30, 0.5, inf).
+std::string num(double x)
+{
+    char b[32];
+    std::snprintf(b, sizeof b, "%g", x);
+    return b;
 }
 
 // One line from tinygltf's multi-line error and warning text.
@@ -284,14 +299,85 @@ bool no_write(std::string *err, const std::string &, const std::vector<unsigned 
 
 // Loading from a file: external buffers and images are read by tinygltf, but through this reader,
 // which refuses what is not a regular file (tinygltf sizes a file by seeking to its end, and a
-// directory or device answers with nonsense such as 2^63 bytes).
-bool regular_file_exists(const std::string &path, void *)
+// directory or device answers with nonsense such as 2^63 bytes), and what lies outside the glTF
+// file's folder (a uri such as ../../etc/passwd) unless SFSIM_ALLOW_OUTSIDE_URIS=1 says otherwise.
+struct FsContext {
+    std::string base;     // the glTF file's folder as tinygltf joins uris to it ("" or "dir/")
+    std::string root;     // the same, absolute and normalized, ending in '/'
+    std::string real;     // the same through realpath (symbolic links resolved), ending in '/'
+    bool allow_outside = false;
+    std::string refused;  // the first uri refused, as the file wrote it
+};
+
+// path made absolute (from the working directory) with "." and ".." resolved by name alone.
+std::string lexical_path(const std::string &path)
 {
+    std::string full = path;
+    if (full.empty() || full[0] != '/') {
+        char cwd[4096];
+        if (!getcwd(cwd, sizeof cwd))
+            return std::string();
+        full = std::string(cwd) + "/" + full;
+    }
+    std::vector<std::string> parts;
+    size_t i = 0;
+    while (i <= full.size()) {
+        size_t j = full.find('/', i);
+        if (j == std::string::npos)
+            j = full.size();
+        std::string part = full.substr(i, j - i);
+        if (part == "..") {
+            if (!parts.empty())
+                parts.pop_back();
+        } else if (!part.empty() && part != ".") {
+            parts.push_back(part);
+        }
+        i = j + 1;
+    }
+    std::string out;
+    for (const auto &part : parts)
+        out += "/" + part;
+    return out.empty() ? "/" : out;
+}
+
+bool under(const std::string &path, const std::string &dir) { return path.compare(0, dir.size(), dir) == 0; }
+
+// Whether `path` stays inside the folder: by name, and, when it exists, through symbolic links.
+bool inside_folder(const FsContext &c, const std::string &path)
+{
+    if (!under(lexical_path(path), c.root))
+        return false;
+    char *r = realpath(path.c_str(), nullptr);
+    if (!r)
+        return true; // does not exist: the read reports it
+    bool in = under(std::string(r), c.real);
+    std::free(r);
+    return in;
+}
+
+bool regular_file_exists(const std::string &path, void *user)
+{
+    const FsContext *c = static_cast<const FsContext *>(user);
+    if (c && !c->allow_outside && !inside_folder(*c, path))
+        // tinygltf tries the file's folder, then the working directory. A uri that leaves the
+        // folder "exists", so the read below refuses it whether or not it does (its existence is
+        // not revealed); the working-directory fallback is simply not searched.
+        return c->base.empty() || under(path, c->base);
     struct stat st;
     return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
-bool read_regular_file(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *)
+
+bool read_regular_file(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *user)
 {
+    FsContext *c = static_cast<FsContext *>(user);
+    if (c && !c->allow_outside && !inside_folder(*c, path)) {
+        std::string uri = under(path, c->base) ? path.substr(c->base.size()) : path;
+        if (c->refused.empty())
+            c->refused = uri;
+        if (err)
+            *err += "'" + uri + "' lies outside the glTF file's folder\n";
+        return false;
+    }
     struct stat st;
     if (stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) {
         if (err)
@@ -345,10 +431,18 @@ struct EmitMap {
     }
 };
 
+// Where a texture reads its coordinates: the TEXCOORD_<set> attribute through the affine map of
+// KHR_texture_transform, u' = m0 u + m1 v + m2, v' = m3 u + m4 v + m5 (identity without one).
+struct UvMap {
+    int set = 0;
+    double m[6] = {1, 0, 0, 0, 1, 0};
+};
+
 struct MatInfo {
     int index = -1;      // SceneMaterial index (absolute) of the material as loaded
     int emit_twin = -1;  // the emitting part when an emissive texture only partly emits, else -1
-    int emit_texcoord = 0;
+    bool emit_tex = false; // an emissive texture is sampled (by the material or its twin)
+    UvMap base_uv, emit_uv;
     const EmitMap *map = nullptr;
 };
 
@@ -364,11 +458,15 @@ struct Loader {
     std::vector<int> image_to_tex; // image index -> absolute SceneTexture index, -1 not decoded
     std::vector<MatInfo> minfo;    // by glTF material index
     std::vector<EmitMap> maps;     // by local texture index (empty map: not analysed)
+    std::deque<std::vector<unsigned char>> dense; // sparse accessors, substituted (Views point here)
     int default_mat = -1;
     // Triangles go straight into the Scene's arrays, after its `old` triangles; only commit()
     // makes them count (Scene.ntris), so a failed file leaves the Scene as it was, with larger
     // arrays. Materials, textures and lights wait here until commit().
     size_t old = 0, cur = 0, cap = 0; // triangles: the Scene's, this file's so far, room for
+    uint32_t primitives = 0, skipped[4] = {0, 0, 0, 0}; // primitives met; skipped by mode (POINTS..LINE_STRIP)
+    std::vector<char> wrap_seen;  // by glTF texture: its sampler's wrap modes were looked at
+    uint32_t not_repeat = 0;      // used textures whose sampler does not repeat (not applied)
     std::vector<SceneMaterial> mats;
     std::vector<SceneTexture> texs;
     std::vector<SceneLight> lights;
@@ -399,6 +497,92 @@ struct Loader {
     SceneMaterial &mat(int absolute) { return mats[(size_t)(absolute - (int)mat_base)]; }
 };
 
+// Checks that `count` elements of elem_size bytes, stride bytes apart, lie inside bufferView bvi
+// from byte offset `offset`; sets `data` to the first. `an` names the accessor in messages,
+// `what` the part of it ("", " sparse indices", " sparse values").
+bool view_range(Loader &L, const std::string &an, const char *what, int bvi, size_t offset, size_t count,
+                size_t elem_size, size_t stride, const unsigned char *&data)
+{
+    const auto &m = L.m;
+    if (bvi < 0 || (size_t)bvi >= m.bufferViews.size())
+        return L.fail(an + ":" + what + " has no data (bufferView " + std::to_string(bvi) + ")");
+    const auto &bv = m.bufferViews[(size_t)bvi];
+    if (bv.buffer < 0 || (size_t)bv.buffer >= m.buffers.size())
+        return L.fail(an + ":" + what + " bufferView " + std::to_string(bvi) + " names missing buffer " +
+                      std::to_string(bv.buffer));
+    const auto &buf = m.buffers[(size_t)bv.buffer];
+    size_t size = buf.data.size();
+    // Every sum below is checked against overflow before it is formed.
+    std::string where_buf = " (bufferView " + std::to_string(bvi) + ": offset " + std::to_string(bv.byteOffset) +
+                            ", length " + std::to_string(bv.byteLength) + "; buffer " + std::to_string(bv.buffer) +
+                            ": " + std::to_string(size) + " bytes)";
+    if (bv.byteOffset > size || bv.byteLength > size - bv.byteOffset)
+        return L.fail(an + ":" + what + " bufferView lies outside its buffer" + where_buf);
+    if (count) {
+        if (offset > bv.byteLength || elem_size > bv.byteLength - offset ||
+            count - 1 > (bv.byteLength - offset - elem_size) / stride)
+            return L.fail(an + ":" + what + " " + std::to_string(count) + " elements at offset " +
+                          std::to_string(offset) + " run past the end of the bufferView" + where_buf);
+    }
+    data = buf.data.data() + bv.byteOffset + (count ? offset : 0);
+    return true;
+}
+
+// The sparse substitution of glTF 2.0 Sec. 3.6.2.3: a dense copy of the accessor (its bufferView's
+// elements, or zeros without one) with sparse.count elements replaced; v then reads the copy.
+bool apply_sparse(Loader &L, const tinygltf::Accessor &a, const std::string &an, size_t elem_size, View &v)
+{
+    const auto &sp = a.sparse;
+    std::string sn = an + ": sparse";
+    if (sp.count < 1 || (size_t)sp.count > a.count)
+        return L.fail(sn + " count " + std::to_string(sp.count) + " is not between 1 and the accessor's count (" +
+                      std::to_string(a.count) + ")");
+    int ics = sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE    ? 1
+              : sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? 2
+              : sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT   ? 4
+                                                                                   : 0;
+    if (!ics)
+        return L.fail(sn + " indices: component type " + ctype_name(sp.indices.componentType) +
+                      " is not UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT");
+    if (sp.indices.byteOffset < 0 || sp.values.byteOffset < 0)
+        return L.fail(sn + ": negative byteOffset");
+    size_t n = (size_t)sp.count;
+    const unsigned char *ip, *vp;
+    if (!view_range(L, an, " sparse indices", sp.indices.bufferView, (size_t)sp.indices.byteOffset, n, (size_t)ics,
+                    (size_t)ics, ip) ||
+        !view_range(L, an, " sparse values", sp.values.bufferView, (size_t)sp.values.byteOffset, n, elem_size,
+                    elem_size, vp))
+        return false;
+    if (a.count > ((size_t)1 << 31) / elem_size)
+        return L.fail(an + ": " + std::to_string(a.count) + " elements are too many for a sparse accessor");
+    L.dense.emplace_back(a.count * elem_size, (unsigned char)0);
+    std::vector<unsigned char> &d = L.dense.back();
+    if (v.base)
+        for (size_t i = 0; i < a.count; i++)
+            std::memcpy(&d[i * elem_size], v.base + i * v.stride, elem_size);
+    View iv;
+    iv.base = ip;
+    iv.stride = (size_t)ics;
+    iv.count = n;
+    iv.ctype = sp.indices.componentType;
+    iv.ncomp = 1;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t at = iv.index(i);
+        // glTF 2.0 Sec. 5.3: indices strictly increasing, each below the accessor's count.
+        if (at >= a.count)
+            return L.fail(sn + " index " + std::to_string(i) + " is " + std::to_string(at) +
+                          ", out of range (accessor count " + std::to_string(a.count) + ")");
+        if (i > 0 && at <= iv.index(i - 1))
+            return L.fail(sn + " index " + std::to_string(i) + " is " + std::to_string(at) +
+                          ", not greater than the one before (" + std::to_string(iv.index(i - 1)) +
+                          "): sparse indices must increase strictly");
+        std::memcpy(&d[(size_t)at * elem_size], vp + i * elem_size, elem_size);
+    }
+    v.base = d.data();
+    v.stride = elem_size;
+    return true;
+}
+
 bool accessor_view(Loader &L, int index, const std::string &where, View &v)
 {
     const auto &m = L.m;
@@ -406,43 +590,32 @@ bool accessor_view(Loader &L, int index, const std::string &where, View &v)
         return L.fail(where + ": accessor " + std::to_string(index) + " does not exist");
     const auto &a = m.accessors[(size_t)index];
     std::string an = where + ": " + elem("accessor", index, a.name);
-    if (a.sparse.isSparse)
-        return L.fail(an + ": sparse accessors are not supported");
     int cs = component_size(a.componentType), nc = type_components(a.type);
     if (!cs)
         return L.fail(an + ": component type " + std::to_string(a.componentType) + " is not a glTF accessor type");
     if (!nc)
         return L.fail(an + ": type " + std::to_string(a.type) + " is not SCALAR or VEC2..VEC4");
-    if (a.bufferView < 0 || (size_t)a.bufferView >= m.bufferViews.size())
-        return L.fail(an + ": has no data (bufferView " + std::to_string(a.bufferView) + ")");
-    const auto &bv = m.bufferViews[(size_t)a.bufferView];
-    if (bv.buffer < 0 || (size_t)bv.buffer >= m.buffers.size())
-        return L.fail(an + ": bufferView " + std::to_string(a.bufferView) + " names missing buffer " +
-                      std::to_string(bv.buffer));
-    const auto &buf = m.buffers[(size_t)bv.buffer];
-    size_t size = buf.data.size(), elem_size = (size_t)cs * (size_t)nc;
-    size_t stride = bv.byteStride ? bv.byteStride : elem_size;
-    if (stride < elem_size)
-        return L.fail(an + ": byteStride " + std::to_string(bv.byteStride) + " is smaller than an element (" +
-                      std::to_string(elem_size) + " bytes)");
-    // Every sum below is checked against overflow before it is formed.
-    std::string where_buf = " (bufferView " + std::to_string(a.bufferView) + ": offset " +
-                            std::to_string(bv.byteOffset) + ", length " + std::to_string(bv.byteLength) + "; buffer " +
-                            std::to_string(bv.buffer) + ": " + std::to_string(size) + " bytes)";
-    if (bv.byteOffset > size || bv.byteLength > size - bv.byteOffset)
-        return L.fail(an + ": bufferView lies outside its buffer" + where_buf);
-    if (a.count) {
-        if (a.byteOffset > bv.byteLength || elem_size > bv.byteLength - a.byteOffset ||
-            a.count - 1 > (bv.byteLength - a.byteOffset - elem_size) / stride)
-            return L.fail(an + ": " + std::to_string(a.count) + " elements at offset " + std::to_string(a.byteOffset) +
-                          " run past the end of the bufferView" + where_buf);
+    size_t elem_size = (size_t)cs * (size_t)nc, stride = elem_size;
+    v = View();
+    // A sparse accessor without a bufferView starts from zeros (glTF 2.0 Sec. 3.6.2.3).
+    if (a.bufferView >= 0 || !a.sparse.isSparse) {
+        if (a.bufferView >= 0 && (size_t)a.bufferView < m.bufferViews.size()) {
+            const auto &bv = m.bufferViews[(size_t)a.bufferView];
+            stride = bv.byteStride ? bv.byteStride : elem_size;
+            if (stride < elem_size)
+                return L.fail(an + ": byteStride " + std::to_string(bv.byteStride) +
+                              " is smaller than an element (" + std::to_string(elem_size) + " bytes)");
+        }
+        if (!view_range(L, an, "", a.bufferView, a.byteOffset, a.count, elem_size, stride, v.base))
+            return false;
+        v.stride = stride;
     }
-    v.base = buf.data.data() + bv.byteOffset + (a.count ? a.byteOffset : 0);
-    v.stride = stride;
     v.count = a.count;
     v.ctype = a.componentType;
     v.ncomp = nc;
     v.normalized = a.normalized;
+    if (a.sparse.isSparse && !apply_sparse(L, a, an, elem_size, v))
+        return false;
     return true;
 }
 
@@ -536,6 +709,16 @@ bool texture_index(Loader &L, int t, const std::string &where, int &out)
     int img = m.textures[(size_t)t].source;
     if (img < 0)
         return true; // no source image (e.g. only an extension's): no texture
+    // Textures always repeat (docs/scenes.md): a sampler that asks for clamping or mirroring is
+    // counted for a warning.
+    if (L.wrap_seen.size() != m.textures.size())
+        L.wrap_seen.assign(m.textures.size(), 0);
+    int smp = m.textures[(size_t)t].sampler;
+    if (!L.wrap_seen[(size_t)t] && smp >= 0 && (size_t)smp < m.samplers.size() &&
+        (m.samplers[(size_t)smp].wrapS != TINYGLTF_TEXTURE_WRAP_REPEAT ||
+         m.samplers[(size_t)smp].wrapT != TINYGLTF_TEXTURE_WRAP_REPEAT))
+        L.not_repeat++;
+    L.wrap_seen[(size_t)t] = 1;
     if ((size_t)img >= m.images.size())
         return L.fail(where + ": texture " + std::to_string(t) + " names missing image " + std::to_string(img));
     if (L.image_to_tex[(size_t)img] >= 0) {
@@ -638,6 +821,51 @@ bool uv_emits(const EmitMap &em, const double *uv)
     return false;
 }
 
+// The coordinates texture info `ti` samples with: texCoord, and KHR_texture_transform's offset,
+// rotation and scale (and its texCoord, which overrides the other), composed as the extension
+// says: translation x rotation x scale.
+bool uv_map(Loader &L, const tinygltf::TextureInfo &ti, const std::string &where, UvMap &out)
+{
+    out = UvMap();
+    out.set = ti.texCoord;
+    auto it = ti.extensions.find("KHR_texture_transform");
+    if (it != ti.extensions.end() && it->second.IsObject()) {
+        const tinygltf::Value &x = it->second;
+        std::string w = where + ": KHR_texture_transform";
+        double off[2] = {0, 0}, sc[2] = {1, 1}, rot = 0;
+        const char *pairs[2] = {"offset", "scale"};
+        double *dst[2] = {off, sc};
+        for (int k = 0; k < 2; k++) {
+            if (!x.Has(pairs[k]))
+                continue;
+            const tinygltf::Value &a = x.Get(pairs[k]);
+            if (!a.IsArray() || a.ArrayLen() != 2 || !a.Get(0).IsNumber() || !a.Get(1).IsNumber())
+                return L.fail(w + ": " + pairs[k] + " is not 2 numbers");
+            dst[k][0] = a.Get(0).GetNumberAsDouble();
+            dst[k][1] = a.Get(1).GetNumberAsDouble();
+        }
+        if (x.Has("rotation")) {
+            if (!x.Get("rotation").IsNumber())
+                return L.fail(w + ": rotation is not a number");
+            rot = x.Get("rotation").GetNumberAsDouble();
+        }
+        if (x.Has("texCoord")) {
+            if (!x.Get("texCoord").IsInt())
+                return L.fail(w + ": texCoord is not an integer");
+            out.set = x.Get("texCoord").GetNumberAsInt();
+        }
+        if (!std::isfinite(off[0]) || !std::isfinite(off[1]) || !std::isfinite(sc[0]) || !std::isfinite(sc[1]) ||
+            !std::isfinite(rot))
+            return L.fail(w + ": a value is not finite");
+        double c = std::cos(rot), sn = std::sin(rot);
+        double m[6] = {c * sc[0], sn * sc[1], off[0], -sn * sc[0], c * sc[1], off[1]};
+        std::memcpy(out.m, m, sizeof m);
+    }
+    if (out.set < 0)
+        return L.fail(where + ": texCoord " + std::to_string(out.set) + " is negative");
+    return true;
+}
+
 // glTF materials -> SceneMaterial (ARCHITECTURE.md Sec. 1 mapping).
 bool load_materials(Loader &L)
 {
@@ -688,12 +916,17 @@ bool load_materials(Loader &L)
         sm.alpha_cutoff = (float)gm.alphaCutoff;
         sm.double_sided = gm.doubleSided ? 1 : 0;
         int tex;
+        MatInfo &info = L.minfo[i];
         if (!texture_index(L, pbr.baseColorTexture.index, where + " baseColorTexture", tex))
+            return false;
+        if (tex >= 0 && !uv_map(L, pbr.baseColorTexture, where + " baseColorTexture", info.base_uv))
             return false;
         sm.base_texture = tex;
         sm.emissive_texture = -1;
         bool emits = sm.emission[0] > 0.0f || sm.emission[1] > 0.0f || sm.emission[2] > 0.0f;
         if (emits && !texture_index(L, gm.emissiveTexture.index, where + " emissiveTexture", tex))
+            return false;
+        if (emits && tex >= 0 && !uv_map(L, gm.emissiveTexture, where + " emissiveTexture", info.emit_uv))
             return false;
         if (emits)
             sm.emissive_texture = tex;
@@ -701,8 +934,9 @@ bool load_materials(Loader &L)
         if (!sm.name)
             return L.fail("out of memory");
         L.mats.push_back(sm);
-        MatInfo &mi = L.minfo[i];
+        MatInfo &mi = info;
         mi.index = (int)(L.mat_base + L.mats.size() - 1);
+        mi.emit_tex = emits && tex >= 0;
         if (emits && tex >= 0) {
             // An emissive texture that is black in places: the triangles that only see black texels
             // do not emit. The material splits into a non-emitting part (this one) and an emitting
@@ -715,6 +949,7 @@ bool load_materials(Loader &L)
                 for (int k = 0; k < 3; k++)
                     me.emission[k] = 0.0f;
                 me.emissive_texture = -1;
+                mi.emit_tex = false;
             } else if (!all) {
                 SceneMaterial twin = me;
                 twin.name = strdup(me.name);
@@ -725,7 +960,6 @@ bool load_materials(Loader &L)
                     return L.fail("out of memory");
                 L.mats.push_back(twin);
                 L.minfo[i].emit_twin = (int)(L.mat_base + L.mats.size() - 1);
-                L.minfo[i].emit_texcoord = gm.emissiveTexture.texCoord;
                 L.minfo[i].map = &em;
             }
         }
@@ -778,6 +1012,20 @@ void geometric_normals(const float *pos, float *nrm, size_t from, size_t to)
     }
 }
 
+// The Scene's optional per-triangle arrays (NULL until a file has the attribute): the address of
+// the pointer, floats per triangle, and the value earlier triangles get (normals: their
+// geometric normal instead).
+struct TriArray {
+    float **p;
+    size_t per;
+    float fill;
+};
+
+std::vector<TriArray> tri_arrays(Scene *s)
+{
+    return {{&s->nrm, 9, 0.0f}, {&s->uv, 6, 0.0f}, {&s->uv_emit, 6, 0.0f}, {&s->col, 9, 1.0f}};
+}
+
 // Room for `more` triangles after the ones written so far (the counting pass in load() usually
 // reserved everything at once).
 bool reserve(Loader &L, size_t more)
@@ -795,36 +1043,33 @@ bool reserve(Loader &L, size_t more)
     uint32_t *tm = pos ? (uint32_t *)std::realloc(s->tri_material, sizeof(uint32_t) * cap) : nullptr;
     if (tm)
         s->tri_material = tm;
-    float *nrm = tm && s->nrm ? (float *)std::realloc(s->nrm, sizeof(float) * 9 * cap) : nullptr;
-    if (nrm)
-        s->nrm = nrm;
-    float *uv = tm && s->uv ? (float *)std::realloc(s->uv, sizeof(float) * 6 * cap) : nullptr;
-    if (uv)
-        s->uv = uv;
-    if (!pos || !tm || (s->nrm && !nrm) || (s->uv && !uv))
+    bool ok = pos && tm;
+    for (const TriArray &a : tri_arrays(s))
+        if (ok && *a.p) {
+            float *r = (float *)std::realloc(*a.p, sizeof(float) * a.per * cap);
+            if (r)
+                *a.p = r;
+            ok = r != nullptr;
+        }
+    if (!ok)
         return L.fail("out of memory for " + std::to_string(need) + " triangles");
     L.cap = cap;
     return true;
 }
 
-// The first vertex normals of the scene: every earlier triangle gets its geometric normal.
-bool add_normals(Loader &L)
+// The first per-triangle array `a` of the scene: every earlier triangle gets a.fill (normals:
+// the geometric normal).
+bool add_array(Loader &L, const TriArray &a)
 {
-    float *n = (float *)std::malloc(sizeof(float) * 9 * (L.cap ? L.cap : 1));
-    if (!n)
-        return L.fail("out of memory for normals");
-    geometric_normals(L.s->pos, n, 0, L.old + L.cur);
-    L.s->nrm = n;
-    return true;
-}
-
-// The first texture coordinates of the scene: zero for every earlier triangle.
-bool add_uvs(Loader &L)
-{
-    float *t = (float *)std::calloc(6 * (L.cap ? L.cap : 1), sizeof(float));
+    size_t n = a.per * (L.cap ? L.cap : 1);
+    float *t = (float *)std::malloc(sizeof(float) * n);
     if (!t)
-        return L.fail("out of memory for texture coordinates");
-    L.s->uv = t;
+        return L.fail("out of memory for per-vertex data");
+    for (size_t i = 0; i < n; i++)
+        t[i] = a.fill;
+    if (a.p == &L.s->nrm)
+        geometric_normals(L.s->pos, t, 0, L.old + L.cur);
+    *a.p = t;
     return true;
 }
 
@@ -842,6 +1087,44 @@ bool check_float_or_quantized(Loader &L, const View &v, const std::string &what,
                   (allow_normalized ? " (FLOAT or normalized UNSIGNED_BYTE/SHORT)" : " (FLOAT)"));
 }
 
+// The TEXCOORD_<map.set> of primitive p through map's transform, 2 floats per vertex into out;
+// has = false (out empty) when the primitive has no such attribute.
+bool read_uvs(Loader &L, const tinygltf::Primitive &p, const std::string &where, const UvMap &map, size_t nverts,
+              std::vector<float> &out, bool &has)
+{
+    std::string attr = "TEXCOORD_" + std::to_string(map.set);
+    auto ta = p.attributes.find(attr);
+    has = ta != p.attributes.end();
+    out.clear();
+    if (!has)
+        return true;
+    View vt;
+    std::string an = where + " " + attr + ": accessor " + std::to_string(ta->second);
+    if (!accessor_view(L, ta->second, where + " " + attr, vt))
+        return false;
+    if (vt.ncomp != 2 || vt.count != nverts)
+        return L.fail(an + " must be VEC2 with " + std::to_string(nverts) + " elements (has " +
+                      std::to_string(vt.ncomp) + " components, " + std::to_string(vt.count) + " elements)");
+    if (!check_float_or_quantized(L, vt, an, true))
+        return false;
+    out.resize(2 * nverts);
+    const double *m = map.m;
+    for (size_t v = 0; v < nverts; v++) {
+        double u = vt.get(v, 0), w = vt.get(v, 1);
+        double t[2] = {m[0] * u + m[1] * w + m[2], m[3] * u + m[4] * w + m[5]};
+        for (int k = 0; k < 2; k++) {
+            if (!std::isfinite((float)t[k]))
+                return L.fail(where + " " + attr + ": vertex " + std::to_string(v) + " is not finite" +
+                              (map.m[0] == 1 && map.m[1] == 0 && map.m[2] == 0 && map.m[3] == 0 && map.m[4] == 1 &&
+                                       map.m[5] == 0
+                                   ? ""
+                                   : " after KHR_texture_transform"));
+            out[2 * v + (size_t)k] = (float)t[k];
+        }
+    }
+    return true;
+}
+
 bool load_primitive(Loader &L, const Mat4 &full, int mesh, int pi)
 {
     const auto &m = L.m;
@@ -849,14 +1132,18 @@ bool load_primitive(Loader &L, const Mat4 &full, int mesh, int pi)
     const auto &p = gm.primitives[(size_t)pi];
     std::string where = elem("mesh", mesh, gm.name) + " primitive " + std::to_string(pi);
     int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+    L.primitives++;
+    // Points and lines have no area for a ray to hit: skipped, counted, and reported (commit).
+    if (mode >= TINYGLTF_MODE_POINTS && mode <= TINYGLTF_MODE_LINE_STRIP) {
+        L.skipped[mode]++;
+        return true;
+    }
     if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN)
-        return L.fail(where + ": mode " + std::to_string(mode) + " (" + mode_name(mode) +
-                      ") is not a triangle primitive; only TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN can be "
-                      "ray traced");
+        return L.fail(where + ": mode " + std::to_string(mode) + " is not a glTF primitive mode (0 to 6)");
     auto pa = p.attributes.find("POSITION");
     if (pa == p.attributes.end())
         return L.fail(where + ": no POSITION attribute");
-    View vp, vn, vt, vi;
+    View vp, vn, vc, vi;
     if (!accessor_view(L, pa->second, where + " POSITION", vp))
         return false;
     if (vp.ncomp != 3)
@@ -875,17 +1162,21 @@ bool load_primitive(Loader &L, const Mat4 &full, int mesh, int pi)
         if (!check_float_or_quantized(L, vn, where + " NORMAL: accessor " + std::to_string(na->second), false))
             return false;
     }
-    auto ta = p.attributes.find("TEXCOORD_0");
-    bool has_t = ta != p.attributes.end();
-    if (has_t) {
-        if (!accessor_view(L, ta->second, where + " TEXCOORD_0", vt))
+    // Vertex colours: COLOR_0 multiplies the base colour (glTF 2.0 Sec. 3.7.2.1; alpha ignored).
+    auto ca = p.attributes.find("COLOR_0");
+    bool has_c = ca != p.attributes.end();
+    if (has_c) {
+        std::string an = where + " COLOR_0: accessor " + std::to_string(ca->second);
+        if (!accessor_view(L, ca->second, where + " COLOR_0", vc))
             return false;
-        if (vt.ncomp != 2 || vt.count != vp.count)
-            return L.fail(where + " TEXCOORD_0: accessor " + std::to_string(ta->second) + " must be VEC2 with " +
-                          std::to_string(vp.count) + " elements (has " + std::to_string(vt.ncomp) + " components, " +
-                          std::to_string(vt.count) + " elements)");
-        if (!check_float_or_quantized(L, vt, where + " TEXCOORD_0: accessor " + std::to_string(ta->second), true))
-            return false;
+        if ((vc.ncomp != 3 && vc.ncomp != 4) || vc.count != vp.count)
+            return L.fail(an + " must be VEC3 or VEC4 with " + std::to_string(vp.count) + " elements (has " +
+                          std::to_string(vc.ncomp) + " components, " + std::to_string(vc.count) + " elements)");
+        if (vc.ctype != TINYGLTF_COMPONENT_TYPE_FLOAT &&
+            !(vc.normalized && (vc.ctype == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                                vc.ctype == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT)))
+            return L.fail(an + ": component type " + ctype_name(vc.ctype) + (vc.normalized ? " (normalized)" : "") +
+                          " is not allowed here (FLOAT or normalized UNSIGNED_BYTE/SHORT)");
     }
     // Indices: any unsigned integer type, each below the vertex count.
     std::vector<uint32_t> idx;
@@ -935,6 +1226,7 @@ bool load_primitive(Loader &L, const Mat4 &full, int mesh, int pi)
     }
     int mat, twin = -1;
     const MatInfo *mi = nullptr;
+    static const MatInfo no_material;
     if (p.material >= 0) {
         if ((size_t)p.material >= m.materials.size())
             return L.fail(where + ": material " + std::to_string(p.material) + " does not exist");
@@ -943,22 +1235,40 @@ bool load_primitive(Loader &L, const Mat4 &full, int mesh, int pi)
         twin = mi->emit_twin;
     } else if ((mat = default_material(L)) < 0) {
         return L.fail("out of memory");
+    } else {
+        mi = &no_material;
     }
+    // Texture coordinates, per texture: the base-colour texture's set through its transform (a
+    // material without one: TEXCOORD_0 as it is), the emissive texture's likewise.
+    std::vector<float> wt, we;
+    bool has_t, has_e = false;
+    if (!read_uvs(L, p, where, mi->base_uv, vp.count, wt, has_t) ||
+        (mi->emit_tex && !read_uvs(L, p, where, mi->emit_uv, vp.count, we, has_e)))
+        return false;
     double nm[9];
     bool nm_ok = normal_matrix(full, nm);
     bool flip = det3(full) < 0.0; // a mirroring transform reverses the winding (glTF 2.0 Sec. 3.7.4)
     // Every vertex once.
-    std::vector<float> wp(3 * vp.count), wn(has_n ? 3 * vp.count : 0), wt(has_t ? 2 * vp.count : 0);
+    std::vector<float> wp(3 * vp.count), wn(has_n ? 3 * vp.count : 0), wc(has_c ? 3 * vp.count : 0);
+    std::string pw = where + " POSITION: accessor " + std::to_string(pa->second) + ": vertex ";
     for (size_t v = 0; v < vp.count; v++) {
         double in[3] = {vp.get(v, 0), vp.get(v, 1), vp.get(v, 2)}, out[3];
-        xform_point(full, in, out);
+        // What the file holds first, then where the node transforms put it: each error says which.
         for (int k = 0; k < 3; k++) {
             if (!std::isfinite(in[k]))
-                return L.fail(where + " POSITION: vertex " + std::to_string(v) + " coordinate " + std::to_string(k) +
-                              " is not finite (" + std::to_string(in[k]) + ")");
-            if (!std::isfinite(out[k]) || std::fabs(out[k]) > 1e30)
-                return L.fail(where + " POSITION: vertex " + std::to_string(v) +
-                              " is not finite after the node transforms");
+                return L.fail(pw + std::to_string(v) + " coordinate " + std::to_string(k) + " is not finite (" +
+                              std::to_string(in[k]) + ")");
+            if (std::fabs(in[k]) > SCENE_COORD_LIMIT)
+                return L.fail(pw + std::to_string(v) + " coordinate " + std::to_string(k) + " is " + num(in[k]) +
+                              ", beyond the limit of " + num(SCENE_COORD_LIMIT) +
+                              " on scene coordinates (docs/scenes.md, Limits)");
+        }
+        xform_point(full, in, out);
+        for (int k = 0; k < 3; k++) {
+            if (!std::isfinite(out[k]) || std::fabs(out[k]) > SCENE_COORD_LIMIT)
+                return L.fail(pw + std::to_string(v) + " is (" + num(out[0]) + ", " + num(out[1]) + ", " + num(out[2]) +
+                              ") after the node transforms, beyond the limit of " + num(SCENE_COORD_LIMIT) +
+                              " on scene coordinates (docs/scenes.md, Limits)");
             wp[3 * v + (size_t)k] = (float)out[k];
         }
         if (has_n) {
@@ -971,21 +1281,28 @@ bool load_primitive(Loader &L, const Mat4 &full, int mesh, int pi)
             for (int k = 0; k < 3; k++)
                 wn[3 * v + (size_t)k] = (float)o[k];
         }
-        if (has_t)
-            for (int k = 0; k < 2; k++) {
-                double t = vt.get(v, k);
-                if (!std::isfinite(t) || std::fabs(t) > 1e30)
-                    return L.fail(where + " TEXCOORD_0: vertex " + std::to_string(v) + " is not finite");
-                wt[2 * v + (size_t)k] = (float)t;
+        if (has_c)
+            for (int k = 0; k < 3; k++) {
+                double c = vc.get(v, k);
+                if (!std::isfinite(c) || c < 0.0)
+                    return L.fail(where + " COLOR_0: vertex " + std::to_string(v) + " component " + std::to_string(k) +
+                                  " is negative or not finite (" + std::to_string(c) + ")");
+                wc[3 * v + (size_t)k] = (float)c;
             }
     }
     size_t nt = tri.size() / 3;
-    if (!reserve(L, nt) || (has_n && !L.s->nrm && !add_normals(L)) || (has_t && !L.s->uv && !add_uvs(L)))
+    Scene *S = L.s;
+    if (!reserve(L, nt) || (has_n && !S->nrm && !add_array(L, tri_arrays(S)[0])) ||
+        (has_t && !S->uv && !add_array(L, tri_arrays(S)[1])) ||
+        (mi->emit_tex && !S->uv_emit && !add_array(L, tri_arrays(S)[2])) ||
+        (has_c && !S->col && !add_array(L, tri_arrays(S)[3])))
         return false;
-    float *P = L.s->pos + 9 * (L.old + L.cur), *N = L.s->nrm ? L.s->nrm + 9 * (L.old + L.cur) : nullptr;
-    float *T = L.s->uv ? L.s->uv + 6 * (L.old + L.cur) : nullptr;
-    uint32_t *M = L.s->tri_material + L.old + L.cur;
-    bool twin_uv = twin >= 0 && has_t && mi->emit_texcoord == 0;
+    size_t at = L.old + L.cur;
+    float *P = S->pos + 9 * at, *N = S->nrm ? S->nrm + 9 * at : nullptr;
+    float *T = S->uv ? S->uv + 6 * at : nullptr, *E = S->uv_emit ? S->uv_emit + 6 * at : nullptr;
+    float *C = S->col ? S->col + 9 * at : nullptr;
+    uint32_t *M = S->tri_material + at;
+    bool twin_uv = twin >= 0 && has_e;
     for (size_t t = 0; t < nt; t++) {
         uint32_t c3[3] = {tri[3 * t], tri[3 * t + 1], tri[3 * t + 2]};
         if (flip)
@@ -1017,10 +1334,15 @@ bool load_primitive(Loader &L, const Mat4 &full, int mesh, int pi)
                     *N++ = usable ? vn3[k] : (float)gn[k];
             for (int k = 0; k < 2; k++) {
                 float u = has_t ? wt[2 * (size_t)c3[c] + (size_t)k] : 0.0f;
+                float e = has_e ? we[2 * (size_t)c3[c] + (size_t)k] : 0.0f;
                 if (T)
                     *T++ = u;
-                tuv[2 * c + k] = u;
+                if (E)
+                    *E++ = e;
+                tuv[2 * c + k] = e;
             }
+            for (int k = 0; C && k < 3; k++)
+                *C++ = has_c ? wc[3 * (size_t)c3[c] + (size_t)k] : 1.0f;
         }
         uint32_t tm = (uint32_t)mat;
         if (twin >= 0 && (!twin_uv || uv_emits(*mi->map, tuv)))
@@ -1195,10 +1517,43 @@ bool visit(Loader &L, int node, const Mat4 &parent, int depth)
     return true;
 }
 
-// Required extensions this loader honours. Everything else that a file requires is an error;
-// extensions that are only used are ignored (docs/scenes.md lists them).
+// Required extensions this loader honours, the one list: everything else that a file requires is
+// refused by name; extensions that are only used are ignored (docs/scenes.md lists them).
 const char *const supported_required[] = {"KHR_materials_emissive_strength", "KHR_materials_transmission",
                                           "KHR_materials_ior", "KHR_lights_punctual", "KHR_mesh_quantization"};
+
+bool supported_extension(const std::string &ext)
+{
+    for (const char *k : supported_required)
+        if (ext == k)
+            return true;
+    return false;
+}
+
+void refuse_extension(const char *name, const std::string &ext, char *err, size_t errlen)
+{
+    std::snprintf(err, errlen, "%s: requires extension %s, which sfsim does not support", name, ext.c_str());
+}
+
+// extensionsRequired, read from the JSON before tinygltf parses the rest: tinygltf fails on what
+// such an extension changes (a Draco-compressed accessor has no bufferView) before the model it
+// would hand back says which extension that was. Broken JSON is left to tinygltf to report.
+bool check_required_first(const unsigned char *json, size_t len, const char *name, char *err, size_t errlen)
+{
+    cJSON *doc = cJSON_ParseWithLength((const char *)json, len);
+    const cJSON *req = cJSON_GetObjectItemCaseSensitive(doc, "extensionsRequired");
+    if (!cJSON_IsArray(req))
+        req = nullptr;
+    const cJSON *e = nullptr;
+    bool ok = true;
+    cJSON_ArrayForEach(e, req)
+        if (ok && cJSON_IsString(e) && !supported_extension(e->valuestring)) {
+            refuse_extension(name, e->valuestring, err, errlen);
+            ok = false;
+        }
+    cJSON_Delete(doc);
+    return ok;
+}
 
 template <class T> bool append(T *&arr, uint32_t n, const std::vector<T> &more)
 {
@@ -1218,6 +1573,20 @@ bool commit(Loader &L)
     Scene *s = L.s;
     if (!append(s->materials, s->nmaterials, L.mats) || !append(s->textures, s->ntextures, L.texs) ||
         !append(s->lights, s->nlights, L.lights))
+        return L.fail("out of memory");
+    uint32_t skipped = L.skipped[0] + L.skipped[1] + L.skipped[2] + L.skipped[3];
+    if (skipped) {
+        std::string by;
+        for (int k = 0; k < 4; k++)
+            if (L.skipped[k])
+                by += std::string(by.empty() ? "" : ", ") + std::to_string(L.skipped[k]) + " " + mode_name(k);
+        if (scene_warn(s, "%s: skipped %u of %u primitives: not triangles (%s); only triangles are ray traced",
+                       L.file.c_str(), skipped, L.primitives, by.c_str()) != 0)
+            return L.fail("out of memory");
+        s->skipped_primitives += skipped;
+    }
+    if (L.not_repeat && scene_warn(s, "%s: %u textures ask for CLAMP_TO_EDGE or MIRRORED_REPEAT wrapping, which is not "
+                                      "applied: every texture repeats", L.file.c_str(), L.not_repeat) != 0)
         return L.fail("out of memory");
     s->ntris = (uint32_t)(L.old + L.cur);
     s->nmaterials += (uint32_t)L.mats.size();
@@ -1257,8 +1626,10 @@ size_t count_triangles(const Loader &L, const std::vector<int> &roots)
             size_t cnt = a.count, tris;
             if (p.mode == TINYGLTF_MODE_TRIANGLES || p.mode < 0)
                 tris = cnt / 3;
-            else // strips and fans; other modes fail later
+            else if (p.mode == TINYGLTF_MODE_TRIANGLE_STRIP || p.mode == TINYGLTF_MODE_TRIANGLE_FAN)
                 tris = cnt >= 2 ? cnt - 2 : 0;
+            else // points and lines are skipped; other modes fail later
+                continue;
             // An accessor cannot hold more elements than its buffer has bytes.
             if (a.bufferView < 0 || (size_t)a.bufferView >= m.bufferViews.size())
                 continue;
@@ -1284,15 +1655,11 @@ int load(bool ok, const std::string &gerr, const std::string &warn, const tinygl
         std::snprintf(err, errlen, "%s: %s", name, e.c_str());
         return -1;
     }
-    for (const auto &ext : model.extensionsRequired) {
-        bool known = false;
-        for (const char *k : supported_required)
-            known |= ext == k;
-        if (!known) {
-            std::snprintf(err, errlen, "%s: required extension %s is not supported", name, ext.c_str());
+    for (const auto &ext : model.extensionsRequired)
+        if (!supported_extension(ext)) {
+            refuse_extension(name, ext, err, errlen);
             return -1;
         }
-    }
     Loader L(model, name, s);
     if (xf)
         std::memcpy(L.pre.m, xf, sizeof L.pre.m);
@@ -1417,6 +1784,8 @@ int load_memory(const unsigned char *data, size_t len, const char *name, const s
         std::snprintf(err, errlen, "%s: JSON nested deeper than %d levels", name, MAX_JSON_DEPTH);
         return -1;
     }
+    if (!check_required_first(json, json_len, name, err, errlen))
+        return -1;
     tinygltf::Model model;
     tinygltf::TinyGLTF loader;
     Stash stash;
@@ -1448,14 +1817,32 @@ extern "C" int gltf_append(const char *path, const double *xf, Scene *s, char *e
         }
         std::vector<unsigned char> data;
         std::string rerr;
-        if (!read_regular_file(&data, &rerr, path, nullptr)) {
+        if (!read_regular_file(&data, &rerr, path, nullptr)) { // (the file named by the user: no folder check)
             std::snprintf(err, errlen, "%s: %s", path, one_line(rerr).c_str());
             return -1;
         }
         const char *slash = std::strrchr(path, '/');
         std::string base_dir = slash ? std::string(path, (size_t)(slash - path) + 1) : std::string();
-        tinygltf::FsCallbacks fs = {regular_file_exists, same_path, read_regular_file, no_write, nullptr};
-        return load_memory(data.data(), data.size(), path, base_dir, fs, xf, s, err, errlen);
+        FsContext ctx;
+        ctx.base = base_dir;
+        ctx.root = lexical_path(base_dir.empty() ? "." : base_dir);
+        char *real = realpath(base_dir.empty() ? "." : base_dir.c_str(), nullptr);
+        ctx.real = real ? real : ctx.root;
+        std::free(real);
+        if (ctx.root.empty() || ctx.root.back() != '/')
+            ctx.root += "/";
+        if (ctx.real.back() != '/')
+            ctx.real += "/";
+        const char *allow = std::getenv("SFSIM_ALLOW_OUTSIDE_URIS");
+        ctx.allow_outside = allow && std::strcmp(allow, "1") == 0;
+        tinygltf::FsCallbacks fs = {regular_file_exists, same_path, read_regular_file, no_write, &ctx};
+        int rc = load_memory(data.data(), data.size(), path, base_dir, fs, xf, s, err, errlen);
+        if (rc != 0 && !ctx.refused.empty())
+            std::snprintf(err, errlen,
+                          "%s: uri '%s' leads outside the folder of the glTF file, which sfsim does not read (set "
+                          "SFSIM_ALLOW_OUTSIDE_URIS=1 to allow it)",
+                          path, ctx.refused.c_str());
+        return rc;
     } catch (const std::exception &e) {
         std::snprintf(err, errlen, "%s: %s", path, e.what());
         return -1;

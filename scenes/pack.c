@@ -108,6 +108,14 @@ static float tri_area(const float *p)
     return 0.5f * sqrtf(cx * cx + cy * cy + cz * cz);
 }
 
+/* The emissive texture a reader samples for material m: its own when it emits, else none. */
+static int32_t emissive_texture(const Scene *s, const SceneMaterial *m)
+{
+    int emits = m->emission[0] + m->emission[1] + m->emission[2] > 0.0f;
+    return emits && m->emissive_texture >= 0 && (uint32_t)m->emissive_texture < s->ntextures ? m->emissive_texture
+                                                                                              : -1;
+}
+
 int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *out, char *err,
                size_t errlen)
 {
@@ -162,6 +170,12 @@ int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *
     uint32_t lights = w_alloc(&w, (size_t)SM_LIGHT_WORDS * nlights);
     uint32_t normals = s->nrm ? w_alloc(&w, (size_t)9 * s->ntris) : 0;
     uint32_t uvs = s->uv ? w_alloc(&w, (size_t)6 * s->ntris) : 0;
+    /* emissive textures and vertex colours only when the scene needs them, so a reader sees one
+     * answer in the header and the needs */
+    int emit_tex = (s->needs & SCENE_NEED_EMISSIVE_TEXTURES) && s->uv_emit;
+    uint32_t emit_uvs = emit_tex ? w_alloc(&w, (size_t)6 * s->ntris) : 0;
+    uint32_t matx = emit_tex ? w_alloc(&w, (size_t)SM_MATX_WORDS * s->nmaterials) : 0;
+    uint32_t colors = (s->needs & SCENE_NEED_VERTEX_COLORS) && s->col ? w_alloc(&w, (size_t)9 * s->ntris) : 0;
     uint32_t lut = w_alloc(&w, 256);
     uint32_t *texels = calloc(s->ntextures ? s->ntextures : 1, sizeof(uint32_t));
     for (uint32_t t = 0; texels && t < s->ntextures; t++)
@@ -189,6 +203,9 @@ int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *
     put_u32(&w, hdr(h, SM_HDR_NORMALS), normals);
     put_u32(&w, hdr(h, SM_HDR_UVS), uvs);
     put_u32(&w, hdr(h, SM_HDR_SRGB_LUT), lut);
+    put_u32(&w, hdr(h, SM_HDR_EMIT_UVS), emit_uvs);
+    put_u32(&w, hdr(h, SM_HDR_COLORS), colors);
+    put_u32(&w, hdr(h, SM_HDR_MATX), matx);
     put_u32(&w, hdr(h, SM_HDR_WIDTH), (uint32_t)s->render.width);
     put_u32(&w, hdr(h, SM_HDR_HEIGHT), (uint32_t)s->render.height);
     put_u32(&w, hdr(h, SM_HDR_SPP), (uint32_t)s->render.spp);
@@ -250,6 +267,8 @@ int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *
         put_f32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_ALPHA), m->alpha);
         put_f32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_TRANSMISSION), m->transmission);
         put_u32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_DOUBLE_SIDED), m->double_sided ? 1u : 0u);
+        if (matx)
+            put_u32(&w, sm_rec(matx, SM_MATX_WORDS, i, SM_MATX_EMIT_TEX), (uint32_t)emissive_texture(s, m));
     }
     for (uint32_t t = 0; t < s->ntextures; t++) {
         const SceneTexture *tx = &s->textures[t];
@@ -275,6 +294,7 @@ int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *
                       : l->kind == SCENE_LIGHT_DIRECTIONAL ? SM_LIGHT_DIRECTIONAL : SM_LIGHT_QUAD;
         put_u32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_KIND), kind);
         put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_RADIANCE), rad, 3);
+        put_u32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_TEX), (uint32_t)-1);
         if (kind == SM_LIGHT_DIRECTIONAL) {
             put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_P), l->direction, 3);
         } else {
@@ -307,6 +327,9 @@ int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *
         put_f32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_AREA), tri_area(p));
         put_u32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_TWO_SIDED),
                 s->materials[s->tri_material[t]].double_sided ? 1u : 0u);
+        put_u32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_TEX),
+                emit_tex ? (uint32_t)emissive_texture(s, &s->materials[s->tri_material[t]]) : (uint32_t)-1);
+        put_u32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_SRC), t);
     }
     if (normals)
         for (uint32_t i = 0; i < 9 * s->ntris; i++)
@@ -314,6 +337,12 @@ int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *
     if (uvs)
         for (uint32_t i = 0; i < 6 * s->ntris; i++)
             put_f32(&w, uvs + 4 * i, s->uv[i]);
+    if (emit_uvs)
+        for (uint32_t i = 0; i < 6 * s->ntris; i++)
+            put_f32(&w, emit_uvs + 4 * i, s->uv_emit[i]);
+    if (colors)
+        for (uint32_t i = 0; i < 9 * s->ntris; i++)
+            put_f32(&w, colors + 4 * i, s->col[i]);
     for (int c = 0; c < 256; c++)
         put_f32(&w, lut + 4u * (uint32_t)c, srgb_decode8(c));
 

@@ -7,6 +7,7 @@
 #include "scene.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -36,7 +37,11 @@ static int ends_with(const char *s, const char *suf)
 int scene_finish(Scene *s, char *err, size_t errlen)
 {
     if (s->ntris == 0 && s->nspheres == 0) {
-        snprintf(err, errlen, "%s: the scene has no geometry", s->source);
+        if (s->skipped_primitives)
+            snprintf(err, errlen, "%s: the scene has no geometry (its %u glTF primitives that are not triangles were "
+                     "skipped)", s->source, s->skipped_primitives);
+        else
+            snprintf(err, errlen, "%s: the scene has no geometry", s->source);
         return -1;
     }
     for (int k = 0; k < 3; k++) {
@@ -116,8 +121,13 @@ int scene_finish(Scene *s, char *err, size_t errlen)
         if (!used[i])
             continue;
         const SceneMaterial *m = &s->materials[i];
-        if (m->emission[0] + m->emission[1] + m->emission[2] > 0.0f)
-            continue; /* a light: shaded by the hit-light filter, not a material shader */
+        if (m->emission[0] + m->emission[1] + m->emission[2] > 0.0f) {
+            /* a light: shaded by the hit-light filter, not a material shader -- unless its
+             * emissive texture makes it partly dark, when it is also shaded (docs/scenes.md) */
+            if (m->emissive_texture < 0 || !s->uv_emit)
+                continue;
+            needs |= SCENE_NEED_EMISSIVE_TEXTURES;
+        }
         needs |= m->kind == SCENE_MAT_LAMBERT ? SCENE_NEED_LAMBERT
                : m->kind == SCENE_MAT_GLOSSY ? SCENE_NEED_GLOSSY : SCENE_NEED_DIELECTRIC;
         if (m->base_texture >= 0 && s->uv)
@@ -126,6 +136,8 @@ int scene_finish(Scene *s, char *err, size_t errlen)
             needs |= SCENE_NEED_ALPHA;
     }
     free(used);
+    if (s->col && s->ntris)
+        needs |= SCENE_NEED_VERTEX_COLORS;
     if (s->nspheres)
         needs |= SCENE_NEED_SPHERES;
     if (s->nemissive)
@@ -174,6 +186,8 @@ void scene_free(Scene *s)
     free(s->pos);
     free(s->nrm);
     free(s->uv);
+    free(s->uv_emit);
+    free(s->col);
     free(s->tri_material);
     free(s->materials);
     free(s->textures);
@@ -181,7 +195,26 @@ void scene_free(Scene *s)
     free(s->emissive_tris);
     free(s->spheres);
     free(s->source);
+    for (uint32_t i = 0; i < s->nwarnings; i++)
+        free(s->warnings[i]);
+    free(s->warnings);
     memset(s, 0, sizeof *s);
+}
+
+int scene_warn(Scene *s, const char *fmt, ...)
+{
+    char **w = realloc(s->warnings, sizeof *w * ((size_t)s->nwarnings + 1));
+    if (!w)
+        return -1;
+    s->warnings = w;
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vasprintf(&w[s->nwarnings], fmt, ap);
+    va_end(ap);
+    if (n < 0)
+        return -1;
+    s->nwarnings++;
+    return 0;
 }
 
 void scene_needs_string(uint32_t needs, char *buf, size_t len)

@@ -98,21 +98,29 @@ enum {
     SCENE_NEED_PUNCTUAL    = 1u << 6,  /* point, spot or directional lights */
     SCENE_NEED_ALPHA       = 1u << 7,  /* alpha mask or blend materials in use */
     SCENE_NEED_BACKGROUND  = 1u << 8,  /* non-zero background radiance */
-    SCENE_NEED_AMBIENT     = 1u << 9   /* constant ambient term */
+    SCENE_NEED_AMBIENT     = 1u << 9,  /* constant ambient term */
+    SCENE_NEED_EMISSIVE_TEXTURES = 1u << 10, /* an emitting material with an emissive texture */
+    SCENE_NEED_VERTEX_COLORS = 1u << 11     /* COLOR_0 on some triangles */
 };
 #define SCENE_NEED_LIST(X) \
     X(SCENE_NEED_LAMBERT, "lambert") X(SCENE_NEED_GLOSSY, "glossy") \
     X(SCENE_NEED_DIELECTRIC, "dielectric") X(SCENE_NEED_TEXTURES, "textures") \
     X(SCENE_NEED_SPHERES, "spheres") X(SCENE_NEED_AREA_LIGHTS, "area_lights") \
     X(SCENE_NEED_PUNCTUAL, "punctual_lights") X(SCENE_NEED_ALPHA, "alpha") \
-    X(SCENE_NEED_BACKGROUND, "background") X(SCENE_NEED_AMBIENT, "ambient")
+    X(SCENE_NEED_BACKGROUND, "background") X(SCENE_NEED_AMBIENT, "ambient") \
+    X(SCENE_NEED_EMISSIVE_TEXTURES, "emissive_textures") X(SCENE_NEED_VERTEX_COLORS, "vertex_colors")
 
 typedef struct Scene {
     /* Triangles, flattened to world space. */
     uint32_t ntris;
     float *pos;               /* ntris * 9: v0 v1 v2 */
     float *nrm;               /* ntris * 9 shading normals, or NULL when the file has none */
-    float *uv;                /* ntris * 6 texture coordinates, or NULL */
+    float *uv;                /* ntris * 6 texture coordinates of the base-colour texture (its
+                                 TEXCOORD set through its KHR_texture_transform), or NULL */
+    float *uv_emit;           /* ntris * 6 texture coordinates of the emissive texture, the same
+                                 way; NULL when no material samples one */
+    float *col;               /* ntris * 9 vertex colours (COLOR_0 rgb, linear; 1 where a file has
+                                 none), or NULL */
     uint32_t *tri_material;   /* ntris material indices */
 
     SceneMaterial *materials; uint32_t nmaterials;
@@ -126,7 +134,18 @@ typedef struct Scene {
     float bounds_min[3], bounds_max[3];  /* of triangles and spheres */
     uint32_t needs;           /* SCENE_NEED_* */
     char *source;             /* the file the scene was loaded from */
+    /* What the loaders left out: glTF primitives that are not triangles (POINTS, LINES,
+     * LINE_LOOP, LINE_STRIP), skipped; and one line per thing left out or approximated, each
+     * naming the file and the feature, for the caller to print (library code prints nothing). */
+    uint32_t skipped_primitives;
+    char **warnings;          uint32_t nwarnings;
 } Scene;
+
+/* The largest magnitude of a triangle vertex coordinate in the world (after all transforms). The
+ * renderers multiply coordinates pairwise in binary32 (edge functions, cross products, box areas),
+ * which stay finite up to about 1e18 (1e36 < FLT_MAX; docs/numerics.md); beyond, hits would be
+ * lost to inf and NaN without a word, so the loader refuses such vertices (docs/scenes.md). */
+#define SCENE_COORD_LIMIT 1e18
 
 /* Load a scene: a .gltf/.glb file, or a scene.ini that names one. Fills every field (defaults,
  * camera framing the bounds when none is given, needs). 0, or -1 with a message naming the file
@@ -139,6 +158,9 @@ void scene_free(Scene *s);
  * default camera, needs; an error for a scene without geometry). */
 void scene_init(Scene *s, const char *source);
 int scene_finish(Scene *s, char *err, size_t errlen);
+
+/* For loaders: adds a warning line (printf format). 0, or -1 when out of memory. */
+int scene_warn(Scene *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 /* Writes the needs as a comma-separated list ("lambert,area_lights"). */
 void scene_needs_string(uint32_t needs, char *buf, size_t len);

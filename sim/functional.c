@@ -675,6 +675,12 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
         add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_NORMALS", 1);
     if ((fp->needs & SCENE_NEED_TEXTURES) && sm_u32(p, sm_hdr(p, SM_HDR_UVS)))
         add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_TEXTURES", 1);
+    /* pack_scene writes these arrays only for scenes that need them; the golden model reads
+     * the same header words */
+    if (sm_u32(p, sm_hdr(p, SM_HDR_MATX)))
+        add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_EMISSIVE_TEX", 1);
+    if (sm_u32(p, sm_hdr(p, SM_HDR_COLORS)))
+        add_define(defs, &nd, st->defines, sizeof st->defines, "HAS_COLORS", 1);
     uint32_t nlights = sm_u32(p, sm_hdr(p, SM_HDR_NLIGHTS)), lights = sm_u32(p, sm_hdr(p, SM_HDR_LIGHTS));
     int punctual = 0;
     for (uint32_t l = 0; l < nlights; l++)

@@ -139,6 +139,7 @@ typedef struct Ctx {
     float *rgb;               /* image accumulator (sum over passes) */
     uint32_t width, height, spp, max_depth, nlights;
     uint32_t mats, prims, lights, texs, normals, uvs, lut;
+    uint32_t emit_uvs, colors, matx;  /* 0 when the scene needs no emissive textures / colours */
     float background[3], ambient[3];
     int ambient_mode;
     float scene_scale;
@@ -199,10 +200,44 @@ typedef struct Surface {
     float ns[3];        /* shading normal, on nf's side */
     float base[3];
     uint32_t mat, kind;
+    uint32_t src, is_sphere;  /* source triangle (or sphere) index; 1 for a sphere */
 } Surface;
 
 static uint32_t mat_u32(const Ctx *c, uint32_t m, int f) { return sm_u32(c->p, sm_rec(c->mats, SM_MAT_WORDS, m, f)); }
 static float mat_f32(const Ctx *c, uint32_t m, int f) { return sm_f32(c->p, sm_rec(c->mats, SM_MAT_WORDS, m, f)); }
+
+/* (tu, tv) := the texture coordinates at barycentrics (w0, u, v) of the 3 pairs at address a. */
+static void interp2(const Ctx *c, uint32_t a, float w0, float u, float v, float *tu, float *tv)
+{
+    const PackedScene *p = c->p;
+    *tu = w0 * sm_f32(p, a) + u * sm_f32(p, a + 8) + v * sm_f32(p, a + 16);
+    *tv = w0 * sm_f32(p, a + 4) + u * sm_f32(p, a + 12) + v * sm_f32(p, a + 20);
+}
+
+/* The texel word of texture tex at (tu, tv): nearest texel, repeat wrapping (docs/golden-model.md). */
+static uint32_t texel(const Ctx *c, uint32_t tex, float tu, float tv)
+{
+    const PackedScene *p = c->p;
+    uint32_t ta = sm_rec(c->texs, SM_TEX_WORDS, tex, 0);
+    uint32_t w = sm_u32(p, ta + 4 * SM_TEX_WIDTH), h = sm_u32(p, ta + 4 * SM_TEX_HEIGHT);
+    float fu = tu - floorf(tu), fv = tv - floorf(tv);
+    int32_t ix = (int32_t)(fu * (float)w), iy = (int32_t)(fv * (float)h);
+    ix = ix < 0 ? 0 : (ix >= (int32_t)w ? (int32_t)w - 1 : ix);
+    iy = iy < 0 ? 0 : (iy >= (int32_t)h ? (int32_t)h - 1 : iy);
+    return sm_u32(p, sm_u32(p, ta + 4 * SM_TEX_TEXELS) + 4u * ((uint32_t)iy * w + (uint32_t)ix));
+}
+
+/* Channel k (0 red .. 2 blue) of a texel word, sRGB-decoded through the header's table. */
+static float texel_channel(const Ctx *c, uint32_t t, int k)
+{
+    return sm_f32(c->p, c->lut + 4u * ((t >> (8 * k)) & 255u));
+}
+
+/* A material's emissive texture (MATX), -1 none or when the scene needs no emissive textures. */
+static int32_t emit_texture(const Ctx *c, uint32_t mat)
+{
+    return c->matx ? (int32_t)sm_u32(c->p, sm_rec(c->matx, SM_MATX_WORDS, mat, SM_MATX_EMIT_TEX)) : -1;
+}
 
 static void surface(const Ctx *c, const Ray *r, Surface *s)
 {
@@ -252,20 +287,23 @@ static void surface(const Ctx *c, const Ray *r, Surface *s)
         s->base[k] = mat_f32(c, s->mat, SM_MAT_BASE + k);
     int32_t tex = (int32_t)mat_u32(c, s->mat, SM_MAT_TEX);
     if (tex >= 0 && !is_sphere && c->uvs) {
-        /* Nearest texel, repeat wrapping (docs/golden-model.md). */
-        uint32_t ua = c->uvs + 24u * src;
-        float tu = w0 * sm_f32(p, ua) + r->hit.u * sm_f32(p, ua + 8) + r->hit.v * sm_f32(p, ua + 16);
-        float tv = w0 * sm_f32(p, ua + 4) + r->hit.u * sm_f32(p, ua + 12) + r->hit.v * sm_f32(p, ua + 20);
-        uint32_t ta = sm_rec(c->texs, SM_TEX_WORDS, (uint32_t)tex, 0);
-        uint32_t w = sm_u32(p, ta + 4 * SM_TEX_WIDTH), h = sm_u32(p, ta + 4 * SM_TEX_HEIGHT);
-        float fu = tu - floorf(tu), fv = tv - floorf(tv);
-        int32_t ix = (int32_t)(fu * (float)w), iy = (int32_t)(fv * (float)h);
-        ix = ix < 0 ? 0 : (ix >= (int32_t)w ? (int32_t)w - 1 : ix);
-        iy = iy < 0 ? 0 : (iy >= (int32_t)h ? (int32_t)h - 1 : iy);
-        uint32_t texel = sm_u32(p, sm_u32(p, ta + 4 * SM_TEX_TEXELS) + 4u * ((uint32_t)iy * w + (uint32_t)ix));
+        float tu, tv;
+        interp2(c, c->uvs + 24u * src, w0, r->hit.u, r->hit.v, &tu, &tv);
+        uint32_t t = texel(c, (uint32_t)tex, tu, tv);
         for (int k = 0; k < 3; k++)
-            s->base[k] = s->base[k] * sm_f32(p, c->lut + 4u * ((texel >> (8 * k)) & 255u));
+            s->base[k] = s->base[k] * texel_channel(c, t, k);
     }
+    if (c->colors && !is_sphere) {
+        /* COLOR_0 multiplies the base colour (docs/golden-model.md). */
+        uint32_t ca = c->colors + 36u * src;
+        for (int k = 0; k < 3; k++) {
+            float col = w0 * sm_f32(p, ca + 4u * (uint32_t)k) + r->hit.u * sm_f32(p, ca + 12u + 4u * (uint32_t)k) +
+                        r->hit.v * sm_f32(p, ca + 24u + 4u * (uint32_t)k);
+            s->base[k] = s->base[k] * col;
+        }
+    }
+    s->src = src;
+    s->is_sphere = is_sphere;
 }
 
 /* Coupled glossy model: a Lambertian lobe kd = base (1 - metallic) and a normalized Phong lobe
@@ -326,6 +364,8 @@ static int sample_light(const Ctx *c, uint32_t l, const float *o, float u, float
     uint32_t la = sm_rec(c->lights, SM_LIGHT_WORDS, l, 0);
     uint32_t kind = sm_u32(p, la + 4 * SM_LIGHT_KIND);
     float P[3], E1[3], E2[3], rad[3];
+    int textured = 0;
+    uint32_t tx = 0;
     for (int k = 0; k < 3; k++) {
         P[k] = sm_f32(p, la + 4u * (uint32_t)(SM_LIGHT_P + k));
         E1[k] = sm_f32(p, la + 4u * (uint32_t)(SM_LIGHT_E1 + k));
@@ -352,6 +392,15 @@ static int sample_light(const Ctx *c, uint32_t l, const float *o, float u, float
         float b1 = su * (1.0f - v), b2 = su * v;
         for (int k = 0; k < 3; k++)
             lp[k] = P[k] + b1 * E1[k] + b2 * E2[k];
+        int32_t tex = c->matx ? (int32_t)sm_u32(p, la + 4 * SM_LIGHT_TEX) : -1;
+        if (tex >= 0) {
+            /* An emissive texture: the texel at the sampled point (its emissive coordinates at
+             * barycentrics (1 - b1 - b2, b1, b2)) scales the radiance. */
+            float tu, tv;
+            interp2(c, c->emit_uvs + 24u * sm_u32(p, la + 4 * SM_LIGHT_SRC), 1.0f - b1 - b2, b1, b2, &tu, &tv);
+            textured = 1;
+            tx = texel(c, (uint32_t)tex, tu, tv);
+        }
     } else {
         memcpy(lp, P, sizeof lp);
     }
@@ -388,6 +437,9 @@ static int sample_light(const Ctx *c, uint32_t l, const float *o, float u, float
     }
     for (int k = 0; k < 3; k++)
         le[k] = rad[k] * scale;
+    if (textured)
+        for (int k = 0; k < 3; k++)
+            le[k] = le[k] * texel_channel(c, tx, k);
     return scale > 0.0f;
 }
 
@@ -550,12 +602,23 @@ static void shade_hit(Worker *w, const Ray *r, uint32_t *n)
     int seen_front = dot3(s.ng, r->dir) < 0.0f || mat_u32(c, s.mat, SM_MAT_DOUBLE_SIDED);
     if (em[0] + em[1] + em[2] > 0.0f && seen_front) {
         /* Hit-light filter: emission counts for camera rays and after delta bounces; other
-         * paths have already counted this light through their shadow rays. Lights end paths. */
+         * paths have already counted this light through their shadow rays. Lights end paths,
+         * except those with an emissive texture: the texel scales the emission, and the surface
+         * is also shaded, since a texture may be dark where it does not glow. */
+        int32_t etex = emit_texture(c, s.mat);
+        if (etex >= 0 && !s.is_sphere) {
+            float tu, tv;
+            interp2(c, c->emit_uvs + 24u * s.src, 1.0f - r->hit.u - r->hit.v, r->hit.u, r->hit.v, &tu, &tv);
+            uint32_t t = texel(c, (uint32_t)etex, tu, tv);
+            for (int k = 0; k < 3; k++)
+                em[k] = em[k] * texel_channel(c, t, k);
+        }
         if (r->depth == 0 || r->specular) {
             float v[3] = {r->thr[0] * em[0], r->thr[1] * em[1], r->thr[2] * em[2]};
             add_radiance(c, r->pixel, v);
         }
-        return;
+        if (etex < 0)
+            return;
     }
     if (c->workload == REF_WORKLOAD_PHONG) {
         shade_phong(w, r, &s, n);
@@ -761,6 +824,9 @@ int ref_render(const PackedScene *p, const RefParams *rp, float *rgb, RefStats *
     c.normals = sm_u32(p, sm_hdr(p, SM_HDR_NORMALS));
     c.uvs = sm_u32(p, sm_hdr(p, SM_HDR_UVS));
     c.lut = sm_u32(p, sm_hdr(p, SM_HDR_SRGB_LUT));
+    c.emit_uvs = sm_u32(p, sm_hdr(p, SM_HDR_EMIT_UVS));
+    c.colors = sm_u32(p, sm_hdr(p, SM_HDR_COLORS));
+    c.matx = sm_u32(p, sm_hdr(p, SM_HDR_MATX));
     c.scene_scale = sm_f32(p, sm_hdr(p, SM_HDR_EPSILON));
     c.workload = rp->workload;
     c.bounces = (uint32_t)rp->bounces;

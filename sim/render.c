@@ -685,6 +685,8 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     double t0 = now();
     if (scene_load(o->scene_path, &s, err, errlen) != 0)
         return -1;
+    for (uint32_t i = 0; i < s.nwarnings; i++) /* what the scene left out (docs/scenes.md) */
+        fprintf(stderr, "sfsim run: warning: %s\n", s.warnings[i]);
     if (apply_overrides(o, &s, err, errlen) != 0)
         goto out;
     BvhParams bp;
@@ -869,6 +871,10 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     cJSON_AddNumberToObject(bvh, "leaf_size", bp.max_leaf_size);
     cJSON_AddNumberToObject(bvh, "bins", bp.bins);
     cJSON_AddNumberToObject(sc, "scene_memory_bytes", p.size);
+    cJSON_AddNumberToObject(sc, "skipped_primitives", s.skipped_primitives);
+    cJSON *warn = cJSON_AddArrayToObject(sc, "warnings");
+    for (uint32_t i = 0; i < s.nwarnings; i++)
+        cJSON_AddItemToArray(warn, cJSON_CreateString(s.warnings[i]));
     /* The machine: every key of sim/config.def as used, in every mode (docs/report.md). */
     cJSON_AddStringToObject(root, "config_file", o->config_path ? o->config_path : "built-in");
     cfg_json(cfg, cJSON_AddObjectToObject(root, "config"));
@@ -939,6 +945,13 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
              s.render.height, s.render.spp, s.render.max_depth, o->seed, tiles_txt, sum / (3.0 * (double)npx),
              nonfinite, (unsigned long long)total_rays, (unsigned long long)rs.primary,
              (unsigned long long)rs.shadow, (unsigned long long)rs.indirect, (unsigned long long)rs.dropped);
+    if (s.skipped_primitives)
+        len += snprintf(txt + len, sizeof txt - (size_t)len, "skipped      %u glTF primitives that are not triangles\n",
+                        s.skipped_primitives);
+    for (uint32_t i = 0; i < s.nwarnings && len < (int)sizeof txt; i++)
+        len += snprintf(txt + len, sizeof txt - (size_t)len, "warning      %s\n", s.warnings[i]);
+    if (len >= (int)sizeof txt) /* (truncated: the writes below stay inside txt) */
+        len = (int)sizeof txt - 1;
     if (functional) {
         const FuncStats *f = &rs.f;
         uint64_t opsum[ISA_C_COUNT] = {0}, all = 0;
