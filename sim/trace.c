@@ -91,6 +91,8 @@ int trace_run(const TraceOptions *o, TraceSummary *sum, char *err, size_t errlen
         return -3;
     if (scene_load(o->scene_path, &s, err, errlen) != 0)
         return -1;
+    for (uint32_t i = 0; i < s.nwarnings; i++) /* what the scene left out (docs/scenes.md) */
+        fprintf(stderr, "sfsim trace: warning: %s\n", s.warnings[i]);
     int rc = -1;
     BvhParams bp;
     bvh_default_params(&bp);

@@ -14,43 +14,7 @@ SFSIM=${SFSIM:-bin/sfsim}
 T=$(mktemp -d "${TMPDIR:-/tmp}/sfsim-cli.XXXXXX") || exit 2
 trap 'rm -rf "$T"' EXIT
 
-pass=0
-fail=0
-name=""
-failed=0
-reasons=""
-cmdline=""
-rc=0
-
-begin() { name=$1; failed=0; reasons=""; cmdline=""; }
-
-# run CMD ARGS...: stdout to $T/out, stderr to $T/err, status in $rc.
-run() {
-    cmdline="$*"
-    "$@" >"$T/out" 2>"$T/err"
-    rc=$?
-}
-
-no() { failed=1; reasons="$reasons    - $*"$'\n'; }
-
-want_rc() { [ "$rc" -eq "$1" ] || no "exit status $rc, expected $1"; }
-want_out() { grep -qiE -- "$1" "$T/out" || no "stdout does not match /$1/"; }
-want_err() { grep -qiE -- "$1" "$T/err" || no "stderr does not match /$1/"; }
-want_any() { cat "$T/out" "$T/err" | grep -qiE -- "$1" || no "output does not match /$1/"; }
-want_no_err() { [ ! -s "$T/err" ] || no "unexpected stderr"; }
-
-end() {
-    if [ "$failed" -eq 0 ]; then
-        pass=$((pass + 1))
-    else
-        fail=$((fail + 1))
-        echo "FAIL: $name"
-        printf '%s' "$reasons"
-        [ -n "$cmdline" ] && echo "    command: $cmdline"
-        [ -s "$T/out" ] && sed -n '1,15s/^/    stdout| /p' "$T/out"
-        [ -s "$T/err" ] && sed -n '1,15s/^/    stderr| /p' "$T/err"
-    fi
-}
+. tests/cli/lib.sh
 
 for tool in "$SFASM" "$SFSIM"; do
     if [ ! -x "$tool" ]; then
@@ -922,5 +886,10 @@ run "$SFSIM" run --mode reference -s "$T/twice-scene.ini" -o "$T/twice-scene" -j
 want_rc 1; want_err "twice-scene.ini:14: key 'render.width': given twice \(first at line 11\)"
 end
 
-echo "cli: $pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+begin "sfsim trace warns, like run, about what a glTF file leaves out (points and lines)"
+run "$SFSIM" trace --mode reference -s tests/scenes/ok_points_lines.gltf --rays tests/cli/cornell_rays.txt -o "$T/pl_hits.txt"
+want_rc 0
+want_err "^sfsim trace: warning: tests/scenes/ok_points_lines.gltf: skipped 3 of 4 primitives"
+end
+
+cli_summary cli

@@ -13,28 +13,7 @@ T=$(mktemp -d "${TMPDIR:-/tmp}/sfsim-standalone.XXXXXX") || exit 2
 trap 'rm -rf "$T"' EXIT
 SMALL=(--set render.width=32 --set render.height=32 --set render.spp=1 --no-progress)
 
-pass=0
-fail=0
-name=""
-failed=0
-reasons=""
-rc=0
-begin() { name=$1; failed=0; reasons=""; }
-no() { failed=1; reasons="$reasons    - $*"$'\n'; }
-run() { "$@" >"$T/out" 2>"$T/err"; rc=$?; }
-want_rc() { [ "$rc" -eq "$1" ] || no "exit status $rc, expected $1"; }
-want_err() { grep -qiE -- "$1" "$T/err" || no "stderr does not match /$1/"; }
-end() {
-    if [ "$failed" -eq 0 ]; then
-        pass=$((pass + 1))
-    else
-        fail=$((fail + 1))
-        echo "FAIL: $name"
-        printf '%s' "$reasons"
-        [ -s "$T/out" ] && sed -n '1,10s/^/    stdout| /p' "$T/out"
-        [ -s "$T/err" ] && sed -n '1,10s/^/    stderr| /p' "$T/err"
-    fi
-}
+. tests/cli/lib.sh
 # scene_file DIR: the scene file a run's report.json names
 scene_file() { python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["scene"]["file"])' "$1/report.json" 2>/dev/null; }
 
@@ -130,5 +109,4 @@ want_rc 0
 [ -s "$T/lonely/out/frame.png" ] || no "no frame.png"
 end
 
-echo "standalone: $pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+cli_summary standalone

@@ -16,41 +16,7 @@ cleanup() {
 }
 trap cleanup EXIT
 
-pass=0
-fail=0
-name=""
-failed=0
-reasons=""
-cmdline=""
-rc=0
-
-begin() { name=$1; failed=0; reasons=""; cmdline=""; : >"$T/out"; : >"$T/err"; }
-
-# run CMD ARGS...: stdout to $T/out, stderr to $T/err, status in $rc.
-run() {
-    cmdline="$*"
-    "$@" >"$T/out" 2>"$T/err"
-    rc=$?
-}
-
-no() { failed=1; reasons="$reasons    - $*"$'\n'; }
-
-want_rc() { [ "$rc" -eq "$1" ] || no "exit status $rc, expected $1"; }
-want_out() { grep -qiE -- "$1" "$T/out" || no "stdout does not match /$1/"; }
-want_err() { grep -qiE -- "$1" "$T/err" || no "stderr does not match /$1/"; }
-
-end() {
-    if [ "$failed" -eq 0 ]; then
-        pass=$((pass + 1))
-    else
-        fail=$((fail + 1))
-        echo "FAIL: $name"
-        printf '%s' "$reasons"
-        [ -n "$cmdline" ] && echo "    command: $cmdline"
-        [ -s "$T/out" ] && sed -n '1,15s/^/    stdout| /p' "$T/out"
-        [ -s "$T/err" ] && sed -n '1,15s/^/    stderr| /p' "$T/err"
-    fi
-}
+. tests/cli/lib.sh
 
 if [ ! -x "$SFSIM" ]; then
     echo "sweep: $SFSIM is missing (run make)"
@@ -450,5 +416,4 @@ for c in "help sweep" "sweep --help" "help merge" "merge --help"; do
 done
 end
 
-echo "sweep: $pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+cli_summary sweep
