@@ -9,63 +9,11 @@
 #include <unistd.h>
 
 #include "../../sim/exithelp.h"
-
-/* The generator next to this test binary ($(BUILD)/tests/unit -> $(BUILD)/gen_exitdoc), unless
- * SFSIM_GEN_EXITDOC or SFSIM_BUILD say otherwise. */
-static void gen_exitdoc_path(char *buf, size_t len)
-{
-    const char *env = getenv("SFSIM_GEN_EXITDOC");
-    if (env) {
-        snprintf(buf, len, "%s", env);
-        return;
-    }
-    env = getenv("SFSIM_BUILD");
-    if (env) {
-        snprintf(buf, len, "%s/gen_exitdoc", env);
-        return;
-    }
-    char exe[1024];
-    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-    if (n > 0) {
-        exe[n] = '\0';
-        char *slash = strrchr(exe, '/');
-        if (slash) {
-            *slash = '\0';
-            slash = strrchr(exe, '/');
-            if (slash) {
-                *slash = '\0';
-                snprintf(buf, len, "%s/gen_exitdoc", exe);
-                if (access(buf, X_OK) == 0)
-                    return;
-            }
-        }
-    }
-    snprintf(buf, len, "build/gen_exitdoc");
-}
+#include "../support/files.h"
 
 Test(exitcodes, docs_exit_codes_md_is_current)
 {
-    char gen[1100];
-    gen_exitdoc_path(gen, sizeof gen);
-    cr_assert_eq(access(gen, X_OK), 0, "%s not found: build it (make), or set SFSIM_GEN_EXITDOC", gen);
-    FILE *g = popen(gen, "r");
-    cr_assert_not_null(g, "cannot run %s", gen);
-    FILE *f = fopen("docs/exit-codes.md", "r");
-    cr_assert_not_null(f, "docs/exit-codes.md is missing: run make docs");
-    int a, b;
-    long at = 0, lineno = 1;
-    do {
-        a = fgetc(g);
-        b = fgetc(f);
-        at++;
-        if (a == b && a == '\n')
-            lineno++;
-    } while (a == b && a != EOF);
-    int rc = pclose(g);
-    fclose(f);
-    cr_assert_eq(rc, 0, "%s failed", gen);
-    cr_expect_eq(a, b, "docs/exit-codes.md is stale: run make docs (first difference at byte %ld, line %ld)", at,
-                 lineno);
+    tu_expect_generated("gen_exitdoc", "SFSIM_GEN_EXITDOC", "docs/exit-codes.md");
 }
 
 /* Each row once in the doc's table, and no two rows share a code. */

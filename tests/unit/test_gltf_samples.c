@@ -21,20 +21,7 @@
 #include "../../sim/reference.h"
 #include "../../sim/render.h"
 #include "../support/shared.h"
-
-static char *slurp(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    cr_assert_not_null(f, "%s missing", path);
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *buf = calloc((size_t)n + 1, 1);
-    cr_assert_not_null(buf);
-    cr_assert_eq(fread(buf, 1, (size_t)n, f), (size_t)n);
-    fclose(f);
-    return buf;
-}
+#include "../support/files.h"
 
 /* A golden-model run of `scene` at 8 x 8 into a fresh folder: report.json parsed, *txt receives
  * report.txt. */
@@ -54,9 +41,9 @@ static cJSON *run_reference(const char *scene, char **txt)
     cr_assert_eq(render_run(&o, err, sizeof err), 0, "%s", err);
     char path[256];
     snprintf(path, sizeof path, "%s/report.json", dir);
-    char *json = slurp(path);
+    char *json = tu_slurp(path);
     snprintf(path, sizeof path, "%s/report.txt", dir);
-    *txt = slurp(path);
+    *txt = tu_slurp(path);
     static const char *const files[] = {"report.json", "report.txt", "frame.exr", "frame.png"};
     for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
         snprintf(path, sizeof path, "%s/%s", dir, files[i]);

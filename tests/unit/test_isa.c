@@ -14,6 +14,7 @@
 #include "../../asm/asm.h"
 #include "../../isa/isa.h"
 #include "../../sim/core.h"
+#include "../support/files.h"
 
 /* Deterministic operand choices: the same words every run. */
 static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
@@ -502,61 +503,9 @@ Test(isa_exec, every_opcode_executes_once_and_halts)
 
 /* ---- docs/isa.md is current ---------------------------------------------------------------- */
 
-/* The generator next to this test binary ($(BUILD)/tests/unit -> $(BUILD)/gen_isadoc), unless
- * SFSIM_GEN_ISADOC or SFSIM_BUILD say otherwise. */
-static void gen_isadoc_path(char *buf, size_t len)
-{
-    const char *env = getenv("SFSIM_GEN_ISADOC");
-    if (env) {
-        snprintf(buf, len, "%s", env);
-        return;
-    }
-    env = getenv("SFSIM_BUILD");
-    if (env) {
-        snprintf(buf, len, "%s/gen_isadoc", env);
-        return;
-    }
-    char exe[1024];
-    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-    if (n > 0) {
-        exe[n] = '\0';
-        char *slash = strrchr(exe, '/');
-        if (slash) {
-            *slash = '\0';
-            slash = strrchr(exe, '/');
-            if (slash) {
-                *slash = '\0';
-                snprintf(buf, len, "%s/gen_isadoc", exe);
-                if (access(buf, X_OK) == 0)
-                    return;
-            }
-        }
-    }
-    snprintf(buf, len, "build/gen_isadoc");
-}
-
 Test(isa_doc, docs_isa_md_is_current)
 {
-    char gen[1100];
-    gen_isadoc_path(gen, sizeof gen);
-    cr_assert_eq(access(gen, X_OK), 0, "%s not found: build it (make), or set SFSIM_GEN_ISADOC", gen);
-    FILE *g = popen(gen, "r");
-    cr_assert_not_null(g, "cannot run %s", gen);
-    FILE *f = fopen("docs/isa.md", "r");
-    cr_assert_not_null(f, "docs/isa.md is missing: run make docs");
-    int a, b;
-    long at = 0, lineno = 1;
-    do {
-        a = fgetc(g);
-        b = fgetc(f);
-        at++;
-        if (a == b && a == '\n')
-            lineno++;
-    } while (a == b && a != EOF);
-    int rc = pclose(g);
-    fclose(f);
-    cr_assert_eq(rc, 0, "%s failed", gen);
-    cr_expect_eq(a, b, "docs/isa.md is stale: run make docs (first difference at byte %ld, line %ld)", at, lineno);
+    tu_expect_generated("gen_isadoc", "SFSIM_GEN_ISADOC", "docs/isa.md");
 }
 
 /* The reference lists every instruction once, with its code. */

@@ -1,0 +1,14 @@
+/* tests/support/files.h -- file helpers the Criterion tests share: read a whole file, and check
+ * that a generated document is current (its generator's output, byte for byte). */
+#ifndef SFSIM_TESTS_FILES_H
+#define SFSIM_TESTS_FILES_H
+
+/* The whole file, NUL-terminated (the test fails when it cannot be read); free() it. */
+char *tu_slurp(const char *path);
+
+/* Fails the test unless running the generator `name` (a program in the build folder:
+ * $ENV_VAR, else $SFSIM_BUILD/name, else next to the test binary's folder, else build/name)
+ * prints exactly the file `doc`. */
+void tu_expect_generated(const char *name, const char *env_var, const char *doc);
+
+#endif
