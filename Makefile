@@ -250,7 +250,7 @@ bench: deps
 	$(BUILD)/bench/speed_vs_error out/bench
 
 # ---- the example `make run` executes --------------------------------------------------------
-# The default scene on the default machine in detailed mode, sized to take one to two minutes on 2
+# The default scene on the default machine in detailed mode, sized to take one to two minutes
 # (2 cores): 512 x 512 pixels, 48 samples per pixel.
 RUN_SIZE ?= --set render.width=512 --set render.height=512 --set render.spp=48
 run-built: all
