@@ -9,6 +9,7 @@
 
 #include "../../sim/heatmap.h"
 #include "../../sim/img.h"
+#include "../support/files.h"
 
 #define DEJAVU "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf"
 
@@ -18,6 +19,11 @@ static void mkdir_tmp(void)
 {
     strcpy(dir, "/tmp/sfsim-heatmap-XXXXXX");
     cr_assert_not_null(mkdtemp(dir));
+}
+
+static void rm_tmp(void)
+{
+    tu_remove_tree(dir);
 }
 
 typedef struct Image {
@@ -66,7 +72,7 @@ static int dark_pixels(const Image *im, int x0, int x1, int y0, int y1)
 /* Map origin (16, 52) and legend bar origin, heatmap.h's layout. */
 enum { MAP_X = 16, TOP = 52, BAR_GAP = 24, BAR_W = 24 };
 
-Test(heatmap, gradient_geometry_and_colour_order, .init = mkdir_tmp)
+Test(heatmap, gradient_geometry_and_colour_order, .init = mkdir_tmp, .fini = rm_tmp)
 {
     /* 16 x 4, each row increasing, not linearly, with x: s = 32 -> map 512 x 128, bar 256. */
     double v[16 * 4];
@@ -111,7 +117,7 @@ Test(heatmap, gradient_geometry_and_colour_order, .init = mkdir_tmp)
     free(im.rgb);
 }
 
-Test(heatmap, constant_maps_show_one_colour, .init = mkdir_tmp)
+Test(heatmap, constant_maps_show_one_colour, .init = mkdir_tmp, .fini = rm_tmp)
 {
     /* One tile: s = 512, map and bar 512 tall. */
     double one = 4200.0;
@@ -136,7 +142,7 @@ Test(heatmap, constant_maps_show_one_colour, .init = mkdir_tmp)
     free(im.rgb);
 }
 
-Test(heatmap, tall_maps_are_scaled_less, .init = mkdir_tmp)
+Test(heatmap, tall_maps_are_scaled_less, .init = mkdir_tmp, .fini = rm_tmp)
 {
     /* 1 x 100: s would be 512 for the width but is capped at 2048 / 100 = 20. */
     double v[100];
@@ -149,7 +155,7 @@ Test(heatmap, tall_maps_are_scaled_less, .init = mkdir_tmp)
     free(im.rgb);
 }
 
-Test(heatmap, title_and_labels_are_drawn_when_a_font_loads, .init = mkdir_tmp)
+Test(heatmap, title_and_labels_are_drawn_when_a_font_loads, .init = mkdir_tmp, .fini = rm_tmp)
 {
     cr_assert_eq(access(DEJAVU, R_OK), 0, "fonts-dejavu-core is in scripts/deps.sh");
     double v[4] = {0, 1000, 2000, 12345};
@@ -165,7 +171,7 @@ Test(heatmap, title_and_labels_are_drawn_when_a_font_loads, .init = mkdir_tmp)
     free(im.rgb);
 }
 
-Test(heatmap, without_a_font_the_map_is_still_written, .init = mkdir_tmp)
+Test(heatmap, without_a_font_the_map_is_still_written, .init = mkdir_tmp, .fini = rm_tmp)
 {
     heatmap_set_font("/nonexistent-dir/no-font.ttf");
     double v[4] = {0, 1000, 2000, 12345};
@@ -182,7 +188,7 @@ Test(heatmap, without_a_font_the_map_is_still_written, .init = mkdir_tmp)
     free(im.rgb);
 }
 
-Test(heatmap, bad_values_name_the_first_bad_pixel, .init = mkdir_tmp)
+Test(heatmap, bad_values_name_the_first_bad_pixel, .init = mkdir_tmp, .fini = rm_tmp)
 {
     char path[128], err[256];
     snprintf(path, sizeof path, "%s/bad.png", dir);

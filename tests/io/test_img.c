@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "../../sim/img.h"
+#include "../support/files.h"
 
 static char dir[64];
 
@@ -16,7 +17,12 @@ static void mkdir_tmp(void)
     cr_assert_not_null(mkdtemp(dir));
 }
 
-Test(img_io, exr_round_trip_is_exact, .init = mkdir_tmp)
+static void rm_tmp(void)
+{
+    tu_remove_tree(dir);
+}
+
+Test(img_io, exr_round_trip_is_exact, .init = mkdir_tmp, .fini = rm_tmp)
 {
     float px[2 * 3 * 3];
     for (int i = 0; i < 18; i++)
@@ -33,7 +39,7 @@ Test(img_io, exr_round_trip_is_exact, .init = mkdir_tmp)
     free(back);
 }
 
-Test(img_io, png_is_clamped_srgb_and_marks_nan, .init = mkdir_tmp)
+Test(img_io, png_is_clamped_srgb_and_marks_nan, .init = mkdir_tmp, .fini = rm_tmp)
 {
     /* linear 0, 0.5, 2.0 (clamps to 1), NaN pixel */
     float px[4 * 3] = {0, 0, 0, 0.5f, 0.5f, 0.5f, 2.0f, 2.0f, 2.0f, NAN, 0, 0};

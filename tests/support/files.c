@@ -2,6 +2,7 @@
 #include "files.h"
 
 #include <criterion/criterion.h>
+#include <ftw.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -75,4 +76,18 @@ void tu_expect_generated(const char *name, const char *env_var, const char *doc)
     fclose(f);
     cr_assert_eq(rc, 0, "%s failed", gen);
     cr_expect_eq(a, b, "%s is stale: run make docs (first difference at byte %ld, line %ld)", doc, at, lineno);
+}
+
+static int remove_entry(const char *path, const struct stat *st, int flag, struct FTW *ftw)
+{
+    (void)st;
+    (void)flag;
+    (void)ftw;
+    remove(path);
+    return 0;
+}
+
+void tu_remove_tree(const char *dir)
+{
+    nftw(dir, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
 }

@@ -11,4 +11,7 @@ char *tu_slurp(const char *path);
  * prints exactly the file `doc`. */
 void tu_expect_generated(const char *name, const char *env_var, const char *doc);
 
+/* Removes a test's temporary folder and everything in it (a missing folder is fine). */
+void tu_remove_tree(const char *dir);
+
 #endif
