@@ -767,7 +767,7 @@ static int step(Core *c)
     return halt;
 }
 
-CoreExit core_run(Core *c, uint64_t max_instr)
+CoreExit core_run_slice(Core *c, uint64_t max_instr, uint64_t limit)
 {
     c->trap[0] = 0;
     for (uint64_t done = 0; max_instr == 0 || done < max_instr; done++) {
@@ -777,8 +777,13 @@ CoreExit core_run(Core *c, uint64_t max_instr)
         if (r < 0)
             return CORE_EXIT_TRAP;
     }
-    trap(c, "instruction limit of %llu reached", (unsigned long long)max_instr);
+    trap(c, "instruction limit of %llu reached", (unsigned long long)limit);
     return CORE_EXIT_LIMIT;
+}
+
+CoreExit core_run(Core *c, uint64_t max_instr)
+{
+    return core_run_slice(c, max_instr, max_instr);
 }
 
 void core_set_hook(Core *c, CoreHook hook, void *ctx)

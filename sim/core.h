@@ -83,6 +83,9 @@ void core_restart(Core *c);
 
 /* Run until halt, trap, or max_instr more instructions (0 = no limit). */
 CoreExit core_run(Core *c, uint64_t max_instr);
+/* core_run for one slice of a longer run: at most max_instr instructions; a CORE_EXIT_LIMIT trap
+ * names `limit`, the whole run's limit, in its message. */
+CoreExit core_run_slice(Core *c, uint64_t max_instr, uint64_t limit);
 /* The trap message after CORE_EXIT_TRAP/CORE_EXIT_LIMIT:
  * "trap: <reason> at pc <n> (<disassembly>) <file>:<line>". */
 const char *core_trap_message(const Core *c);

@@ -287,7 +287,7 @@ static CoreExit run_with_progress(Core *c, uint64_t limit, int progress)
     uint64_t done = 0;
     for (;;) {
         uint64_t slice = limit - done < SLICE ? limit - done : SLICE;
-        CoreExit ex = core_run(c, slice);
+        CoreExit ex = core_run_slice(c, slice, limit);
         done += slice;
         if (ex != CORE_EXIT_LIMIT || done >= limit)
             return ex;
@@ -490,13 +490,7 @@ static int cmd_exec(int argc, char **argv)
         timing_free(tm);
     }
     if (ex == CORE_EXIT_LIMIT) {
-        /* The core names the limit of its last slice; the run's limit is the configured one. */
-        const char *msg = core_trap_message(c), *tail = strstr(msg, " reached");
-        if (!strncmp(msg, "trap: instruction limit of ", 27) && tail)
-            fprintf(stderr, "sfsim exec: trap: instruction limit of %llu reached%s\n",
-                    (unsigned long long)cfg.sim_max_instructions, tail + 8);
-        else
-            fprintf(stderr, "sfsim exec: %s\n", msg);
+        fprintf(stderr, "sfsim exec: %s\n", core_trap_message(c));
         rc = EXIT_PROGRAM;
     } else if (ex != CORE_EXIT_HALT) {
         fprintf(stderr, "sfsim exec: %s\n", core_trap_message(c));
