@@ -24,7 +24,7 @@ SAN     := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-re
 # Library sources: everything but the programs' main files.
 ISA_SRC := isa/isa.c
 ASM_SRC := $(filter-out asm/main_sfasm.c,$(wildcard asm/*.c))
-SIM_SRC := $(filter-out sim/main.c,$(wildcard sim/*.c))
+SIM_SRC := $(filter-out sim/main.c,$(wildcard sim/*.c sim/*/*.c))
 SCN_SRC := $(wildcard scenes/*.c)
 CXX_SRC := $(wildcard scenes/*.cpp sim/*.cpp)
 LIB_SRC := $(ISA_SRC) $(ASM_SRC) $(SIM_SRC) $(SCN_SRC)
