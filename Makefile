@@ -39,7 +39,7 @@ ASMLIB_OBJ = $(patsubst %.c,$(BUILD)/obj/%.o,$(ISA_SRC) $(ASM_SRC))
 LIB_OBJ  = $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/obj/%.o,$(CXX_SRC))
 ASAN_OBJ = $(patsubst %.c,$(BUILD)/asan/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/asan/%.o,$(CXX_SRC))
 
-.PHONY: all deps install run test test-standalone test-asan test-unit test-hard fuzz fuzz-run bench validation docs check-docs clean run-built test-built help
+.PHONY: all deps install run test test-standalone test-asan test-unit test-hard fuzz fuzz-run bench validation docs check-docs clean run-built test-built check-outputs help
 
 all: bin/sfasm bin/sfsim
 
@@ -52,7 +52,12 @@ help:
 	@echo "                make fuzz-run FUZZ_SECONDS=600 runs each for that long"
 	@echo "make bench      build and run the benchmarks in bench/ (core, functional and detailed speed, Embree)"
 	@echo "make docs       regenerate docs/isa.md, docs/exit-codes.md, the layout include and docs, the shipped Cornell box"
+	@echo "make check-outputs  the same-outputs table alone (tests/outputs/check.sh; part of make test)"
 	@echo "make install    install into PREFIX (default /usr/local; DESTDIR honoured): docs/install.md"
+
+# The same-outputs table (tests/outputs/outputs.tsv): cycles, instructions, image and report hashes.
+check-outputs: all $(BUILD)/outputs_digest
+	@bash tests/outputs/check.sh
 
 deps:
 	@bash scripts/deps.sh
@@ -111,6 +116,10 @@ $(BUILD)/gen_layout: tools/gen_layout.c scenes/layout.def
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) tools/gen_layout.c -o $@
 
+# The same-outputs table's digest of a run folder (tests/outputs/check.sh).
+$(BUILD)/outputs_digest: tools/outputs_digest.c $(BUILD)/libsfsim.a
+	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
+
 # The shipped Cornell box, from the published measurements (scenes/cornell/cornell-box.gltf).
 $(BUILD)/gen_cornell: tools/gen_cornell.c
 	@mkdir -p $(dir $@)
@@ -154,7 +163,8 @@ test-hard: deps
 # CLI tests first, Criterion last: its synthesis line closes the run.
 TEST_ENV = SFSIM_BUILD=$(BUILD) SFSIM_GEN_ISADOC=$(BUILD)/gen_isadoc
 
-test-built: all $(BUILD)/tests/unit $(BUILD)/tests/io $(BUILD)/gen_cornell
+test-built: all $(BUILD)/tests/unit $(BUILD)/tests/io $(BUILD)/gen_cornell $(BUILD)/outputs_digest
+	@bash tests/outputs/check.sh
 	@bash tests/cli/run.sh
 	@bash tests/cli/sweep.sh
 	@SFSIM_GEN_CORNELL=$(BUILD)/gen_cornell bash tests/cli/standalone.sh
