@@ -1,10 +1,11 @@
 /* sim/functional.h -- the functional mode: the path-tracing kernel (kernels/pathtrace.s)
  * assembled for the scene and the machine, run tile by tile on functional cores.
  *
- * Owns: choosing the kernel's -D symbols from the scene's needs, the kernel's launch ABI
- * (kernels/lib/abi.inc, read back from the object's symbols), host threads over tiles, and
- * the statistics that need no timing, and (detailed mode) attaching a timing model to each
- * core. Must not: compute any pixel itself or model time (sim/timing.c does).
+ * Owns: running the kernel that sim/run/kernel.c built, tile by tile (sim/run/tiles.c hands the
+ * tiles to host threads): the launch block of each run, copying the tile out of the framebuffer,
+ * the statistics that need no timing, and (detailed mode) attaching a timing model to each core.
+ * Must not: choose the kernel's symbols or assemble it (sim/run/kernel.c), build acceleration
+ * structures (sim/run/accel.c), compute any pixel itself or model time (sim/timing.c does).
  */
 #ifndef SFSIM_FUNCTIONAL_H
 #define SFSIM_FUNCTIONAL_H
@@ -28,14 +29,6 @@ enum { FUNC_KD_NODES, FUNC_KD_LEAVES, FUNC_KD_PRIMS, FUNC_KD_RESTARTS, FUNC_KD_O
 extern const char *const func_kd_kind_keys[FUNC_KD_KINDS];       /* "camera", "indirect", "shadow" */
 extern const char *const func_kd_counter_keys[FUNC_KD_COUNTERS]; /* "nodes", "leaves", "prims", "restarts",
                                                                     "overflows", "underflows" */
-
-/* accel.structure = kd: the tree func_add_kd built and packed. */
-typedef struct FuncKdInfo {
-    uint32_t nodes, leaves, empty_leaves, depth, largest_leaf;
-    uint32_t prims, refs;      /* primitives; leaf-list entries (a primitive may be in several leaves) */
-    double sah_cost;
-    double build_seconds;      /* build, invariant check and packing */
-} FuncKdInfo;
 
 typedef struct FuncParams {
     const CfgMachine *cfg;     /* SIMD width, stream size, memories, instruction limit */
@@ -102,15 +95,7 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
                 size_t errlen);
 void func_stats_free(FuncStats *st);
 
-/* accel.structure = kd (cfg): build the kd-tree of the kd.* keys over p's packed primitives, check
- * its invariants and append it to p (pack_add_kd); info receives its figures. For accel.structure
- * = bvh nothing happens. 0, or -1 with a message naming the keys. func_render needs this first. */
-int func_add_kd(PackedScene *p, const CfgMachine *cfg, FuncKdInfo *info, char *err, size_t errlen);
-
 /* `sfsim trace` through the kernel: fp->batch and fp->hits must be set. Same returns. */
 int func_trace(const PackedScene *p, const FuncParams *fp, FuncStats *st, char *err, size_t errlen);
-
-/* The shipped kernel: $SFSIM_KERNEL, or kernels/pathtrace.s in the data folder (sim/datadir.h). */
-const char *func_default_kernel(char *buf, size_t len);
 
 #endif

@@ -706,8 +706,6 @@ static int cmd_run(int argc, char **argv)
     if (build_config(&ca, &cfg))
         return EXIT_INPUT;
     o.stream_rays = cfg.stream_rays;
-    o.bvh_leaf_size = cfg.bvh_leaf_size;
-    o.bvh_bins = cfg.bvh_bins;
     o.cfg = &cfg;
     o.config_path = ca.path;
     static char err[65536];

@@ -15,52 +15,6 @@ const char *const ref_kd_variant_names[REF_KD_VARIANTS] = {"stack", "restart", "
 #define KD_WIDEN 9.5367431640625e-7f
 #define KD_WIDEN_FLOOR 1e-30f
 
-int ref_kd_prim_boxes(const PackedScene *p, float **bmin, float **bmax)
-{
-    uint32_t n = p->nprims, prims = sm_u32(p, sm_hdr(p, SM_HDR_PRIMS));
-    *bmin = malloc(3 * ((size_t)n + 1) * sizeof **bmin);
-    *bmax = malloc(3 * ((size_t)n + 1) * sizeof **bmax);
-    if (!*bmin || !*bmax) {
-        free(*bmin);
-        free(*bmax);
-        *bmin = *bmax = NULL;
-        return -1;
-    }
-    for (uint32_t i = 0; i < n; i++) {
-        float g[9];
-        uint32_t a = sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_V0);
-        for (int k = 0; k < 9; k++)
-            g[k] = sm_f32(p, a + 4u * (uint32_t)k);
-        int sphere = sm_u32(p, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_KIND)) == 1;
-        for (int k = 0; k < 3; k++) {
-            float lo, hi;
-            if (sphere) {
-                lo = g[k] - g[3];
-                hi = g[k] + g[3];
-            } else {
-                lo = fminf(g[k], fminf(g[3 + k], g[6 + k]));
-                hi = fmaxf(g[k], fmaxf(g[3 + k], g[6 + k]));
-            }
-            (*bmin)[3 * i + k] = lo;
-            (*bmax)[3 * i + k] = hi;
-        }
-    }
-    return 0;
-}
-
-int ref_kd_build(const PackedScene *p, const KdParams *kp, KdTree *out, char *err, size_t errlen)
-{
-    float *bmin, *bmax;
-    if (ref_kd_prim_boxes(p, &bmin, &bmax)) {
-        snprintf(err, errlen, "kd-tree: out of memory for %u primitive boxes", p->nprims);
-        return -1;
-    }
-    int rc = kd_build(kp, bmin, bmax, p->nprims, out, err, errlen);
-    free(bmin);
-    free(bmax);
-    return rc;
-}
-
 typedef struct Entry {
     uint32_t node;
     float tmin, tmax;  /* the segment of the ray in the node's voxel (ends widened) */

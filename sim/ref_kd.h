@@ -4,7 +4,7 @@
  * underflows, primitive tests).
  *
  * Owns: the reference algorithms the kd-tree kernels must reproduce and the definition of each
- * counter. Must not: build trees (scenes/kdtree.c) or shade.
+ * counter. Must not: build trees (scenes/kdtree.c builds them, sim/run/accel.c for a packed scene) or shade.
  *
  * The traversals are the paper's, in binary32, with one change for robustness: a split distance
  * is widened to tSplit +- 2^-20 |tSplit| (more than its rounding error) before the paper's
@@ -57,11 +57,6 @@ typedef struct RefKdStats {
  * continue from their hits (counted as such). */
 void ref_kd_packet_closest_hit(const PackedScene *p, const KdTree *t, int stack_depth, const RefRay *rays, int n,
                                RefHit *hits, RefKdStats *st);
-
-/* Build a kd-tree over the packed scene's primitives (packed indices), from their boxes. */
-int ref_kd_build(const PackedScene *p, const KdParams *kp, KdTree *out, char *err, size_t errlen);
-/* The primitives' boxes as ref_kd_build uses them (n * 3 floats each, malloc'ed). */
-int ref_kd_prim_boxes(const PackedScene *p, float **bmin, float **bmax);
 
 /* Closest hit; stack_depth is the short stack's entries (variant shortstack, >= 1). */
 void ref_kd_closest_hit(const PackedScene *p, const KdTree *t, RefKdVariant v, int stack_depth, const RefRay *r,

@@ -9,13 +9,12 @@
 #include "reference.h"
 
 #include <math.h>
-#include <pthread.h>
-#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "ref_trace.h"
+#include "run/tiles.h"
 
 #define PI_F 3.14159265f
 #define INV_PI_F 0.318309886f
@@ -769,29 +768,16 @@ static void render_tile(Worker *w, uint32_t tile)
     w->st.tiles++;
 }
 
-typedef struct Pool {
-    atomic_uint next_tile;
-    atomic_uint done_tiles;
-    const RefParams *rp;
-    uint32_t ntiles;
-    Worker *workers;
-} Pool;
+/* sim/run/tiles.h: thread `index` renders with worker ws[index]. */
+typedef struct Launch {
+    Worker *ws;
+} Launch;
 
-typedef struct ThreadArg { Pool *pool; Worker *w; } ThreadArg;
-
-static void *thread_main(void *arg)
+static int launch_tile(void *ctx, int index, uint32_t tile)
 {
-    ThreadArg *a = arg;
-    for (;;) {
-        uint32_t t = atomic_fetch_add(&a->pool->next_tile, 1u);
-        if (t >= a->pool->ntiles)
-            break;
-        render_tile(a->w, t);
-        uint32_t done = atomic_fetch_add(&a->pool->done_tiles, 1u) + 1u;
-        if (a->pool->rp->progress)
-            a->pool->rp->progress(a->pool->rp->progress_ctx, done, a->pool->ntiles);
-    }
-    return NULL;
+    Launch *l = ctx;
+    render_tile(&l->ws[index], tile);
+    return 0;
 }
 
 int ref_render(const PackedScene *p, const RefParams *rp, float *rgb, RefStats *stats, char *err,
@@ -840,19 +826,11 @@ int ref_render(const PackedScene *p, const RefParams *rp, float *rgb, RefStats *
         return -1;
     }
     uint32_t T = (uint32_t)rp->tile;
-    Pool pool;
-    atomic_init(&pool.next_tile, 0u);
-    atomic_init(&pool.done_tiles, 0u);
-    pool.rp = rp;
-    pool.ntiles = ((c.width + T - 1) / T) * ((c.height + T - 1) / T);
-    int nthreads = rp->threads < 1 ? 1 : rp->threads;
-    if ((uint32_t)nthreads > pool.ntiles)
-        nthreads = (int)pool.ntiles;
+    uint32_t ntiles = ((c.width + T - 1) / T) * ((c.height + T - 1) / T);
+    int nthreads = tiles_threads(rp->threads, ntiles);
     Worker *ws = calloc((size_t)nthreads, sizeof(Worker));
-    ThreadArg *args = calloc((size_t)nthreads, sizeof(ThreadArg));
-    pthread_t *th = calloc((size_t)nthreads, sizeof(pthread_t));
     int rc = 0;
-    if (!ws || !args || !th) {
+    if (!ws) {
         snprintf(err, errlen, "reference: out of memory");
         rc = -1;
         goto out;
@@ -862,20 +840,15 @@ int ref_render(const PackedScene *p, const RefParams *rp, float *rgb, RefStats *
         ws[i].c = &c;
         ws[i].cur = malloc(sizeof(Ray) * T * T);
         ws[i].next = malloc(sizeof(Ray) * T * T);
-        args[i] = (ThreadArg){&pool, &ws[i]};
         if (!ws[i].cur || !ws[i].next) {
             snprintf(err, errlen, "reference: out of memory for ray buffers");
             rc = -1;
             goto out;
         }
     }
-    int started = 0;
-    for (int i = 1; i < nthreads; i++, started++)
-        if (pthread_create(&th[i], NULL, thread_main, &args[i]) != 0)
-            break;
-    thread_main(&args[0]);
-    for (int i = 1; i <= started; i++)
-        pthread_join(th[i], NULL);
+    Launch launch = {ws};
+    TileLaunch tl = {ntiles, rp->threads, NULL, launch_tile, NULL, &launch, rp->progress, rp->progress_ctx};
+    tiles_run(&tl);
     /* Mean over samples. */
     float inv = 1.0f / (float)c.spp;
     for (size_t i = 0; i < 3 * (size_t)c.width * c.height; i++)
@@ -903,7 +876,5 @@ out:
         free(ws[i].next);
     }
     free(ws);
-    free(args);
-    free(th);
     return rc;
 }

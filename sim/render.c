@@ -30,6 +30,8 @@
 #include "heatmap.h"
 #include "outfile.h"
 #include "reference.h"
+#include "run/accel.h"
+#include "run/kernel.h"
 #include "sampling.h"
 #include "timing.h"
 
@@ -48,8 +50,6 @@ void render_default_options(RenderOptions *o)
     o->seed = 1;
     o->threads = 0;
     o->width = o->height = o->spp = o->max_depth = -1;
-    o->bvh_leaf_size = 4;
-    o->bvh_bins = 16;
     o->exposure = 1.0f;
     o->mode = "detailed";
     o->sample = 0.05;
@@ -168,7 +168,7 @@ typedef struct RunStats {
     uint64_t nodes_visited, prims_tested;   /* reference only */
     int functional;
     FuncStats f;
-    FuncKdInfo kd;                          /* accel.structure = kd */
+    AccelKdInfo kd;                          /* accel.structure = kd */
 } RunStats;
 
 /* One kd counter object: each counter's total and per ray of the kind. */
@@ -205,7 +205,7 @@ static void kd_totals(const FuncStats *f, uint64_t rays[FUNC_KD_KINDS], uint64_t
 static void add_kd_json(cJSON *root, const RunStats *rs, const CfgMachine *cfg)
 {
     const FuncStats *f = &rs->f;
-    const FuncKdInfo *t = &rs->kd;
+    const AccelKdInfo *t = &rs->kd;
     cJSON *kd = cJSON_AddObjectToObject(root, "kd");
     cJSON_AddStringToObject(kd, "structure", cfg_enum_name("accel", "structure", cfg->accel_structure));
     cJSON_AddStringToObject(kd, "traversal", cfg_enum_name("kd", "traversal", cfg->kd_traversal));
@@ -232,7 +232,7 @@ static void add_kd_json(cJSON *root, const RunStats *rs, const CfgMachine *cfg)
 static int kd_text(char *txt, size_t cap, const RunStats *rs, const CfgMachine *cfg)
 {
     const FuncStats *f = &rs->f;
-    const FuncKdInfo *t = &rs->kd;
+    const AccelKdInfo *t = &rs->kd;
     char sah[64];
     int len = snprintf(txt, cap,
                        "kd-tree      %s traversal, stack depth %u; %u nodes, %u leaves (%u empty), depth %u, "
@@ -689,17 +689,11 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         fprintf(stderr, "sfsim run: warning: %s\n", s.warnings[i]);
     if (apply_overrides(o, &s, err, errlen) != 0)
         goto out;
-    BvhParams bp;
-    bvh_default_params(&bp);
-    bp.max_leaf_size = o->bvh_leaf_size;
-    bp.bins = o->bvh_bins;
     double t_load = now();
-    if (pack_scene(&s, &bp, 0, &p, err, errlen) != 0)
+    AccelInfo accel;
+    if (accel_pack(&s, cfg, functional, &p, &accel, err, errlen) != 0)
         goto out;
-    double t_pack = now();
-    /* The kernel modes with accel.structure = kd traverse a kd-tree; the golden model, the BVH. */
-    if (functional && func_add_kd(&p, cfg, &rs.kd, err, errlen) != 0)
-        goto out;
+    rs.kd = accel.kd;
     double t_kd = now();
     size_t npx = (size_t)s.render.width * (size_t)s.render.height;
     rgb = calloc(3 * npx, sizeof(float));
@@ -713,7 +707,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     if (functional) {
         char kpath[4200];
         FuncParams fp = {.cfg = cfg,
-                         .kernel_path = o->kernel_path ? o->kernel_path : func_default_kernel(kpath, sizeof kpath),
+                         .kernel_path = o->kernel_path ? o->kernel_path : kernel_default_path(kpath, sizeof kpath),
                          .needs = s.needs,
                          .seed = o->seed,
                          .threads = threads,
@@ -868,8 +862,8 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     cJSON_AddNumberToObject(bvh, "leaves", p.bvh.nleaves);
     cJSON_AddNumberToObject(bvh, "depth", p.bvh.depth);
     add_sah_json(bvh, p.bvh.sah_cost);
-    cJSON_AddNumberToObject(bvh, "leaf_size", bp.max_leaf_size);
-    cJSON_AddNumberToObject(bvh, "bins", bp.bins);
+    cJSON_AddNumberToObject(bvh, "leaf_size", cfg->bvh_leaf_size);
+    cJSON_AddNumberToObject(bvh, "bins", cfg->bvh_bins);
     cJSON_AddNumberToObject(sc, "scene_memory_bytes", p.size);
     cJSON_AddNumberToObject(sc, "skipped_primitives", s.skipped_primitives);
     cJSON *warn = cJSON_AddArrayToObject(sc, "warnings");
@@ -894,7 +888,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     cJSON *host = cJSON_AddObjectToObject(root, "host");
     cJSON_AddNumberToObject(host, "seconds", secs);
     cJSON_AddNumberToObject(host, "load_seconds", t_load - t0);
-    cJSON_AddNumberToObject(host, "bvh_pack_seconds", t_pack - t_load);
+    cJSON_AddNumberToObject(host, "bvh_pack_seconds", accel.pack_seconds);
     cJSON_AddNumberToObject(host, "threads", threads);
     cJSON_AddNumberToObject(host, "rays_per_second", secs > 0 ? (double)total_rays / secs : 0.0);
     if (functional) {
@@ -992,13 +986,13 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
                         trav_len, isect_len, ratio(f->shade_rays, f->shade_streams),
                         f->trav_streams ? "" : " (traversal one ray per lane: no stream filters)", secs, threads, thr,
                         secs > 0 ? 1e-6 * (double)f->instructions / secs : 0.0,
-                        secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, t_load - t0, t_pack - t_load);
+                        secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, t_load - t0, accel.pack_seconds);
     } else {
         len += snprintf(txt + len, sizeof txt - (size_t)len,
                         "traversal    %llu nodes visited, %llu primitive tests\n"
                         "host         %.2f s rendering on %d %s (%.3f M rays/s); load %.2f s, BVH+pack %.2f s\n",
                         (unsigned long long)rs.nodes_visited, (unsigned long long)rs.prims_tested, secs, threads, thr,
-                        secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, t_load - t0, t_pack - t_load);
+                        secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, t_load - t0, accel.pack_seconds);
     }
     snprintf(path, sizeof path, "%s/report.txt", o->out_dir);
     if (outfile_write_file(set, path, txt, strlen(txt), err, errlen) != 0)

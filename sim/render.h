@@ -17,7 +17,6 @@ typedef struct RenderOptions {
     uint32_t seed;
     int threads;               /* host threads; 0 = all cores */
     int width, height, spp, max_depth; /* overrides of the scene's [render]; -1 = keep */
-    int bvh_leaf_size, bvh_bins;
     float exposure;            /* for frame.png */
     int progress;              /* 1: progress bar on stderr (the CLI sets it when stderr is a tty) */
     const char *mode;          /* "detailed", "sampled", "functional" or "reference" */

@@ -13,6 +13,8 @@
 #include "functional.h"
 #include "outfile.h"
 #include "ref_trace.h"
+#include "run/accel.h"
+#include "run/kernel.h"
 
 static double now(void)
 {
@@ -60,7 +62,7 @@ int trace_batch_run(const PackedScene *p, uint32_t needs, const RayBatch *b, Bat
     }
     char kpath[4200];
     FuncParams fp = {.cfg = cfg,
-                     .kernel_path = kernel_path ? kernel_path : func_default_kernel(kpath, sizeof kpath),
+                     .kernel_path = kernel_path ? kernel_path : kernel_default_path(kpath, sizeof kpath),
                      .needs = needs,
                      .seed = 1,
                      .threads = threads,
@@ -94,15 +96,8 @@ int trace_run(const TraceOptions *o, TraceSummary *sum, char *err, size_t errlen
     for (uint32_t i = 0; i < s.nwarnings; i++) /* what the scene left out (docs/scenes.md) */
         fprintf(stderr, "sfsim trace: warning: %s\n", s.warnings[i]);
     int rc = -1;
-    BvhParams bp;
-    bvh_default_params(&bp);
-    bp.max_leaf_size = o->cfg->bvh_leaf_size;
-    bp.bins = o->cfg->bvh_bins;
-    if (pack_scene(&s, &bp, 0, &p, err, errlen) != 0)
-        goto out;
-    /* The kernel with accel.structure = kd traverses a kd-tree; the golden model, the BVH. */
-    FuncKdInfo kd;
-    if (strcmp(o->mode, "reference") != 0 && func_add_kd(&p, o->cfg, &kd, err, errlen) != 0)
+    AccelInfo accel;
+    if (accel_pack(&s, o->cfg, strcmp(o->mode, "reference") != 0, &p, &accel, err, errlen) != 0)
         goto out;
     if (raybatch_load(o->rays_path, &b, err, errlen) != 0)
         goto out;

@@ -22,6 +22,7 @@
 #include "../sim/config.h"
 #include "../sim/functional.h"
 #include "../sim/ref_kd.h"
+#include "../sim/run/accel.h"
 #include "../sim/ref_trace.h"
 #include "../sim/timing.h"
 
@@ -424,7 +425,7 @@ static void kd_tables(void)
         kd_default_params(&kp);
         KdTree t;
         char err[1024];
-        if (ref_kd_build(&l.p, &kp, &t, err, sizeof err) != 0) {
+        if (accel_kd_build(&l.p, &kp, &t, err, sizeof err) != 0) {
             fprintf(stderr, "%s: %s\n", l.name, err);
             exit(1);
         }
@@ -495,8 +496,8 @@ static void kd_kernel_scene(const char *name, const char *path, int w, int h, in
     cfg.workload_bounces = bounces;
     static char err[65536];
     CfgErrors ce = {0};
-    FuncKdInfo info;
-    if (cfg_set(&cfg, "accel.structure=kd", &ce) != 0 || func_add_kd(&l.p, &cfg, &info, err, sizeof err) != 0) {
+    AccelKdInfo info;
+    if (cfg_set(&cfg, "accel.structure=kd", &ce) != 0 || accel_add_kd(&l.p, &cfg, &info, err, sizeof err) != 0) {
         fprintf(stderr, "%s: %s%s\n", l.name, ce.text ? ce.text : "", err);
         exit(1);
     }

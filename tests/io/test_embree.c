@@ -10,6 +10,7 @@
 
 #include "../../scenes/scene.h"
 #include "../../sim/ref_kd.h"
+#include "../../sim/run/accel.h"
 #include "../support/xcheck.h"
 #include "../support/shared.h"
 
@@ -43,7 +44,7 @@ static void expect_agreement(const char *name, const Scene *s, uint32_t ncam, ui
         KdTree t;
         KdParams kp;
         kd_default_params(&kp);
-        cr_assert_eq(ref_kd_build(&p, &kp, &t, err, sizeof err), 0, "%s: %s", name, err);
+        cr_assert_eq(accel_kd_build(&p, &kp, &t, err, sizeof err), 0, "%s: %s", name, err);
         XcheckTracer stack = {&t, REF_KD_STACK, 0}, shortstack = {&t, REF_KD_SHORTSTACK, 3};
         expect_tracer(name, "kd stack", s, &p, &stack, ncam, nrand);
         expect_tracer(name, "kd shortstack 3", s, &p, &shortstack, ncam, nrand);

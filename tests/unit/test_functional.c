@@ -16,6 +16,7 @@
 #include "../../sim/config.h"
 #include "../../sim/functional.h"
 #include "../../sim/ref_kd.h"
+#include "../../sim/run/accel.h"
 #include "../../sim/reference.h"
 
 #include "../support/shared.h"
@@ -551,23 +552,23 @@ Test(functional, kd_tree_from_the_kd_keys_is_packed)
     load_packed("scenes/cornell/scene.ini", 16, 16, 1, &s, &p);
     CfgMachine cfg;
     cfg_defaults(&cfg);
-    FuncKdInfo info;
+    AccelKdInfo info;
     char err[1024];
     /* accel.structure = bvh: nothing to add */
-    cr_expect_eq(func_add_kd(&p, &cfg, &info, err, sizeof err), 0, "%s", err);
+    cr_expect_eq(accel_add_kd(&p, &cfg, &info, err, sizeof err), 0, "%s", err);
     cr_expect_eq(sm_u32(&p, sm_hdr(&p, SM_HDR_KD_NODES)), 0u);
     cr_expect_eq(info.nodes, 0u);
     kd_cfg(&cfg, CFG_KD_STACK);
     cfg.kd_leaf_size = 4;
     cfg.kd_empty_bonus = 0.5;
-    cr_assert_eq(func_add_kd(&p, &cfg, &info, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(accel_add_kd(&p, &cfg, &info, err, sizeof err), 0, "%s", err);
     /* The tree of those keys: the builder's with the same parameters. */
     KdParams kp;
     kd_default_params(&kp);
     kp.leaf_size = 4;
     kp.empty_bonus = 0.5f;
     KdTree t;
-    cr_assert_eq(ref_kd_build(&p, &kp, &t, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(accel_kd_build(&p, &kp, &t, err, sizeof err), 0, "%s", err);
     cr_expect_eq(info.nodes, t.nnodes);
     cr_expect_eq(info.leaves, t.nleaves);
     cr_expect_eq(info.empty_leaves, t.nempty);
@@ -581,7 +582,7 @@ Test(functional, kd_tree_from_the_kd_keys_is_packed)
     cr_expect_eq(sm_u32(&p, sm_hdr(&p, SM_HDR_KD_NNODES)), t.nnodes);
     kd_default_params(&kp);
     KdTree d;
-    cr_assert_eq(ref_kd_build(&p, &kp, &d, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(accel_kd_build(&p, &kp, &d, err, sizeof err), 0, "%s", err);
     cr_expect_neq(d.nnodes, t.nnodes, "kd.leaf_size and kd.empty_bonus changed nothing");
     kd_free(&d);
     kd_free(&t);
@@ -599,9 +600,9 @@ Test(functional, kd_counters_and_build_symbols)
     load_packed("scenes/cornell/scene.ini", w, h, 1, &s, &p);
     CfgMachine cfg;
     kd_cfg(&cfg, CFG_KD_STACK);
-    FuncKdInfo info;
+    AccelKdInfo info;
     char err[65536];
-    cr_assert_eq(func_add_kd(&p, &cfg, &info, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(accel_add_kd(&p, &cfg, &info, err, sizeof err), 0, "%s", err);
     struct { int traversal, lanes; uint32_t depth; } cases[] = {
         {CFG_KD_STACK, 16, info.depth + 1}, {CFG_KD_RESTART, 16, 1}, {CFG_KD_PUSHDOWN, 5, 1},
         {CFG_KD_SHORTSTACK, 5, 7}, {CFG_KD_PACKET, 16, 7}, {CFG_KD_STREAM, 8, 1}};
@@ -641,13 +642,13 @@ Test(functional, kd_memory_checks_name_the_keys)
     load_packed("scenes/cornell/scene.ini", 16, 16, 1, &s, &p);
     CfgMachine cfg;
     kd_cfg(&cfg, CFG_KD_STACK);
-    FuncKdInfo info;
+    AccelKdInfo info;
     char err[65536];
     FuncStats st;
     /* A kd run needs the tree in the packed scene. */
     cr_expect_neq(kd_render(&p, s.needs, &cfg, 16, 16, &st, err, sizeof err), 0);
     cr_expect(strstr(err, "accel.structure = kd") && strstr(err, "without a kd-tree"), "%s", err);
-    cr_assert_eq(func_add_kd(&p, &cfg, &info, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(accel_add_kd(&p, &cfg, &info, err, sizeof err), 0, "%s", err);
     cr_assert_geq(p.kd_depth, 4u, "the stream case below assumes a depth of 4 or more");
     /* Counters end at 4096 + 3 x 6 x 256 = 8704 bytes, the per-lane state at 8704 + 29 x 256 = 16128;
      * packet stacks of 3 x 1040 bytes need 19248; the stream filter's 36 x (3 x depth + 8) bytes

@@ -16,6 +16,7 @@
 #include "../../sim/config.h"
 #include "../../sim/functional.h"
 #include "../../sim/ref_kd.h"
+#include "../../sim/run/accel.h"
 #include "../../sim/ref_trace.h"
 
 #include "../support/shared.h"
@@ -69,13 +70,13 @@ static void check_kernel(const char *path, uint32_t n, const Case *cases, int nc
     KdTree t;
     KdParams kp;
     kd_default_params(&kp);
-    cr_assert_eq(ref_kd_build(&p, &kp, &t, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(accel_kd_build(&p, &kp, &t, err, sizeof err), 0, "%s", err);
     CfgMachine base;
     cfg_defaults(&base);
     CfgErrors ce = {0};
     cr_assert_eq(cfg_set(&base, "accel.structure=kd", &ce), 0);
-    FuncKdInfo info;
-    cr_assert_eq(func_add_kd(&p, &base, &info, err, sizeof err), 0, "%s", err);
+    AccelKdInfo info;
+    cr_assert_eq(accel_add_kd(&p, &base, &info, err, sizeof err), 0, "%s", err);
     cr_assert_eq(info.nodes, t.nnodes, "the kernel's tree is the golden model's (default kd.* keys)");
     BatchRay *rays = calloc(n, sizeof *rays);
     BatchHit *hits = calloc(n, sizeof *hits);
@@ -219,8 +220,8 @@ static void check_images(const char *path, int w, int h, int workload, int bounc
     cfg.workload_bounces = bounces;
     CfgErrors ce = {0};
     cr_assert_eq(cfg_set(&cfg, "accel.structure=kd", &ce), 0);
-    FuncKdInfo info;
-    cr_assert_eq(func_add_kd(&p, &cfg, &info, err, sizeof err), 0, "%s", err);
+    AccelKdInfo info;
+    cr_assert_eq(accel_add_kd(&p, &cfg, &info, err, sizeof err), 0, "%s", err);
     static const char *const trav[] = {NULL, "stack", "restart", "pushdown", "shortstack", "packet", "stream"};
     size_t n = 3 * (size_t)w * h;
     float *ref = calloc(n, sizeof(float)), *rgb = calloc(n, sizeof(float));

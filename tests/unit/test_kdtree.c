@@ -15,6 +15,7 @@
 #include "../../scenes/pack.h"
 #include "../../scenes/scene.h"
 #include "../../sim/ref_kd.h"
+#include "../../sim/run/accel.h"
 #include "../../sim/ref_trace.h"
 
 #include "../support/shared.h"
@@ -73,7 +74,7 @@ static void load_kd(const char *path, Scene *s, PackedScene *p, KdTree *t)
     cr_assert_eq(pack_load_file(path, 0, 0, 0, s, p, err, sizeof err), 0, "%s", err);
     KdParams kp;
     kd_default_params(&kp);
-    cr_assert_eq(ref_kd_build(p, &kp, t, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(accel_kd_build(p, &kp, t, err, sizeof err), 0, "%s", err);
 }
 
 typedef struct Agg {
@@ -91,7 +92,7 @@ static void compare_scene(const char *path, uint32_t nrays, Agg agg[12], uint32_
     char err[1024];
     load_kd(path, &s, &p, &t);
     float *bmin, *bmax;
-    cr_assert_eq(ref_kd_prim_boxes(&p, &bmin, &bmax), 0);
+    cr_assert_eq(accel_prim_boxes(&p, &bmin, &bmax), 0);
     cr_assert_eq(kd_check(&t, bmin, bmax, err, sizeof err), 0, "%s: %s", path, err);
     *tree_depth = t.depth;
     printf("kd-tree %s: %u primitives, %u nodes, %u leaves (%u empty), depth %u, %u references (%.2f per "

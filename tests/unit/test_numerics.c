@@ -13,6 +13,7 @@
 #include "../../sim/functional.h"
 #include "../../sim/reference.h"
 #include "../../sim/ref_trace.h"
+#include "../../sim/run/accel.h"
 #include "../../sim/trace.h"
 #include "../support/numerics.h"
 
@@ -390,9 +391,9 @@ Test(numerics, rays_leaving_a_large_triangle_do_not_hit_it, .timeout = 120)
     cfg_defaults(&cfg);
     CfgErrors ce = {0};
     cr_assert_eq(cfg_set(&cfg, "accel.structure=kd", &ce), 0);
-    FuncKdInfo info;
+    AccelKdInfo info;
     char err[4096];
-    cr_assert_eq(func_add_kd(&p, &cfg, &info, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(accel_add_kd(&p, &cfg, &info, err, sizeof err), 0, "%s", err);
     const char *trav[] = {"kd.traversal=stack", "kd.traversal=restart", "kd.traversal=shortstack",
                           "kd.traversal=packet", "kd.traversal=stream"};
     for (int v = 0; v < 5; v++) {

@@ -8,6 +8,7 @@
 
 #include "../../scenes/pack.h"
 #include "../../sim/ref_kd.h"
+#include "../../sim/run/accel.h"
 
 /* A hand-made scene: two triangles (one emissive), one sphere, two materials, a 2x1 texture,
  * a quad light; camera at the origin looking down -z, 90 degree fov, 2:1 image. */
@@ -165,7 +166,7 @@ Test(pack, kd_tree_round_trip)
     KdParams kp;
     kd_default_params(&kp);
     KdTree t;
-    cr_assert_eq(ref_kd_build(&p, &kp, &t, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(accel_kd_build(&p, &kp, &t, err, sizeof err), 0, "%s", err);
     cr_expect_eq(sm_u32(&p, sm_hdr(&p, SM_HDR_KD_NODES)), 0u, "no kd-tree before pack_add_kd");
     uint32_t old_size = p.size;
     uint8_t *before = malloc(old_size);
@@ -226,7 +227,7 @@ Test(pack, kd_tree_errors)
     KdParams kp;
     kd_default_params(&kp);
     KdTree t;
-    cr_assert_eq(ref_kd_build(&p, &kp, &t, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(accel_kd_build(&p, &kp, &t, err, sizeof err), 0, "%s", err);
     /* An index past 30 bits cannot be encoded. */
     uint32_t a = t.nodes[0].a;
     t.nodes[0].a = 1u << 30;
