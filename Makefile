@@ -191,7 +191,7 @@ $(BUILD)/fuzz/fuzz_scene: tests/fuzz/fuzz_scene.c scenes/scene.c scenes/scene_fi
 	$(CLANG)++ -x c -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined \
 	    $(filter %.c,$^) -x none $(filter %.o,$^) -o $@ -linih -lcjson -lm
 
-$(BUILD)/fuzz/fuzz_rays: tests/fuzz/fuzz_rays.c sim/raybatch.c sim/outfile.c
+$(BUILD)/fuzz/fuzz_rays: tests/fuzz/fuzz_rays.c sim/raybatch.c sim/outfile.c sim/util.c
 	@mkdir -p $(dir $@)
 	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ -lm
 

@@ -16,12 +16,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "../asm/asm.h"
 #include "datadir.h"
 #include "ref_kd.h"
+#include "util.h"
 
 const char *const func_kd_kind_keys[FUNC_KD_KINDS] = {"camera", "indirect", "shadow"};
 const char *const func_kd_counter_keys[FUNC_KD_COUNTERS] = {"nodes", "leaves", "prims", "restarts", "overflows",
@@ -118,13 +118,6 @@ static int abi_lookup(const AsmObject *obj, Abi *abi, char *err, size_t errlen)
 static const char *const kd_variant_syms[CFG_KD_TRAVERSALS] = {"KD_STACK", "KD_RESTART", "KD_PUSHDOWN",
                                                                "KD_SHORTSTACK", "KD_PACKET", "KD_STREAM"};
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static void kd_params(const CfgMachine *cfg, KdParams *kp)
 {
     kd_default_params(kp);
@@ -174,7 +167,7 @@ int func_add_kd(PackedScene *p, const CfgMachine *cfg, FuncKdInfo *info, char *e
     memset(info, 0, sizeof *info);
     if (cfg->accel_structure != CFG_ACCEL_KD)
         return 0;
-    double t0 = now();
+    double t0 = util_now();
     KdParams kp;
     kd_params(cfg, &kp);
     KdTree t;
@@ -189,7 +182,7 @@ int func_add_kd(PackedScene *p, const CfgMachine *cfg, FuncKdInfo *info, char *e
     if (rc == 0)
         kd_info(&t, info);
     kd_free(&t);
-    info->build_seconds = now() - t0;
+    info->build_seconds = util_now() - t0;
     return rc;
 }
 

@@ -19,7 +19,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "../scenes/pack.h"
@@ -32,6 +31,7 @@
 #include "reference.h"
 #include "sampling.h"
 #include "timing.h"
+#include "util.h"
 
 const RenderKey render_keys[RENDER_KEY_COUNT] = {
     {"render.width", 1, 16384},
@@ -56,13 +56,6 @@ void render_default_options(RenderOptions *o)
     o->sample_seed = 1;
 }
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 typedef struct Progress {
     pthread_mutex_t lock;
     double start;
@@ -75,7 +68,7 @@ static void progress_cb(void *ctx, uint32_t done, uint32_t total)
     if (!pr->enabled)
         return;
     pthread_mutex_lock(&pr->lock);
-    double el = now() - pr->start;
+    double el = util_now() - pr->start;
     double left = done ? el * (double)(total - done) / (double)done : 0.0;
     int width = 40, fill = (int)((double)width * done / total);
     fprintf(stderr, "\r[%.*s%*s] %u/%u tiles  %.1fs elapsed, ~%.1fs left ", fill,
@@ -682,7 +675,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     if (outfile_check_dir(o->out_dir, err, errlen) != 0)
         return -3;
     SampleEstimate est_store, *est = NULL;
-    double t0 = now();
+    double t0 = util_now();
     if (scene_load(o->scene_path, &s, err, errlen) != 0)
         return -1;
     for (uint32_t i = 0; i < s.nwarnings; i++) /* what the scene left out (docs/scenes.md) */
@@ -693,14 +686,14 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     bvh_default_params(&bp);
     bp.max_leaf_size = o->bvh_leaf_size;
     bp.bins = o->bvh_bins;
-    double t_load = now();
+    double t_load = util_now();
     if (pack_scene(&s, &bp, 0, &p, err, errlen) != 0)
         goto out;
-    double t_pack = now();
+    double t_pack = util_now();
     /* The kernel modes with accel.structure = kd traverse a kd-tree; the golden model, the BVH. */
     if (functional && func_add_kd(&p, cfg, &rs.kd, err, errlen) != 0)
         goto out;
-    double t_kd = now();
+    double t_kd = util_now();
     size_t npx = (size_t)s.render.width * (size_t)s.render.height;
     rgb = calloc(3 * npx, sizeof(float));
     if (!rgb) {
@@ -708,7 +701,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         goto out;
     }
     int threads = o->threads > 0 ? o->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
-    Progress pr = {PTHREAD_MUTEX_INITIALIZER, now(), o->progress};
+    Progress pr = {PTHREAD_MUTEX_INITIALIZER, util_now(), o->progress};
     int tile = (int)lrint(sqrt((double)o->stream_rays));
     if (functional) {
         char kpath[4200];
@@ -793,7 +786,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         rs.nodes_visited = st.nodes_visited;
         rs.prims_tested = st.prims_tested;
     }
-    double t_render = now();
+    double t_render = util_now();
 
     /* From here on a failure is an output that could not be written (EXIT_IO); the folder is
      * made now that there is something to write, and removed again if nothing is written. */
