@@ -20,7 +20,7 @@
 #include "exithelp.h"
 #include "img.h"
 #include "render.h"
-#include "sweep.h"
+#include "sweep/sweep.h"
 #include "timing.h"
 #include "trace.h"
 #include "util.h"
