@@ -28,6 +28,12 @@ SIM_SRC := $(filter-out sim/main.c,$(wildcard sim/*.c sim/*/*.c))
 SCN_SRC := $(wildcard scenes/*.c)
 CXX_SRC := $(wildcard scenes/*.cpp sim/*.cpp)
 LIB_SRC := $(ISA_SRC) $(ASM_SRC) $(SIM_SRC) $(SCN_SRC)
+# An archive keeps members by file name only: two sources with one name in different folders
+# (sim/a/x.c, sim/b/x.c) would silently replace each other in libsfsim.a.
+LIB_NAMES := $(notdir $(basename $(LIB_SRC) $(CXX_SRC)))
+ifneq ($(words $(LIB_NAMES)),$(words $(sort $(LIB_NAMES))))
+$(error two library sources share a file name: $(shell echo $(LIB_NAMES) | tr ' ' '\n' | sort | uniq -d))
+endif
 # Two Criterion binaries: tests/io (image files, Embree, scene files: they link OpenImageIO,
 # Embree and tinygltf, whose ~270 shared libraries make every forked test process start slowly)
 # and tests/unit (everything else, linked --as-needed so it starts fast). unit runs last.
@@ -86,14 +92,17 @@ $(BUILD)/asan/%.o: %.cpp
 
 $(BUILD)/libsfasm.a: $(ASMLIB_OBJ)
 	@mkdir -p $(dir $@)
+	@rm -f $@
 	$(AR) rcs $@ $^
 
 $(BUILD)/libsfsim.a: $(LIB_OBJ)
 	@mkdir -p $(dir $@)
+	@rm -f $@
 	$(AR) rcs $@ $^
 
 $(BUILD)/libsfsim-asan.a: $(ASAN_OBJ)
 	@mkdir -p $(dir $@)
+	@rm -f $@
 	$(AR) rcs $@ $^
 
 bin/sfasm: $(BUILD)/obj/asm/main_sfasm.o $(BUILD)/libsfasm.a
@@ -201,7 +210,7 @@ $(BUILD)/fuzz/fuzz_scene: tests/fuzz/fuzz_scene.c scenes/scene.c scenes/scene_fi
 	$(CLANG)++ -x c -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined \
 	    $(filter %.c,$^) -x none $(filter %.o,$^) -o $@ -linih -lcjson -lm
 
-$(BUILD)/fuzz/fuzz_rays: tests/fuzz/fuzz_rays.c sim/raybatch.c sim/outfile.c
+$(BUILD)/fuzz/fuzz_rays: tests/fuzz/fuzz_rays.c sim/raybatch.c sim/outfile.c sim/util.c
 	@mkdir -p $(dir $@)
 	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ -lm
 

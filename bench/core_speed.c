@@ -19,12 +19,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "../asm/object.h"
 #include "../isa/isa.h"
 #include "../sim/config.h"
 #include "../sim/core.h"
+#include "../sim/util.h"
 
 #define X(OP, a, b, c, d, m, imm) {ISA_OP_##OP, (a), (b), (c), (d), (m), (uint32_t)(imm)}
 
@@ -36,13 +36,6 @@ static uint32_t fbits(float f)
     uint32_t u;
     memcpy(&u, &f, 4);
     return u;
-}
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 /* ---- the mixes ---------------------------------------------------------------------------------- */
@@ -177,7 +170,7 @@ static int time_once(const Mix *m, int lanes, double target, uint64_t *instr, ui
     }
     if (m->setup)
         m->setup(c);
-    double t0 = now(), t = 0;
+    double t0 = util_now(), t = 0;
     int rc = 0;
     do {
         CoreExit e = core_run(c, CHUNK);
@@ -186,7 +179,7 @@ static int time_once(const Mix *m, int lanes, double target, uint64_t *instr, ui
             rc = -1;
             break;
         }
-        t = now() - t0;
+        t = util_now() - t0;
     } while (t < target);
     const CoreStats *st = core_stats(c);
     *instr = core_instructions(c);

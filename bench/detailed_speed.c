@@ -14,7 +14,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "../scenes/pack.h"
@@ -23,13 +22,7 @@
 #include "../scenes/scene.h"
 #include "../sim/config.h"
 #include "../sim/functional.h"
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "../sim/util.h"
 
 typedef struct Result {
     double secs;
@@ -45,12 +38,12 @@ static int render(const PackedScene *p, uint32_t needs, int timed, int threads, 
     FuncParams fp = {.cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .needs = needs, .seed = 1, .threads = threads, .timed = timed};
     FuncStats st;
     r->rgb = calloc(n, sizeof(float));
-    double t0 = now();
+    double t0 = util_now();
     if (!r->rgb || func_render(p, &fp, r->rgb, &st, err, sizeof err) != 0) {
         fprintf(stderr, "%s\n", err);
         return -1;
     }
-    r->secs = now() - t0;
+    r->secs = util_now() - t0;
     r->instructions = st.instructions;
     r->rays = st.rays_camera + st.rays_indirect + st.rays_shadow;
     r->cycles = st.timing.cycles;

@@ -9,11 +9,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "../scenes/scene.h"
 #include "../tests/support/xcheck.h"
 #include "bench_scenes.h"
+#include "../sim/util.h"
 
 static const char *const shared[] = {
     "scenes/cornell/cornell-box.gltf", /* the shipped box: the one scene a clone on its own has */
@@ -30,13 +30,6 @@ static const char *const shared[] = {
     "../shared/scenes/conference/conference.glb",
     "../shared/scenes/metal-rough-spheres/MetalRoughSpheresNoTextures.glb",
 };
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 int main(int argc, char **argv)
 {
@@ -66,14 +59,14 @@ int main(int argc, char **argv)
         BvhParams bp;
         bvh_default_params(&bp);
         PackedScene p;
-        double t0 = now();
+        double t0 = util_now();
         if (pack_scene(&s, &bp, 0, &p, err, sizeof err) != 0) {
             printf("%-58s error: %s\n", list[i], err);
             scene_free(&s);
             failed = 1;
             continue;
         }
-        double tb = now() - t0;
+        double tb = util_now() - t0;
         XcheckResult x;
         if (xcheck_run(&s, &p, NULL, rays / 4, rays - rays / 4, 17, &x, err, sizeof err) != 0) {
             printf("%-58s error: %s\n", list[i], err);

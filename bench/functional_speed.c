@@ -15,7 +15,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "../scenes/pack.h"
 #include "bench_args.h"
@@ -24,13 +23,7 @@
 #include "../sim/config.h"
 #include "../sim/functional.h"
 #include "../sim/reference.h"
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "../sim/util.h"
 
 int main(int argc, char **argv)
 {
@@ -60,12 +53,12 @@ int main(int argc, char **argv)
         size_t n = 3 * (size_t)w * h;
         float *ref = calloc(n, sizeof(float)), *fun = calloc(n, sizeof(float));
         RefParams rp = {.tile = 64, .seed = 1, .threads = 1};
-        double t0 = now();
+        double t0 = util_now();
         if (!ref || !fun || ref_render(&p, &rp, ref, NULL, err, sizeof err) != 0) {
             fprintf(stderr, "%s: %s\n", scenes[i], err);
             return 1;
         }
-        double t1 = now();
+        double t1 = util_now();
         CfgMachine cfg;
         cfg_defaults(&cfg);
         FuncParams fp = {.cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .needs = s.needs, .seed = 1, .threads = 1};
@@ -74,7 +67,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "%s: %s\n", scenes[i], err);
             return 1;
         }
-        double t2 = now();
+        double t2 = util_now();
         uint64_t rays = st.rays_camera + st.rays_indirect + st.rays_shadow;
         int same = memcmp(ref, fun, n * sizeof(float)) == 0;
         printf("%-34s %12llu %10llu %9.3f %9.3f %10.2f %10.3f %8.1fx%s\n", scenes[i],

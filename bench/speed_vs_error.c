@@ -20,7 +20,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "../scenes/pack.h"
@@ -29,13 +28,7 @@
 #include "../sim/functional.h"
 #include "../sim/sampling.h"
 #include "bench_scenes.h"
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "../sim/util.h"
 
 typedef struct Run {
     FuncStats st;
@@ -49,9 +42,9 @@ static int render(const PackedScene *p, uint32_t needs, const CfgMachine *cfg, i
     FuncParams fp = {.cfg = cfg, .kernel_path = "kernels/pathtrace.s", .needs = needs, .seed = 1, .threads = threads,
                      .timed = timed, .sample = sample, .sample_seed = 1};
     float *rgb = calloc(n, sizeof *rgb);
-    double t0 = now();
+    double t0 = util_now();
     int rc = rgb ? func_render(p, &fp, rgb, &r->st, err, sizeof err) : -1;
-    r->secs = now() - t0;
+    r->secs = util_now() - t0;
     free(rgb);
     if (rc != 0)
         fprintf(stderr, "%s\n", err);

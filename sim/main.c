@@ -10,7 +10,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "../asm/object.h"
@@ -21,9 +20,10 @@
 #include "exithelp.h"
 #include "img.h"
 #include "render.h"
-#include "sweep.h"
+#include "sweep/sweep.h"
 #include "timing.h"
 #include "trace.h"
+#include "util.h"
 
 #define SFSIM_VERSION "0.1"
 
@@ -184,13 +184,6 @@ static int add_set(ConfigArgs *a, const char *s)
     return 0;
 }
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static void print_float_of(uint32_t u, char *buf, size_t len)
 {
     float f;
@@ -283,7 +276,7 @@ static CoreExit run_with_progress(Core *c, uint64_t limit, int progress)
         if (!*end && v >= 0.0 && isfinite(v))
             after = v;
     }
-    double t0 = now(), next = t0 + after;
+    double t0 = util_now(), next = t0 + after;
     uint64_t done = 0;
     for (;;) {
         uint64_t slice = limit - done < SLICE ? limit - done : SLICE;
@@ -291,7 +284,7 @@ static CoreExit run_with_progress(Core *c, uint64_t limit, int progress)
         done += slice;
         if (ex != CORE_EXIT_LIMIT || done >= limit)
             return ex;
-        double t = now();
+        double t = util_now();
         if (progress && t >= next) {
             uint64_t n = core_instructions(c);
             fprintf(stderr, "sfsim exec: still running after %.0f s: %llu instructions of the limit %llu "
@@ -470,9 +463,9 @@ static int cmd_exec(int argc, char **argv)
         }
         core_set_hook(c, timing_hook, tm);
     }
-    double t0 = now();
+    double t0 = util_now();
     CoreExit ex = run_with_progress(c, (uint64_t)cfg.sim_max_instructions, progress);
-    double secs = now() - t0;
+    double secs = util_now() - t0;
     if (tm)
         timing_end(tm);
     uint64_t ni = core_instructions(c);
@@ -593,14 +586,12 @@ static int cmd_compare(int argc, char **argv)
 /* An integer option value in lo..hi; a bad value is bad input (EXIT_INPUT), said by the caller. */
 static int parse_int(const char *cmd, const char *opt, const char *s, long lo, long hi, long *out)
 {
-    char *end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (end == s || *end || errno || v < lo || v > hi) {
+    long long v;
+    if (util_parse_int(s, lo, hi, &v)) {
         fprintf(stderr, "sfsim %s: %s %s: expected an integer in %ld..%ld\n", cmd, opt, s, lo, hi);
         return -1;
     }
-    *out = v;
+    *out = (long)v;
     return 0;
 }
 

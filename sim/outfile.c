@@ -23,6 +23,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "util.h"
+
 enum { OUT_BUF = 1 << 16, OUT_PATH_MAX = 4096 };
 
 /* ---- fault injection ------------------------------------------------------------------------ */
@@ -37,10 +39,9 @@ static void fault_init(void)
     const char *s = getenv("SFSIM_FAIL_WRITE");
     if (!s || atomic_load(&fault_overridden))
         return;
-    char *end;
-    long k = strtol(s, &end, 10);
+    long long k;
     /* A test hook: anything but a positive integer leaves it off. */
-    atomic_store(&fault_at, *s && !*end && k > 0 ? k : 0);
+    atomic_store(&fault_at, util_parse_int(s, 1, LONG_MAX, &k) == 0 ? (long)k : 0);
 }
 
 /* One operation that can fail on a full disk: -1 with errno = ENOSPC if it is the one to fail. */

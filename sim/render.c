@@ -19,7 +19,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "../scenes/pack.h"
@@ -34,6 +33,7 @@
 #include "run/kernel.h"
 #include "sampling.h"
 #include "timing.h"
+#include "util.h"
 
 const RenderKey render_keys[RENDER_KEY_COUNT] = {
     {"render.width", 1, 16384},
@@ -56,13 +56,6 @@ void render_default_options(RenderOptions *o)
     o->sample_seed = 1;
 }
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 typedef struct Progress {
     pthread_mutex_t lock;
     double start;
@@ -75,7 +68,7 @@ static void progress_cb(void *ctx, uint32_t done, uint32_t total)
     if (!pr->enabled)
         return;
     pthread_mutex_lock(&pr->lock);
-    double el = now() - pr->start;
+    double el = util_now() - pr->start;
     double left = done ? el * (double)(total - done) / (double)done : 0.0;
     int width = 40, fill = (int)((double)width * done / total);
     fprintf(stderr, "\r[%.*s%*s] %u/%u tiles  %.1fs elapsed, ~%.1fs left ", fill,
@@ -682,19 +675,19 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     if (outfile_check_dir(o->out_dir, err, errlen) != 0)
         return -3;
     SampleEstimate est_store, *est = NULL;
-    double t0 = now();
+    double t0 = util_now();
     if (scene_load(o->scene_path, &s, err, errlen) != 0)
         return -1;
     for (uint32_t i = 0; i < s.nwarnings; i++) /* what the scene left out (docs/scenes.md) */
         fprintf(stderr, "sfsim run: warning: %s\n", s.warnings[i]);
     if (apply_overrides(o, &s, err, errlen) != 0)
         goto out;
-    double t_load = now();
+    double t_load = util_now();
     AccelInfo accel;
     if (accel_pack(&s, cfg, functional, &p, &accel, err, errlen) != 0)
         goto out;
     rs.kd = accel.kd;
-    double t_kd = now();
+    double t_kd = util_now();
     size_t npx = (size_t)s.render.width * (size_t)s.render.height;
     rgb = calloc(3 * npx, sizeof(float));
     if (!rgb) {
@@ -702,7 +695,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         goto out;
     }
     int threads = o->threads > 0 ? o->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
-    Progress pr = {PTHREAD_MUTEX_INITIALIZER, now(), o->progress};
+    Progress pr = {PTHREAD_MUTEX_INITIALIZER, util_now(), o->progress};
     int tile = (int)lrint(sqrt((double)o->stream_rays));
     if (functional) {
         char kpath[4200];
@@ -787,7 +780,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         rs.nodes_visited = st.nodes_visited;
         rs.prims_tested = st.prims_tested;
     }
-    double t_render = now();
+    double t_render = util_now();
 
     /* From here on a failure is an output that could not be written (EXIT_IO); the folder is
      * made now that there is something to write, and removed again if nothing is written. */

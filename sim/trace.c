@@ -7,7 +7,6 @@
 
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "../scenes/scene.h"
 #include "functional.h"
@@ -15,13 +14,8 @@
 #include "ref_trace.h"
 #include "run/accel.h"
 #include "run/kernel.h"
+#include "util.h"
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 int trace_batch_run(const PackedScene *p, uint32_t needs, const RayBatch *b, BatchHit *hits, const char *mode,
                     const CfgMachine *cfg, const char *kernel_path, int threads, uint64_t *sim_instructions,
@@ -106,11 +100,11 @@ int trace_run(const TraceOptions *o, TraceSummary *sum, char *err, size_t errlen
         snprintf(err, errlen, "out of memory for %u hits", b.count);
         goto out;
     }
-    double t0 = now();
+    double t0 = util_now();
     rc = trace_batch_run(&p, s.needs, &b, hits, o->mode, o->cfg, o->kernel_path, o->threads, &sum->sim_instructions,
                          &sum->timing, err, errlen);
     sum->timed = !strcmp(o->mode, "detailed");
-    sum->seconds = now() - t0;
+    sum->seconds = util_now() - t0;
     if (rc != 0)
         goto out;
     rc = -3; /* an output that could not be written */

@@ -6,14 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <time.h>
-
-static double util_now(void) /* until sim/util.c lands */
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "../util.h"
 
 int accel_prim_boxes(const PackedScene *p, float **bmin, float **bmax)
 {

@@ -7,18 +7,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "../../sim/ref_kd.h"
 #include "../../sim/ref_trace.h"
 #include "../../sim/reference.h"
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "../../sim/util.h"
 
 static void make_ray(const PackedScene *p, uint32_t i, uint32_t camera_rays, uint32_t seed, RefRay *r)
 {
@@ -135,13 +128,13 @@ int xcheck_run(const Scene *scene, const PackedScene *p, const XcheckTracer *tr,
     }
     for (uint32_t i = 0; i < n; i++)
         make_ray(p, i, camera_rays, seed, &rays[i]);
-    double t0 = now();
+    double t0 = util_now();
     for (uint32_t i = 0; i < n; i++)
         if (tr && tr->kd)
             ref_kd_closest_hit(p, tr->kd, (RefKdVariant)tr->variant, tr->depth, &rays[i], &ours[i], NULL);
         else
             ref_closest_hit(p, &rays[i], &ours[i], NULL);
-    double t1 = now();
+    double t1 = util_now();
     for (uint32_t i = 0; tr && tr->kd && i < n; i++) {
         RefHit b;
         ref_closest_hit(p, &rays[i], &b, NULL);
@@ -164,9 +157,9 @@ int xcheck_run(const Scene *scene, const PackedScene *p, const XcheckTracer *tr,
         rh.ray.tfar = INFINITY;
         rh.ray.mask = 0xFFFFFFFFu;
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        double a = now();
+        double a = util_now();
         rtcIntersect1(es, &ctx, &rh);
-        te += now() - a;
+        te += util_now() - a;
         int ehit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
         int ohit = ours[i].prim != REF_NO_HIT;
         uint32_t osrc = ohit ? sm_u32(p, sm_rec(prims, SM_PRIM_WORDS, ours[i].prim, SM_PRIM_SRC)) : 0;

@@ -1,10 +1,11 @@
-/* sim/sweep.h -- `sfsim sweep` and `sfsim merge`: runs of one scene over many machine configs.
+/* sim/sweep/sweep.h -- `sfsim sweep` and `sfsim merge`: runs of one scene over many machine configs.
  *
  * Owns: sweep files (the INI files in configs/sweeps: lists, ranges, cross products or explicit points),
  * the sweep folder (manifest, one folder per point, done/failed markers), running points in
  * parallel as child `sfsim run` processes, resuming, sweep.csv, the gnuplot plots, and the
  * Slurm / GNU parallel scripts. Must not: simulate (each point is an `sfsim run`).
- * docs/sweep.md is the user's reference.
+ * docs/sweep.md is the user's reference; the files of sim/sweep/ each hold one of these jobs
+ * (sweep_int.h lists them).
  */
 #ifndef SFSIM_SWEEP_H
 #define SFSIM_SWEEP_H

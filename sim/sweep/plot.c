@@ -1,0 +1,628 @@
+/* sim/sweep/plot.c -- the sweep's plots: gnuplot scripts, their data and the PNGs they draw in
+ * DIR/plots (docs/sweep.md, "Plots").
+ *
+ * Owns: which plots a sweep gets (lines and stacked bars against each numeric swept key, or bar
+ * charts against the point), their .gp and .dat files, titles, axis units and colours, and
+ * running gnuplot (a missing or failing gnuplot is a warning). Must not: read reports (csv.c
+ * gives the rows), or change the exit status of a sweep.
+ */
+#include "sweep_int.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+typedef struct Plotter {
+    const SweepPlan *pl;
+    const SweepRow *rows;
+    const char *dir; /* DIR/plots */
+    char *subtitle;  /* scene, mode and fixed keys, gnuplot-escaped, lines joined by \n */
+    int made;
+    int gnuplot_missing, gnuplot_failed;
+} Plotter;
+
+/* A string in gnuplot double quotes. */
+static void gp_str(UtilBuf *b, const char *s)
+{
+    util_buf_puts(b, "\"");
+    for (const char *c = s; *c; c++) {
+        if (*c == '"' || *c == '\\')
+            util_buf_puts(b, "\\");
+        util_buf_add(b, c, 1);
+    }
+    util_buf_puts(b, "\"");
+}
+
+/* Units of a key for its axis label. */
+static const char *key_unit(const char *key)
+{
+    static const struct { const char *suffix, *unit; } units[] = {
+        {"core.simd_width", "lanes"}, {"stream.rays", "rays per stream"}, {"render.width", "pixels"},
+        {"render.height", "pixels"}, {"render.spp", "samples per pixel"}, {"render.max_depth", "bounces"},
+        {"kd.max_depth", "levels"},
+        {"_per_cycle", "per cycle"}, {"_kb", "KiB"}, {"_mb", "MiB"}, {"_mhz", "MHz"}, {"_bytes", "bytes"},
+        {"_cycles", "cycles"}, {"_penalty", "cycles"}, {"latency", "cycles"}, {"banks", "banks"}, {"ports", "ports"},
+        {"_ways", "ways"}, {"_depth", "entries"}, {"bins", "bins"}, {"leaf_size", "primitives"},
+        {"bounces", "bounces"}};
+    size_t kl = strlen(key);
+    for (size_t i = 0; i < sizeof units / sizeof units[0]; i++) {
+        size_t sl = strlen(units[i].suffix);
+        if (kl >= sl && !strcmp(key + kl - sl, units[i].suffix))
+            return units[i].unit;
+    }
+    if (!strncmp(key, "latency.", 8))
+        return "cycles";
+    if (!strncmp(key, "issue.", 6))
+        return "cycles between issues";
+    return NULL;
+}
+
+static void axis_label(UtilBuf *b, const char *key)
+{
+    const char *u = key_unit(key);
+    UtilBuf t = {0};
+    util_buf_printf(&t, u ? "%s (%s)" : "%s", key, u);
+    gp_str(b, sweep_buf_text(&t));
+    util_buf_free(&t);
+}
+
+/* Distinct values of a key over all points; *numeric when every point sets it to a number. */
+static int key_values(const SweepPlan *pl, const char *key, int *numeric)
+{
+    SweepStrs seen = {0};
+    *numeric = 1;
+    for (int p = 0; p < pl->npoints; p++) {
+        const char *v = sweep_plan_value(pl, p, key);
+        double d;
+        if (!v || !sweep_is_number(v, &d))
+            *numeric = 0;
+        int dup = 0;
+        for (int i = 0; i < seen.n && !dup; i++)
+            dup = sweep_str_eq(seen.v[i], v);
+        if (!dup)
+            sweep_strs_push(&seen, v ? xstrdup(v) : NULL);
+    }
+    int n = seen.n;
+    sweep_strs_free(&seen);
+    return n;
+}
+
+static int key_swept(const SweepPlan *pl, const char *key)
+{
+    int numeric;
+    return key_values(pl, key, &numeric) > 1;
+}
+
+static int row_usable(const Plotter *p, int r, int m0, int n)
+{
+    if (p->rows[r].state != SWEEP_DONE)
+        return 0;
+    for (int m = m0; m < m0 + n; m++)
+        if (p->rows[r].has[m])
+            return 1;
+    return 0;
+}
+
+static void dat_num(UtilBuf *b, const SweepRow *row, int m)
+{
+    char v[64];
+    if (row->has[m])
+        sweep_fmt_num(row->m[m], v, sizeof v);
+    else
+        snprintf(v, sizeof v, "NaN");
+    util_buf_printf(b, " %s", v);
+}
+
+/* A group of rows: the points that share the values of the swept keys other than x. */
+typedef struct Group {
+    char *label;
+    int *rows;
+    int n;
+} Group;
+
+static void groups_free(Group *g, int n)
+{
+    for (int i = 0; i < n; i++) {
+        free(g[i].label);
+        free(g[i].rows);
+    }
+    free(g);
+}
+
+/* Usable rows (metrics m0..m0+n-1) grouped by the other swept keys, each sorted by x. */
+static int groups_make(const Plotter *p, const char *xkey, int m0, int nm, Group **out)
+{
+    const SweepPlan *pl = p->pl;
+    Group *g = NULL;
+    int ng = 0;
+    for (int r = 0; r < pl->npoints; r++) {
+        if (!row_usable(p, r, m0, nm))
+            continue;
+        UtilBuf label = {0};
+        for (int k = 0; k < pl->nkeys; k++) {
+            if (!strcmp(pl->keys[k], xkey) || !key_swept(pl, pl->keys[k]))
+                continue;
+            const char *v = sweep_plan_value(pl, r, pl->keys[k]);
+            util_buf_printf(&label, "%s%s=%s", label.len ? ", " : "", pl->keys[k], v ? v : "(unset)");
+        }
+        int i = 0;
+        while (i < ng && strcmp(g[i].label, sweep_buf_text(&label)))
+            i++;
+        if (i == ng) {
+            g = xrealloc(g, (size_t)(ng + 1) * sizeof *g);
+            g[ng].label = xstrdup(sweep_buf_text(&label));
+            g[ng].rows = NULL;
+            g[ng].n = 0;
+            ng++;
+        }
+        util_buf_free(&label);
+        g[i].rows = xrealloc(g[i].rows, (size_t)(g[i].n + 1) * sizeof *g[i].rows);
+        double x, y;
+        sweep_is_number(sweep_plan_value(pl, r, xkey), &x);
+        int j = g[i].n++;
+        while (j > 0 && sweep_is_number(sweep_plan_value(pl, g[i].rows[j - 1], xkey), &y) && y > x) {
+            g[i].rows[j] = g[i].rows[j - 1];
+            j--;
+        }
+        g[i].rows[j] = r;
+    }
+    *out = g;
+    return ng;
+}
+
+/* Run gnuplot on base.gp in the plots folder; its messages go to gnuplot.log. */
+static void gp_run(Plotter *p, const char *base)
+{
+    if (p->gnuplot_missing)
+        return;
+    char *script = xasprintf("%s.gp", base);
+    char *logpath = xasprintf("%s/gnuplot.log", p->dir);
+    int logfd = open(logpath, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+    if (logfd < 0) {
+        fprintf(stderr, "sfsim sweep: warning: %s: cannot create: %s; no plots\n", logpath, strerror(errno));
+        p->gnuplot_missing = 1;
+        goto out;
+    }
+    dprintf(logfd, "== gnuplot %s\n", script);
+    pid_t pid = fork();
+    if (pid == 0) {
+        if (chdir(p->dir) != 0 || dup2(logfd, 1) < 0 || dup2(logfd, 2) < 0)
+            _exit(126);
+        execlp("gnuplot", "gnuplot", script, (char *)NULL);
+        _exit(127);
+    }
+    close(logfd);
+    int st = 0;
+    if (pid < 0) {
+        fprintf(stderr, "sfsim sweep: warning: cannot start gnuplot: %s; no plots\n", strerror(errno));
+        p->gnuplot_missing = 1;
+        goto out;
+    }
+    while (waitpid(pid, &st, 0) < 0 && errno == EINTR)
+        ;
+    if (WIFEXITED(st) && WEXITSTATUS(st) == 127) {
+        fprintf(stderr, "sfsim sweep: warning: gnuplot is not installed (Debian: gnuplot-nox); no plots, the CSV is "
+                        "written\n");
+        p->gnuplot_missing = 1;
+    } else if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+        fprintf(stderr, "sfsim sweep: warning: gnuplot failed on %s/%s (see %s)\n", p->dir, script, logpath);
+        p->gnuplot_failed++;
+    } else {
+        p->made++;
+    }
+out:
+    free(script);
+    free(logpath);
+}
+
+/* Write base.gp and base.dat, then draw base.png. */
+static void plot_write(Plotter *p, const char *base, const UtilBuf *gp, const UtilBuf *dat)
+{
+    char err[PATH_MAX + 256];
+    char *gpath = xasprintf("%s/%s.gp", p->dir, base), *dpath = xasprintf("%s/%s.dat", p->dir, base);
+    if (util_file_write_atomic(dpath, sweep_buf_text(dat), dat->len, err, sizeof err) ||
+        util_file_write_atomic(gpath, sweep_buf_text(gp), gp->len, err, sizeof err))
+        fprintf(stderr, "sfsim sweep: warning: %s\n", err);
+    else
+        gp_run(p, base);
+    free(gpath);
+    free(dpath);
+}
+
+/* End the script (closing a multiplot), write both files, draw, and free the buffers. */
+static void plot_finish(Plotter *p, const char *base, UtilBuf *gp, UtilBuf *dat, int multiplot)
+{
+    if (multiplot)
+        util_buf_puts(gp, "unset multiplot\n");
+    plot_write(p, base, gp, dat);
+    util_buf_free(gp);
+    util_buf_free(dat);
+}
+
+static void gp_head(const Plotter *p, UtilBuf *g, const char *base, int w, int h, const char *what, const char *against)
+{
+    util_buf_printf(g, "# Written by sfsim sweep / sfsim merge from the points of this sweep; the data is in %s.dat.\n"
+                       "# Restyle and redraw: cd into this folder, then gnuplot %s.gp\n", base, base);
+    util_buf_printf(g, "set terminal pngcairo size %d,%d noenhanced font \"sans,11\"\nset output \"%s.png\"\n", w, h,
+                    base);
+    util_buf_puts(g, "set datafile missing \"NaN\"\nset grid\n");
+    UtilBuf t = {0};
+    util_buf_printf(&t, "%s against %s", what, against);
+    util_buf_puts(g, "set title ");
+    gp_str(g, sweep_buf_text(&t));
+    util_buf_printf(g, " . \"\\n\" . %s\n", p->subtitle);
+    util_buf_free(&t);
+}
+
+/* Colours of stacked bars (matplotlib's tab10). */
+static const char *const palette[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
+                                      "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
+#define N_PALETTE (int)(sizeof palette / sizeof palette[0])
+
+static void gp_palette(UtilBuf *g, int n)
+{
+    for (int i = 0; i < n; i++)
+        util_buf_printf(g, "set linetype %d lc rgb \"%s\"\n", i + 1, palette[i % N_PALETTE]);
+}
+
+/* Series of a stacked plot: stall causes or operation categories. */
+typedef struct Series {
+    int m0, n;
+    const char *const *names;
+    const char *what, *ylabel, *base;
+    int unit_range;
+} Series;
+
+static const Series stall_series = {SWEEP_M_STALL, TM_CAUSE_COUNT, tm_cause_keys, "stall cycles by cause",
+                                    "share of all cycles", "stalls", 0};
+static const Series ops_series = {SWEEP_M_OPS, ISA_C_COUNT, isa_category_keys, "operation mix",
+                                  "share of executed instructions", "ops", 1};
+
+/* fps (lines, with the confidence interval as error bars when every point has one), SIMD
+ * utilization (three panels) or, for kd-tree runs, nodes visited per ray against a numeric key.
+ * what: 0 fps, 1 utilization, 2 kd-tree nodes. */
+static void plot_lines(Plotter *p, const char *xkey, int what)
+{
+    const int util = what == 1, kd = what == 2;
+    int m0 = util ? SWEEP_M_UTIL : kd ? SWEEP_M_KD : SWEEP_M_FPS, nm = util ? 3 : 1;
+    Group *g;
+    int ng = groups_make(p, xkey, m0, nm, &g);
+    if (!ng) {
+        groups_free(g, ng);
+        return;
+    }
+    int ci = !util && !kd;
+    for (int i = 0; i < ng && ci; i++)
+        for (int j = 0; j < g[i].n && ci; j++)
+            ci = p->rows[g[i].rows[j]].has[SWEEP_M_FPS_LO] && p->rows[g[i].rows[j]].has[SWEEP_M_FPS_HI];
+    char *base = xasprintf("%s_%s", util ? "utilization" : kd ? "kd_nodes" : "fps", xkey);
+    UtilBuf gp = {0}, dat = {0};
+    for (int i = 0; i < ng; i++) {
+        util_buf_printf(&dat, "%s# %s\n# %s %s\n", i ? "\n\n" : "", g[i].label[0] ? g[i].label : "all points", xkey,
+                        util ? "utilization_traversal utilization_intersection utilization_shading"
+                        : kd ? "kd_camera_nodes_per_ray kd_nodes_per_ray" : "fps fps_lo fps_hi");
+        for (int j = 0; j < g[i].n; j++) {
+            const SweepRow *row = &p->rows[g[i].rows[j]];
+            util_buf_printf(&dat, "%s", sweep_plan_value(p->pl, g[i].rows[j], xkey));
+            if (util) {
+                for (int s = 0; s < 3; s++)
+                    dat_num(&dat, row, SWEEP_M_UTIL + s);
+            } else if (kd) {
+                dat_num(&dat, row, SWEEP_M_KD_CAMERA_NODES);
+                dat_num(&dat, row, SWEEP_M_KD);
+            } else {
+                dat_num(&dat, row, SWEEP_M_FPS);
+                dat_num(&dat, row, SWEEP_M_FPS_LO);
+                dat_num(&dat, row, SWEEP_M_FPS_HI);
+            }
+            util_buf_puts(&dat, "\n");
+        }
+    }
+    gp_head(p, &gp, base, util ? 1500 : 960, util ? 560 : 620,
+            util ? "SIMD utilization per stage" : kd ? "kd-tree nodes visited per ray" : "frames per second", xkey);
+    util_buf_puts(&gp, "set xlabel ");
+    axis_label(&gp, xkey);
+    util_buf_puts(&gp, "\n");
+    int numeric, nv = key_values(p->pl, xkey, &numeric);
+    double lo = INFINITY, hi = -INFINITY;
+    for (int r = 0; r < p->pl->npoints; r++) {
+        double x;
+        if (sweep_is_number(sweep_plan_value(p->pl, r, xkey), &x))
+            lo = fmin(lo, x), hi = fmax(hi, x);
+    }
+    if (lo > 0 && hi / lo >= 100)
+        util_buf_puts(&gp, "set logscale x\n");
+    if (nv <= 16) {
+        util_buf_puts(&gp, "set xtics (");
+        SweepStrs seen = {0};
+        for (int r = 0; r < p->pl->npoints; r++) {
+            const char *v = sweep_plan_value(p->pl, r, xkey);
+            int dup = 0;
+            for (int i = 0; i < seen.n && !dup; i++)
+                dup = !strcmp(seen.v[i], v);
+            if (!dup) {
+                util_buf_printf(&gp, "%s%s", seen.n ? ", " : "", v);
+                sweep_strs_push(&seen, xstrdup(v));
+            }
+        }
+        sweep_strs_free(&seen);
+        util_buf_puts(&gp, ")\n");
+    }
+    util_buf_puts(&gp, "set offsets graph 0.03, graph 0.03, 0, 0\n");
+    util_buf_puts(&gp, ng > 1 || kd ? "set key outside below center horizontal\n" : "unset key\n");
+    if (util) {
+        util_buf_puts(&gp, "set yrange [0:1]\nset ylabel \"SIMD utilization (active lanes / N)\"\n");
+        util_buf_puts(&gp, "set multiplot layout 1,3 title ");
+        UtilBuf t = {0};
+        util_buf_printf(&t, "SIMD utilization per stage against %s", xkey);
+        gp_str(&gp, sweep_buf_text(&t));
+        util_buf_free(&t);
+        util_buf_printf(&gp, " . \"\\n\" . %s\nunset title\n", p->subtitle);
+    } else if (kd) {
+        util_buf_puts(&gp, "set yrange [0:*]\nset ylabel \"nodes visited per ray (inner nodes and leaves)\"\n");
+    } else {
+        util_buf_printf(&gp, "set yrange [0:*]\nset ylabel \"frames per second (at core.clock_mhz)%s\"\n",
+                        ci ? "; bars: 95% confidence interval" : "");
+    }
+    for (int s = 0; s < (util ? 3 : 1); s++) {
+        if (util)
+            util_buf_printf(&gp, "set title \"%s\"\n", isa_stage_keys[sweep_stages[s]]);
+        util_buf_puts(&gp, "plot ");
+        for (int i = 0; i < ng && kd; i++)
+            for (int c = 0; c < 2; c++) {
+                UtilBuf t = {0};
+                util_buf_printf(&t, "%s%s%s", c ? "all rays" : "camera rays", g[i].label[0] ? ", " : "", g[i].label);
+                util_buf_printf(&gp, "%s\"%s.dat\" index %d using 1:%d with linespoints lw 2 pt 7 ps 1.2 title ",
+                                i || c ? ", \\\n     " : "", base, i, 2 + c);
+                gp_str(&gp, sweep_buf_text(&t));
+                util_buf_free(&t);
+            }
+        for (int i = 0; i < ng && !kd; i++) {
+            util_buf_printf(&gp, "%s\"%s.dat\" index %d using 1:%d%s with %s lw 2 pt 7 ps 1.2 title ",
+                            i ? ", \\\n     " : "", base, i, 2 + s, ci ? ":3:4" : "",
+                            ci ? "yerrorlines" : "linespoints");
+            gp_str(&gp, g[i].label[0] ? g[i].label : (ci ? "fps, 95% confidence interval" : "all points"));
+        }
+        util_buf_puts(&gp, "\n");
+    }
+    plot_finish(p, base, &gp, &dat, util);
+    free(base);
+    groups_free(g, ng);
+}
+
+/* Stall shares or the operation mix as stacked bars against a numeric key, one panel per
+ * combination of the other swept keys. */
+static void plot_stacked(Plotter *p, const char *xkey, const Series *se)
+{
+    Group *g;
+    int ng = groups_make(p, xkey, se->m0, se->n, &g);
+    if (!ng) {
+        groups_free(g, ng);
+        return;
+    }
+    int cols = ng == 1 ? 1 : ng <= 4 ? 2 : 3, rws = (ng + cols - 1) / cols;
+    char *base = xasprintf("%s_%s", se->base, xkey);
+    UtilBuf gp = {0}, dat = {0};
+    for (int i = 0; i < ng; i++) {
+        util_buf_printf(&dat, "%s# %s\n# %s", i ? "\n\n" : "", g[i].label[0] ? g[i].label : "all points", xkey);
+        for (int c = 0; c < se->n; c++)
+            util_buf_printf(&dat, " %s", se->names[c]);
+        util_buf_puts(&dat, "\n");
+        for (int j = 0; j < g[i].n; j++) {
+            util_buf_printf(&dat, "\"%s\"", sweep_plan_value(p->pl, g[i].rows[j], xkey));
+            for (int c = 0; c < se->n; c++)
+                dat_num(&dat, &p->rows[g[i].rows[j]], se->m0 + c);
+            util_buf_puts(&dat, "\n");
+        }
+    }
+    gp_head(p, &gp, base, 820 * cols, 480 * rws + 60, se->what, xkey);
+    util_buf_puts(&gp, "set style data histograms\nset style histogram rowstacked\n"
+                       "set style fill solid 0.85 border -1\nset boxwidth 0.7 relative\nset key outside right top\n");
+    util_buf_printf(&gp, "set yrange [0:%s]\nset ylabel \"%s\"\nset xlabel ", se->unit_range ? "1" : "*", se->ylabel);
+    axis_label(&gp, xkey);
+    util_buf_puts(&gp, "\n");
+    gp_palette(&gp, se->n);
+    if (ng > 1) {
+        util_buf_printf(&gp, "set multiplot layout %d,%d title ", rws, cols);
+        UtilBuf t = {0};
+        util_buf_printf(&t, "%s against %s (a panel per combination of the other keys)", se->what, xkey);
+        gp_str(&gp, sweep_buf_text(&t));
+        util_buf_free(&t);
+        util_buf_printf(&gp, " . \"\\n\" . %s\n", p->subtitle);
+    }
+    for (int i = 0; i < ng; i++) {
+        if (ng > 1) {
+            util_buf_puts(&gp, "set title ");
+            gp_str(&gp, g[i].label);
+            util_buf_puts(&gp, "\n");
+        }
+        util_buf_puts(&gp, "plot ");
+        for (int c = 0; c < se->n; c++)
+            util_buf_printf(&gp, "%s\"%s.dat\" index %d using %d%s title \"%s\"", c ? ", \\\n     " : "", base, i,
+                            c + 2, c ? "" : ":xtic(1)", se->names[c]);
+        util_buf_puts(&gp, "\n");
+    }
+    plot_finish(p, base, &gp, &dat, ng > 1);
+    free(base);
+    groups_free(g, ng);
+}
+
+/* Bar charts against the point (explicit points, or no numeric key swept). kind: 0 fps,
+ * 1 utilization, 2 stalls, 3 ops. */
+static void plot_bars(Plotter *p, int kind)
+{
+    const SweepPlan *pl = p->pl;
+    const Series *se = kind == 2 ? &stall_series : kind == 3 ? &ops_series : NULL;
+    int m0 = se ? se->m0 : kind == 1 ? SWEEP_M_UTIL : kind == 4 ? SWEEP_M_KD : SWEEP_M_FPS;
+    int nm = se ? se->n : kind == 1 ? 3 : 1;
+    static const char *const bases[] = {"fps_point", "utilization_point", "stalls_point", "ops_point",
+                                        "kd_nodes_point"};
+    static const char *const whats[] = {"frames per second", "SIMD utilization per stage", "stall cycles by cause",
+                                        "operation mix", "kd-tree nodes visited per ray"};
+    UtilBuf gp = {0}, dat = {0};
+    int n = 0, ci = kind == 0, longest = 0;
+    for (int r = 0; r < pl->npoints; r++) {
+        if (!row_usable(p, r, m0, nm))
+            continue;
+        UtilBuf label = {0};
+        if (pl->points[r].name)
+            util_buf_puts(&label, pl->points[r].name);
+        for (int k = 0; k < pl->nkeys && !pl->points[r].name; k++)
+            if (key_swept(pl, pl->keys[k])) {
+                const char *v = sweep_plan_value(pl, r, pl->keys[k]);
+                util_buf_printf(&label, "%s%s=%s", label.len ? ", " : "", pl->keys[k], v ? v : "(unset)");
+            }
+        if (!label.len)
+            util_buf_printf(&label, "%d", r);
+        longest = (int)label.len > longest ? (int)label.len : longest;
+        gp_str(&dat, sweep_buf_text(&label));
+        util_buf_free(&label);
+        if (kind == 0) {
+            dat_num(&dat, &p->rows[r], SWEEP_M_FPS);
+            dat_num(&dat, &p->rows[r], SWEEP_M_FPS_LO);
+            dat_num(&dat, &p->rows[r], SWEEP_M_FPS_HI);
+            ci = ci && p->rows[r].has[SWEEP_M_FPS_LO] && p->rows[r].has[SWEEP_M_FPS_HI];
+        } else if (kind == 4) {
+            dat_num(&dat, &p->rows[r], SWEEP_M_KD_CAMERA_NODES);
+            dat_num(&dat, &p->rows[r], SWEEP_M_KD);
+        } else {
+            for (int m = m0; m < m0 + nm; m++)
+                dat_num(&dat, &p->rows[r], m);
+        }
+        util_buf_puts(&dat, "\n");
+        n++;
+    }
+    if (!n) {
+        util_buf_free(&dat);
+        return;
+    }
+    int w = 300 + 70 * n * (kind == 1 || kind == 4 ? 2 : 1);
+    int wmin = kind == 0 ? 900 : 1100;
+    gp_head(p, &gp, bases[kind], w < wmin ? wmin : w, 600 + 6 * (longest > 12 ? longest : 0), whats[kind], "the point");
+    util_buf_puts(&gp, "set style fill solid 0.85 border -1\nset xlabel \"point\"\n");
+    if (n > 6 || longest > 10)
+        util_buf_puts(&gp, "set xtics rotate by 30 right\n");
+    if (kind == 0) {
+        util_buf_printf(&gp, "set boxwidth 0.6\nset xrange [-0.6:%g]\nset yrange [0:*]\n"
+                             "set ylabel \"frames per second (at core.clock_mhz)\"\n", n - 0.4);
+        util_buf_printf(&gp, "plot \"%s.dat\" using 0:2:xtic(1) with boxes lc rgb \"%s\" %s", bases[kind], palette[0],
+                        ci ? "title \"fps\"" : "notitle");
+        if (ci)
+            util_buf_printf(&gp, ", \\\n     \"%s.dat\" using 0:2:3:4 with yerrorbars lc rgb \"black\" pt -1 "
+                                 "title \"95%% confidence interval\"", bases[kind]);
+        util_buf_puts(&gp, "\n");
+    } else if (kind == 4) {
+        util_buf_puts(&gp, "set style data histograms\nset style histogram clustered gap 1\nset yrange [0:*]\n"
+                           "set ylabel \"nodes visited per ray (inner nodes and leaves)\"\n"
+                           "set key outside right top\n");
+        gp_palette(&gp, 2);
+        util_buf_printf(&gp, "plot \"%s.dat\" using 2:xtic(1) title \"camera rays\", \\\n     \"%s.dat\" using 3 "
+                             "title \"all rays\"\n", bases[kind], bases[kind]);
+    } else if (kind == 1) {
+        util_buf_puts(&gp, "set style data histograms\nset style histogram clustered gap 1\nset yrange [0:1]\n"
+                           "set ylabel \"SIMD utilization (active lanes / N)\"\nset key outside right top\n");
+        gp_palette(&gp, 3);
+        for (int s = 0; s < 3; s++)
+            util_buf_printf(&gp, "%s\"%s.dat\" using %d%s title \"%s\"", s ? ", \\\n     " : "plot ", bases[kind],
+                            s + 2, s ? "" : ":xtic(1)", isa_stage_keys[sweep_stages[s]]);
+        util_buf_puts(&gp, "\n");
+    } else {
+        util_buf_printf(&gp, "set style data histograms\nset style histogram rowstacked\nset boxwidth 0.7 relative\n"
+                             "set yrange [0:%s]\nset ylabel \"%s\"\nset key outside right top\n",
+                   se->unit_range ? "1" : "*", se->ylabel);
+        gp_palette(&gp, se->n);
+        for (int c = 0; c < se->n; c++)
+            util_buf_printf(&gp, "%s\"%s.dat\" using %d%s title \"%s\"", c ? ", \\\n     " : "plot ", bases[kind],
+                            c + 2, c ? "" : ":xtic(1)", se->names[c]);
+        util_buf_puts(&gp, "\n");
+    }
+    plot_finish(p, bases[kind], &gp, &dat, 0);
+}
+
+/* "cornell/scene.ini": the scene's file and its folder. */
+static const char *short_path(const char *path)
+{
+    const char *last = strrchr(path, '/');
+    if (!last)
+        return path;
+    const char *prev = last;
+    while (prev > path && prev[-1] != '/')
+        prev--;
+    return prev > path ? prev : last + 1;
+}
+
+/* The second title line(s): scene, mode, config and the keys every point shares. */
+static char *plot_subtitle(const SweepPlan *pl)
+{
+    UtilBuf s = {0}, line = {0};
+    SweepStrs parts = {0};
+    sweep_strs_push(&parts, xasprintf("scene %s", short_path(pl->scene)));
+    sweep_strs_push(&parts, pl->sample ? xasprintf("%s mode (sample %s)", pl->mode, pl->sample)
+                                       : xasprintf("%s mode", pl->mode));
+    sweep_strs_push(&parts, xasprintf("config %s", pl->config ? short_path(pl->config) : "built-in"));
+    for (int i = 0; i < pl->nsets; i++)
+        sweep_strs_push(&parts, xstrdup(pl->sets[i]));
+    for (int k = 0; k < pl->nkeys && !pl->explicit_points; k++)
+        if (!key_swept(pl, pl->keys[k]))
+            sweep_strs_push(&parts, xasprintf("%s=%s", pl->keys[k], sweep_plan_value(pl, 0, pl->keys[k])));
+    /* Lines of at most ~110 characters. */
+    for (int i = 0; i < parts.n; i++) {
+        if (line.len && line.len + strlen(parts.v[i]) > 110) {
+            if (s.len)
+                util_buf_puts(&s, " . \"\\n\" . ");
+            gp_str(&s, sweep_buf_text(&line));
+            line.len = 0;
+            line.s[0] = 0;
+        }
+        util_buf_printf(&line, "%s%s", line.len ? ", " : "", parts.v[i]);
+    }
+    if (s.len)
+        util_buf_puts(&s, " . \"\\n\" . ");
+    gp_str(&s, sweep_buf_text(&line));
+    util_buf_free(&line);
+    sweep_strs_free(&parts);
+    if (s.failed)
+        sweep_oom();
+    return s.s;
+}
+
+int sweep_plots_make(const SweepPlan *pl, const SweepRow *rows, const char *dir, int *failed)
+{
+    char err[PATH_MAX + 256];
+    Plotter p = {0};
+    p.pl = pl;
+    p.rows = rows;
+    char *pdir = xasprintf("%s/plots", dir);
+    p.dir = pdir;
+    *failed = 0;
+    if (util_mkdir_p(pdir, err, sizeof err)) {
+        fprintf(stderr, "sfsim sweep: warning: %s; no plots\n", err);
+        free(pdir);
+        return 0;
+    }
+    char *logpath = xasprintf("%s/gnuplot.log", pdir);
+    unlink(logpath);
+    free(logpath);
+    p.subtitle = plot_subtitle(pl);
+    int lines = 0;
+    for (int k = 0; k < pl->nkeys && !pl->explicit_points; k++) {
+        int numeric, nv = key_values(pl, pl->keys[k], &numeric);
+        if (nv < 2 || !numeric)
+            continue;
+        lines++;
+        plot_lines(&p, pl->keys[k], 0);
+        plot_lines(&p, pl->keys[k], 1);
+        plot_lines(&p, pl->keys[k], 2); /* only when some point ran on a kd-tree */
+        plot_stacked(&p, pl->keys[k], &stall_series);
+        plot_stacked(&p, pl->keys[k], &ops_series);
+    }
+    if (!lines)
+        for (int kind = 0; kind < 5; kind++)
+            plot_bars(&p, kind); /* (kd_nodes_point: only when some point ran on a kd-tree) */
+    free(p.subtitle);
+    free(pdir);
+    *failed = p.gnuplot_failed || p.gnuplot_missing;
+    return p.made;
+}

@@ -1,0 +1,384 @@
+/* tests/unit/test_sweep_csv.c -- sweep.csv (sim/sweep/csv.c, csv_columns.def): the figure
+ * columns and their order, figures read back from a report.json written in a temporary folder
+ * (shares, the confidence interval, values of the wrong type), and the whole file: key columns,
+ * status and error, quoting, number formats, and the rows of failed, unfinished and report-less
+ * points. docs/sweep.md, "sweep.csv", is the contract.
+ *
+ * Suites: sweep_columns, sweep_report, sweep_csv.
+ */
+#include <criterion/criterion.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "../../sim/sweep/sweep_int.h"
+#include "../support/files.h"
+
+/* ---- helpers ------------------------------------------------------------------------------------ */
+
+static void make_tmpdir(char *dir, size_t len)
+{
+    snprintf(dir, len, "/tmp/sfsim-sweepcsv-XXXXXX");
+    cr_assert_not_null(mkdtemp(dir));
+}
+
+static void write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    cr_assert_not_null(f, "cannot create %s", path);
+    fputs(text, f);
+    fclose(f);
+}
+
+static char *name_of(int m)
+{
+    static char buf[8][64];
+    static int next;
+    char *b = buf[next++ % 8];
+    sweep_metric_name(m, b, 64);
+    return b;
+}
+
+static int starts_with(const char *s, const char *prefix)
+{
+    return !strncmp(s, prefix, strlen(prefix));
+}
+
+/* SWEEP_M_COUNT commas: the figure cells of a row that has none. */
+static const char *no_figures(void)
+{
+    static char buf[512];
+    buf[0] = 0;
+    for (int m = 0; m < SWEEP_M_COUNT; m++)
+        strcat(buf, ",");
+    return buf;
+}
+
+/* The column named name, or -1. */
+static int column(const char *name)
+{
+    for (int m = 0; m < SWEEP_M_COUNT; m++)
+        if (!strcmp(name_of(m), name))
+            return m;
+    return -1;
+}
+
+/* A report.json in dir, read into a fresh row. */
+static SweepRow read_report(const char *dir, const char *json)
+{
+    char path[256], err[512] = "";
+    snprintf(path, sizeof path, "%s/report.json", dir);
+    write_file(path, json);
+    SweepRow row;
+    memset(&row, 0, sizeof row);
+    cr_assert_eq(sweep_row_read_report(&row, path, err, sizeof err), 0, "%s", err);
+    return row;
+}
+
+/* The cells of one CSV line (quoted fields unquoted), into cells; returns how many. */
+static int split_csv(const char *line, char cells[][256], int max)
+{
+    int n = 0;
+    const char *p = line;
+    for (;;) {
+        cr_assert_lt(n, max);
+        char *c = cells[n++];
+        size_t k = 0;
+        if (*p == '"') {
+            for (p++; *p && !(*p == '"' && p[1] != '"'); p++) {
+                if (*p == '"')
+                    p++;
+                c[k++] = *p;
+            }
+            p += *p == '"';
+        } else {
+            while (*p && *p != ',' && *p != '\n')
+                c[k++] = *p++;
+        }
+        c[k] = 0;
+        if (*p != ',')
+            return n;
+        p++;
+    }
+}
+
+/* ---- the column list ---------------------------------------------------------------------------- */
+
+Test(sweep_columns, names_in_the_documented_order)
+{
+    /* docs/sweep.md's table, in order */
+    cr_expect_str_eq(name_of(0), "cycles");
+    cr_expect_str_eq(name_of(1), "busy_cycles");
+    cr_expect_str_eq(name_of(2), "fps");
+    cr_expect_str_eq(name_of(3), "fps_no_stall");
+    cr_expect_str_eq(name_of(4), "fps_lo");
+    cr_expect_str_eq(name_of(5), "fps_hi");
+    cr_expect_str_eq(name_of(6), "utilization_traversal");
+    cr_expect_str_eq(name_of(7), "utilization_intersection");
+    cr_expect_str_eq(name_of(8), "utilization_shading");
+    cr_expect_str_eq(name_of(9), "utilization_other");
+    cr_expect_str_eq(name_of(10), "utilization_timed_traversal");
+    cr_expect_str_eq(name_of(13), "utilization_timed_other");
+    cr_expect_str_eq(name_of(14), "stall_share_address_fetch");
+    cr_expect_str_eq(name_of(14 + TM_CAUSE_COUNT), "ops_share_load");
+    int rays = 14 + TM_CAUSE_COUNT + ISA_C_COUNT;
+    cr_expect_str_eq(name_of(rays - 1), "ops_share_control");
+    cr_expect_str_eq(name_of(rays), "rays_total");
+    cr_expect_str_eq(name_of(rays + 1), "host_seconds");
+    cr_expect_str_eq(name_of(rays + 2), "kd_nodes_per_ray");
+    cr_expect_str_eq(name_of(rays + 7), "kd_underflows_per_ray");
+    cr_expect_str_eq(name_of(rays + 8), "kd_camera_nodes_per_ray");
+    cr_expect_str_eq(name_of(rays + 8 + 6), "kd_indirect_nodes_per_ray");
+    cr_expect_str_eq(name_of(SWEEP_M_COUNT - 1), "kd_shadow_underflows_per_ray");
+    cr_expect_eq(SWEEP_M_COUNT, rays + 2 + 6 + 3 * 6);
+}
+
+Test(sweep_columns, the_named_indices_are_the_named_columns)
+{
+    cr_expect_eq(column("fps"), SWEEP_M_FPS);
+    cr_expect_eq(column("fps_lo"), SWEEP_M_FPS_LO);
+    cr_expect_eq(column("fps_hi"), SWEEP_M_FPS_HI);
+    cr_expect_eq(column("utilization_traversal"), SWEEP_M_UTIL);
+    cr_expect_eq(column("stall_share_address_fetch"), SWEEP_M_STALL);
+    cr_expect_eq(column("ops_share_load"), SWEEP_M_OPS);
+    cr_expect_eq(column("kd_nodes_per_ray"), SWEEP_M_KD);
+    cr_expect_eq(column("kd_camera_nodes_per_ray"), SWEEP_M_KD_CAMERA_NODES);
+    cr_expect_eq(column("host_seconds"), SWEEP_M_HOST);
+}
+
+Test(sweep_columns, every_name_is_different)
+{
+    for (int a = 0; a < SWEEP_M_COUNT; a++)
+        for (int b = a + 1; b < SWEEP_M_COUNT; b++)
+            cr_expect_str_neq(name_of(a), name_of(b), "columns %d and %d", a, b);
+}
+
+/* ---- reading a report --------------------------------------------------------------------------- */
+
+Test(sweep_report, figures_are_read_at_their_paths)
+{
+    char dir[64];
+    make_tmpdir(dir, sizeof dir);
+    SweepRow row = read_report(dir, "{\"cycles\": 123456, \"busy_cycles\": 100000, \"fps\": 12.5,"
+                                    " \"fps_ci95\": [11, 14],"
+                                    " \"utilization\": {\"traversal\": 0.5, \"shading\": 0.25, \"other\": 1},"
+                                    " \"stall_shares\": {\"bank_conflict\": 0.125},"
+                                    " \"rays\": {\"primary\": 3, \"total\": 10}, \"host\": {\"seconds\": 0.75},"
+                                    " \"kd\": {\"total\": {\"nodes_per_ray\": 7.5},"
+                                    "          \"camera\": {\"nodes_per_ray\": 5, \"leaves_per_ray\": 2}}}");
+    cr_expect_eq(row.has[column("cycles")], 1);
+    cr_expect_float_eq(row.m[column("cycles")], 123456, 0);
+    cr_expect_float_eq(row.m[column("busy_cycles")], 100000, 0);
+    cr_expect_float_eq(row.m[SWEEP_M_FPS], 12.5, 0);
+    cr_expect_eq(row.has[column("fps_no_stall")], 0, "not in the report: no value");
+    cr_expect_float_eq(row.m[SWEEP_M_FPS_LO], 11, 0);
+    cr_expect_float_eq(row.m[SWEEP_M_FPS_HI], 14, 0);
+    cr_expect_float_eq(row.m[column("utilization_traversal")], 0.5, 0);
+    cr_expect_eq(row.has[column("utilization_intersection")], 0);
+    cr_expect_float_eq(row.m[column("utilization_shading")], 0.25, 0);
+    cr_expect_float_eq(row.m[column("utilization_other")], 1, 0);
+    cr_expect_eq(row.has[column("utilization_timed_traversal")], 0);
+    cr_expect_float_eq(row.m[column("stall_share_bank_conflict")], 0.125, 0);
+    cr_expect_float_eq(row.m[column("rays_total")], 10, 0);
+    cr_expect_float_eq(row.m[column("host_seconds")], 0.75, 0);
+    cr_expect_float_eq(row.m[column("kd_nodes_per_ray")], 7.5, 0);
+    cr_expect_float_eq(row.m[column("kd_camera_nodes_per_ray")], 5, 0);
+    cr_expect_float_eq(row.m[column("kd_camera_leaves_per_ray")], 2, 0);
+    cr_expect_eq(row.has[column("kd_shadow_nodes_per_ray")], 0);
+    int n = 0;
+    for (int m = 0; m < SWEEP_M_COUNT; m++)
+        n += row.has[m];
+    cr_expect_eq(n, 14, "figures the report does not hold have no value"); /* the 14 checked above */
+    tu_remove_tree(dir);
+}
+
+Test(sweep_report, operation_counts_become_shares)
+{
+    char dir[64];
+    make_tmpdir(dir, sizeof dir);
+    SweepRow row = read_report(dir, "{\"ops\": {\"load\": 10, \"store\": 30, \"compute\": 60}}");
+    cr_expect_float_eq(row.m[column("ops_share_load")], 0.1, 1e-15);
+    cr_expect_float_eq(row.m[column("ops_share_store")], 0.3, 1e-15);
+    cr_expect_float_eq(row.m[column("ops_share_compute")], 0.6, 1e-15);
+    cr_expect_eq(row.has[column("ops_share_control")], 0, "a category the report lacks stays empty");
+    /* no operations at all: no shares */
+    row = read_report(dir, "{\"ops\": {\"load\": 0, \"store\": 0}}");
+    for (int c = 0; c < ISA_C_COUNT; c++)
+        cr_expect_eq(row.has[SWEEP_M_OPS + c], 0, "ops_share_%s", isa_category_keys[c]);
+    tu_remove_tree(dir);
+}
+
+Test(sweep_report, values_of_the_wrong_kind_are_left_out)
+{
+    char dir[64];
+    make_tmpdir(dir, sizeof dir);
+    /* an interval of 3 numbers is not one; a string or null is no number; utilization not an object */
+    SweepRow row = read_report(dir, "{\"cycles\": \"12\", \"fps\": null, \"fps_ci95\": [1, 2, 3], \"utilization\": 0.5,"
+                                    " \"rays\": [10]}");
+    for (int m = 0; m < SWEEP_M_COUNT; m++)
+        cr_expect_eq(row.has[m], 0, "%s has a value", name_of(m));
+    tu_remove_tree(dir);
+}
+
+Test(sweep_report, a_report_that_is_no_object_is_an_error)
+{
+    char dir[64], path[256], err[512] = "", want[512];
+    make_tmpdir(dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/report.json", dir);
+    write_file(path, "[1, 2]");
+    SweepRow row;
+    memset(&row, 0, sizeof row);
+    cr_expect_eq(sweep_row_read_report(&row, path, err, sizeof err), -1);
+    snprintf(want, sizeof want, "%s: not a JSON object", path);
+    cr_expect_str_eq(err, want);
+    unlink(path);
+    cr_expect_eq(sweep_row_read_report(&row, path, err, sizeof err), -1);
+    snprintf(want, sizeof want, "%s: cannot open: No such file or directory", path);
+    cr_expect_str_eq(err, want);
+    tu_remove_tree(dir);
+}
+
+/* ---- the file ----------------------------------------------------------------------------------- */
+
+/* A sweep of four points in dir, written by hand (keys need not be machine keys here):
+ * 0 done, its report in its folder; 1 failed, an error with a comma and quotes; 2 unfinished;
+ * 3 done but its report.json is missing (a warning; an empty row). Point 0's value of "k.a" holds a quote; only point 1
+ * sets "k.b". */
+static void csv_sweep(const char *dir, SweepPlan *pl)
+{
+    cJSON *m = cJSON_CreateObject();
+    cJSON_AddStringToObject(m, "format", SWEEP_MANIFEST_FORMAT);
+    cJSON_AddNullToObject(m, "config");
+    cJSON_AddNullToObject(m, "config_contents");
+    cJSON_AddStringToObject(m, "sweep_file", "/s.ini");
+    cJSON_AddStringToObject(m, "sweep_contents", "");
+    cJSON_AddStringToObject(m, "scene", "/scene.ini");
+    cJSON_AddStringToObject(m, "mode", "detailed");
+    cJSON_AddNullToObject(m, "sample");
+    cJSON_AddArrayToObject(m, "sets");
+    cJSON_AddStringToObject(m, "kind", "cross");
+    cJSON *points = cJSON_AddArrayToObject(m, "points");
+    static const char *const a[] = {"x\"y", "2", "3", "4"};
+    for (int k = 0; k < 4; k++) {
+        cJSON *p = cJSON_CreateObject(), *set = cJSON_AddObjectToObject(p, "settings");
+        cJSON_AddStringToObject(set, "k.a", a[k]);
+        if (k == 1)
+            cJSON_AddStringToObject(set, "k.b", "only");
+        cJSON_AddItemToArray(points, p);
+    }
+    char err[256] = "";
+    cr_assert_eq(sweep_plan_load(m, pl, err, sizeof err), 0, "%s", err);
+    char path[256];
+    for (int k = 0; k < 4; k++) {
+        snprintf(path, sizeof path, "%s/points/%03d", dir, k);
+        cr_assert_eq(util_mkdir_p(path, err, sizeof err), 0, "%s", err);
+    }
+    snprintf(path, sizeof path, "%s/points/000/done", dir);
+    write_file(path, "exit_status 0\nhost_seconds 1.5\n");
+    snprintf(path, sizeof path, "%s/points/000/report.json", dir);
+    write_file(path, "{\"cycles\": 1234567, \"fps\": 12.345678901234, \"utilization\": {\"traversal\": 0.5},"
+                     " \"ops\": {\"load\": 1, \"store\": 3}, \"host\": {\"seconds\": 1.25}}");
+    snprintf(path, sizeof path, "%s/points/001/failed", dir);
+    write_file(path, "exit_status 1\nhost_seconds 0.5\nerror exit 1: bad value, \"8\" is no width\n");
+    snprintf(path, sizeof path, "%s/points/001/report.json", dir); /* a failed point's figures are not read */
+    write_file(path, "{\"cycles\": 99}");
+    snprintf(path, sizeof path, "%s/points/003/done", dir);
+    write_file(path, "exit_status 0\nhost_seconds 1\n");
+}
+
+Test(sweep_csv, rows_hold_keys_status_error_and_figures)
+{
+    char dir[64], path[256], err[512] = "";
+    make_tmpdir(dir, sizeof dir);
+    SweepPlan pl;
+    csv_sweep(dir, &pl);
+    int nd, nf, nu;
+    SweepRow *rows = sweep_rows_collect(&pl, dir, &nd, &nf, &nu);
+    cr_expect_eq(nd, 2);
+    cr_expect_eq(nf, 1);
+    cr_expect_eq(nu, 1);
+    snprintf(path, sizeof path, "%s/sweep.csv", dir);
+    cr_assert_eq(sweep_csv_write(&pl, rows, path, err, sizeof err), 0, "%s", err);
+    sweep_rows_free(rows, pl.npoints);
+    char *text = tu_slurp(path);
+
+    /* five lines: the header and a row per point */
+    char *line[6] = {0};
+    int nl = 0;
+    for (char *p = text; *p && nl < 6; nl++) {
+        line[nl] = p;
+        p = strchr(p, '\n');
+        cr_assert_not_null(p, "the last line has no line end");
+        *p++ = 0;
+    }
+    cr_assert_eq(nl, 5, "%d lines", nl);
+    static char cells[5][200][256];
+    int want_cells = 1 + 2 + 2 + SWEEP_M_COUNT;
+    for (int i = 0; i < 5; i++)
+        cr_expect_eq(split_csv(line[i], cells[i], 200), want_cells, "line %d: %s", i, line[i]);
+    cr_expect(starts_with(line[0], "point,k.a,k.b,status,error,cycles,busy_cycles,fps,fps_no_stall,fps_lo,fps_hi,"),
+              "%s", line[0]);
+    for (int m = 0; m < SWEEP_M_COUNT; m++)
+        cr_expect_str_eq(cells[0][5 + m], name_of(m));
+
+    /* point 0: done; its value with a quote is quoted, its figures read and formatted */
+    cr_expect(starts_with(line[1], "0,\"x\"\"y\",,ok,,1234567,,12.3456789,,,,0.5,"), "%s", line[1]);
+    cr_expect_str_eq(cells[1][5 + column("ops_share_load")], "0.25");
+    cr_expect_str_eq(cells[1][5 + column("ops_share_store")], "0.75");
+    cr_expect_str_eq(cells[1][5 + column("host_seconds")], "1.25");
+    cr_expect_str_eq(cells[1][5 + column("rays_total")], "");
+    /* point 1: failed, the error always quoted, no figures */
+    char want[1024];
+    snprintf(want, sizeof want, "1,2,only,failed,\"exit 1: bad value, \"\"8\"\" is no width\"%s", no_figures());
+    cr_expect_str_eq(line[2], want);
+    /* point 2: unfinished; point 3: done, but without its report */
+    snprintf(want, sizeof want, "2,3,,unfinished,%s", no_figures());
+    cr_expect_str_eq(line[3], want);
+    snprintf(want, sizeof want, "3,4,,ok,%s", no_figures());
+    cr_expect_str_eq(line[4], want);
+    tu_remove_tree(dir);
+    free(text);
+    sweep_plan_free(&pl);
+}
+
+Test(sweep_csv, named_points_give_their_name_and_numbers_keep_their_precision)
+{
+    char buf[64];
+    sweep_fmt_num(1234567, buf, sizeof buf);
+    cr_expect_str_eq(buf, "1234567");
+    sweep_fmt_num(-3, buf, sizeof buf);
+    cr_expect_str_eq(buf, "-3");
+    sweep_fmt_num(0.1, buf, sizeof buf);
+    cr_expect_str_eq(buf, "0.1");
+    sweep_fmt_num(2.0 / 3.0, buf, sizeof buf);
+    cr_expect_str_eq(buf, "0.6666666667");
+    sweep_fmt_num(1e15, buf, sizeof buf);
+    cr_expect_str_eq(buf, "1e+15", "integers from 1e15 on are printed as other numbers");
+
+    char dir[64], path[256], err[512] = "";
+    make_tmpdir(dir, sizeof dir);
+    cJSON *m = cJSON_Parse("{\"format\": \"sfsim sweep 1\", \"config\": null, \"config_contents\": null,"
+                           " \"sweep_file\": \"/s.ini\", \"sweep_contents\": \"\", \"scene\": \"/x\", \"mode\": \"detailed\","
+                           " \"sample\": null, \"sets\": [], \"kind\": \"points\", \"points\": ["
+                           " {\"name\": \"small\", \"settings\": {\"core.simd_width\": \"4\"}},"
+                           " {\"name\": \"big\", \"settings\": {\"core.simd_width\": \"64\"}}]}");
+    SweepPlan pl;
+    cr_assert_eq(sweep_plan_load(m, &pl, err, sizeof err), 0, "%s", err);
+    int nd, nf, nu;
+    SweepRow *rows = sweep_rows_collect(&pl, dir, &nd, &nf, &nu);
+    cr_expect_eq(nu, 2);
+    snprintf(path, sizeof path, "%s/sweep.csv", dir);
+    cr_assert_eq(sweep_csv_write(&pl, rows, path, err, sizeof err), 0, "%s", err);
+    sweep_rows_free(rows, pl.npoints);
+    char *text = tu_slurp(path);
+    char *row1 = strchr(text, '\n') + 1;
+    cr_expect(starts_with(row1, "small,4,unfinished,,"), "%s", row1);
+    char *row2 = strchr(row1, '\n') + 1;
+    cr_expect(starts_with(row2, "big,64,unfinished,,"), "%s", row2);
+    cr_expect(starts_with(text, "point,core.simd_width,status,error,cycles,"), "%s", text);
+    free(text);
+    sweep_plan_free(&pl);
+    tu_remove_tree(dir);
+}
