@@ -96,51 +96,6 @@ char *util_file_read(const char *path, size_t *len, char *err, size_t errlen)
     return b.s;
 }
 
-int util_file_write_atomic(const char *path, const char *data, size_t len, char *err, size_t errlen)
-{
-    const char *slash = strrchr(path, '/');
-    char *tmp = NULL;
-    int made = slash ? asprintf(&tmp, "%.*s/.%s.tmp.%ld", (int)(slash - path), path, slash + 1, (long)getpid())
-                     : asprintf(&tmp, ".%s.tmp.%ld", path, (long)getpid());
-    if (made < 0) {
-        snprintf(err, errlen, "%s: out of memory", path);
-        return -1;
-    }
-    int rc = -1;
-    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) {
-        snprintf(err, errlen, "%s: cannot create: %s", tmp, strerror(errno));
-        goto out;
-    }
-    size_t off = 0;
-    while (off < len) {
-        ssize_t w = write(fd, data + off, len - off);
-        if (w < 0 && errno == EINTR)
-            continue;
-        if (w < 0) {
-            snprintf(err, errlen, "%s: cannot write: %s", tmp, strerror(errno));
-            close(fd);
-            unlink(tmp);
-            goto out;
-        }
-        off += (size_t)w;
-    }
-    if (fsync(fd) != 0 || close(fd) != 0) {
-        snprintf(err, errlen, "%s: cannot write: %s", tmp, strerror(errno));
-        unlink(tmp);
-        goto out;
-    }
-    if (rename(tmp, path) != 0) {
-        snprintf(err, errlen, "%s: cannot rename to %s: %s", tmp, path, strerror(errno));
-        unlink(tmp);
-        goto out;
-    }
-    rc = 0;
-out:
-    free(tmp);
-    return rc;
-}
-
 /* ---- the string buffer ----------------------------------------------------------------------- */
 
 int util_buf_add(UtilBuf *b, const char *s, size_t n)

@@ -1,5 +1,5 @@
 /* sim/util.h -- small helpers every part of sfsim shares, written once: a monotonic clock, strict
- * integer parsing, mkdir -p, reading and writing whole files, and a growable string buffer.
+ * integer parsing, mkdir -p, reading whole files (outputs are written by sim/outfile.c), and a growable string buffer.
  *
  * Owns: these helpers and nothing else. Must not: print, exit or abort (each returns 0 / -1 or
  * NULL with a message in err, or records a failure the caller checks), or know about any sfsim
@@ -24,10 +24,6 @@ int util_mkdir_p(const char *path, char *err, size_t errlen);
 
 /* The whole file, NUL-terminated (malloc'ed), its length in *len; NULL with the reason in err. */
 char *util_file_read(const char *path, size_t *len, char *err, size_t errlen);
-
-/* Writes the file through a temporary file beside it (.NAME.tmp.PID), fsync'ed and renamed over
- * it, so a reader sees the old file or the whole new one. 0, or -1 with the reason in err. */
-int util_file_write_atomic(const char *path, const char *data, size_t len, char *err, size_t errlen);
 
 /* A growable NUL-terminated string; {0} is empty. When memory runs out the buffer keeps what it
  * held, `failed` is set and every later append is dropped: check it once, before using the text. */

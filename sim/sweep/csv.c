@@ -7,6 +7,7 @@
  * a figure the report does not hold (beyond the SHARE rows' division), or decide a point's state
  * (folder.c reads its markers).
  */
+#include "../outfile.h"
 #include "sweep_int.h"
 
 #include <math.h>
@@ -256,7 +257,7 @@ int sweep_csv_write(const SweepPlan *pl, const SweepRow *rows, const char *path,
         }
         util_buf_puts(&b, "\n");
     }
-    int rc = util_file_write_atomic(path, sweep_buf_text(&b), b.len, err, errlen);
+    int rc = outfile_write_file(NULL, path, sweep_buf_text(&b), b.len, err, errlen);
     util_buf_free(&b);
     return rc;
 }

@@ -6,6 +6,7 @@
  * K` with the defining arguments, paths absolute) and the next steps it prints. Must not: run
  * anything, or write into the point folders.
  */
+#include "../outfile.h"
 #include "sweep_int.h"
 
 #include "../exitcodes.h"
@@ -59,7 +60,7 @@ int sweep_emit_scripts(const SweepPlan *pl, const SweepArgs *a, const char *exe,
             util_buf_printf(&b, " --point %d\n", k);
         }
     }
-    int rc = util_file_write_atomic(path, sweep_buf_text(&b), b.len, err, sizeof err);
+    int rc = outfile_write_file(NULL, path, sweep_buf_text(&b), b.len, err, sizeof err);
     util_buf_free(&b);
     if (rc) {
         fprintf(stderr, "sfsim sweep: %s\n", err);

@@ -6,6 +6,7 @@
  * failed marker's log tail. Must not: decide which points run (plan.c), start processes
  * (runner.c), or read reports (csv.c).
  */
+#include "../outfile.h"
 #include "sweep_int.h"
 
 #include <dirent.h>
@@ -149,7 +150,7 @@ int sweep_dir_open(const char *dir, const SweepPlan *cur, int exclusive, int *lo
         UtilBuf b = {0};
         util_buf_printf(&b, "%s\n", text);
         cJSON_free(text);
-        int w = util_file_write_atomic(manifest, sweep_buf_text(&b), b.len, err, sizeof err);
+        int w = outfile_write_file(NULL, manifest, sweep_buf_text(&b), b.len, err, sizeof err);
         util_buf_free(&b);
         if (w) {
             fprintf(stderr, "sfsim sweep: %s\n", err);
@@ -251,7 +252,7 @@ int sweep_point_ini_write(const SweepPlan *pl, const char *pdir, int k, char *co
     for (int i = 0; i < pl->points[k].n; i++)
         util_buf_printf(&b, "%s = %s\n", pl->points[k].key[i], pl->points[k].val[i]);
     char *path = xasprintf("%s/point.ini", pdir);
-    int rc = util_file_write_atomic(path, sweep_buf_text(&b), b.len, err, errlen);
+    int rc = outfile_write_file(NULL, path, sweep_buf_text(&b), b.len, err, errlen);
     free(path);
     util_buf_free(&b);
     return rc;

@@ -6,6 +6,7 @@
  * running gnuplot (a missing or failing gnuplot is a warning). Must not: read reports (csv.c
  * gives the rows), or change the exit status of a sweep.
  */
+#include "../outfile.h"
 #include "sweep_int.h"
 
 #include <errno.h>
@@ -222,8 +223,8 @@ static void plot_write(Plotter *p, const char *base, const UtilBuf *gp, const Ut
 {
     char err[PATH_MAX + 256];
     char *gpath = xasprintf("%s/%s.gp", p->dir, base), *dpath = xasprintf("%s/%s.dat", p->dir, base);
-    if (util_file_write_atomic(dpath, sweep_buf_text(dat), dat->len, err, sizeof err) ||
-        util_file_write_atomic(gpath, sweep_buf_text(gp), gp->len, err, sizeof err))
+    if (outfile_write_file(NULL, dpath, sweep_buf_text(dat), dat->len, err, sizeof err) ||
+        outfile_write_file(NULL, gpath, sweep_buf_text(gp), gp->len, err, sizeof err))
         fprintf(stderr, "sfsim sweep: warning: %s\n", err);
     else
         gp_run(p, base);

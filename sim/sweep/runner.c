@@ -6,6 +6,7 @@
  * while points run. Must not: decide which points run (plan.c gives the list), or read the
  * points' reports (csv.c).
  */
+#include "../outfile.h"
 #include "sweep_int.h"
 
 #include <errno.h>
@@ -186,7 +187,7 @@ static int marker_write(SweepRunner *r, const char *pdir, const char *name, cons
 {
     char err[PATH_MAX + 256];
     char *path = xasprintf("%s/%s", pdir, name);
-    int rc = util_file_write_atomic(path, sweep_buf_text(text), text->len, err, sizeof err);
+    int rc = outfile_write_file(NULL, path, sweep_buf_text(text), text->len, err, sizeof err);
     if (rc) {
         fprintf(stderr, "sfsim sweep: %s\n", err);
         r->fatal = 1;

@@ -37,19 +37,6 @@ static int is_dir(const char *path)
     return stat(path, &st) == 0 && S_ISDIR(st.st_mode);
 }
 
-/* Entries of a folder other than . and .. */
-static int entries(const char *dir)
-{
-    DIR *d = opendir(dir);
-    cr_assert_not_null(d);
-    int n = 0;
-    struct dirent *e;
-    while ((e = readdir(d)))
-        n += strcmp(e->d_name, ".") && strcmp(e->d_name, "..");
-    closedir(d);
-    return n;
-}
-
 /* ---- the clock ---------------------------------------------------------------------------------- */
 
 Test(util_clock, is_monotonic_and_counts_seconds)
@@ -170,40 +157,6 @@ Test(util_files, file_read_of_a_missing_file_says_so)
     size_t len = 99;
     cr_expect_null(util_file_read("/nonexistent/sfsim-util-test", &len, err, sizeof err));
     cr_expect_str_eq(err, "/nonexistent/sfsim-util-test: cannot open: No such file or directory");
-}
-
-Test(util_files, write_atomic_replaces_the_file_and_leaves_no_temporary)
-{
-    char dir[64], path[128], err[512] = "";
-    make_tmpdir(dir, sizeof dir);
-    snprintf(path, sizeof path, "%s/out.txt", dir);
-    write_file(path, "old contents, longer than the new\n", 34);
-    cr_assert_eq(util_file_write_atomic(path, "new\n", 4, err, sizeof err), 0, "%s", err);
-    char *got = tu_slurp(path);
-    cr_expect_str_eq(got, "new\n");
-    free(got);
-    cr_expect_eq(entries(dir), 1, "a temporary file was left beside out.txt");
-    /* a file of its own name in the current folder (no slash) */
-    char cwd[4096];
-    cr_assert_not_null(getcwd(cwd, sizeof cwd));
-    cr_assert_eq(chdir(dir), 0);
-    cr_expect_eq(util_file_write_atomic("bare.txt", "b", 1, err, sizeof err), 0, "%s", err);
-    cr_assert_eq(chdir(cwd), 0);
-    snprintf(path, sizeof path, "%s/bare.txt", dir);
-    got = tu_slurp(path);
-    cr_expect_str_eq(got, "b");
-    free(got);
-    cr_expect_eq(entries(dir), 2);
-    tu_remove_tree(dir);
-}
-
-Test(util_files, write_atomic_into_a_missing_folder_fails_with_the_reason)
-{
-    char err[512] = "";
-    cr_expect_eq(util_file_write_atomic("/nonexistent/sfsim/x.csv", "x", 1, err, sizeof err), -1);
-    char want[128];
-    snprintf(want, sizeof want, "/nonexistent/sfsim/.x.csv.tmp.%ld: cannot create: ", (long)getpid());
-    cr_expect_eq(strncmp(err, want, strlen(want)), 0, "got: %s", err);
 }
 
 /* ---- the string buffer -------------------------------------------------------------------------- */
