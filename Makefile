@@ -214,7 +214,7 @@ $(BUILD)/fuzz/fuzz_rays: tests/fuzz/fuzz_rays.c sim/raybatch.c sim/outfile.c sim
 	@mkdir -p $(dir $@)
 	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ -lm
 
-$(BUILD)/fuzz/fuzz_config: tests/fuzz/fuzz_config.c sim/config.c sim/ini.c sim/timing.c sim/event.c sim/scenemem.c isa/isa.c
+$(BUILD)/fuzz/fuzz_config: tests/fuzz/fuzz_config.c sim/config.c sim/ini.c sim/timing.c sim/event.c $(wildcard sim/machine/*.c) isa/isa.c
 	@mkdir -p $(dir $@)
 	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ $(INIH) $(CJSON) -lm
 

@@ -156,8 +156,22 @@ enum {
     ISA_FL_IDM    = 1u << 5, /* touches ID-stream memory */
     ISA_FL_SPAD   = 1u << 6, /* touches the scratchpad */
     ISA_FL_SCENE  = 1u << 7, /* touches scene memory */
-    ISA_FL_FB     = 1u << 8  /* touches the framebuffer */
+    ISA_FL_FB     = 1u << 8, /* touches the framebuffer */
+    ISA_FL_WRITE  = 1u << 9  /* writes the memory it touches (store, scatter, append, scatter-add,
+                                in-place partition); without it a memory instruction only reads */
 };
+
+/* The two ID-vector moves, told apart by the flags (the timing model dispatches on these, never
+ * on opcodes): an ID fetch reads the next ID vector of a stream (sfetch; the AGUs fetch it ahead),
+ * an ID append writes one (sapp). */
+static inline int isa_id_fetch(uint32_t flags)
+{
+    return (flags & (ISA_FL_VEC | ISA_FL_IDM | ISA_FL_WRITE)) == (ISA_FL_VEC | ISA_FL_IDM);
+}
+static inline int isa_id_append(uint32_t flags)
+{
+    return (flags & (ISA_FL_VEC | ISA_FL_IDM | ISA_FL_WRITE)) == (ISA_FL_VEC | ISA_FL_IDM | ISA_FL_WRITE);
+}
 
 /* Operand access, per operand (the ACC column). */
 typedef enum IsaAccess { ISA_ACC_READ = 'r', ISA_ACC_WRITE = 'w', ISA_ACC_RW = 'x' } IsaAccess;

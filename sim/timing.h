@@ -2,12 +2,15 @@
  *
  * Owns: time. It consumes the functional core's CoreRecord stream (core_set_hook(core,
  * timing_hook, t)) and schedules each instruction's issue and completion, and each unit's work,
- * as events on a time-ordered queue (sim/event.h); time jumps from event to event. Units: the
- * in-order single-issue SIMD execution unit with per-class latency and issue interval and a
- * register scoreboard; the banked ray buffers (lines, bank conflicts); the decoupled address-
- * generation units that fetch ID vectors ahead of the data path; the multiplexer interconnect
- * (latency, ports shared by data path, AGUs and partition unit); the partition unit; the
- * scratchpad ports; scene memory with an optional cache (sim/scenemem.h).
+ * as events on a time-ordered queue (sim/event.h); time jumps from event to event. The units,
+ * one file each under sim/machine/ (Gribble & Ramani 2008, Sec. 3.3): the in-order single-issue
+ * SIMD execution unit with per-class latency and issue interval and a register scoreboard
+ * (simd.h); the banked ray buffers, lines, bank conflicts and alignment (raybuf.h); the
+ * decoupled address-generation units that fetch ID vectors ahead of the data path (agu.h); the
+ * multiplexer interconnect, its latency and the ports the data path, AGUs and partition unit
+ * share (interconnect.h); the partition unit (partition.h); the scratchpad ports (spad.h); scene
+ * memory with an optional cache (scenemem.h). sim/timing.c keeps the event loop, the stall
+ * accounting and the dispatch to the units by the ISA table's UNIT and FLAGS columns.
  * Must not: compute any architectural value or change what the program does (the functional
  * core does); results are identical with and without timing.
  *
@@ -24,7 +27,13 @@
 
 #include "config.h"
 #include "core.h"
-#include "scenemem.h"
+#include "machine/agu.h"
+#include "machine/interconnect.h"
+#include "machine/partition.h"
+#include "machine/raybuf.h"
+#include "machine/scenemem.h"
+#include "machine/simd.h"
+#include "machine/spad.h"
 
 /* Stall causes (ARCHITECTURE.md Sec. 3), in the order reports list them. */
 #define TM_CAUSES(X) \
@@ -49,17 +58,13 @@ typedef enum TmCause {
 extern const char *const tm_cause_keys[TM_CAUSE_COUNT];
 extern const char *const tm_cause_descs[TM_CAUSE_COUNT];
 
-typedef struct TimingParams {
-    int lanes;
-    int lat[ISA_U_COUNT];     /* result latency per unit class (compute classes, AGU, branch) */
-    int issue[ISA_U_COUNT];   /* cycles between issues per unit class */
-    int taken_penalty;
-    int rb_banks, rb_line, rb_access, align_cycles;
-    int agu_ids_per_cycle, agu_depth;
-    int icn_latency, icn_ports;
-    int part_setup, part_ids_per_cycle;
-    int spad_ports, spad_latency, spad_line;
-    int scene_ports;
+typedef struct TimingParams {  /* each unit's part, filled from the config by its *_params */
+    SimdParams simd;
+    RbParams rb;
+    AguParams agu;
+    XbarParams xbar;
+    PartParams part;
+    SpadParams spad;
     SceneMemParams scene;
 } TimingParams;
 

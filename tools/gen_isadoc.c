@@ -35,7 +35,7 @@ static const Group groups[] = {
 };
 #define NGROUPS (sizeof groups / sizeof groups[0])
 
-static const char *const flag_names[] = {"vec", "float", "branch", "end", "rb", "idm", "spad", "scene", "fb"};
+static const char *const flag_names[] = {"vec", "float", "branch", "end", "rb", "idm", "spad", "scene", "fb", "write"};
 
 static const char *const flag_descs[] = {
     "operates on N lanes; counts toward SIMD utilization",
@@ -47,6 +47,7 @@ static const char *const flag_descs[] = {
     "touches the scratchpad",
     "touches scene memory",
     "touches the framebuffer",
+    "writes the memory it touches (store, scatter, append, scatter-add, in-place partition); without it a memory instruction only reads",
 };
 
 /* Operand placeholder as written in the syntax column: the kind letter and the field letter,

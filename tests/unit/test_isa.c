@@ -124,7 +124,8 @@ Test(isa_table, access_strings_match_formats)
 Test(isa_table, units_categories_flags_and_descriptions_are_valid)
 {
     const uint32_t all_flags = ISA_FL_VEC | ISA_FL_FLOAT | ISA_FL_BRANCH | ISA_FL_END | ISA_FL_RB | ISA_FL_IDM |
-                               ISA_FL_SPAD | ISA_FL_SCENE | ISA_FL_FB;
+                               ISA_FL_SPAD | ISA_FL_SCENE | ISA_FL_FB | ISA_FL_WRITE;
+    const uint32_t memories = ISA_FL_RB | ISA_FL_IDM | ISA_FL_SPAD | ISA_FL_SCENE | ISA_FL_FB;
     for (int i = 0; i < ISA_OP_COUNT; i++) {
         const IsaOpInfo *oi = &isa_ops[i];
         const IsaFormatInfo *fi = &isa_formats[oi->format];
@@ -150,6 +151,13 @@ Test(isa_table, units_categories_flags_and_descriptions_are_valid)
         if (oi->flags & ISA_FL_IDM)
             cr_expect(oi->unit == ISA_U_AGU || oi->unit == ISA_U_PART, "%s: idm flag on unit %s", oi->mnemonic,
                       isa_unit_names[oi->unit]);
+        /* the timing model tells loads from stores, gathers from scatters by the write flag */
+        if (oi->flags & ISA_FL_WRITE)
+            cr_expect(oi->flags & memories, "%s: write flag without a memory flag", oi->mnemonic);
+        if (oi->category == ISA_C_STORE)
+            cr_expect(oi->flags & ISA_FL_WRITE, "%s: store without the write flag", oi->mnemonic);
+        if (oi->category == ISA_C_LOAD)
+            cr_expect(!(oi->flags & ISA_FL_WRITE), "%s: load with the write flag", oi->mnemonic);
     }
     cr_expect_eq(isa_ops[isa_op_from_mnemonic("halt")].flags & ISA_FL_END, ISA_FL_END);
     for (int u = 0; u < ISA_U_COUNT; u++)
@@ -161,6 +169,18 @@ Test(isa_table, units_categories_flags_and_descriptions_are_valid)
     cr_expect_str_eq(isa_stage_keys[ISA_STAGE_TRAVERSAL], "traversal");
     cr_expect_str_eq(isa_stage_keys[ISA_STAGE_INTERSECTION], "intersection");
     cr_expect_str_eq(isa_stage_keys[ISA_STAGE_SHADING], "shading");
+}
+
+Test(isa_table, id_vector_moves_are_sfetch_and_sapp)
+{
+    /* The timing model sends ID fetches to the AGUs' run-ahead queue and ID appends over one
+     * interconnect cycle by these flag tests; a new instruction that matched them would be timed
+     * as one of the two. */
+    for (int i = 0; i < ISA_OP_COUNT; i++) {
+        const IsaOpInfo *oi = &isa_ops[i];
+        cr_expect_eq(isa_id_fetch(oi->flags), i == ISA_OP_SFETCH, "%s: isa_id_fetch", oi->mnemonic);
+        cr_expect_eq(isa_id_append(oi->flags), i == ISA_OP_SAPP, "%s: isa_id_append", oi->mnemonic);
+    }
 }
 
 Test(isa_table, register_limits)

@@ -17,7 +17,7 @@
 #include "../../sim/config.h"
 #include "../../sim/core.h"
 #include "../../sim/event.h"
-#include "../../sim/scenemem.h"
+#include "../../sim/machine/scenemem.h"
 #include "../../sim/timing.h"
 
 /* A timing figure by its expect key, or -1 for an unknown key. */
@@ -163,25 +163,25 @@ Test(timing, event_queue_orders_by_time_then_insertion)
 
 Test(timing, scene_cache_lru_and_bus)
 {
-    /* 2 sets x 2 ways of 64-byte lines; latency 10, 16 bytes per cycle (4 cycles a line). */
-    SceneMemParams p = {10, 16, 64, 1, 256, 2};
+    /* 2 sets x 2 ways of 64-byte lines; latency 10, 16 bytes per cycle (4 cycles a line); one port. */
+    SceneMemParams p = {10, 16, 64, 1, 256, 2, 1};
     SceneMem m;
-    smem_init(&m, &p);
+    mem_init(&m, &p);
     cr_assert_eq(m.instantiated, 0, "the tag array exists before the first access");
-    cr_expect_eq(smem_access(&m, 0, 0, 0, 0), 14);      /* miss: bus 0..3, ready 0 + 10 + 4 */
+    cr_expect_eq(mem_access(&m, 0, 0, 0, 0), 14);       /* miss: bus 0..3, ready 0 + 10 + 4 */
     cr_expect_eq(m.instantiated, 1);
-    cr_expect_eq(smem_access(&m, 0, 128, 0, 0), 18);    /* same set, other way: bus 4..7 */
-    cr_expect_eq(smem_access(&m, 0, 4, 20, 0), 21);     /* hit on line 0 (now most recent) */
-    cr_expect_eq(smem_access(&m, 0, 256, 30, 1), 44);   /* miss evicts line 128 (LRU), dirty */
-    cr_expect_eq(smem_access(&m, 0, 0, 50, 0), 51);     /* line 0 still there */
-    cr_expect_eq(smem_access(&m, 0, 128, 60, 0), 78);   /* 128 again: evicts dirty 256: write-back 60..63, fill 64..67 */
+    cr_expect_eq(mem_access(&m, 0, 128, 0, 0), 18);     /* same set, other way: bus 4..7 */
+    cr_expect_eq(mem_access(&m, 0, 4, 20, 0), 21);      /* hit on line 0 (now most recent) */
+    cr_expect_eq(mem_access(&m, 0, 256, 30, 1), 44);    /* miss evicts line 128 (LRU), dirty */
+    cr_expect_eq(mem_access(&m, 0, 0, 50, 0), 51);      /* line 0 still there */
+    cr_expect_eq(mem_access(&m, 0, 128, 60, 0), 78);    /* 128 again: evicts dirty 256: write-back 60..63, fill 64..67 */
     cr_expect_eq(m.st.writebacks, 1);
     cr_expect_eq(m.st.hits, 2);
     cr_expect_eq(m.st.misses, 4);
-    cr_expect_eq(smem_access(&m, 1, 0, 100, 0), 114);   /* framebuffer address 0 is another line */
-    smem_reset(&m);
-    cr_expect_eq(smem_access(&m, 0, 0, 0, 0), 14, "reset leaves a cold cache");
-    smem_free(&m);
+    cr_expect_eq(mem_access(&m, 1, 0, 100, 0), 114);    /* framebuffer address 0 is another line */
+    mem_reset(&m);
+    cr_expect_eq(mem_access(&m, 0, 0, 0, 0), 14, "reset leaves a cold cache");
+    mem_free(&m);
 }
 
 Test(timing, every_cause_has_a_key_and_a_description)

@@ -1,10 +1,29 @@
-/* sim/scenemem.c -- scene-memory timing: cache tags, LRU, bus (see scenemem.h). */
+/* sim/machine/scenemem.c -- scene-memory timing: ports, cache tags, LRU, bus (see scenemem.h).
+ *
+ * Owns: what a scene or framebuffer access costs. Must not: charge stalls or hold data.
+ */
 #include "scenemem.h"
 
 #include <stdlib.h>
 #include <string.h>
 
-void smem_init(SceneMem *m, const SceneMemParams *p)
+#include "../timing.h"
+#include "lines.h"
+
+void mem_params(const CfgMachine *c, SceneMemParams *p)
+{
+    /* Assumptions (docs/model.md): a 64 KB 4-way cache of 64-byte lines suffices because a node
+     * load serves a whole stream; DRAM at 500 MHz is 50 cycles away. */
+    p->latency = c->scene_latency;
+    p->bytes_per_cycle = c->scene_bytes_per_cycle;
+    p->line_bytes = c->scene_line_bytes;
+    p->hit_latency = c->scene_hit_latency;
+    p->cache_bytes = c->scene_cache_kb * 1024;
+    p->ways = c->scene_cache_ways;
+    p->ports = c->scene_ports;
+}
+
+void mem_init(SceneMem *m, const SceneMemParams *p)
 {
     memset(m, 0, sizeof *m);
     m->p = *p;
@@ -16,7 +35,7 @@ void smem_init(SceneMem *m, const SceneMemParams *p)
     m->sets = p->cache_bytes > 0 ? p->cache_bytes / (p->line_bytes * p->ways) : 0;
 }
 
-void smem_free(SceneMem *m)
+void mem_free(SceneMem *m)
 {
     free(m->tag);
     free(m->ready);
@@ -27,7 +46,7 @@ void smem_free(SceneMem *m)
     m->instantiated = 0;
 }
 
-void smem_reset(SceneMem *m)
+void mem_reset(SceneMem *m)
 {
     if (m->instantiated) {
         size_t n = (size_t)m->sets * (size_t)m->p.ways;
@@ -48,7 +67,7 @@ static int instantiate(SceneMem *m)
     m->lru = calloc(n, sizeof *m->lru);
     m->dirty = calloc(n, 1);
     if (!m->tag || !m->ready || !m->lru || !m->dirty) {
-        smem_free(m);
+        mem_free(m);
         return -1;
     }
     m->instantiated = 1;
@@ -64,7 +83,7 @@ static uint64_t bus_fill(SceneMem *m, uint64_t t)
     return s + (uint64_t)m->p.latency + (uint64_t)m->xfer;
 }
 
-uint64_t smem_access(SceneMem *m, int space, uint32_t addr, uint64_t t, int write)
+uint64_t mem_access(SceneMem *m, int space, uint32_t addr, uint64_t t, int write)
 {
     m->st.accesses++;
     if (m->sets == 0) { /* no cache: every access is a memory access */
@@ -73,7 +92,7 @@ uint64_t smem_access(SceneMem *m, int space, uint32_t addr, uint64_t t, int writ
     }
     if (!m->instantiated && instantiate(m))
         return UINT64_MAX;
-    uint64_t line = smem_line(m, space, addr);
+    uint64_t line = mem_line(m, space, addr);
     size_t set = (size_t)(line % (uint64_t)m->sets), w = (size_t)m->p.ways;
     uint64_t *tag = m->tag + set * w;
     m->stamp++;
@@ -102,4 +121,24 @@ uint64_t smem_access(SceneMem *m, int space, uint32_t addr, uint64_t t, int writ
     m->dirty[k] = (uint8_t)(write != 0);
     m->ready[k] = bus_fill(m, t);
     return m->ready[k];
+}
+
+uint64_t mem_issue(SceneMem *m, uint32_t flags, const uint32_t *addr, int naddr, uint64_t at, uint64_t *ready,
+                   TimingStats *st)
+{
+    const int space = (flags & ISA_FL_FB) ? 1 : 0, write = (flags & ISA_FL_WRITE) != 0;
+    uint64_t lines[ISA_MAX_LANES], d[ISA_MAX_LANES];
+    for (int i = 0; i < naddr; i++)
+        lines[i] = mem_line(m, space, addr[i]);
+    int k = lines_distinct(lines, naddr, d);
+    *ready = 0;
+    for (int i = 0; i < k; i++) { /* one line per port-slot */
+        uint64_t slot = at + (uint64_t)(i / m->p.ports);
+        uint32_t a = (uint32_t)((d[i] << m->line_shift) & 0xffffffffu);
+        uint64_t r = mem_access(m, space, a, slot, write);
+        if (r > *ready)
+            *ready = r;
+    }
+    st->scene_instr++;
+    return ((uint64_t)k + (uint64_t)m->p.ports - 1) / (uint64_t)m->p.ports;
 }

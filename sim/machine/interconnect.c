@@ -1,0 +1,106 @@
+/* sim/machine/interconnect.c -- the multiplexer interconnect: ports and their reservations (see
+ * interconnect.h; the model and its sources: docs/model.md, "Interconnect").
+ *
+ * Owns: the port search and the reservations. Must not: charge stalls or know what a transfer
+ * carries.
+ */
+#include "interconnect.h"
+
+#include <string.h>
+
+#include "../timing.h"
+
+void xbar_params(const CfgMachine *c, XbarParams *p)
+{
+    /* Gribble & Ramani 2008, Sec. 3.3: the multiplexers are "sized to allow for single-cycle
+     * operation"; two ports (assumption) carry "the bandwidth requirements of the address fetch
+     * and execution units". */
+    p->latency = c->interconnect_latency;
+    p->ports = c->interconnect_ports;
+}
+
+void xbar_init(Xbar *x, const XbarParams *p)
+{
+    memset(x, 0, sizeof *x);
+    x->p = *p;
+}
+
+void xbar_reset(Xbar *x)
+{
+    x->agu_n = 0;
+    x->dp.s = x->dp.e = 0;
+    x->part.s = x->part.e = 0;
+}
+
+/* The first cycle s >= from at which a transfer of len cycles finds a free port in each of its
+ * cycles, given the other users' transfers. */
+static uint64_t earliest(const Xbar *x, uint64_t from, uint64_t len, XbarUser user)
+{
+    XbarIvl iv[XBAR_AGU_MAX + 2];
+    int n = 0;
+    if (user != XBAR_PART && x->part.e > from)
+        iv[n++] = x->part;
+    if (user != XBAR_AGU)
+        for (int i = 0; i < x->agu_n; i++)
+            if (x->agu[i].e > from)
+                iv[n++] = x->agu[i];
+    if (user != XBAR_DP && x->dp.e > from)
+        iv[n++] = x->dp;
+    uint64_t s = from;
+    for (;;) {
+        /* The most ports taken at any cycle of [s, s + len): check s and every start inside. */
+        int worst = 0;
+        for (int a = -1; a < n; a++) {
+            uint64_t pt = a < 0 ? s : iv[a].s;
+            if (pt < s || pt >= s + len)
+                continue;
+            int used = 0;
+            for (int b = 0; b < n; b++)
+                used += iv[b].s <= pt && pt < iv[b].e;
+            if (used > worst)
+                worst = used;
+        }
+        if (worst < x->p.ports)
+            return s;
+        uint64_t next = UINT64_MAX;
+        for (int b = 0; b < n; b++)
+            if (iv[b].e > s && iv[b].s < s + len && iv[b].e < next)
+                next = iv[b].e;
+        s = next;
+    }
+}
+
+static void hold_agu(Xbar *x, uint64_t s, uint64_t e, uint64_t now)
+{
+    /* Drop transfers that ended before the present. */
+    int k = 0;
+    for (int i = 0; i < x->agu_n; i++)
+        if (x->agu[i].e > now)
+            x->agu[k++] = x->agu[i];
+    x->agu_n = k;
+    if (k == XBAR_AGU_MAX) {
+        x->overflow = 1;
+        return;
+    }
+    x->agu[x->agu_n++] = (XbarIvl){s, e};
+}
+
+uint64_t xbar_transfer(Xbar *x, XbarUser user, uint64_t from, uint64_t len, uint64_t now, TimingStats *st)
+{
+    const uint64_t s = earliest(x, from, len ? len : 1, user);
+    switch (user) {
+    case XBAR_DP:
+        x->dp = (XbarIvl){s, s + len};
+        st->icn_transfers++;
+        break;
+    case XBAR_AGU:
+        st->icn_unit_delay += s - from;
+        hold_agu(x, s, s + len, now);
+        break;
+    case XBAR_PART:
+        st->icn_unit_delay += s - from;
+        x->part = (XbarIvl){s, s + len};
+        break;
+    }
+    return s;
+}

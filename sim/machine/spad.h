@@ -1,0 +1,45 @@
+/* sim/machine/spad.h -- the scratchpad's ports (Gribble & Ramani 2008, Sec. 3.3: a dual-ported
+ * scratchpad holds the traversal stack and intermediates).
+ *
+ * Owns: spad.ports, spad.latency and spad.line_bytes, the cost of one access, when a load's data
+ * are back, and the counters spad_accesses and spad_lines. Must not: charge a stall (the timing
+ * core charges the extra port cycles to `scratchpad`) or hold data (the functional core does).
+ *
+ * An access touching k distinct lines takes ceil(k / ports) issue cycles; a load's data are
+ * ready spad.latency cycles after its last issue cycle (docs/model.md, "Scratchpad").
+ */
+#ifndef SFSIM_MACHINE_SPAD_H
+#define SFSIM_MACHINE_SPAD_H
+
+#include <stdint.h>
+
+#include "../config.h"
+
+struct TimingStats;
+
+typedef struct SpadParams {
+    int ports;                 /* lines per cycle */
+    int latency;               /* load latency */
+    int line;                  /* port width in bytes (a power of two) */
+} SpadParams;
+
+void spad_params(const CfgMachine *c, SpadParams *p);
+
+typedef struct Spad {
+    SpadParams p;
+    int shift;                 /* byte address -> line */
+} Spad;
+
+void spad_init(Spad *s, const SpadParams *p);
+
+/* An access of naddr lanes (naddr >= 1): its issue cycles, ceil(distinct lines / ports).
+ * Counts the access and its lines. */
+uint64_t spad_access(const Spad *s, const uint32_t *addr, int naddr, struct TimingStats *st);
+
+/* When a load whose last issue cycle is `last` delivers. */
+static inline uint64_t spad_load_ready(const Spad *s, uint64_t last)
+{
+    return last + (uint64_t)s->p.latency;
+}
+
+#endif
