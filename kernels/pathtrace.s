@@ -15,6 +15,8 @@
 
         .include "abi.inc"
         .include "layout.inc"
+        .include "kconst.inc"
+        .include "frames.inc"
         .include "vmath.inc"
         .include "isect.inc"
 
@@ -28,9 +30,6 @@ SLAB_FAR_SCALE = 1.00000072
 HIT_SCALE_F = 1.000244140625    ; 1 + 2^-12: pruning beyond the hit so far (REF_HIT_SCALE)
 INF_BITS  = 0x7F800000
 NODE_BYTES_LOG2 = 5
-MAT_LAMBERT = 0
-MAT_GLOSSY = 1
-MAT_DIELECTRIC = 2
 DIM_DIRECT = 0
 DIM_LIGHT = 1
 DIM_LIGHT_U = 2
@@ -39,10 +38,6 @@ DIM_LOBE = 4
 DIM_DIR_U = 5
 DIM_DIR_V = 6
 DIM_RR = 7
-WL_PATH = 0                     ; WORKLOAD: the path tracer, or a utilization workload
-WL_SPECULAR = 1
-WL_DIFFUSE = 2
-WL_PHONG = 3
 .ifndef WORKLOAD
 WORKLOAD = WL_PATH
 .endif
@@ -50,11 +45,6 @@ WORKLOAD = WL_PATH
         .error "the specular and phong workloads need -D BOUNCES=n"
 .endif
 PHONG_AMBIENT = 0.05            ; phong: the ambient light of a scene without render.ambient
-LIGHT_POINT = 0
-LIGHT_SPOT = 1
-LIGHT_DIRECTIONAL = 2
-LIGHT_QUAD = 3
-LIGHT_TRIANGLE = 4
 
 ; ---- registers kept for the whole run ---------------------------------------------------------
 ; r0 = 0 (never written)          r16 chunk pointer of the running stream loop
@@ -64,9 +54,6 @@ LIGHT_TRIANGLE = 4
 ; r23 next ray slot counter       r24 traversal stack pointer (scratchpad)
 ; r25 N                           r26, r27: scene header values (below)
 ; r28 spp   r29 max depth         r30, r31 link registers
-; v31 = 0.0 in every lane, v30 = 0xFFFFFFFE (the shadow-ray mark of F_PRIM)
-.alias  vz, v31
-.alias  vm2, v30
 
 .macro  PUSH node, b, e
         spst    \node, r24, 0
@@ -123,7 +110,7 @@ trace_only_done:
 
 ; ==== one pass per sample: camera rays of the tile ==============================================
 sample_loop:
-        stage   0
+        stage   STAGE_OTHER
         sgen    r0                      ; counters of generation 0 (camera rays)
         li      r19, 0                  ; streams live at IDM 0 and IDM FIELD_BYTES
         mov     r20, r19
@@ -145,72 +132,53 @@ sample_loop:
         cvtif   r14, r6                 ; (float) width, height
         cvtif   r15, r13
         li      r7, 0                   ; ly
-.alias  vlx, v0
-.alias  vid, v1
-.alias  vkey, v2
-.alias  vt, v3
-.alias  vt2, v4
-.alias  jx, v5
-.alias  jy, v6
-.alias  lr, v7
-.alias  phi, v8
-.alias  lensx, v9
-.alias  lensy, v10
-.alias  dx, v11
-.alias  dy, v12
-.alias  dz, v13
-.alias  ox, v14
-.alias  oy, v15
-.alias  oz, v16
-.alias  w0, v17
-.alias  w1, v18
-.alias  w2, v19
+        FRAME_CAMERA
 cam_row:
         li      r8, 0                   ; lx of the chunk's first lane
 cam_chunk:
         sub     r9, r1, r8
         mtail   m1, r9
         viota   vlx @m1
-        vbcast  vt, r8 @m1
-        vadd    vlx, vlx, vt @m1
+        vbcast  tc, r8 @m1
+        vadd    vlx, vlx, tc @m1
         mul     r10, r7, r1
-        vbcast  vt, r10 @m1
-        vadd    vid, vlx, vt @m1        ; ray ID = ly * w + lx (raster order in the tile)
+        vbcast  tc, r10 @m1
+        vadd    cid, vlx, tc @m1        ; ray ID = ly * w + lx (raster order in the tile)
         add     r11, r4, r7             ; y
         mul     r12, r11, r6
         add     r12, r12, r3
-        vbcast  vt, r12 @m1
-        vadd    vkey, vlx, vt @m1       ; pixel = y * width + x
-        vbcast  vt, r5 @m1
-        vxor    vkey, vkey, vt @m1
-        HASH    vkey, vt
-        vbcast  vt, r17 @m1
-        vadd    vkey, vkey, vt @m1
-        HASH    vkey, vt                ; path key
-        RAND    jx, vkey, 0, vt
-        RAND    jy, vkey, 1, vt
-        RAND    lr, vkey, 2, vt
-        RAND    phi, vkey, 3, vt
+        vbcast  tc, r12 @m1
+        vadd    vkey, vlx, tc @m1       ; pixel = y * width + x
+        vbcast  tc, r5 @m1
+        vxor    vkey, vkey, tc @m1
+        HASH    vkey, tc
+        vbcast  tc, r17 @m1
+        vadd    vkey, vkey, tc @m1
+        HASH    vkey, tc                ; path key
+        RAND    jx, vkey, 0, tc
+        RAND    jy, vkey, 1, tc
+        RAND    lr, vkey, 2, tc
+        RAND    phi, vkey, 3, tc
         ; px = ((float) x + jx) / width - 0.5
-        vbcast  vt, r3 @m1
-        vadd    vt, vlx, vt @m1
-        vcvtif  vt, vt @m1
-        vfadd   jx, vt, jx @m1
-        vbcast  vt, r14 @m1
-        vfdiv   jx, jx, vt @m1
-        vli     vt, 0.5 @m1
-        vfsub   jx, jx, vt @m1
+        vbcast  tc, r3 @m1
+        vadd    tc, vlx, tc @m1
+        vcvtif  tc, tc @m1
+        vfadd   jx, tc, jx @m1
+        vbcast  tc, r14 @m1
+        vfdiv   jx, jx, tc @m1
+        vli     tc, 0.5 @m1
+        vfsub   jx, jx, tc @m1
         ; py = 0.5 - ((float) y + jy) / height
         cvtif   r12, r11
-        vbcast  vt2, r12 @m1
-        vfadd   jy, vt2, jy @m1
-        vbcast  vt2, r15 @m1
-        vfdiv   jy, jy, vt2 @m1
-        vfsub   jy, vt, jy @m1
+        vbcast  tc2, r12 @m1
+        vfadd   jy, tc2, jy @m1
+        vbcast  tc2, r15 @m1
+        vfdiv   jy, jy, tc2 @m1
+        vfsub   jy, tc, jy @m1
         ; lens sample
         vsqrt   lr, lr @m1
-        vli     vt, TWO_PI_F @m1
-        vfmul   phi, vt, phi @m1
+        vli     tc, TWO_PI_F @m1
+        vfmul   phi, tc, phi @m1
         vcos    lensx, phi @m1
         vfmul   lensx, lr, lensx @m1
         vsin    lensy, phi @m1
@@ -235,27 +203,27 @@ cam_chunk:
         CAMAXIS dx, ox, 0
         CAMAXIS dy, oy, 4
         CAMAXIS dz, oz, 8
-        NORMALIZE3 d, vt, vt2
-        rsct    ox, vid, r0, F_ORGX @m1
-        rsct    oy, vid, r0, F_ORGY @m1
-        rsct    oz, vid, r0, F_ORGZ @m1
-        rsct    dx, vid, r0, F_DIRX @m1
-        rsct    dy, vid, r0, F_DIRY @m1
-        rsct    dz, vid, r0, F_DIRZ @m1
-        vli     vt, INF_BITS @m1
-        rsct    vt, vid, r0, F_TMAX @m1
-        vli     vt, 1.0 @m1
-        rsct    vt, vid, r0, F_THRR @m1
-        rsct    vt, vid, r0, F_THRG @m1
-        rsct    vt, vid, r0, F_THRB @m1
-        vmuli   vt, vid, 12 @m1
-        rsct    vt, vid, r0, F_FBOFF @m1
-        rsct    vkey, vid, r0, F_KEY @m1
-        vli     vt, KIND_CAMERA @m1
-        rsct    vt, vid, r0, F_KIND @m1
-        vli     vt, 0 @m1
-        rsct    vt, vid, r0, F_SPEC @m1
-        sapp    r20, vid @m1
+        NORMALIZE3 d, tc, tc2
+        rsct    ox, cid, r0, F_ORGX @m1
+        rsct    oy, cid, r0, F_ORGY @m1
+        rsct    oz, cid, r0, F_ORGZ @m1
+        rsct    dx, cid, r0, F_DIRX @m1
+        rsct    dy, cid, r0, F_DIRY @m1
+        rsct    dz, cid, r0, F_DIRZ @m1
+        vli     tc, INF_BITS @m1
+        rsct    tc, cid, r0, F_TMAX @m1
+        vli     tc, 1.0 @m1
+        rsct    tc, cid, r0, F_THRR @m1
+        rsct    tc, cid, r0, F_THRG @m1
+        rsct    tc, cid, r0, F_THRB @m1
+        vmuli   tc, cid, 12 @m1
+        rsct    tc, cid, r0, F_FBOFF @m1
+        rsct    vkey, cid, r0, F_KEY @m1
+        vli     tc, KIND_CAMERA @m1
+        rsct    tc, cid, r0, F_KIND @m1
+        vli     tc, 0 @m1
+        rsct    tc, cid, r0, F_SPEC @m1
+        sapp    r20, cid @m1
         add     r8, r8, r25
         blt     r8, r1, cam_chunk
         addi    r7, r7, 1
@@ -264,7 +232,7 @@ cam_chunk:
 
 ; ==== generations ================================================================================
 gen_loop:
-        stage   0
+        stage   STAGE_OTHER
         sgen    r18                     ; per-generation counters
         li      r1, FIELD_BYTES
         sub     r21, r1, r19            ; the other stream region
@@ -289,7 +257,7 @@ gen_counted:
         jal     r30, trace
 gen_shade:
         jal     r30, shade
-        stage   0
+        stage   STAGE_OTHER
         rswap
         mov     r19, r21
         mov     r20, r22
@@ -312,25 +280,7 @@ err_stack:
 ; Stream [r19, r20) -> [r19, r20') of finite rays; r20 moves down.
 setup:
         beq     r19, r20, setup_done
-.alias  vid, v0
-.alias  ox, v1
-.alias  oy, v2
-.alias  oz, v3
-.alias  dx, v4
-.alias  dy, v5
-.alias  dz, v6
-.alias  vt, v7
-.alias  vt2, v8
-.alias  ax, v9
-.alias  ay, v10
-.alias  az, v11
-.alias  kx, v12
-.alias  ky, v13
-.alias  kz, v14
-.alias  vone, v15
-.alias  vtwo, v16
-.alias  sel, v17
-.alias  dkz, v18
+        FRAME_SETUP
         mov     r16, r19
 setup_chunk:
         sfetch  vid, m1, r16, r20
@@ -465,7 +415,7 @@ setup_done:
 ; pushed so that every ray meets the near child's whole subtree first -- the golden model's
 ; visiting order, hence its hit distances and tie breaks, for every ray.
 trace:
-        stage   1
+        stage   STAGE_TRAVERSAL
         ld      r15, r0, SM_HDR_NNODES
         beq     r15, r0, trace_done
         ld      r26, r0, SM_HDR_NODES
@@ -475,25 +425,7 @@ trace:
         spst    r19, r24, 4
         spst    r20, r24, 8
         addi    r24, r24, 12
-.alias  vid, v0
-.alias  bminx, v1
-.alias  bminy, v2
-.alias  bminz, v3
-.alias  bmaxx, v4
-.alias  bmaxy, v5
-.alias  bmaxz, v6
-.alias  ox, v7
-.alias  oy, v8
-.alias  oz, v9
-.alias  ix, v10
-.alias  iy, v11
-.alias  iz, v12
-.alias  tn, v13
-.alias  tf, v14
-.alias  t0, v15
-.alias  t1, v16
-.alias  tlo, v17
-.alias  vscale, v18
+        FRAME_BOX
 trav_pop:
         li      r1, STACK_BASE
         beq     r24, r1, trace_done
@@ -533,9 +465,9 @@ box_chunk:
         ld      r6, r2, SM_NODE_INFO
         ld      r7, r2, SM_NODE_FIRST
         blt     r6, r0, trav_inner
-        stage   2
+        stage   STAGE_INTERSECTION
         jal     r31, isect
-        stage   1
+        stage   STAGE_TRAVERSAL
         jmp     trav_pop
 trav_inner:
         andi    r8, r6, 3               ; split axis: F_INV of that axis
@@ -593,7 +525,7 @@ push_neg_only:
         PUSH    r11, r3, r9
         jmp     trav_pop
 trace_done:
-        stage   0
+        stage   STAGE_OTHER
         jr      r30
 
 .endif
@@ -604,7 +536,7 @@ trace_done:
 ; registers over the leaf and is scattered once per chunk (conditional scatter).
 ; In: r7 first primitive, r6 count. Clobbers r1-r15 (not r24, r26, r27).
 isect:
-        ISECT_REGS
+        FRAME_ISECT
         COUNT_STREAM ST_G_ISECT, r3, r5, r8, r9, r10
 .ifdef ACCEL_KD
         shli    r8, r7, 2               ; kd-tree leaf: r7 is its first KD_PRIMS entry
@@ -636,7 +568,7 @@ isect_prim:
         ld      r12, r10, SM_PRIM_KIND
         bne     r12, r0, isect_sphere
 .endif
-        vbcast  vt, r10 @m1
+        vbcast  ta, r10 @m1
         TRI_TEST isect_next
 isect_update:
         HIT_UPDATE vbcast, r11
@@ -839,43 +771,6 @@ fe\@:
 fd\@:
 .endm
 
-; The registers of direct lighting (direct) and the Phong workload's light passes (phong),
-; which share LIGHT_SAMPLE; wi names lu, lv, lk once the light is sampled.
-.macro  LIGHT_ALIASES
-.alias  vid, v0
-.alias  kb, v1
-.alias  px, v2
-.alias  py, v3
-.alias  pz, v4
-.alias  nfx, v5
-.alias  nfy, v6
-.alias  nfz, v7
-.alias  ox, v8
-.alias  oy, v9
-.alias  oz, v10
-.alias  la, v11
-.alias  lu, v12
-.alias  lv, v13
-.alias  lk, v14
-.alias  lpx, v15
-.alias  lpy, v16
-.alias  lpz, v17
-.alias  e1x, v18
-.alias  e1y, v19
-.alias  e1z, v20
-.alias  e2x, v21
-.alias  e2y, v22
-.alias  e2z, v23
-.alias  nlx, v24
-.alias  nly, v25
-.alias  nlz, v26
-.alias  vt, v27
-.alias  vt2, v28
-.alias  vt3, v29
-.alias  wix, v12
-.alias  wiy, v13
-.alias  wiz, v14
-.endm
 
 .macro  LPOINT p, e1, e2, o
         vfmul   vt, lu, \e1 @m4
@@ -891,7 +786,7 @@ fd\@:
 ; light), wi := it normalized, e1 := le, the radiance it brings x geometry, e2 := the shading
 ; normal, vt3 := cos at it; m2 := the m1 lanes that receive light and see it from both
 ; normals (nf facing the ray). sample_light and shade_direct of sim/reference.c, operation
-; for operation. Aliases of LIGHT_ALIASES; clobbers m3-m7, nl, vt, vt2, r1, r7 (and, with
+; for operation. Registers of FRAME_LIGHT; clobbers m3-m7, nl, vt, vt2, r1, r7 (and, with
 ; HAS_EMISSIVE_TEX, p: the emissive texel of a textured triangle light).
 .macro  LIGHT_SAMPLE
         ldg     lk, la, SM_LIGHT_KIND @m1
@@ -1102,7 +997,7 @@ ls_nodir\@:
 
 shade:
         spst    r30, r0, L_LINK         ; the shaders below use r30 and r31 themselves
-        stage   3
+        stage   STAGE_SHADING
         beq     r19, r20, shade_done
         ; ---- shadow filter: unoccluded shadow rays add the radiance they carry
         FILTER_EQ r19, r20, r3, F_KIND, KIND_SHADOW
@@ -1122,12 +1017,7 @@ sh_count:
         spst    r2, r4, 0
         beq     r19, r3, sh_shadow_done
         SHADE_STREAM r19, r3
-.alias  vid, v0
-.alias  tm, v1
-.alias  thx, v2
-.alias  thy, v3
-.alias  thz, v4
-.alias  vt, v5
+        FRAME_SHADE
         SHADOW_ADD r19, r3, tm, th, vt
 sh_shadow_done:
         ; ---- miss filter
@@ -1135,9 +1025,6 @@ sh_shadow_done:
 .ifdef HAS_BACKGROUND
         beq     r3, r4, sh_miss_done
         SHADE_STREAM r3, r4
-.alias  bgx, v6
-.alias  bgy, v7
-.alias  bgz, v8
         mov     r16, r3
 sh_miss:
         sfetch  vid, m1, r16, r4
@@ -1207,34 +1094,7 @@ shade_done:
 ; dead set-up fields; emitters seen from their emitting side go first ([r3, r5)) and add their
 ; emission for camera rays and after delta bounces. Clobbers r1, r2, r4, r7-r16.
 surface:
-.alias  vid, v0
-.alias  pa, v1
-.alias  ax, v2
-.alias  ay, v3
-.alias  az, v4
-.alias  ex, v5
-.alias  ey, v6
-.alias  ez, v7
-.alias  fx, v8
-.alias  fy, v9
-.alias  fz, v10
-.alias  gx, v11
-.alias  gy, v12
-.alias  gz, v13
-.alias  vt, v14
-.alias  vt2, v15
-.alias  dn, v16
-.alias  nfx, v17
-.alias  nfy, v18
-.alias  nfz, v19
-.alias  nsx, v20
-.alias  nsy, v21
-.alias  nsz, v22
-.alias  mat, v23
-.alias  bu, v24
-.alias  bv, v25
-.alias  w0, v26
-.alias  vt3, v27
+        FRAME_SURFACE
         ld      r7, r0, SM_HDR_PRIMS
         ld      r8, r0, SM_HDR_MATS
         ld      r9, r0, SM_HDR_NORMALS
@@ -1535,32 +1395,22 @@ diff_pd2:
         bne     r10, r0, diff_pd3
         li      r11, 0.0
 diff_pd3:
-.alias  vid, v0
-.alias  kb, v1
-.alias  u0, v2
-.alias  vt, v3
-.alias  vpd, v4
+        FRAME_SPLIT
         ; ---- split: direct (u < p_direct) first
         mov     r16, r12
 diff_split:
         sfetch  vid, m1, r16, r13
         rgat    kb, vid, r0, F_KEY @m1
-        vbcast  vt, r8 @m1
-        vadd    kb, kb, vt @m1
-        RAND    u0, kb, DIM_DIRECT, vt
+        vbcast  st, r8 @m1
+        vadd    kb, kb, st @m1
+        RAND    u0, kb, DIM_DIRECT, st
         vbcast  vpd, r11 @m1
         vflt    m2, u0, vpd @m1
         pmask   m2
 .ifdef HAS_AMBIENT
         li      r1, MAT_LAMBERT
         bne     r14, r1, diff_noamb
-.alias  thx, v5
-.alias  thy, v6
-.alias  thz, v7
-.alias  bx, v8
-.alias  by, v9
-.alias  bz, v10
-        AMBIENT_ADD th, b, vt
+        AMBIENT_ADD th, b, st
 diff_noamb:
 .endif
         blt     r16, r13, diff_split
@@ -1580,7 +1430,7 @@ diff_done:
 ; Scalars: r8 = 16 * vertex, r10 = number of lights, r11 = p_direct (float), r14 = kind.
 ; Clobbers r1-r4, r7, r16.
 direct:
-        LIGHT_ALIASES
+        FRAME_LIGHT
         ld      r1, r0, SM_HDR_LIGHTS
         cvtif   r2, r10                 ; (float) nlights
         fdiv    r3, r2, r11             ; weight nlights / p_direct
@@ -1697,36 +1547,7 @@ rr\@:
 ; ---- indirect bounce on [r15, r13): cosine-weighted (Lambert) or lobe-sampled (glossy).
 ; Scalars: r8 = 16 * vertex, r11 = p_direct, r14 = kind. Clobbers r1-r4, r7, r16.
 indirect:
-.alias  vid, v0
-.alias  kb, v1
-.alias  u5, v2
-.alias  phi, v3
-.alias  nsx, v4
-.alias  nsy, v5
-.alias  nsz, v6
-.alias  dx, v7
-.alias  dy, v8
-.alias  dz, v9
-.alias  nfx, v10
-.alias  nfy, v11
-.alias  nfz, v12
-.alias  thx, v13
-.alias  thy, v14
-.alias  thz, v15
-.alias  bx, v16
-.alias  by, v17
-.alias  bz, v18
-.alias  cx, v19
-.alias  cy, v20
-.alias  cz, v21
-.alias  vt, v22
-.alias  vt2, v23
-.alias  vt3, v24
-.alias  vt4, v25
-.alias  vt5, v26
-.alias  vt6, v27
-.alias  vt7, v28
-.alias  vt8, v29
+        FRAME_BOUNCE
         addi    r7, r18, 1              ; depth of the new rays
         li      r1, 1.0
         fsub    r2, r1, r11
@@ -1864,34 +1685,7 @@ dielectric:
         addi    r7, r18, 1
         blt     r29, r7, diel_done      ; cannot bounce
         shli    r8, r7, 4
-.alias  vid, v0
-.alias  kb, v1
-.alias  dx, v2
-.alias  dy, v3
-.alias  dz, v4
-.alias  ngx, v5
-.alias  ngy, v6
-.alias  ngz, v7
-.alias  nnx, v8
-.alias  nny, v9
-.alias  nnz, v10
-.alias  eta, v11
-.alias  cc, v12
-.alias  ct, v13
-.alias  fr, v14
-.alias  ox, v15
-.alias  oy, v16
-.alias  oz, v17
-.alias  thx, v18
-.alias  thy, v19
-.alias  thz, v20
-.alias  vt, v21
-.alias  vt2, v22
-.alias  vt3, v23
-.alias  cosi, v24
-.alias  px, v25
-.alias  py, v26
-.alias  pz, v27
+        FRAME_DIELECTRIC
         mov     r16, r12
 diel_chunk:
         sfetch  vid, m1, r16, r13
@@ -1992,37 +1786,20 @@ forced_specular:
         li      r1, BOUNCES
         slt     r9, r1, r7
         xori    r9, r9, 1               ; another bounce?
-.alias  vid, v0
-.alias  dx, v1
-.alias  dy, v2
-.alias  dz, v3
-.alias  nfx, v4
-.alias  nfy, v5
-.alias  nfz, v6
-.alias  px, v7
-.alias  py, v8
-.alias  pz, v9
-.alias  ox, v10
-.alias  oy, v11
-.alias  oz, v12
-.alias  thx, v13
-.alias  thy, v14
-.alias  thz, v15
-.alias  vt, v16
-.alias  vt2, v17
+        FRAME_MIRROR
         mov     r16, r12
 fs_chunk:
         sfetch  vid, m1, r16, r13
-        GATHER3 th, F_THRR, F_THRG, F_THRB
+        GATHER3 mth, F_THRR, F_THRG, F_THRB
         bne     r9, r0, fs_bounce
         GATHER3 p, F_BASER, F_BASEG, F_BASEB
-        vfmul   thx, thx, px @m1
-        vfmul   thy, thy, py @m1
-        vfmul   thz, thz, pz @m1
-        FBADD3  th, vt, m1
+        vfmul   mthx, mthx, px @m1
+        vfmul   mthy, mthy, py @m1
+        vfmul   mthz, mthz, pz @m1
+        FBADD3  mth, vt, m1
         jmp     fs_next
 fs_bounce:
-        MIRROR_EMIT th
+        MIRROR_EMIT mth
 fs_next:
         blt     r16, r13, fs_chunk
 fs_done:
@@ -2038,33 +1815,7 @@ one_bounce_diffuse:
         SHADE_STREAM r12, r13
         addi    r7, r18, 1
         shli    r8, r7, 4
-.alias  vid, v0
-.alias  kb, v1
-.alias  u5, v2
-.alias  phi, v3
-.alias  nsx, v4
-.alias  nsy, v5
-.alias  nsz, v6
-.alias  dx, v7
-.alias  dy, v8
-.alias  dz, v9
-.alias  nfx, v10
-.alias  nfy, v11
-.alias  nfz, v12
-.alias  thx, v13
-.alias  thy, v14
-.alias  thz, v15
-.alias  bx, v16
-.alias  by, v17
-.alias  bz, v18
-.alias  cx, v19
-.alias  cy, v20
-.alias  cz, v21
-.alias  vt, v22
-.alias  vt2, v23
-.alias  vt3, v24
-.alias  vt4, v25
-.alias  vt5, v26
+        FRAME_BOUNCE
         mov     r16, r12
 od_chunk:
         sfetch  vid, m1, r16, r13
@@ -2146,7 +1897,7 @@ phong:
         spst    r12, r0, PH_BEGIN
         spst    r13, r0, PH_END
         SHADE_STREAM r12, r13
-        LIGHT_ALIASES
+        FRAME_LIGHT
         mov     r16, r12
 ph_ambient:
         sfetch  vid, m1, r16, r13
@@ -2207,7 +1958,7 @@ ph_chunk:
         addi    r19, r19, PH_IDS
         mov     r20, r22
         beq     r19, r20, ph_next
-        stage   0
+        stage   STAGE_OTHER
         jal     r30, setup
         sub     r4, r20, r19
         shri    r4, r4, 2               ; rays traced: shadow rays of this generation
@@ -2220,11 +1971,11 @@ ph_chunk:
         spst    r3, r2, ST_PER_GEN
         beq     r19, r20, ph_traced     ; everything dropped
         jal     r30, trace
-        stage   3
+        stage   STAGE_SHADING
         SHADE_STREAM r19, r20
         SHADOW_ADD r19, r20, kb, p, vt
 ph_traced:
-        stage   3
+        stage   STAGE_SHADING
 ph_next:
         spld    r19, r0, PH_R19
         spld    r20, r0, PH_R20
@@ -2240,12 +1991,7 @@ ph_bounce:
         spld    r12, r0, PH_BEGIN
         spld    r13, r0, PH_END
         SHADE_STREAM r12, r13
-.alias  thx, v11
-.alias  thy, v12
-.alias  thz, v13
-.alias  dx, v14
-.alias  dy, v15
-.alias  dz, v16
+        FRAME_PHONG_MIRROR
         mov     r16, r12
 ph_mirror:
         sfetch  vid, m1, r16, r13

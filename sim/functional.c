@@ -642,12 +642,12 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
     if (cfg->stream_order == CFG_STREAM_ORDER_FIRST)
         add_define(defs, &nd, st->defines, sizeof st->defines, "ORDER_FIRST", 1);
     if (cfg->workload_kind == CFG_WORKLOAD_SPECULAR) {
-        add_define(defs, &nd, st->defines, sizeof st->defines, "WORKLOAD", 1);
+        add_define(defs, &nd, st->defines, sizeof st->defines, "WORKLOAD", CFG_WORKLOAD_SPECULAR);
         add_define(defs, &nd, st->defines, sizeof st->defines, "BOUNCES", cfg->workload_bounces);
     } else if (cfg->workload_kind == CFG_WORKLOAD_DIFFUSE) {
-        add_define(defs, &nd, st->defines, sizeof st->defines, "WORKLOAD", 2);
+        add_define(defs, &nd, st->defines, sizeof st->defines, "WORKLOAD", CFG_WORKLOAD_DIFFUSE);
     } else if (phong) {
-        add_define(defs, &nd, st->defines, sizeof st->defines, "WORKLOAD", 3);
+        add_define(defs, &nd, st->defines, sizeof st->defines, "WORKLOAD", CFG_WORKLOAD_PHONG);
         add_define(defs, &nd, st->defines, sizeof st->defines, "BOUNCES", cfg->workload_bounces);
     }
     uint32_t spad_bytes = (uint32_t)cfg->spad_size_kb * 1024u;
@@ -656,7 +656,7 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
     int kinds = 0;
     for (uint32_t m = 0; m < nmats; m++) {
         uint32_t k = sm_u32(p, sm_rec(mats, SM_MAT_WORDS, m, SM_MAT_KIND));
-        if (k < 3)
+        if (k <= SCENE_MAT_DIELECTRIC)
             kinds |= 1 << k;
     }
     if (kinds & (1 << SCENE_MAT_LAMBERT))
