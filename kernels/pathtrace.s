@@ -205,44 +205,21 @@ shade:
         mov     r3, r4
         jal     r31, surface            ; [r3, r20) -> emitters first, r5 = end of them
 .if WORKLOAD == WL_SPECULAR
-        mov     r12, r5
-        mov     r13, r20
-        jal     r31, forced_specular
-        jmp     sh_return
+        WORKLOAD_SHADER forced_specular
 .elif WORKLOAD == WL_DIFFUSE
-        mov     r12, r5
-        mov     r13, r20
-        jal     r31, one_bounce_diffuse
-        jmp     sh_return
+        WORKLOAD_SHADER one_bounce_diffuse
 .elif WORKLOAD == WL_PHONG
-        mov     r12, r5
-        mov     r13, r20
-        jal     r31, phong
-        jmp     sh_return
+        WORKLOAD_SHADER phong
 .else
-        ; ---- one filter per material kind on [r5, r20)
+        ; ---- one filter per material kind on the hits [r5, r20), each to its shader
 .ifdef HAS_LAMBERT
-        FILTER_EQ r5, r20, r6, F_MATKIND, MAT_LAMBERT
-        mov     r12, r5
-        mov     r13, r6
-        li      r14, MAT_LAMBERT
-        jal     r31, diffuse
-        mov     r5, r6
+        MATERIAL_FILTER MAT_LAMBERT, diffuse
 .endif
 .ifdef HAS_GLOSSY
-        FILTER_EQ r5, r20, r6, F_MATKIND, MAT_GLOSSY
-        mov     r12, r5
-        mov     r13, r6
-        li      r14, MAT_GLOSSY
-        jal     r31, diffuse
-        mov     r5, r6
+        MATERIAL_FILTER MAT_GLOSSY, diffuse
 .endif
 .ifdef HAS_DIELECTRIC
-        FILTER_EQ r5, r20, r6, F_MATKIND, MAT_DIELECTRIC
-        mov     r12, r5
-        mov     r13, r6
-        jal     r31, dielectric
-        mov     r5, r6
+        MATERIAL_FILTER MAT_DIELECTRIC, dielectric, 0
 .endif
 .endif
 sh_return:
