@@ -51,7 +51,7 @@ help:
 	@echo "make fuzz       build the libFuzzer targets, assembler and scene loader (clang);"
 	@echo "                make fuzz-run FUZZ_SECONDS=600 runs each for that long"
 	@echo "make bench      build and run the benchmarks in bench/ (core, functional and detailed speed, Embree)"
-	@echo "make docs       regenerate docs/isa.md, docs/exit-codes.md, the layout include and docs, the shipped Cornell box"
+	@echo "make docs       regenerate docs/isa.md, docs/exit-codes.md, the layout include and docs, the kernel constants, the shipped Cornell box"
 	@echo "make install    install into PREFIX (default /usr/local; DESTDIR honoured): docs/install.md"
 
 deps:

@@ -114,7 +114,7 @@ static int abi_lookup(const AsmObject *obj, Abi *abi, char *err, size_t errlen)
 #define KD_STREAM_ENTRY_BYTES 36u   /* stream-filter stack, 3 * depth + 8 entries like the BVH kernel's */
 #define KD_LANE_ENTRY_BYTES 1024u   /* per-lane stacks, in the next generation's ray buffer */
 
-/* abi.inc's KD_VARIANT constants, in kd.traversal order. */
+/* The kernel's KD_VARIANT constants (kernels/lib/kconst.inc, generated from kd.traversal's names). */
 static const char *const kd_variant_syms[CFG_KD_TRAVERSALS] = {"KD_STACK", "KD_RESTART", "KD_PUSHDOWN",
                                                                "KD_SHORTSTACK", "KD_PACKET", "KD_STREAM"};
 
@@ -626,7 +626,7 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
     }
     uint32_t rays = tile_w * tile_h;
     /* The Phong workload traces each hit's shadow rays from the current ray buffer, beside the
-     * hits (kernels/pathtrace.s, phong): two ray records per pixel, so a stream-mode tile holds
+     * hits (kernels/filters/phong.inc): two ray records per pixel, so a stream-mode tile holds
      * M/2 pixels (64 x 32 for M = 4096) and a packet's buffers 2N records. */
     int phong = cfg->workload_kind == CFG_WORKLOAD_PHONG && !fp->batch;
     if (phong) {
