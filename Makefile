@@ -57,7 +57,7 @@ help:
 	@echo "make fuzz       build the libFuzzer targets, assembler and scene loader (clang);"
 	@echo "                make fuzz-run FUZZ_SECONDS=600 runs each for that long"
 	@echo "make bench      build and run the benchmarks in bench/ (core, functional and detailed speed, Embree)"
-	@echo "make docs       regenerate docs/isa.md, docs/exit-codes.md, the layout include and docs, the shipped Cornell box"
+	@echo "make docs       regenerate docs/isa.md, docs/exit-codes.md, the layout include and docs, the kernel constants, the shipped Cornell box"
 	@echo "make check-outputs  the same-outputs table alone (tests/outputs/check.sh; part of make test)"
 	@echo "make install    install into PREFIX (default /usr/local; DESTDIR honoured): docs/install.md"
 
@@ -129,20 +129,26 @@ $(BUILD)/gen_layout: tools/gen_layout.c scenes/layout.def
 $(BUILD)/outputs_digest: tools/outputs_digest.c $(BUILD)/libsfsim.a
 	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
 
+# The kernel's shared numbers (stages, workloads, kd variants, material and light kinds).
+$(BUILD)/gen_kconst: tools/gen_kconst.c $(BUILD)/libsfsim.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(LDAS) $^ -o $@ $(INIH) $(LDLIBS)
+
 # The shipped Cornell box, from the published measurements (scenes/cornell/cornell-box.gltf).
 $(BUILD)/gen_cornell: tools/gen_cornell.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) tools/gen_cornell.c -o $@ $(CJSON) -lm
 
-docs: $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_exitdoc $(BUILD)/gen_cornell
+docs: $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_exitdoc $(BUILD)/gen_cornell
 	$(BUILD)/gen_cornell scenes/cornell
 	$(BUILD)/gen_isadoc > docs/isa.md
 	$(BUILD)/gen_exitdoc > docs/exit-codes.md
 	$(BUILD)/gen_layout inc > kernels/lib/layout.inc
 	$(BUILD)/gen_layout md > docs/scene-memory.md
+	$(BUILD)/gen_kconst > kernels/lib/kconst.inc
 
 # ---- tests ----------------------------------------------------------------------------------
-$(BUILD)/tests/unit: $(TEST_SRC) $(BUILD)/libsfsim.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_exitdoc
+$(BUILD)/tests/unit: $(TEST_SRC) $(BUILD)/libsfsim.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_exitdoc
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(LDAS) $(TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
 
@@ -150,7 +156,7 @@ $(BUILD)/tests/io: $(IO_TEST_SRC) $(BUILD)/libsfsim.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(LDAS) $(IO_TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(EMBREE) $(INIH) $(LDLIBS)
 
-$(BUILD)/tests/unit-asan: $(TEST_SRC) $(BUILD)/libsfsim-asan.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_exitdoc
+$(BUILD)/tests/unit-asan: $(TEST_SRC) $(BUILD)/libsfsim-asan.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_exitdoc
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(SAN) $(LDAS) $(TEST_SRC) $(BUILD)/libsfsim-asan.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
 
@@ -290,11 +296,12 @@ SHIPPED_SCENES := scenes/cornell/scene.ini scenes/cornell/glossy.ini scenes/corn
                   scenes/cornell/cornell-box.gltf scenes/cornell/cornell-box.bin
 
 install: all
-	install -d $(DESTDIR)$(PREFIX)/bin $(DATADIR)/kernels/lib $(DATADIR)/kernels/bench $(DATADIR)/kernels/examples \
+	install -d $(DESTDIR)$(PREFIX)/bin $(DATADIR)/kernels/lib $(DATADIR)/kernels/filters $(DATADIR)/kernels/bench $(DATADIR)/kernels/examples \
 	    $(DATADIR)/configs/sweeps $(DATADIR)/scenes/cornell $(DOCDIR)/docs
 	install -m 755 bin/sfsim bin/sfasm $(DESTDIR)$(PREFIX)/bin/
 	install -m 644 kernels/*.s $(DATADIR)/kernels/
 	install -m 644 kernels/lib/* $(DATADIR)/kernels/lib/
+	install -m 644 kernels/filters/* $(DATADIR)/kernels/filters/
 	install -m 644 kernels/bench/* $(DATADIR)/kernels/bench/
 	install -m 644 kernels/examples/* $(DATADIR)/kernels/examples/
 	install -m 644 configs/*.ini $(DATADIR)/configs/

@@ -270,6 +270,79 @@ static void alias_directive(Asm *a, const AsmToken *t, int i)
     asm_alias_set(a, name, kind, num);
 }
 
+/* .regs FIRST, item, ...: a register frame -- consecutive registers of FIRST's kind from FIRST on,
+ * one .alias per name; an item `name:SUFFIXES` names one register per suffix letter (`d:xyz` is
+ * dx, dy, dz). docs/assembler.md, "Register frames". */
+static void regs_directive(Asm *a, const AsmToken *t, int i)
+{
+    const AsmToken *first = &t[i + 1];
+    char d[64];
+    int kind, num;
+    if (!as_register(a, first, first->kind == ASM_TOK_EOL ? 0 : 1, &kind, &num)) {
+        asm_error_at(a, first->col, "expected the frame's first register after .regs, found %s",
+                     asm_tok_describe(first, d, sizeof d));
+        return;
+    }
+    if (!reg_in_range(a, first, kind, num))
+        return;
+    int max = isa_kind_max_reg((IsaOperandKind)kind), j = i + 2;
+    if (t[j].kind == ASM_TOK_EOL) {
+        asm_error_at(a, t[j].col, "expected ',' and names after the first register of .regs");
+        return;
+    }
+    while (t[j].kind != ASM_TOK_EOL) {
+        const AsmToken *name = &t[j + 1], *suf = NULL;
+        if (!is_punct(&t[j], ASM_P_COMMA)) {
+            asm_error_at(a, t[j].col, "expected ',' before the next name in .regs, found %s",
+                         asm_tok_describe(&t[j], d, sizeof d));
+            return;
+        }
+        if (name->kind != ASM_TOK_IDENT && name->kind != ASM_TOK_REG) {
+            asm_error_at(a, name->col, "expected a register name in .regs, found %s",
+                         asm_tok_describe(name, d, sizeof d));
+            return;
+        }
+        j += 2;
+        if (is_punct(&t[j], ASM_P_COLON)) {
+            suf = &t[j + 1];
+            if (suf->kind != ASM_TOK_IDENT) {
+                asm_error_at(a, suf->col, "expected suffix letters after ':' in .regs, found %s",
+                             asm_tok_describe(suf, d, sizeof d));
+                return;
+            }
+            j += 2;
+        }
+        for (uint32_t k = 0; k < (suf ? suf->len : 1u); k++, num++) {
+            if (num > max) {
+                asm_error_at(a, name->col, "register frame runs past %c%d at '%.*s'", kind_letter(kind), max,
+                             (int)name->len, name->text);
+                return;
+            }
+            if (!suf) {
+                asm_alias_set(a, name, kind, num);
+                continue;
+            }
+            char buf[128];
+            AsmToken one = *name;
+            int len = snprintf(buf, sizeof buf, "%.*s%c", (int)name->len, name->text, suf->text[k]);
+            AsmTokens lexed = {0};
+            AsmLexError le;
+            /* the joined name is lexed again: `v:1` would make the register v1, not an alias */
+            if (len >= (int)sizeof buf || asm_lex_line(buf, (size_t)len, NULL, &lexed, &le) < 0 || lexed.n != 2) {
+                asm_error_at(a, name->col, "'%s' is not a name", buf);
+                asm_tokens_free(&lexed);
+                return;
+            }
+            one.kind = lexed.v[0].kind;
+            one.text = buf;
+            one.len = (uint32_t)len;
+            asm_tokens_free(&lexed);
+            if (asm_alias_set(a, &one, kind, num) < 0)
+                return;
+        }
+    }
+}
+
 static void unalias_directive(Asm *a, const AsmToken *t, int i)
 {
     char d[64];
@@ -307,6 +380,7 @@ static const struct {
     {".word", data_directive},     {".float", data_directive},     {".byte", data_directive},
     {".space", space_directive},   {".align", align_directive},    {".equ", equ_directive},
     {".set", equ_directive},       {".alias", alias_directive},    {".unalias", unalias_directive},
+    {".regs", regs_directive},
     {".error", error_directive},   {".if", structural_directive},  {".ifdef", structural_directive},
     {".ifndef", structural_directive}, {".elif", structural_directive}, {".else", structural_directive},
     {".endif", structural_directive},  {".macro", structural_directive}, {".endm", structural_directive},

@@ -53,7 +53,7 @@ enum { CFG_STREAM_MODE_STREAM = 0, CFG_STREAM_MODE_PACKET = 1 };
 enum { CFG_STREAM_ORDER_RAY = 0, CFG_STREAM_ORDER_FIRST = 1 };
 enum { CFG_WORKLOAD_PATH = 0, CFG_WORKLOAD_SPECULAR = 1, CFG_WORKLOAD_DIFFUSE = 2, CFG_WORKLOAD_PHONG = 3 };
 enum { CFG_ACCEL_BVH = 0, CFG_ACCEL_KD = 1 };
-/* kd.traversal; the kernel's KD_VARIANT takes these values (kernels/lib/abi.inc: KD_STACK..KD_STREAM). */
+/* kd.traversal; the kernel's KD_VARIANT takes these values (kernels/lib/kconst.inc: KD_STACK..KD_STREAM, generated). */
 enum { CFG_KD_STACK = 0, CFG_KD_RESTART = 1, CFG_KD_PUSHDOWN = 2, CFG_KD_SHORTSTACK = 3, CFG_KD_PACKET = 4,
        CFG_KD_STREAM = 5, CFG_KD_TRAVERSALS };
 /* The name of an ENUM key's value ("packet"), or NULL for other keys. */

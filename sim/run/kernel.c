@@ -81,7 +81,7 @@ static int abi_lookup(const AsmObject *obj, KernelAbi *abi, char *err, size_t er
 #define KD_STREAM_ENTRY_BYTES 36u   /* stream-filter stack, 3 * depth + 8 entries like the BVH kernel's */
 #define KD_LANE_ENTRY_BYTES 1024u   /* per-lane stacks, in the next generation's ray buffer */
 
-/* abi.inc's KD_VARIANT constants, in kd.traversal order. */
+/* The kernel's KD_VARIANT constants (kernels/lib/kconst.inc, generated from kd.traversal's names). */
 static const char *const kd_variant_syms[CFG_KD_TRAVERSALS] = {"KD_STACK", "KD_RESTART", "KD_PUSHDOWN",
                                                                "KD_SHORTSTACK", "KD_PACKET", "KD_STREAM"};
 
@@ -188,7 +188,7 @@ static void add_define(AsmDefine *defs, int *n, char *list, size_t len, const ch
 
 /* Stream mode: tiles of sqrt(M) x sqrt(M) rays; packet mode: packets of N rays, as square as N
  * allows (2 x 2, 4 x 2, 4 x 3, 4 x 4, 8 x 8). The Phong workload traces each hit's shadow rays from
- * the current ray buffer, beside the hits (kernels/pathtrace.s, phong): two ray records per pixel,
+ * the current ray buffer, beside the hits (kernels/filters/phong.inc): two ray records per pixel,
  * so a stream-mode tile holds M/2 pixels (64 x 32 for M = 4096) and a packet's buffers 2N records. */
 static void tile_shape(const CfgMachine *cfg, int phong, Kernel *k)
 {
@@ -227,7 +227,7 @@ static void scene_defines(const PackedScene *p, uint32_t needs, AsmDefine *defs,
     int kinds = 0;
     for (uint32_t m = 0; m < nmats; m++) {
         uint32_t kind = sm_u32(p, sm_rec(mats, SM_MAT_WORDS, m, SM_MAT_KIND));
-        if (kind < 3)
+        if (kind <= SCENE_MAT_DIELECTRIC)
             kinds |= 1 << kind;
     }
     if (kinds & (1 << SCENE_MAT_LAMBERT))
@@ -284,12 +284,12 @@ static int choose_defines(const PackedScene *p, const CfgMachine *cfg, uint32_t 
     if (cfg->stream_order == CFG_STREAM_ORDER_FIRST)
         add_define(defs, nd, list, len, "ORDER_FIRST", 1);
     if (cfg->workload_kind == CFG_WORKLOAD_SPECULAR) {
-        add_define(defs, nd, list, len, "WORKLOAD", 1);
+        add_define(defs, nd, list, len, "WORKLOAD", CFG_WORKLOAD_SPECULAR);
         add_define(defs, nd, list, len, "BOUNCES", cfg->workload_bounces);
     } else if (cfg->workload_kind == CFG_WORKLOAD_DIFFUSE) {
-        add_define(defs, nd, list, len, "WORKLOAD", 2);
+        add_define(defs, nd, list, len, "WORKLOAD", CFG_WORKLOAD_DIFFUSE);
     } else if (phong) {
-        add_define(defs, nd, list, len, "WORKLOAD", 3);
+        add_define(defs, nd, list, len, "WORKLOAD", CFG_WORKLOAD_PHONG);
         add_define(defs, nd, list, len, "BOUNCES", cfg->workload_bounces);
     }
     add_define(defs, nd, list, len, "SPAD_BYTES", (uint32_t)cfg->spad_size_kb * 1024u);

@@ -65,6 +65,7 @@ begin "make install PREFIX=... installs binaries, kernels, configs, the default 
 run make --no-print-directory install PREFIX="$T/prefix"
 want_rc 0
 for f in bin/sfsim bin/sfasm share/sfsim/kernels/pathtrace.s share/sfsim/kernels/lib/layout.inc \
+    share/sfsim/kernels/lib/kconst.inc share/sfsim/kernels/lib/frames.inc share/sfsim/kernels/filters/traverse.inc \
     share/sfsim/configs/streamray.ini share/sfsim/configs/sweeps/width.ini share/sfsim/scenes/cornell/scene.ini \
     share/sfsim/scenes/cornell/cornell-box.gltf share/sfsim/scenes/cornell/cornell-box.bin \
     share/doc/sfsim/README.md share/doc/sfsim/docs/README.md; do

@@ -5,6 +5,7 @@
 ; only lanes 0..N-1, and must have cleared them: the counters are added to, not stored), and
 ; counts 2 camera rays and 3 indirect rays per run.
 .include "../../kernels/lib/abi.inc"
+.include "../../kernels/lib/kconst.inc"          ; KD_STACK .. KD_STREAM, which the host checks
 
 .ifndef ACCEL_KD
         .error "built without ACCEL_KD"

@@ -568,6 +568,42 @@ Test(asm_features, macros_args_defaults_unique)
     asm_object_free(&obj);
 }
 
+/* A register frame (.regs) is one .alias per name on consecutive registers; name:xyz names three. */
+Test(asm_features, register_frames)
+{
+    AsmObject obj;
+    assemble_ok(".regs v3, a, d:xyz, m\n.regs m2, hit\nvfadd dy, a, dz @hit\nvmov m, dx\n"
+                ".regs v29, t:ab, u\nvmov ta, u\n.alias dx, v9\nvmov dx, dz\n", NULL, &obj);
+    IsaInstr in = decode_at(&obj, 0);
+    cr_assert_eq(in.op, ISA_OP_VFADD);
+    cr_assert_eq(in.a, 5);
+    cr_assert_eq(in.b, 3);
+    cr_assert_eq(in.c, 6);
+    cr_assert_eq(in.mask, 2);
+    in = decode_at(&obj, 1);
+    cr_assert_eq(in.a, 7);
+    cr_assert_eq(in.b, 4);
+    in = decode_at(&obj, 2);
+    cr_assert_eq(in.a, 29);
+    cr_assert_eq(in.b, 31);
+    in = decode_at(&obj, 3);
+    cr_assert_eq(in.a, 9);
+    cr_assert_eq(in.b, 6);
+    asm_object_free(&obj);
+}
+
+Test(asm_errors, register_frames)
+{
+    expect_diag(".regs v30, a, d:xyz\n", "bad.s:1:15: register frame runs past v31 at 'd'\n");
+    expect_diag(".regs v1\n", "bad.s:1:9: expected ',' and names after the first register of .regs\n");
+    expect_diag(".regs v1, a b\n", "bad.s:1:13: expected ',' before the next name in .regs, found 'b'\n");
+    expect_diag(".regs 3, a\n", "bad.s:1:7: expected the frame's first register after .regs, found '3'\n");
+    expect_diag(".regs v1, a:\n", "bad.s:1:13: expected suffix letters after ':' in .regs, found end of line\n");
+    expect_diag(".regs v1, v:_1\n", "bad.s:1:11: 'v1' is a register name and cannot be an alias\n");
+    expect_diag("x = 1\n.regs v1, a, x\n", "bad.s:2:14: 'x' is already a symbol and cannot be an alias\n");
+    expect_diag(".regs m6, p, q, r\n", "bad.s:1:17: register frame runs past m7 at 'r'\n");
+}
+
 Test(asm_features, register_aliases)
 {
     AsmObject obj;

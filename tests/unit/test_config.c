@@ -736,7 +736,7 @@ Test(config_load, kd_keys)
     cr_expect_eq(c.kd_empty_bonus, 1.0);
     cr_expect_eq(c.kd_max_depth, 60);
     cr_expect_eq(c.kd_leaf_size, 8);
-    /* every traversal name, in abi.inc's KD_VARIANT order */
+    /* every traversal name, in KD_VARIANT order (kernels/lib/kconst.inc is generated from these names) */
     const char *names[] = {"stack", "restart", "pushdown", "shortstack", "packet", "stream"};
     CfgErrors e = {0};
     for (int i = 0; i < 6; i++) {
