@@ -76,7 +76,7 @@ static int abi_lookup(const AsmObject *obj, KernelAbi *abi, char *err, size_t er
     return 0;
 }
 
-/* Bytes per entry of the kd kernel's stacks (kernels/pathtrace.s owns their layout). */
+/* Bytes per entry of the kd kernel's stacks (kernels/lib/kdtrace.inc, kdpacket.inc and kdstream.inc own their layout). */
 #define KD_PACKET_ENTRY_BYTES 1040u /* packet short stack, in the scratchpad from KSTACK_BASE */
 #define KD_STREAM_ENTRY_BYTES 36u   /* stream-filter stack, 3 * depth + 8 entries like the BVH kernel's */
 #define KD_LANE_ENTRY_BYTES 1024u   /* per-lane stacks, in the next generation's ray buffer */
