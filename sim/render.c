@@ -31,6 +31,7 @@
 #include "outfile.h"
 #include "reference.h"
 #include "sampling.h"
+#include "stats.h"
 #include "timing.h"
 
 const RenderKey render_keys[RENDER_KEY_COUNT] = {
@@ -138,8 +139,6 @@ static int remove_stale(const char *dir, const char *const *keep, char *err, siz
     return 0;
 }
 
-static double ratio(uint64_t a, uint64_t b) { return b ? (double)a / (double)b : 0.0; }
-
 /* A SAH cost for report.txt: "%.2f", or why there is none (a cost is a ratio of surface areas,
  * undefined when the scene's bounds are not finite). */
 static const char *sah_text(double cost, char *buf, size_t len)
@@ -160,28 +159,42 @@ static void add_sah_json(cJSON *o, double cost)
         cJSON_AddNullToObject(o, "sah_cost");
 }
 
-/* Statistics of either mode, in the report's terms. */
+static double ratio(uint64_t a, uint64_t b) { return b ? (double)a / (double)b : 0.0; }
+
+/* Either renderer's figures. */
 typedef struct RunStats {
-    uint64_t primary, shadow, indirect, dropped;
-    uint64_t per_gen[REF_MAX_GENERATIONS];
-    uint64_t generations;
-    uint64_t nodes_visited, prims_tested;   /* reference only */
+    StatsRun run;                           /* rays, generations; the golden model's traversal */
     int functional;
     FuncStats f;
     FuncKdInfo kd;                          /* accel.structure = kd */
 } RunStats;
 
-/* One kd counter object: each counter's total and per ray of the kind. */
-static void add_kd_counts_json(cJSON *kd, const char *name, const uint64_t *counts, uint64_t rays)
+/* The object name of root, made if the statistics walk did not make it. */
+static cJSON *object_of(cJSON *root, const char *name)
 {
-    cJSON *o = cJSON_AddObjectToObject(kd, name);
-    cJSON_AddNumberToObject(o, "rays", (double)rays);
-    for (int c = 0; c < FUNC_KD_COUNTERS; c++) {
-        char key[64];
-        snprintf(key, sizeof key, "%s_per_ray", func_kd_counter_keys[c]);
-        cJSON_AddNumberToObject(o, func_kd_counter_keys[c], (double)counts[c]);
-        cJSON_AddNumberToObject(o, key, ratio(counts[c], rays));
-    }
+    cJSON *o = cJSON_GetObjectItemCaseSensitive(root, name);
+    return o ? o : cJSON_AddObjectToObject(root, name);
+}
+
+/* accel.structure = kd: the tree and the traversal (the kernel's counters: sim/stats.def). */
+static void add_kd_json(cJSON *root, const RunStats *rs, const CfgMachine *cfg)
+{
+    const FuncKdInfo *t = &rs->kd;
+    cJSON *kd = object_of(root, "kd");
+    cJSON_AddStringToObject(kd, "structure", cfg_enum_name("accel", "structure", cfg->accel_structure));
+    cJSON_AddStringToObject(kd, "traversal", cfg_enum_name("kd", "traversal", cfg->kd_traversal));
+    cJSON_AddNumberToObject(kd, "stack_depth", rs->f.kd_stack_depth);
+    cJSON *tr = cJSON_AddObjectToObject(kd, "tree");
+    cJSON_AddNumberToObject(tr, "nodes", t->nodes);
+    cJSON_AddNumberToObject(tr, "leaves", t->leaves);
+    cJSON_AddNumberToObject(tr, "empty_leaves", t->empty_leaves);
+    cJSON_AddNumberToObject(tr, "depth", t->depth);
+    cJSON_AddNumberToObject(tr, "primitives", t->prims);
+    cJSON_AddNumberToObject(tr, "references", t->refs);
+    cJSON_AddNumberToObject(tr, "references_per_primitive", stats_ratio(t->refs, t->prims));
+    cJSON_AddNumberToObject(tr, "largest_leaf", t->largest_leaf);
+    add_sah_json(tr, t->sah_cost);
+    cJSON_AddNumberToObject(tr, "build_seconds", t->build_seconds);
 }
 
 /* The counters of all kinds together, and the rays of each kind (FUNC_KD_* order). */
@@ -199,33 +212,6 @@ static void kd_totals(const FuncStats *f, uint64_t rays[FUNC_KD_KINDS], uint64_t
         for (int c = 0; c < FUNC_KD_COUNTERS; c++)
             total[c] += f->kd_counts[k][c];
     }
-}
-
-/* accel.structure = kd: the tree and the kernel's kd counters (docs/report.md). */
-static void add_kd_json(cJSON *root, const RunStats *rs, const CfgMachine *cfg)
-{
-    const FuncStats *f = &rs->f;
-    const FuncKdInfo *t = &rs->kd;
-    cJSON *kd = cJSON_AddObjectToObject(root, "kd");
-    cJSON_AddStringToObject(kd, "structure", cfg_enum_name("accel", "structure", cfg->accel_structure));
-    cJSON_AddStringToObject(kd, "traversal", cfg_enum_name("kd", "traversal", cfg->kd_traversal));
-    cJSON_AddNumberToObject(kd, "stack_depth", f->kd_stack_depth);
-    cJSON *tr = cJSON_AddObjectToObject(kd, "tree");
-    cJSON_AddNumberToObject(tr, "nodes", t->nodes);
-    cJSON_AddNumberToObject(tr, "leaves", t->leaves);
-    cJSON_AddNumberToObject(tr, "empty_leaves", t->empty_leaves);
-    cJSON_AddNumberToObject(tr, "depth", t->depth);
-    cJSON_AddNumberToObject(tr, "primitives", t->prims);
-    cJSON_AddNumberToObject(tr, "references", t->refs);
-    cJSON_AddNumberToObject(tr, "references_per_primitive", ratio(t->refs, t->prims));
-    cJSON_AddNumberToObject(tr, "largest_leaf", t->largest_leaf);
-    add_sah_json(tr, t->sah_cost);
-    cJSON_AddNumberToObject(tr, "build_seconds", t->build_seconds);
-    uint64_t rays[FUNC_KD_KINDS], total[FUNC_KD_COUNTERS], all;
-    kd_totals(f, rays, total, &all);
-    for (int k = 0; k < FUNC_KD_KINDS; k++)
-        add_kd_counts_json(kd, func_kd_kind_keys[k], f->kd_counts[k], rays[k]);
-    add_kd_counts_json(kd, "total", total, all);
 }
 
 /* accel.structure = kd: report.txt lines for the tree and the counters per ray. */
@@ -257,84 +243,9 @@ static int kd_text(char *txt, size_t cap, const RunStats *rs, const CfgMachine *
     return len;
 }
 
-static void add_functional_json(cJSON *root, const RunStats *rs, const CfgMachine *cfg)
+/* Kernel modes: the kernel that ran (its statistics: sim/stats.def). */
+static void add_kernel_json(cJSON *root, const FuncStats *f, const CfgMachine *cfg)
 {
-    const FuncStats *f = &rs->f;
-    cJSON *ops = cJSON_AddObjectToObject(root, "ops");
-    for (int c = 0; c < ISA_C_COUNT; c++) {
-        uint64_t n = 0;
-        for (int k = 0; k < ISA_STAGE_COUNT; k++)
-            n += f->core.ops[k][c];
-        cJSON_AddNumberToObject(ops, isa_category_keys[c], (double)n);
-    }
-    cJSON *opst = cJSON_AddObjectToObject(root, "ops_by_stage");
-    for (int k = 0; k < ISA_STAGE_COUNT; k++) {
-        cJSON *o = cJSON_AddObjectToObject(opst, isa_stage_keys[k]);
-        for (int c = 0; c < ISA_C_COUNT; c++)
-            cJSON_AddNumberToObject(o, isa_category_keys[c], (double)f->core.ops[k][c]);
-    }
-    cJSON *ut = cJSON_AddObjectToObject(root, "utilization");
-    int n = cfg->core_simd_width;
-    for (int k = 0; k < ISA_STAGE_COUNT; k++)
-        cJSON_AddNumberToObject(ut, isa_stage_keys[k],
-                                ratio(f->core.active_lanes[k], (uint64_t)n * f->core.vec_instructions[k]));
-    /* Primary rays are generation 0 (camera rays only); the rest are secondary (Tables 2, 3). */
-    cJSON *ug = cJSON_AddArrayToObject(root, "utilization_by_generation");
-    uint64_t sec_act[ISA_STAGE_COUNT] = {0}, sec_vec[ISA_STAGE_COUNT] = {0};
-    for (uint64_t g = 0; g < f->generations && g < CORE_GENERATIONS; g++) {
-        cJSON *o = cJSON_CreateObject();
-        for (int k = 0; k < ISA_STAGE_COUNT; k++) {
-            cJSON_AddNumberToObject(o, isa_stage_keys[k],
-                                    ratio(f->core.gen_active_lanes[g][k], (uint64_t)n * f->core.gen_vec_instructions[g][k]));
-            if (g > 0) {
-                sec_act[k] += f->core.gen_active_lanes[g][k];
-                sec_vec[k] += f->core.gen_vec_instructions[g][k];
-            }
-        }
-        cJSON_AddItemToArray(ug, o);
-    }
-    cJSON *up = cJSON_AddObjectToObject(root, "utilization_primary");
-    cJSON *us = cJSON_AddObjectToObject(root, "utilization_secondary");
-    for (int k = 0; k < ISA_STAGE_COUNT; k++) {
-        cJSON_AddNumberToObject(up, isa_stage_keys[k],
-                                ratio(f->core.gen_active_lanes[0][k], (uint64_t)n * f->core.gen_vec_instructions[0][k]));
-        cJSON_AddNumberToObject(us, isa_stage_keys[k], ratio(sec_act[k], (uint64_t)n * sec_vec[k]));
-    }
-    cJSON *sl = cJSON_AddObjectToObject(root, "stream_length");
-    cJSON_AddNumberToObject(sl, "traversal", ratio(f->trav_rays, f->trav_streams));
-    cJSON_AddNumberToObject(sl, "intersection", ratio(f->isect_rays, f->isect_streams));
-    cJSON_AddNumberToObject(sl, "shading", ratio(f->shade_rays, f->shade_streams));
-    static const char *const stage3[FUNC_STAGES] = {"traversal", "intersection", "shading"};
-    uint64_t ss[FUNC_STAGES] = {0}, sr[FUNC_STAGES] = {0};
-    cJSON *slg = cJSON_AddArrayToObject(root, "stream_length_by_generation");
-    for (uint64_t g = 0; g < f->generations && g < FUNC_MAX_GENERATIONS; g++) {
-        cJSON *o = cJSON_CreateObject();
-        for (int k = 0; k < FUNC_STAGES; k++) {
-            cJSON_AddNumberToObject(o, stage3[k], ratio(f->gen_rays[g][k], f->gen_streams[g][k]));
-            if (g > 0) {
-                ss[k] += f->gen_streams[g][k];
-                sr[k] += f->gen_rays[g][k];
-            }
-        }
-        cJSON_AddItemToArray(slg, o);
-    }
-    cJSON *sls = cJSON_AddObjectToObject(root, "stream_length_secondary");
-    for (int k = 0; k < FUNC_STAGES; k++)
-        cJSON_AddNumberToObject(sls, stage3[k], ratio(sr[k], ss[k]));
-    cJSON *sc = cJSON_AddObjectToObject(root, "streams");
-    cJSON_AddNumberToObject(sc, "traversal", (double)f->trav_streams);
-    cJSON_AddNumberToObject(sc, "intersection", (double)f->isect_streams);
-    cJSON_AddNumberToObject(sc, "shading", (double)f->shade_streams);
-    cJSON *ins = cJSON_AddObjectToObject(root, "instructions");
-    for (int k = 0; k < ISA_STAGE_COUNT; k++)
-        cJSON_AddNumberToObject(ins, isa_stage_keys[k], (double)f->core.instructions[k]);
-    cJSON *vi = cJSON_AddObjectToObject(root, "vector_instructions");
-    for (int k = 0; k < ISA_STAGE_COUNT; k++)
-        cJSON_AddNumberToObject(vi, isa_stage_keys[k], (double)f->core.vec_instructions[k]);
-    cJSON *byop = cJSON_AddObjectToObject(root, "by_opcode");
-    for (int o = 0; o < ISA_OP_COUNT; o++)
-        if (f->core.by_op[o])
-            cJSON_AddNumberToObject(byop, isa_ops[o].mnemonic, (double)f->core.by_op[o]);
     cJSON *k = cJSON_AddObjectToObject(root, "kernel");
     cJSON_AddStringToObject(k, "stream_mode", cfg_enum_name("stream", "mode", cfg->stream_mode));
     cJSON_AddStringToObject(k, "workload", cfg_enum_name("workload", "kind", cfg->workload_kind));
@@ -344,17 +255,16 @@ static void add_functional_json(cJSON *root, const RunStats *rs, const CfgMachin
     cJSON_AddNumberToObject(k, "tile_height", f->tile_h);
     cJSON_AddStringToObject(k, "defines", f->defines);
     cJSON_AddNumberToObject(k, "instructions", f->kernel_instructions);
-    cJSON *tiles = cJSON_AddArrayToObject(root, "tiles");
-    for (uint32_t t = 0; t < f->ntiles; t++) {
-        cJSON *o = cJSON_CreateObject();
-        cJSON_AddNumberToObject(o, "x", f->tiles[t].x0);
-        cJSON_AddNumberToObject(o, "y", f->tiles[t].y0);
-        cJSON_AddNumberToObject(o, "width", f->tiles[t].w);
-        cJSON_AddNumberToObject(o, "height", f->tiles[t].h);
-        cJSON_AddNumberToObject(o, "instructions", (double)f->tiles[t].instructions);
-        cJSON_AddNumberToObject(o, "rays", (double)f->tiles[t].rays);
-        cJSON_AddItemToArray(tiles, o);
-    }
+}
+
+/* Sampled mode: how the sample was drawn and estimated (its figures: sim/stats.def). */
+static void add_sample_json(cJSON *root, double fraction, uint32_t seed)
+{
+    cJSON *sm = object_of(root, "sample");
+    cJSON_AddNumberToObject(sm, "fraction", fraction);
+    cJSON_AddNumberToObject(sm, "seed", seed);
+    cJSON_AddStringToObject(sm, "estimator", "ratio of cycles to instructions (docs/sampling.md)");
+    cJSON_AddNumberToObject(sm, "confidence", 0.95);
 }
 
 /* Active lanes of a stage over the timed tiles (all tiles in detailed mode, the sample in sampled
@@ -388,122 +298,6 @@ static FrameTiming frame_timing(const FuncStats *f, const CfgMachine *cfg, const
     ft.fps_lo = ft.cycles_hi > 0 ? hz / ft.cycles_hi : 0.0;
     ft.fps_hi = ft.cycles_lo > 0 ? hz / ft.cycles_lo : 0.0;
     return ft;
-}
-
-/* Detailed and sampled modes: the timing fields of report.json (names: ARCHITECTURE.md Sec. 1;
- * docs/report.md). In sampled mode the frame figures are estimates and the breakdowns (stages,
- * generations, units) are those of the sampled tiles; stall cycles are the sample's shares of the
- * estimated cycles. */
-static void add_timing_json(cJSON *root, const FuncStats *f, const CfgMachine *cfg, const SampleEstimate *est,
-                            double fraction, uint32_t seed)
-{
-    const TimingStats *t = &f->timing;
-    FrameTiming ft = frame_timing(f, cfg, est);
-    cJSON_ReplaceItemInObject(root, "cycles", cJSON_CreateNumber(round(ft.cycles)));
-    cJSON_ReplaceItemInObject(root, "busy_cycles", cJSON_CreateNumber(ft.busy));
-    cJSON_ReplaceItemInObject(root, "fps", cJSON_CreateNumber(ft.fps));
-    cJSON_ReplaceItemInObject(root, "fps_no_stall", cJSON_CreateNumber(ft.fps_no_stall));
-    cJSON_AddNumberToObject(root, "clock_mhz", cfg->core_clock_mhz);
-    if (est) {
-        cJSON *cc = cJSON_AddArrayToObject(root, "cycles_ci95");
-        cJSON_AddItemToArray(cc, cJSON_CreateNumber(round(ft.cycles_lo)));
-        cJSON_AddItemToArray(cc, cJSON_CreateNumber(round(ft.cycles_hi)));
-        cJSON *fc = cJSON_AddArrayToObject(root, "fps_ci95");
-        cJSON_AddItemToArray(fc, cJSON_CreateNumber(ft.fps_lo));
-        cJSON_AddItemToArray(fc, cJSON_CreateNumber(ft.fps_hi));
-        cJSON *sm = cJSON_AddObjectToObject(root, "sample");
-        cJSON_AddNumberToObject(sm, "fraction", fraction);
-        cJSON_AddNumberToObject(sm, "seed", seed);
-        cJSON_AddNumberToObject(sm, "tiles", est->N);
-        cJSON_AddNumberToObject(sm, "tiles_sampled", est->n);
-        cJSON_AddStringToObject(sm, "estimator", "ratio of cycles to instructions (docs/sampling.md)");
-        cJSON_AddNumberToObject(sm, "confidence", 0.95);
-        cJSON_AddNumberToObject(sm, "t", est->t);
-        cJSON_AddNumberToObject(sm, "std_error_cycles", est->std_error);
-        cJSON_AddNumberToObject(sm, "cycles_per_instruction", est->ratio);
-        cJSON_AddNumberToObject(sm, "sampled_cycles", (double)t->cycles);
-    }
-    cJSON *st = cJSON_AddObjectToObject(root, "stalls");
-    cJSON *sh = cJSON_AddObjectToObject(root, "stall_shares");
-    for (int c = 0; c < TM_CAUSE_COUNT; c++) {
-        double share = ratio(t->stalls[c], t->cycles);
-        cJSON_AddNumberToObject(st, tm_cause_keys[c], est ? round(share * ft.cycles) : (double)t->stalls[c]);
-        cJSON_AddNumberToObject(sh, tm_cause_keys[c], share);
-    }
-    cJSON *cs = cJSON_AddObjectToObject(root, "cycles_by_stage");
-    cJSON *ss = cJSON_AddObjectToObject(root, "stalls_by_stage");
-    cJSON *ut = cJSON_AddObjectToObject(root, "utilization_timed");
-    int n = cfg->core_simd_width;
-    for (int k = 0; k < ISA_STAGE_COUNT; k++) {
-        cJSON *o = cJSON_AddObjectToObject(cs, isa_stage_keys[k]);
-        cJSON_AddNumberToObject(o, "cycles", (double)t->stage_cycles[k]);
-        cJSON_AddNumberToObject(o, "busy", (double)t->stage_busy[k]);
-        cJSON *so = cJSON_AddObjectToObject(ss, isa_stage_keys[k]);
-        uint64_t stalls = 0;
-        for (int c = 0; c < TM_CAUSE_COUNT; c++) {
-            cJSON_AddNumberToObject(so, tm_cause_keys[c], (double)t->stage_stalls[k][c]);
-            stalls += t->stage_stalls[k][c];
-        }
-        /* Lanes doing work over the lane-cycles of the stage's vector issue and stall cycles:
-         * the paper's utilization with the overheads of address fetch, alignment, partition. */
-        cJSON_AddNumberToObject(ut, isa_stage_keys[k],
-                                ratio(timed_lanes(f, k), (uint64_t)n * (t->stage_vec_busy[k] + stalls)));
-    }
-    cJSON *cg = cJSON_AddArrayToObject(root, "cycles_by_generation");
-    cJSON *tg = cJSON_AddArrayToObject(root, "timing_by_generation");
-    for (uint64_t g = 0; g < f->generations && g < CORE_GENERATIONS; g++) {
-        cJSON_AddItemToArray(cg, cJSON_CreateNumber((double)t->gen_cycles[g]));
-        cJSON *o = cJSON_CreateObject();
-        cJSON_AddNumberToObject(o, "cycles", (double)t->gen_cycles[g]);
-        cJSON_AddNumberToObject(o, "busy_cycles", (double)t->gen_busy[g]);
-        cJSON *gs = cJSON_AddObjectToObject(o, "stalls");
-        for (int c = 0; c < TM_CAUSE_COUNT; c++)
-            cJSON_AddNumberToObject(gs, tm_cause_keys[c], (double)t->gen_stalls[g][c]);
-        cJSON_AddItemToArray(tg, o);
-    }
-    cJSON *u = cJSON_AddObjectToObject(root, "units");
-    cJSON *rb = cJSON_AddObjectToObject(u, "ray_buffers");
-    cJSON_AddNumberToObject(rb, "accesses", (double)t->rb_accesses);
-    cJSON_AddNumberToObject(rb, "lines", (double)t->rb_lines);
-    cJSON_AddNumberToObject(rb, "accesses_with_bank_conflict", (double)t->rb_conflicted);
-    cJSON_AddNumberToObject(rb, "bank_conflict_cycles", (double)t->stalls[TM_BANK_CONFLICT]);
-    cJSON *ag = cJSON_AddObjectToObject(u, "agu");
-    cJSON_AddNumberToObject(ag, "id_vectors", (double)t->agu_fetches);
-    cJSON_AddNumberToObject(ag, "fetched_ahead", (double)t->agu_ahead);
-    cJSON *ic = cJSON_AddObjectToObject(u, "interconnect");
-    cJSON_AddNumberToObject(ic, "data_path_transfers", (double)t->icn_transfers);
-    cJSON_AddNumberToObject(ic, "contention_stall_cycles", (double)t->stalls[TM_INTERCONNECT]);
-    cJSON_AddNumberToObject(ic, "unit_wait_cycles", (double)t->icn_unit_delay);
-    cJSON *pa = cJSON_AddObjectToObject(u, "partition");
-    cJSON_AddNumberToObject(pa, "partitions", (double)t->partitions);
-    cJSON_AddNumberToObject(pa, "ids", (double)t->partition_ids);
-    cJSON_AddNumberToObject(pa, "busy_cycles", (double)t->partition_cycles);
-    cJSON *sp = cJSON_AddObjectToObject(u, "scratchpad");
-    cJSON_AddNumberToObject(sp, "accesses", (double)t->spad_accesses);
-    cJSON_AddNumberToObject(sp, "lines", (double)t->spad_lines);
-    cJSON *sm = cJSON_AddObjectToObject(u, "scene_memory");
-    cJSON_AddBoolToObject(sm, "cache", cfg->scene_cache_kb > 0);
-    cJSON_AddNumberToObject(sm, "instructions", (double)t->scene_instr);
-    cJSON_AddNumberToObject(sm, "line_accesses", (double)t->scene.accesses);
-    cJSON_AddNumberToObject(sm, "hits", (double)t->scene.hits);
-    cJSON_AddNumberToObject(sm, "misses", (double)t->scene.misses);
-    cJSON_AddNumberToObject(sm, "hit_rate", ratio(t->scene.hits, t->scene.accesses));
-    cJSON_AddNumberToObject(sm, "writebacks", (double)t->scene.writebacks);
-    cJSON_AddNumberToObject(sm, "bus_bytes", (double)t->scene.bus_bytes);
-    /* What the kernel exercised: a unit no instruction used was never stepped (docs/model.md). */
-    cJSON *mod = cJSON_AddArrayToObject(root, "units_exercised");
-    cJSON *nmod = cJSON_AddArrayToObject(root, "units_not_exercised");
-    for (int k = 0; k < ISA_U_COUNT; k++)
-        cJSON_AddItemToArray(t->unit_uses[k] ? mod : nmod, cJSON_CreateString(isa_unit_names[k]));
-    cJSON *tiles = cJSON_GetObjectItem(root, "tiles");
-    for (uint32_t i = 0; tiles && i < f->ntiles; i++) {
-        cJSON *o = cJSON_GetArrayItem(tiles, (int)i);
-        cJSON_AddNumberToObject(o, "cycles", (double)f->tiles[i].cycles);
-        cJSON_AddNumberToObject(o, "busy_cycles", (double)f->tiles[i].busy);
-        cJSON *tsl = cJSON_AddObjectToObject(o, "stalls");
-        for (int c = 0; c < TM_CAUSE_COUNT; c++)
-            cJSON_AddNumberToObject(tsl, tm_cause_keys[c], (double)f->tiles[i].stalls[c]);
-    }
 }
 
 /* Detailed and sampled modes: report.txt lines for the timing. */
@@ -741,35 +535,14 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         rs.functional = 1;
         if (sampled) {
             /* The frame's cycles from the sampled tiles (sim/sampling.h). */
-            uint32_t nt = rs.f.ntiles;
-            double *y = calloc(nt ? nt : 1, sizeof *y), *x = calloc(nt ? nt : 1, sizeof *x);
-            uint8_t *sel = calloc(nt ? nt : 1, 1);
-            int erc = -1;
-            if (y && x && sel) {
-                for (uint32_t i = 0; i < nt; i++) {
-                    y[i] = (double)rs.f.tiles[i].cycles;
-                    x[i] = (double)rs.f.tiles[i].instructions;
-                    sel[i] = rs.f.tiles[i].sampled;
-                }
-                erc = sample_ratio_estimate(y, x, sel, nt, &est_store);
-            }
-            free(y);
-            free(x);
-            free(sel);
-            if (erc != 0) {
+            if (stats_sample_estimate(&rs.f, &est_store) != 0) {
                 snprintf(err, errlen, "sampled mode: cannot estimate from %u sampled of %u tiles (the frame needs at "
-                         "least 2 tiles; render more pixels or use --mode detailed)", rs.f.tiles_timed, nt);
+                         "least 2 tiles; render more pixels or use --mode detailed)", rs.f.tiles_timed, rs.f.ntiles);
                 goto out;
             }
             est = &est_store;
         }
-        rs.primary = rs.f.rays_camera;
-        rs.shadow = rs.f.rays_shadow;
-        rs.indirect = rs.f.rays_indirect;
-        rs.dropped = rs.f.dropped;
-        rs.generations = rs.f.generations;
-        for (int g = 0; g < REF_MAX_GENERATIONS && g < FUNC_MAX_GENERATIONS; g++)
-            rs.per_gen[g] = rs.f.rays_per_generation[g];
+        stats_run_from_func(&rs.run, &rs.f);
     } else {
         /* The golden model renders the path tracer and the Phong workload; the forced specular and
          * diffuse workloads exist only as kernel variants (docs/kernel.md). */
@@ -784,14 +557,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         RefStats st;
         if (ref_render(&p, &rp, rgb, &st, err, errlen) != 0)
             goto out;
-        rs.primary = st.rays[REF_RAY_CAMERA];
-        rs.shadow = st.rays[REF_RAY_SHADOW];
-        rs.indirect = st.rays[REF_RAY_INDIRECT];
-        rs.dropped = st.dropped;
-        rs.generations = st.generations;
-        memcpy(rs.per_gen, st.rays_per_generation, sizeof rs.per_gen);
-        rs.nodes_visited = st.nodes_visited;
-        rs.prims_tested = st.prims_tested;
+        stats_run_from_ref(&rs.run, &st);
     }
     double t_render = now();
 
@@ -821,36 +587,27 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         else
             sum += rgb[i];
     }
-    uint64_t total_rays = rs.primary + rs.shadow + rs.indirect;
+    uint64_t total_rays = rs.run.primary + rs.run.shadow + rs.run.indirect;
     double secs = t_render - t_kd;
 
-    /* report.json: the names of ARCHITECTURE.md Sec. 1; the timing fields stay null unless detailed. */
+    /* report.json: the names of ARCHITECTURE.md Sec. 1. The statistics come from the registry
+     * (sim/stats.def; the timing fields are null unless timed); the blocks below describe the run. */
+    StatsCtx sx = {.mode = (detailed ? STATS_M_DET : sampled ? STATS_M_SAMP : functional ? STATS_M_FUNC : STATS_M_REF) |
+                           (functional && rs.f.kd ? STATS_M_KD : 0),
+                   .cfg = cfg, .run = &rs.run, .f = functional ? &rs.f : NULL,
+                   .t = detailed || sampled ? &rs.f.timing : NULL, .est = est};
     root = cJSON_CreateObject();
     cJSON_AddStringToObject(root, "mode", o->mode);
-    cJSON_AddNullToObject(root, "cycles");
-    cJSON_AddNullToObject(root, "busy_cycles");
-    cJSON_AddNullToObject(root, "fps");
-    cJSON_AddNullToObject(root, "fps_no_stall");
-    cJSON *rays = cJSON_AddObjectToObject(root, "rays");
-    cJSON_AddNumberToObject(rays, "primary", (double)rs.primary);
-    cJSON_AddNumberToObject(rays, "shadow", (double)rs.shadow);
-    cJSON_AddNumberToObject(rays, "indirect", (double)rs.indirect);
-    cJSON_AddNumberToObject(rays, "total", (double)total_rays);
-    cJSON_AddNumberToObject(rays, "dropped", (double)rs.dropped);
-    cJSON *gens = cJSON_AddArrayToObject(root, "rays_per_generation");
-    for (uint64_t g = 0; g < rs.generations && g < REF_MAX_GENERATIONS; g++)
-        cJSON_AddItemToArray(gens, cJSON_CreateNumber((double)rs.per_gen[g]));
-    if (functional) {
-        add_functional_json(root, &rs, cfg);
-        if (detailed || sampled)
-            add_timing_json(root, &rs.f, cfg, est, o->sample, o->sample_seed);
-        if (rs.f.kd)
-            add_kd_json(root, &rs, cfg);
-    } else {
-        cJSON *trav = cJSON_AddObjectToObject(root, "traversal");
-        cJSON_AddNumberToObject(trav, "nodes_visited", (double)rs.nodes_visited);
-        cJSON_AddNumberToObject(trav, "primitives_tested", (double)rs.prims_tested);
+    if (stats_json(root, &sx) != 0) {
+        snprintf(err, errlen, "%s/report.json: out of memory", o->out_dir);
+        goto out;
     }
+    if (functional)
+        add_kernel_json(root, &rs.f, cfg);
+    if (sampled)
+        add_sample_json(root, o->sample, o->sample_seed);
+    if (functional && rs.f.kd)
+        add_kd_json(root, &rs, cfg);
     cJSON *sc = cJSON_AddObjectToObject(root, "scene");
     cJSON_AddStringToObject(sc, "file", o->scene_path);
     cJSON_AddNumberToObject(sc, "triangles", s.ntris);
@@ -943,8 +700,8 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
              p.bvh.nleaves, p.bvh.depth, sah_text(p.bvh.sah_cost, sah, sizeof sah), p.size,
              o->config_path ? o->config_path : "built-in (the defaults of sim/config.def)", s.render.width,
              s.render.height, s.render.spp, s.render.max_depth, o->seed, tiles_txt, sum / (3.0 * (double)npx),
-             nonfinite, (unsigned long long)total_rays, (unsigned long long)rs.primary,
-             (unsigned long long)rs.shadow, (unsigned long long)rs.indirect, (unsigned long long)rs.dropped);
+             nonfinite, (unsigned long long)total_rays, (unsigned long long)rs.run.primary,
+             (unsigned long long)rs.run.shadow, (unsigned long long)rs.run.indirect, (unsigned long long)rs.run.dropped);
     if (s.skipped_primitives)
         len += snprintf(txt + len, sizeof txt - (size_t)len, "skipped      %u glTF primitives that are not triangles\n",
                         s.skipped_primitives);
@@ -997,7 +754,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         len += snprintf(txt + len, sizeof txt - (size_t)len,
                         "traversal    %llu nodes visited, %llu primitive tests\n"
                         "host         %.2f s rendering on %d %s (%.3f M rays/s); load %.2f s, BVH+pack %.2f s\n",
-                        (unsigned long long)rs.nodes_visited, (unsigned long long)rs.prims_tested, secs, threads, thr,
+                        (unsigned long long)rs.run.nodes_visited, (unsigned long long)rs.run.prims_tested, secs, threads, thr,
                         secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, t_load - t0, t_pack - t_load);
     }
     snprintf(path, sizeof path, "%s/report.txt", o->out_dir);
