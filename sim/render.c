@@ -159,8 +159,6 @@ static void add_sah_json(cJSON *o, double cost)
         cJSON_AddNullToObject(o, "sah_cost");
 }
 
-static double ratio(uint64_t a, uint64_t b) { return b ? (double)a / (double)b : 0.0; }
-
 /* Either renderer's figures. */
 typedef struct RunStats {
     StatsRun run;                           /* rays, generations; the golden model's traversal */
@@ -197,50 +195,17 @@ static void add_kd_json(cJSON *root, const RunStats *rs, const CfgMachine *cfg)
     cJSON_AddNumberToObject(tr, "build_seconds", t->build_seconds);
 }
 
-/* The counters of all kinds together, and the rays of each kind (FUNC_KD_* order). */
-static void kd_totals(const FuncStats *f, uint64_t rays[FUNC_KD_KINDS], uint64_t total[FUNC_KD_COUNTERS],
-                      uint64_t *all_rays)
-{
-    rays[FUNC_KD_CAMERA] = f->rays_camera;
-    rays[FUNC_KD_INDIRECT] = f->rays_indirect;
-    rays[FUNC_KD_SHADOW] = f->rays_shadow;
-    *all_rays = 0;
-    for (int c = 0; c < FUNC_KD_COUNTERS; c++)
-        total[c] = 0;
-    for (int k = 0; k < FUNC_KD_KINDS; k++) {
-        *all_rays += rays[k];
-        for (int c = 0; c < FUNC_KD_COUNTERS; c++)
-            total[c] += f->kd_counts[k][c];
-    }
-}
-
-/* accel.structure = kd: report.txt lines for the tree and the counters per ray. */
+/* accel.structure = kd: report.txt's line for the tree (the counters per ray: sim/stats.def). */
 static int kd_text(char *txt, size_t cap, const RunStats *rs, const CfgMachine *cfg)
 {
-    const FuncStats *f = &rs->f;
     const FuncKdInfo *t = &rs->kd;
     char sah[64];
-    int len = snprintf(txt, cap,
-                       "kd-tree      %s traversal, stack depth %u; %u nodes, %u leaves (%u empty), depth %u, "
-                       "%.2f references per primitive, largest leaf %u, SAH cost %s; built in %.2f s\n"
-                       "kd per ray   %-8s",
-                       cfg_enum_name("kd", "traversal", cfg->kd_traversal), f->kd_stack_depth, t->nodes, t->leaves,
-                       t->empty_leaves, t->depth, ratio(t->refs, t->prims), t->largest_leaf, sah_text(t->sah_cost, sah, sizeof sah),
-                       t->build_seconds, "");
-    for (int c = 0; c < FUNC_KD_COUNTERS; c++)
-        len += snprintf(txt + len, cap - (size_t)len, " %10s", func_kd_counter_keys[c]);
-    len += snprintf(txt + len, cap - (size_t)len, "\n");
-    uint64_t rays[FUNC_KD_KINDS], total[FUNC_KD_COUNTERS], all;
-    kd_totals(f, rays, total, &all);
-    for (int k = 0; k <= FUNC_KD_KINDS; k++) {
-        const uint64_t *n = k < FUNC_KD_KINDS ? f->kd_counts[k] : total;
-        uint64_t r = k < FUNC_KD_KINDS ? rays[k] : all;
-        len += snprintf(txt + len, cap - (size_t)len, "             %-8s", k < FUNC_KD_KINDS ? func_kd_kind_keys[k] : "all");
-        for (int c = 0; c < FUNC_KD_COUNTERS; c++)
-            len += snprintf(txt + len, cap - (size_t)len, " %10.3f", ratio(n[c], r));
-        len += snprintf(txt + len, cap - (size_t)len, "\n");
-    }
-    return len;
+    return snprintf(txt, cap,
+                    "kd-tree      %s traversal, stack depth %u; %u nodes, %u leaves (%u empty), depth %u, "
+                    "%.2f references per primitive, largest leaf %u, SAH cost %s; built in %.2f s\n",
+                    cfg_enum_name("kd", "traversal", cfg->kd_traversal), rs->f.kd_stack_depth, t->nodes, t->leaves,
+                    t->empty_leaves, t->depth, stats_ratio(t->refs, t->prims), t->largest_leaf,
+                    sah_text(t->sah_cost, sah, sizeof sah), t->build_seconds);
 }
 
 /* Kernel modes: the kernel that ran (its statistics: sim/stats.def). */
@@ -265,101 +230,6 @@ static void add_sample_json(cJSON *root, double fraction, uint32_t seed)
     cJSON_AddNumberToObject(sm, "seed", seed);
     cJSON_AddStringToObject(sm, "estimator", "ratio of cycles to instructions (docs/sampling.md)");
     cJSON_AddNumberToObject(sm, "confidence", 0.95);
-}
-
-/* Active lanes of a stage over the timed tiles (all tiles in detailed mode, the sample in sampled
- * mode), so that timed utilization compares like with like. */
-static uint64_t timed_lanes(const FuncStats *f, int stage)
-{
-    uint64_t s = 0;
-    for (uint32_t i = 0; i < f->ntiles; i++)
-        if (f->tiles[i].sampled)
-            s += f->tiles[i].active_lanes[stage];
-    return s;
-}
-
-/* The frame's timing figures: measured (detailed mode), or estimated from the sampled tiles
- * (sampled mode: est != NULL). Busy cycles are one per instruction, known for every tile. */
-typedef struct FrameTiming {
-    double cycles, busy, fps, fps_no_stall;
-    double cycles_lo, cycles_hi, fps_lo, fps_hi;   /* sampled mode: the 95 % intervals */
-} FrameTiming;
-
-static FrameTiming frame_timing(const FuncStats *f, const CfgMachine *cfg, const SampleEstimate *est)
-{
-    FrameTiming ft;
-    double hz = cfg->core_clock_mhz * 1e6;
-    ft.cycles = est ? est->total : (double)f->timing.cycles;
-    ft.busy = est ? (double)f->instructions : (double)f->timing.busy;
-    ft.cycles_lo = est ? est->lo : ft.cycles;
-    ft.cycles_hi = est ? est->hi : ft.cycles;
-    ft.fps = ft.cycles > 0 ? hz / ft.cycles : 0.0;
-    ft.fps_no_stall = ft.busy > 0 ? hz / ft.busy : 0.0;
-    ft.fps_lo = ft.cycles_hi > 0 ? hz / ft.cycles_hi : 0.0;
-    ft.fps_hi = ft.cycles_lo > 0 ? hz / ft.cycles_lo : 0.0;
-    return ft;
-}
-
-/* Detailed and sampled modes: report.txt lines for the timing. */
-static int timing_text(char *txt, size_t cap, const FuncStats *f, const CfgMachine *cfg, const SampleEstimate *est)
-{
-    const TimingStats *t = &f->timing;
-    FrameTiming ft = frame_timing(f, cfg, est);
-    int len;
-    if (est)
-        len = snprintf(txt, cap,
-                       "cycles       ~%.0f (95%%: %.0f .. %.0f) = %.0f busy + ~%.0f stalled; estimated from %u of %u tiles\n"
-                       "fps          ~%.2f (95%%: %.2f .. %.2f) at %g MHz (%.2f fps with no stalls)\n"
-                       "sample       the shares and unit lines below are those of the %u sampled tiles (docs/sampling.md)\n"
-                       "stalls      ",
-                       ft.cycles, ft.cycles_lo, ft.cycles_hi, ft.busy, ft.cycles - ft.busy, est->n, est->N, ft.fps,
-                       ft.fps_lo, ft.fps_hi, cfg->core_clock_mhz, ft.fps_no_stall, est->n);
-    else
-        len = snprintf(txt, cap,
-                       "cycles       %llu = %llu busy + %llu stalled; %.2f fps at %g MHz (%.2f fps with no stalls)\n"
-                       "stalls      ",
-                       (unsigned long long)t->cycles, (unsigned long long)t->busy,
-                       (unsigned long long)(t->cycles - t->busy), ft.fps, cfg->core_clock_mhz, ft.fps_no_stall);
-    for (int c = 0; c < TM_CAUSE_COUNT; c++)
-        len += snprintf(txt + len, cap - (size_t)len, " %s %.1f%%%s", tm_cause_keys[c],
-                        100.0 * ratio(t->stalls[c], t->cycles), c + 1 < TM_CAUSE_COUNT ? "," : "  (of all cycles)\n");
-    len += snprintf(txt + len, cap - (size_t)len, "cycles by   ");
-    for (int k = 0; k < ISA_STAGE_COUNT; k++)
-        len += snprintf(txt + len, cap - (size_t)len, " %s %.1f%%%s", isa_stage_keys[k],
-                        100.0 * ratio(t->stage_cycles[k], t->cycles), k + 1 < ISA_STAGE_COUNT ? "," : " (stage)\n");
-    len += snprintf(txt + len, cap - (size_t)len, "utilization ");
-    for (int k = 0; k < ISA_STAGE_COUNT; k++) {
-        uint64_t stalls = 0;
-        for (int c = 0; c < TM_CAUSE_COUNT; c++)
-            stalls += t->stage_stalls[k][c];
-        len += snprintf(txt + len, cap - (size_t)len, " %s %.1f%%%s", isa_stage_keys[k],
-                        100.0 * ratio(timed_lanes(f, k),
-                                      (uint64_t)cfg->core_simd_width * (t->stage_vec_busy[k] + stalls)),
-                        k + 1 < ISA_STAGE_COUNT ? "," : "  (timed: stall cycles count as idle lanes)\n");
-    }
-    len += snprintf(txt + len, cap - (size_t)len,
-                    "ray buffers  %llu gathers/scatters over %llu lines; %llu with a bank conflict (%llu cycles)\n"
-                    "AGUs         %llu ID vectors, %llu of them fetched ahead of the data path\n"
-                    "interconnect %llu data-path transfers; contention: %llu stall cycles, units waited %llu cycles\n"
-                    "partition    %llu partitions of %llu IDs, %llu unit cycles\n"
-                    "scene memory %llu line accesses, hit rate %.1f%% (%s), %llu bytes over the bus\n",
-                    (unsigned long long)t->rb_accesses, (unsigned long long)t->rb_lines,
-                    (unsigned long long)t->rb_conflicted, (unsigned long long)t->stalls[TM_BANK_CONFLICT],
-                    (unsigned long long)t->agu_fetches, (unsigned long long)t->agu_ahead,
-                    (unsigned long long)t->icn_transfers, (unsigned long long)t->stalls[TM_INTERCONNECT],
-                    (unsigned long long)t->icn_unit_delay, (unsigned long long)t->partitions,
-                    (unsigned long long)t->partition_ids, (unsigned long long)t->partition_cycles,
-                    (unsigned long long)t->scene.accesses, 100.0 * ratio(t->scene.hits, t->scene.accesses),
-                    cfg->scene_cache_kb > 0 ? "cached" : "no cache", (unsigned long long)t->scene.bus_bytes);
-    len += snprintf(txt + len, cap - (size_t)len, "not used    ");
-    int any = 0;
-    for (int k = 0; k < ISA_U_COUNT; k++)
-        if (!t->unit_uses[k]) {
-            len += snprintf(txt + len, cap - (size_t)len, " %s", isa_unit_names[k]);
-            any = 1;
-        }
-    len += snprintf(txt + len, cap - (size_t)len, "%s\n", any ? " (no instruction of the kernel used them)" : " -");
-    return len;
 }
 
 /* Detailed and sampled modes: cost.png, simulated cycles per pixel of each tile (sampled mode:
@@ -689,8 +559,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
              "             BVH %u nodes, %u leaves, depth %u, SAH cost %s; %u bytes of scene memory\n"
              "config       %s\n"
              "image        %d x %d, %d spp, max depth %d, seed %u, %s\n"
-             "             mean %.5f, non-finite values %ld\n"
-             "rays         %llu total: %llu primary, %llu shadow, %llu indirect; %llu dropped\n",
+             "             mean %.5f, non-finite values %ld\n",
              o->mode,
              detailed     ? "the kernel on the timing model of the machine"
              : sampled    ? "the kernel; sampled tiles on the timing model, the frame's cycles estimated"
@@ -700,8 +569,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
              p.bvh.nleaves, p.bvh.depth, sah_text(p.bvh.sah_cost, sah, sizeof sah), p.size,
              o->config_path ? o->config_path : "built-in (the defaults of sim/config.def)", s.render.width,
              s.render.height, s.render.spp, s.render.max_depth, o->seed, tiles_txt, sum / (3.0 * (double)npx),
-             nonfinite, (unsigned long long)total_rays, (unsigned long long)rs.run.primary,
-             (unsigned long long)rs.run.shadow, (unsigned long long)rs.run.indirect, (unsigned long long)rs.run.dropped);
+             nonfinite);
     if (s.skipped_primitives)
         len += snprintf(txt + len, sizeof txt - (size_t)len, "skipped      %u glTF primitives that are not triangles\n",
                         s.skipped_primitives);
@@ -711,52 +579,28 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         len = (int)sizeof txt - 1;
     if (functional) {
         const FuncStats *f = &rs.f;
-        uint64_t opsum[ISA_C_COUNT] = {0}, all = 0;
-        for (int c = 0; c < ISA_C_COUNT; c++) {
-            for (int k = 0; k < ISA_STAGE_COUNT; k++)
-                opsum[c] += f->core.ops[k][c];
-            all += opsum[c];
-        }
         len += snprintf(txt + len, sizeof txt - (size_t)len,
-                        "machine      N = %d lanes, %s of %u x %u rays, workload %s; kernel %u instructions (%s)\n"
-                        "instructions %llu executed\n"
-                        "ops          ",
+                        "machine      N = %d lanes, %s of %u x %u rays, workload %s; kernel %u instructions (%s)\n",
                         cfg->core_simd_width, cfg->stream_mode == CFG_STREAM_MODE_PACKET ? "packets" : "streams",
                         f->tile_w, f->tile_h, cfg_enum_name("workload", "kind", cfg->workload_kind),
-                        f->kernel_instructions, f->defines,
-                        (unsigned long long)f->instructions);
-        for (int c = 0; c < ISA_C_COUNT; c++)
-            len += snprintf(txt + len, sizeof txt - (size_t)len, "%s %.1f%%%s", isa_category_keys[c],
-                            100.0 * ratio(opsum[c], all), c + 1 < ISA_C_COUNT ? ", " : "\n");
-        len += snprintf(txt + len, sizeof txt - (size_t)len, "utilization  ");
-        for (int k = 0; k < ISA_STAGE_COUNT; k++)
-            len += snprintf(txt + len, sizeof txt - (size_t)len, "%s %.1f%%%s", isa_stage_keys[k],
-                            100.0 * ratio(f->core.active_lanes[k],
-                                          (uint64_t)cfg->core_simd_width * f->core.vec_instructions[k]),
-                            k + 1 < ISA_STAGE_COUNT ? ", " : "  (active lanes / (N x vector instructions))\n");
-        if (detailed || sampled)
-            len += timing_text(txt + len, sizeof txt - (size_t)len, f, cfg, est);
+                        f->kernel_instructions, f->defines);
         if (f->kd)
             len += kd_text(txt + len, sizeof txt - (size_t)len, &rs, cfg);
-        char trav_len[32] = "-", isect_len[32] = "-"; /* per-lane kd-tree traversals filter no streams */
-        if (f->trav_streams)
-            snprintf(trav_len, sizeof trav_len, "%.1f", ratio(f->trav_rays, f->trav_streams));
-        if (f->isect_streams)
-            snprintf(isect_len, sizeof isect_len, "%.1f", ratio(f->isect_rays, f->isect_streams));
-        len += snprintf(txt + len, sizeof txt - (size_t)len,
-                        "streams      mean length: traversal %s, intersection %s, shading %.1f rays%s\n"
-                        "host         %.2f s on %d %s: %.2f M instructions/s, %.3f M rays/s; load %.2f s, BVH+pack %.2f s\n",
-                        trav_len, isect_len, ratio(f->shade_rays, f->shade_streams),
-                        f->trav_streams ? "" : " (traversal one ray per lane: no stream filters)", secs, threads, thr,
-                        secs > 0 ? 1e-6 * (double)f->instructions / secs : 0.0,
-                        secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, t_load - t0, t_pack - t_load);
-    } else {
-        len += snprintf(txt + len, sizeof txt - (size_t)len,
-                        "traversal    %llu nodes visited, %llu primitive tests\n"
-                        "host         %.2f s rendering on %d %s (%.3f M rays/s); load %.2f s, BVH+pack %.2f s\n",
-                        (unsigned long long)rs.run.nodes_visited, (unsigned long long)rs.run.prims_tested, secs, threads, thr,
-                        secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, t_load - t0, t_pack - t_load);
     }
+    if (len >= (int)sizeof txt)
+        len = (int)sizeof txt - 1;
+    size_t tlen = (size_t)len;   /* the statistics: sim/stats.def */
+    stats_text(txt, sizeof txt, &tlen, &sx);
+    len = (int)tlen;
+    if (functional)
+        len += snprintf(txt + len, sizeof txt - (size_t)len,
+                        "host         %.2f s on %d %s: %.2f M instructions/s, %.3f M rays/s; load %.2f s, BVH+pack %.2f s\n",
+                        secs, threads, thr, secs > 0 ? 1e-6 * (double)rs.f.instructions / secs : 0.0,
+                        secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, t_load - t0, t_pack - t_load);
+    else
+        len += snprintf(txt + len, sizeof txt - (size_t)len,
+                        "host         %.2f s rendering on %d %s (%.3f M rays/s); load %.2f s, BVH+pack %.2f s\n", secs,
+                        threads, thr, secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, t_load - t0, t_pack - t_load);
     snprintf(path, sizeof path, "%s/report.txt", o->out_dir);
     if (outfile_write_file(set, path, txt, strlen(txt), err, errlen) != 0)
         goto out;

@@ -798,7 +798,8 @@ static void text_row(void *wp, const StatsRow *r)
     int idx[STATS_MAX_DIMS] = {0}, na;
     if (r->text == STATS_T_LINE || !w->open) {
         char head[160];
-        snprintf(head, sizeof head, "%s%s%s", r->label, r->ndims && name[0] ? " " : "", r->ndims ? name : "");
+        int named = r->ndims && name[0] && !(r->flags & (STATS_F_LIST_NZ | STATS_F_LIST_Z));
+        snprintf(head, sizeof head, "%s%s%s", r->label, named ? " " : "", named ? name : "");
         line_start(w, head);
     }
     if (r->flags & (STATS_F_LIST_NZ | STATS_F_LIST_Z)) {
