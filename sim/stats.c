@@ -987,3 +987,59 @@ void stats_csv_read(const cJSON *report, double *value, unsigned char *has)
         col += ne;
     }
 }
+
+/* ---- the table's own rules (tests/unit/test_stats.c) ----------------------------------------- */
+
+/* Bytes of a field source struct. */
+static size_t src_size(StatsSrc s)
+{
+    return s == STATS_SRC_RUN ? sizeof(StatsRun) : s == STATS_SRC_CORE ? sizeof(CoreStats) : s == STATS_SRC_FUNC ? sizeof(FuncStats)
+         : s == STATS_SRC_TIMING ? sizeof(TimingStats) : s == STATS_SRC_TILE ? sizeof(FuncTile) : 0;
+}
+
+int stats_row_check(const StatsRow *r, char *err, size_t errlen)
+{
+    Seg seg[MAX_SEGS];
+    const char *what = NULL;
+    int list = (r->flags & (STATS_F_LIST_NZ | STATS_F_LIST_Z)) != 0;
+    if (r->path && path_parse(r, seg) < 0)
+        what = "its path does not name its dimensions in order";
+    else if (!r->path && (r->text == STATS_T_NONE || r->csv))
+        what = "a row without a path is a report.txt line and nothing else";
+    else if ((r->src == STATS_SRC_FN) != (r->fn != NULL))
+        what = "FN rows, and only they, have a function";
+    else if (r->src == STATS_SRC_TILE && (r->ndims == 0 || r->dims[0] != STATS_D_TILE))
+        what = "a TILE field's first dimension is the tile";
+    else if (r->src != STATS_SRC_TILE && r->ndims && r->dims[0] == STATS_D_TILE)
+        what = "the tile dimension indexes FuncTile fields";
+    else if (list && (r->ndims != 1 || r->text == STATS_T_MORE))
+        what = "a list has one dimension";
+    else if ((r->text == STATS_T_MORE && r->ndims) || (r->text == STATS_T_LINE && r->ndims > 1 && !list))
+        what = "report.txt lines hold scalars or one dimension (MORE: scalars)";
+    else if ((r->text == STATS_T_TABLE && r->ndims != 2) || (r->text == STATS_T_TROW && r->ndims != 1))
+        what = "a TABLE row has two dimensions, a TROW one";
+    else if (r->text == STATS_T_HEAD && r->ndims)
+        what = "the headline is a scalar";
+    else if (r->src == STATS_SRC_EXTERNAL && (r->text != STATS_T_NONE || (r->modes & STATS_M_EXEC)))
+        what = "an EXTERNAL row is written by its owner only";
+    else if ((r->modes & (STATS_M_ALL | STATS_M_EXEC)) == 0)
+        what = "the row appears in no mode";
+    if (!what && src_size(r->src)) {
+        size_t n = r->u32 ? 4 : 8;
+        for (int k = r->src == STATS_SRC_TILE; k < r->ndims; k++)
+            n *= (size_t)stats_dim_size(r->dims[k]);
+        if (r->offset + n > src_size(r->src))
+            what = "its field and dimensions reach past the end of the struct";
+    }
+    if (!what && r->csv) {
+        for (int k = 0; k < r->ndims && !what; k++) {
+            char ph[32];
+            snprintf(ph, sizeof ph, "{%s}", stats_dim_names[r->dims[k]]);
+            if (!strstr(r->csv, ph) || r->dims[k] == STATS_D_GEN || r->dims[k] == STATS_D_TILE)
+                what = "its CSV name does not name each (static) dimension";
+        }
+    }
+    if (what)
+        snprintf(err, errlen, "stats.def row %s: %s", r->path ? r->path : r->label, what);
+    return what ? -1 : 0;
+}

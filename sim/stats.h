@@ -221,6 +221,10 @@ StatsFrame stats_frame(const TimingStats *t, uint64_t instructions, double clock
 /* Sampled mode: the ratio estimate of the frame's cycles from f's sampled tiles. 0, or -1. */
 int stats_sample_estimate(const FuncStats *f, SampleEstimate *est);
 
+/* The table's rules for one row (path names the dimensions, sources and text styles fit, fields
+ * inside their struct): 0, or -1 with the row and the rule in err. */
+int stats_row_check(const StatsRow *r, char *err, size_t errlen);
+
 /* ---- the sweep CSV ------------------------------------------------------------------------- */
 /* Its figure columns, in order: the rows with a csv name, by csv_order, expanded over their
  * dimensions. */
