@@ -1,17 +1,17 @@
-/* sim/stats.c -- the statistics registry (sim/stats.def) and the one walk that writes it: the
- * statistics of report.json, report.txt's statistics lines, the exec print-out; the sweep CSV's
- * columns and reader; every derived figure.
+/* sim/stats.c -- the statistics registry (sim/stats.def) and the one walk over it; report.json's
+ * statistics; every derived figure. report.txt and the exec print-out: sim/stats_text.c; the sweep
+ * CSV: sim/stats_csv.c.
  *
  * Owns: how a row's value is found (a field by offset, or a fig_* function below), the JSON
- * path syntax, report.txt's and the exec print-out's layout of the values, the CSV columns.
+ * path syntax and how the walk builds report.json from it, the table's own rules.
  * Must not: count (the core, the timing model and the renderers do), know a counter by name
  * outside the table and its fig_* function, or write a non-statistics block (render.c does).
  */
 #include "stats.h"
+#include "stats_walk.h"
 
 #include <cjson/cJSON.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -46,10 +46,6 @@ const char *const stats_unit_names[STATS_U_COUNT] = {
 
 static const char *const filter_keys[FUNC_STAGES] = {"traversal", "intersection", "shading"};
 static const char *const bound_keys[2] = {"lo", "hi"};
-/* The sweep CSV has always listed the ray stages first. */
-static const int stage_csv_order[ISA_STAGE_COUNT] = {ISA_STAGE_TRAVERSAL, ISA_STAGE_INTERSECTION, ISA_STAGE_SHADING,
-                                                     ISA_STAGE_OTHER};
-
 int stats_dim_size(StatsDim d)
 {
     switch (d) {
@@ -87,7 +83,7 @@ const char *stats_dim_key(StatsDim d, int i)
 }
 
 /* Elements of d in this run: generations reached, tiles rendered; the others are static. */
-static int dim_len(const StatsCtx *c, StatsDim d)
+int stats_dim_len(const StatsCtx *c, StatsDim d)
 {
     if (d == STATS_D_GEN) {
         uint64_t g = c->run ? c->run->generations : c->f ? c->f->generations : 0;
@@ -251,7 +247,7 @@ int stats_sample_estimate(const FuncStats *f, SampleEstimate *est)
 #define FIG(name) static double fig_##name(const StatsCtx *c, const int *idx, int *na)
 #define UNUSED_FIG_ARGS ((void)c, (void)idx, (void)na)
 
-static StatsFrame frame(const StatsCtx *c)
+StatsFrame stats_frame_of(const StatsCtx *c)
 {
     return stats_frame(c->t, c->f ? c->f->instructions : 0, c->cfg ? c->cfg->core_clock_mhz : 0.0, c->est);
 }
@@ -263,13 +259,13 @@ static double defined_if(double v, int ok, int *na)
 }
 static int lanes(const StatsCtx *c) { return c->cfg->core_simd_width; }
 
-FIG(frame_cycles) { UNUSED_FIG_ARGS; return frame(c).cycles; }
-FIG(frame_busy) { UNUSED_FIG_ARGS; return frame(c).busy; }
-FIG(fps) { UNUSED_FIG_ARGS; return frame(c).fps; }
-FIG(fps_no_stall) { UNUSED_FIG_ARGS; return frame(c).fps_no_stall; }
+FIG(frame_cycles) { UNUSED_FIG_ARGS; return stats_frame_of(c).cycles; }
+FIG(frame_busy) { UNUSED_FIG_ARGS; return stats_frame_of(c).busy; }
+FIG(fps) { UNUSED_FIG_ARGS; return stats_frame_of(c).fps; }
+FIG(fps_no_stall) { UNUSED_FIG_ARGS; return stats_frame_of(c).fps_no_stall; }
 FIG(clock_mhz) { UNUSED_FIG_ARGS; return c->cfg->core_clock_mhz; }
-FIG(cycles_ci95) { UNUSED_FIG_ARGS; return idx[0] ? frame(c).cycles_hi : frame(c).cycles_lo; }
-FIG(fps_ci95) { UNUSED_FIG_ARGS; return idx[0] ? frame(c).fps_hi : frame(c).fps_lo; }
+FIG(cycles_ci95) { UNUSED_FIG_ARGS; return idx[0] ? stats_frame_of(c).cycles_hi : stats_frame_of(c).cycles_lo; }
+FIG(fps_ci95) { UNUSED_FIG_ARGS; return idx[0] ? stats_frame_of(c).fps_hi : stats_frame_of(c).fps_lo; }
 FIG(sample_tiles) { UNUSED_FIG_ARGS; return c->est->N; }
 FIG(sample_tiles_sampled) { UNUSED_FIG_ARGS; return c->est->n; }
 FIG(sample_t) { UNUSED_FIG_ARGS; return c->est->t; }
@@ -298,7 +294,7 @@ FIG(utilization_secondary)
 {
     UNUSED_FIG_ARGS;
     /* Primary rays are generation 0 (camera rays only); the rest are secondary (001 Tables 2, 3). */
-    return stats_utilization_gens(&c->f->core, lanes(c), idx[0], 1, dim_len(c, STATS_D_GEN));
+    return stats_utilization_gens(&c->f->core, lanes(c), idx[0], 1, stats_dim_len(c, STATS_D_GEN));
 }
 FIG(utilization_gen)
 {
@@ -321,7 +317,7 @@ FIG(stream_length)
 FIG(stream_length_secondary)
 {
     UNUSED_FIG_ARGS;
-    return stats_stream_length(c->f, idx[0], 1, dim_len(c, STATS_D_GEN));
+    return stats_stream_length(c->f, idx[0], 1, stats_dim_len(c, STATS_D_GEN));
 }
 FIG(stream_length_gen)
 {
@@ -333,7 +329,7 @@ FIG(stalls)
     UNUSED_FIG_ARGS;
     /* Sampled mode: the sample's share of the estimated cycles. */
     if (c->est)
-        return round(stats_stall_share(c->t, idx[0]) * frame(c).cycles);
+        return round(stats_stall_share(c->t, idx[0]) * stats_frame_of(c).cycles);
     return (double)c->t->stalls[idx[0]];
 }
 FIG(stall_share) { return defined_if(stats_stall_share(c->t, idx[0]), c->t->cycles > 0, na); }
@@ -411,7 +407,7 @@ const int stats_nrows = (int)(sizeof stats_rows / sizeof stats_rows[0]);
 
 /* ---- reading a row ------------------------------------------------------------------------ */
 
-static double row_value(const StatsCtx *c, const StatsRow *r, const int *idx, int *na)
+double stats_row_value(const StatsCtx *c, const StatsRow *r, const int *idx, int *na)
 {
     *na = 0;
     const unsigned char *base;
@@ -438,7 +434,7 @@ static double row_value(const StatsCtx *c, const StatsRow *r, const int *idx, in
     return (double)v;
 }
 
-static int row_present(const StatsRow *r, unsigned mode)
+int stats_row_present(const StatsRow *r, unsigned mode)
 {
     if (!(r->modes & mode & ~(unsigned)STATS_M_KD))
         return 0;
@@ -448,25 +444,25 @@ static int row_present(const StatsRow *r, unsigned mode)
 /* Every mode has the key: null where the row is not (cycles in functional mode). */
 static int row_nulled(const StatsRow *r, unsigned mode)
 {
-    return (r->flags & STATS_F_NULLED) && !row_present(r, mode) && (mode & STATS_M_ALL);
+    return (r->flags & STATS_F_NULLED) && !stats_row_present(r, mode) && (mode & STATS_M_ALL);
 }
 
 /* The first element (all 0); 0 when the row has none in this run. */
-static int idx_first(const StatsCtx *c, const StatsRow *r, int *idx)
+int stats_idx_first(const StatsCtx *c, const StatsRow *r, int *idx)
 {
     for (int k = 0; k < r->ndims; k++) {
         idx[k] = 0;
-        if (dim_len(c, r->dims[k]) == 0)
+        if (stats_dim_len(c, r->dims[k]) == 0)
             return 0;
     }
     return 1;
 }
 
 /* The next element, row-major; 0 after the last. */
-static int idx_next(const StatsCtx *c, const StatsRow *r, int *idx)
+int stats_idx_next(const StatsCtx *c, const StatsRow *r, int *idx)
 {
     for (int k = r->ndims - 1; k >= 0; k--) {
-        if (++idx[k] < dim_len(c, r->dims[k]))
+        if (++idx[k] < stats_dim_len(c, r->dims[k]))
             return 1;
         idx[k] = 0;
     }
@@ -475,19 +471,12 @@ static int idx_next(const StatsCtx *c, const StatsRow *r, int *idx)
 
 /* ---- paths: "a.b", "{dim}" (with text around it), "[dim]" ---------------------------------- */
 
-typedef struct Seg {
-    int array;             /* "[dim]" */
-    int dim;               /* the row's dimension it indexes (position in dims), or -1 */
-    const char *pre, *post;
-    int prelen, postlen;   /* the text around "{dim}" (pre alone for a literal key) */
-} Seg;
-#define MAX_SEGS 8
 
-static int name_is(const char *s, size_t n, const char *name) { return strlen(name) == n && !strncmp(s, name, n); }
+int stats_name_is(const char *s, size_t n, const char *name) { return strlen(name) == n && !strncmp(s, name, n); }
 
 /* The segments of r's path; -1 when the path does not name r's dimensions in order (a list
  * row's one dimension is the list's contents). */
-static int path_parse(const StatsRow *r, Seg *seg)
+int stats_path_parse(const StatsRow *r, Seg *seg)
 {
     const char *p = r->path;
     int n = 0, nd = 0;
@@ -499,7 +488,7 @@ static int path_parse(const StatsRow *r, Seg *seg)
         g->dim = -1;
         if (*p == '[') {
             const char *e = strchr(p, ']');
-            if (!e || nd >= r->ndims || !name_is(p + 1, (size_t)(e - p - 1), stats_dim_names[r->dims[nd]]))
+            if (!e || nd >= r->ndims || !stats_name_is(p + 1, (size_t)(e - p - 1), stats_dim_names[r->dims[nd]]))
                 return -1;
             g->array = 1;
             g->dim = nd++;
@@ -511,7 +500,7 @@ static int path_parse(const StatsRow *r, Seg *seg)
             g->prelen = (int)(e - p);
             if (b) {
                 const char *cb = memchr(b, '}', (size_t)(e - b));
-                if (!cb || nd >= r->ndims || !name_is(b + 1, (size_t)(cb - b - 1), stats_dim_names[r->dims[nd]]))
+                if (!cb || nd >= r->ndims || !stats_name_is(b + 1, (size_t)(cb - b - 1), stats_dim_names[r->dims[nd]]))
                     return -1;
                 g->prelen = (int)(b - p);
                 g->post = cb + 1;
@@ -529,7 +518,7 @@ static int path_parse(const StatsRow *r, Seg *seg)
     return n > 0 && nd == r->ndims - ((r->flags & (STATS_F_LIST_NZ | STATS_F_LIST_Z)) ? 1 : 0) ? n : -1;
 }
 
-static const char *seg_key(const Seg *g, const StatsRow *r, const int *idx, char *buf, size_t len)
+const char *stats_seg_key(const Seg *g, const StatsRow *r, const int *idx, char *buf, size_t len)
 {
     snprintf(buf, len, "%.*s%s%.*s", g->prelen, g->pre, g->dim < 0 ? "" : stats_dim_key(r->dims[g->dim], idx[g->dim]),
              g->postlen, g->post ? g->post : "");
@@ -538,10 +527,10 @@ static const char *seg_key(const Seg *g, const StatsRow *r, const int *idx, char
 
 /* The row's last key if it is a literal ("accesses_with_bank_conflict" -> "accesses with bank
  * conflict"), else "": report.txt's and the exec print-out's name of a value. */
-static const char *leaf_name(const StatsRow *r, char *buf, size_t len)
+const char *stats_leaf_name(const StatsRow *r, char *buf, size_t len)
 {
     Seg seg[MAX_SEGS];
-    int n = r->path ? path_parse(r, seg) : -1;
+    int n = r->path ? stats_path_parse(r, seg) : -1;
     buf[0] = '\0';
     if (n > 0 && !seg[n - 1].array && seg[n - 1].dim < 0)
         snprintf(buf, len, "%.*s", seg[n - 1].prelen, seg[n - 1].pre);
@@ -554,11 +543,11 @@ static const char *leaf_name(const StatsRow *r, char *buf, size_t len)
 /* ---- the walk ------------------------------------------------------------------------------- */
 
 /* Every row of c's mode (and the rows that are null in it), in table order. */
-static void walk(const StatsCtx *c, void (*visit)(void *w, const StatsRow *r), void *w)
+void stats_walk(const StatsCtx *c, void (*visit)(void *w, const StatsRow *r), void *w)
 {
     for (int i = 0; i < stats_nrows; i++) {
         const StatsRow *r = &stats_rows[i];
-        if (r->src != STATS_SRC_EXTERNAL && (row_present(r, c->mode) || row_nulled(r, c->mode)))
+        if (r->src != STATS_SRC_EXTERNAL && (stats_row_present(r, c->mode) || row_nulled(r, c->mode)))
             visit(w, r);
     }
 }
@@ -576,20 +565,20 @@ typedef struct JsonW {
 static cJSON *json_value(JsonW *w)
 {
     const StatsRow *r = w->r;
-    if (!row_present(r, w->c->mode))
+    if (!stats_row_present(r, w->c->mode))
         return cJSON_CreateNull();
     if (r->flags & (STATS_F_LIST_NZ | STATS_F_LIST_Z)) {
         cJSON *a = cJSON_CreateArray();
         int idx[STATS_MAX_DIMS] = {0}, na;
-        for (int ok = idx_first(w->c, r, idx); ok && a; ok = idx_next(w->c, r, idx)) {
-            int nz = row_value(w->c, r, idx, &na) != 0;
+        for (int ok = stats_idx_first(w->c, r, idx); ok && a; ok = stats_idx_next(w->c, r, idx)) {
+            int nz = stats_row_value(w->c, r, idx, &na) != 0;
             if (nz == !!(r->flags & STATS_F_LIST_NZ) && !cJSON_AddItemToArray(a, cJSON_CreateString(stats_dim_key(r->dims[0], idx[0]))))
                 w->oom = 1;
         }
         return a;
     }
     int na;
-    double v = row_value(w->c, r, w->idx, &na);
+    double v = stats_row_value(w->c, r, w->idx, &na);
     if (r->unit == STATS_U_FLAG)
         return cJSON_CreateBool(v != 0);
     return cJSON_CreateNumber(r->flags & STATS_F_ROUND ? round(v) : v);
@@ -612,12 +601,12 @@ static void json_at(JsonW *w, cJSON *node, int s)
 {
     const Seg *g = &w->seg[s];
     const StatsRow *r = w->r;
-    int leaf = s == w->nseg - 1, n = g->dim < 0 ? 1 : dim_len(w->c, r->dims[g->dim]), na;
+    int leaf = s == w->nseg - 1, n = g->dim < 0 ? 1 : stats_dim_len(w->c, r->dims[g->dim]), na;
     cJSON *item = g->array ? node->child : NULL;
     for (int i = 0; i < n && !w->oom; i++) {
         if (g->dim >= 0)
             w->idx[g->dim] = i;
-        if (leaf && (r->flags & STATS_F_SPARSE) && row_value(w->c, r, w->idx, &na) == 0)
+        if (leaf && (r->flags & STATS_F_SPARSE) && stats_row_value(w->c, r, w->idx, &na) == 0)
             continue;
         char key[128];
         cJSON *x;
@@ -629,10 +618,10 @@ static void json_at(JsonW *w, cJSON *node, int s)
             item = x ? x->next : NULL;
         } else if (leaf) {
             x = json_value(w);
-            if (x && !cJSON_AddItemToObject(node, seg_key(g, r, w->idx, key, sizeof key), x))
+            if (x && !cJSON_AddItemToObject(node, stats_seg_key(g, r, w->idx, key, sizeof key), x))
                 x = NULL;
         } else {
-            x = json_child(w, node, seg_key(g, r, w->idx, key, sizeof key), s + 1);
+            x = json_child(w, node, stats_seg_key(g, r, w->idx, key, sizeof key), s + 1);
         }
         if (!x)
             w->oom = 1;
@@ -647,7 +636,7 @@ static void json_row(void *wp, const StatsRow *r)
     if (!r->path)
         return;
     w->r = r;
-    w->nseg = path_parse(r, w->seg);
+    w->nseg = stats_path_parse(r, w->seg);
     if (w->nseg < 0) {   /* a table error the unit test rules out */
         w->oom = 1;
         return;
@@ -659,333 +648,8 @@ static void json_row(void *wp, const StatsRow *r)
 int stats_json(cJSON *root, const StatsCtx *c)
 {
     JsonW w = {.c = c, .root = root};
-    walk(c, json_row, &w);
+    stats_walk(c, json_row, &w);
     return w.oom ? -1 : 0;
-}
-
-/* ---- report.txt and the exec print-out ---------------------------------------------------------- */
-
-typedef struct TextW {
-    const StatsCtx *c;
-    FILE *fp;              /* the exec print-out; else buf */
-    char *buf;
-    size_t cap, *len;
-    int open, items;       /* a line is open; values on it */
-} TextW;
-
-static void out(TextW *w, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void out(TextW *w, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    if (w->fp) {
-        vfprintf(w->fp, fmt, ap);
-    } else if (*w->len < w->cap) {
-        int n = vsnprintf(w->buf + *w->len, w->cap - *w->len, fmt, ap);
-        *w->len = n < 0 ? *w->len : *w->len + (size_t)n < w->cap ? *w->len + (size_t)n : w->cap - 1;
-    }
-    va_end(ap);
-}
-
-/* A value in its unit's format; "-" where it has no meaning. */
-static const char *fmt_value(const StatsRow *r, double v, int na, char *buf, size_t len)
-{
-    if (na)
-        return "-";
-    switch (r->unit) {
-    case STATS_U_RATIO: snprintf(buf, len, "%.1f%%", 100.0 * v); break;
-    case STATS_U_PER_RAY: case STATS_U_CPI: snprintf(buf, len, "%.3f", v); break;
-    case STATS_U_RAYS_PER_STREAM: snprintf(buf, len, "%.1f", v); break;
-    case STATS_U_FPS: snprintf(buf, len, "%.2f", v); break;
-    case STATS_U_MHZ: case STATS_U_NUMBER: snprintf(buf, len, "%g", v); break;
-    case STATS_U_FLAG: snprintf(buf, len, "%s", v != 0 ? "yes" : "no"); break;
-    default: snprintf(buf, len, "%.0f", v); break;
-    }
-    return buf;
-}
-
-static const char *elem_text(TextW *w, const StatsRow *r, const int *idx, char *buf, size_t len)
-{
-    int na;
-    double v = row_value(w->c, r, idx, &na);
-    return fmt_value(r, v, na, buf, len);
-}
-
-static void line_end(TextW *w)
-{
-    if (w->open)
-        out(w, "\n");
-    w->open = w->items = 0;
-}
-
-static void line_start(TextW *w, const char *head)
-{
-    line_end(w);
-    out(w, "%-12s", head);
-    w->open = 1;
-}
-
-static void line_item(TextW *w, const char *name, const char *value)
-{
-    out(w, "%s %s %s", w->items++ ? "," : "", name, value);
-}
-
-/* The headline: report.txt's first timing lines, the exec print-out's first line. */
-static void headline(TextW *w, const StatsRow *r)
-{
-    const StatsCtx *c = w->c;
-    const TimingStats *t = c->t;
-    line_end(w);
-    if (c->mode & STATS_M_EXEC) {
-        out(w, "timing: %llu cycles = %llu busy + %llu stall\n", (unsigned long long)t->cycles,
-            (unsigned long long)t->busy, (unsigned long long)(t->cycles - t->busy));
-        return;
-    }
-    StatsFrame s = frame(c);
-    double mhz = c->cfg->core_clock_mhz;
-    if (c->est)
-        out(w, "%-12s ~%.0f (95%%: %.0f .. %.0f) = %.0f busy + ~%.0f stalled; estimated from %u of %u tiles\n"
-            "fps          ~%.2f (95%%: %.2f .. %.2f) at %g MHz (%.2f fps with no stalls)\n"
-            "sample       the shares and unit lines below are those of the %u sampled tiles (docs/sampling.md)\n",
-            r->label, s.cycles, s.cycles_lo, s.cycles_hi, s.busy, s.cycles - s.busy, c->est->n, c->est->N, s.fps,
-            s.fps_lo, s.fps_hi, mhz, s.fps_no_stall, c->est->n);
-    else
-        out(w, "%-12s %llu = %llu busy + %llu stalled; %.2f fps at %g MHz (%.2f fps with no stalls)\n", r->label,
-            (unsigned long long)t->cycles, (unsigned long long)t->busy, (unsigned long long)(t->cycles - t->busy),
-            s.fps, mhz, s.fps_no_stall);
-}
-
-/* A 2-D row as a table (kd counters per ray: a line per ray kind), or one more line of it. */
-static void text_table(TextW *w, const StatsRow *r)
-{
-    char v[64];
-    int idx[STATS_MAX_DIMS] = {0};
-    StatsDim col = r->dims[r->ndims - 1];
-    line_end(w);
-    if (r->text == STATS_T_TABLE) {
-        out(w, "%-12s %-8s", r->label, "");
-        for (int j = 0; j < dim_len(w->c, col); j++)
-            out(w, " %10s", stats_dim_key(col, j));
-        out(w, "\n");
-    }
-    int rows = r->text == STATS_T_TABLE ? dim_len(w->c, r->dims[0]) : 1;
-    for (int i = 0; i < rows; i++) {
-        out(w, "%13s%-8s", "", r->text == STATS_T_TABLE ? stats_dim_key(r->dims[0], i) : r->label);
-        for (int j = 0; j < dim_len(w->c, col); j++) {
-            idx[0] = r->text == STATS_T_TABLE ? i : j;
-            idx[1] = j;
-            out(w, " %10s", elem_text(w, r, idx, v, sizeof v));
-        }
-        out(w, "\n");
-    }
-}
-
-static void text_row(void *wp, const StatsRow *r)
-{
-    TextW *w = wp;
-    char name[96], v[64];
-    if (!row_present(r, w->c->mode) || r->text == STATS_T_NONE)
-        return;
-    if (r->text == STATS_T_HEAD) {
-        headline(w, r);
-        return;
-    }
-    if (r->text == STATS_T_TABLE || r->text == STATS_T_TROW) {
-        text_table(w, r);
-        return;
-    }
-    leaf_name(r, name, sizeof name);
-    int idx[STATS_MAX_DIMS] = {0}, na;
-    if (r->text == STATS_T_LINE || !w->open) {
-        char head[160];
-        int named = r->ndims && name[0] && !(r->flags & (STATS_F_LIST_NZ | STATS_F_LIST_Z));
-        snprintf(head, sizeof head, "%s%s%s", r->label, named ? " " : "", named ? name : "");
-        line_start(w, head);
-    }
-    if (r->flags & (STATS_F_LIST_NZ | STATS_F_LIST_Z)) {
-        int any = 0;
-        for (int ok = idx_first(w->c, r, idx); ok; ok = idx_next(w->c, r, idx))
-            if ((row_value(w->c, r, idx, &na) != 0) == !!(r->flags & STATS_F_LIST_NZ)) {
-                out(w, " %s", stats_dim_key(r->dims[0], idx[0]));
-                any = 1;
-            }
-        if (!any)
-            out(w, " -");
-    } else if (r->ndims == 0) {
-        line_item(w, r->path ? name : r->label, elem_text(w, r, idx, v, sizeof v));
-    } else {
-        for (int ok = idx_first(w->c, r, idx); ok; ok = idx_next(w->c, r, idx))
-            if (!(r->flags & STATS_F_SPARSE) || row_value(w->c, r, idx, &na) != 0)
-                line_item(w, stats_dim_key(r->dims[0], idx[0]), elem_text(w, r, idx, v, sizeof v));
-    }
-}
-
-void stats_text(char *buf, size_t cap, size_t *len, const StatsCtx *c)
-{
-    TextW w = {.c = c, .buf = buf, .cap = cap, .len = len};
-    walk(c, text_row, &w);
-    line_end(&w);
-}
-
-/* The exec print-out: a line per value, "  label [keys] [name]  value"; elements that are 0 left out. */
-static void exec_row(void *wp, const StatsRow *r)
-{
-    TextW *w = wp;
-    if (!row_present(r, w->c->mode))
-        return;
-    if (r->text == STATS_T_HEAD) {
-        headline(w, r);
-        return;
-    }
-    char name[96], v[64], left[256];
-    leaf_name(r, name, sizeof name);
-    int idx[STATS_MAX_DIMS] = {0}, na;
-    for (int ok = idx_first(w->c, r, idx); ok; ok = idx_next(w->c, r, idx)) {
-        double x = row_value(w->c, r, idx, &na);
-        if (r->ndims && x == 0)
-            continue;
-        int n = snprintf(left, sizeof left, "%s", r->label);
-        for (int k = 0; k < r->ndims; k++)
-            n += snprintf(left + n, sizeof left - (size_t)n, " %s", stats_dim_key(r->dims[k], idx[k]));
-        if (name[0])
-            snprintf(left + n, sizeof left - (size_t)n, " %s", name);
-        out(w, "  %-40s %12s\n", left, fmt_value(r, x, na, v, sizeof v));
-    }
-}
-
-void stats_print_exec(FILE *fp, const StatsCtx *c)
-{
-    TextW w = {.c = c, .fp = fp};
-    walk(c, exec_row, &w);
-}
-
-/* ---- the sweep CSV ------------------------------------------------------------------------- */
-
-/* The rows with CSV columns, by their column order; their count. */
-static int csv_rows(int *rows)
-{
-    int n = 0;
-    for (int i = 0; i < stats_nrows; i++) {
-        if (stats_rows[i].csv_order < 0)
-            continue;
-        int j = n++;
-        for (; j > 0 && stats_rows[rows[j - 1]].csv_order > stats_rows[i].csv_order; j--)
-            rows[j] = rows[j - 1];
-        rows[j] = i;
-    }
-    return n;
-}
-
-static int row_elements(const StatsRow *r)
-{
-    int n = 1;
-    for (int k = 0; k < r->ndims; k++)
-        n *= stats_dim_size(r->dims[k]);
-    return n;
-}
-
-/* Element e of a CSV row (row-major in the CSV's order of each dimension) as indices. */
-static void csv_element(const StatsRow *r, int e, int *idx)
-{
-    for (int k = r->ndims - 1; k >= 0; k--) {
-        int size = stats_dim_size(r->dims[k]), j = e % size;
-        e /= size;
-        idx[k] = r->dims[k] == STATS_D_STAGE ? stage_csv_order[j] : j;
-    }
-}
-
-int stats_csv_count(void)
-{
-    int rows[512], n = csv_rows(rows), cols = 0;
-    for (int i = 0; i < n; i++)
-        cols += row_elements(&stats_rows[rows[i]]);
-    return cols;
-}
-
-/* The column name: the row's csv template with each "{dim}" replaced by the element's key. */
-static void csv_name(const StatsRow *r, const int *idx, char *buf, size_t len)
-{
-    size_t o = 0;
-    buf[0] = '\0';
-    for (const char *p = r->csv; *p && o + 1 < len; p++) {
-        const char *e = *p == '{' ? strchr(p, '}') : NULL;
-        int k = 0;
-        while (e && k < r->ndims && !name_is(p + 1, (size_t)(e - p - 1), stats_dim_names[r->dims[k]]))
-            k++;
-        if (e && k < r->ndims) {
-            o += (size_t)snprintf(buf + o, len - o, "%s", stats_dim_key(r->dims[k], idx[k]));
-            p = e;
-        } else {
-            buf[o++] = *p;
-            buf[o] = '\0';
-        }
-    }
-    if (o >= len)
-        buf[len - 1] = '\0';
-}
-
-const char *stats_csv_name(int col, char *buf, size_t len)
-{
-    int rows[512], n = csv_rows(rows);
-    buf[0] = '\0';
-    for (int i = 0; i < n && col >= 0; i++) {
-        const StatsRow *r = &stats_rows[rows[i]];
-        int ne = row_elements(r);
-        if (col < ne) {
-            int idx[STATS_MAX_DIMS] = {0};
-            csv_element(r, col, idx);
-            csv_name(r, idx, buf, len);
-            break;
-        }
-        col -= ne;
-    }
-    return buf;
-}
-
-/* The report's item at r's path for element idx, or NULL. An array must have the dimension's size. */
-static const cJSON *json_find(const cJSON *report, const StatsRow *r, const int *idx)
-{
-    Seg seg[MAX_SEGS];
-    int n = path_parse(r, seg);
-    const cJSON *node = report;
-    for (int s = 0; s < n && node; s++) {
-        char key[128];
-        if (seg[s].array) {
-            StatsDim d = r->dims[seg[s].dim];
-            if (!cJSON_IsArray(node) || cJSON_GetArraySize(node) != stats_dim_size(d))
-                return NULL;
-            node = cJSON_GetArrayItem(node, idx[seg[s].dim]);
-        } else {
-            node = cJSON_GetObjectItemCaseSensitive(node, seg_key(&seg[s], r, idx, key, sizeof key));
-        }
-    }
-    return n > 0 ? node : NULL;
-}
-
-void stats_csv_read(const cJSON *report, double *value, unsigned char *has)
-{
-    int rows[512], n = csv_rows(rows), col = 0;
-    for (int i = 0; i < n; i++) {
-        const StatsRow *r = &stats_rows[rows[i]];
-        int ne = row_elements(r);
-        double sum = 0;
-        for (int e = 0; e < ne; e++) {
-            int idx[STATS_MAX_DIMS] = {0};
-            csv_element(r, e, idx);
-            const cJSON *it = json_find(report, r, idx);
-            has[col + e] = cJSON_IsNumber(it) && isfinite(it->valuedouble);
-            value[col + e] = has[col + e] ? it->valuedouble : 0.0;
-            sum += value[col + e];
-        }
-        /* shares: each element over the row's sum, none when the sum is not positive */
-        for (int e = 0; e < ne && (r->flags & STATS_F_NORMALIZE); e++) {
-            if (sum > 0)
-                value[col + e] /= sum;
-            else
-                has[col + e] = 0;
-        }
-        col += ne;
-    }
 }
 
 /* ---- the table's own rules (tests/unit/test_stats.c) ----------------------------------------- */
@@ -1002,7 +666,7 @@ int stats_row_check(const StatsRow *r, char *err, size_t errlen)
     Seg seg[MAX_SEGS];
     const char *what = NULL;
     int list = (r->flags & (STATS_F_LIST_NZ | STATS_F_LIST_Z)) != 0;
-    if (r->path && path_parse(r, seg) < 0)
+    if (r->path && stats_path_parse(r, seg) < 0)
         what = "its path does not name its dimensions in order";
     else if (!r->path && (r->text == STATS_T_NONE || r->csv))
         what = "a row without a path is a report.txt line and nothing else";
