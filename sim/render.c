@@ -232,6 +232,192 @@ static void add_sample_json(cJSON *root, double fraction, uint32_t seed)
     cJSON_AddNumberToObject(sm, "confidence", 0.95);
 }
 
+/* What the report files say about a run (render_run fills it once the image is made). */
+typedef struct Report {
+    const RenderOptions *o;
+    const CfgMachine *cfg;
+    const Scene *s;
+    const PackedScene *p;
+    const BvhParams *bp;
+    const RunStats *rs;
+    const SampleEstimate *est;     /* sampled mode */
+    int detailed, sampled, functional, tile, threads;
+    double load_seconds, pack_seconds, secs;   /* host: load, BVH + pack, rendering */
+    double mean;                   /* of the image's finite values */
+    long nonfinite;
+} Report;
+
+/* The statistics walk's view of the run (sim/stats.h). */
+static StatsCtx stats_ctx(const Report *r)
+{
+    StatsCtx c = {.mode = (r->detailed ? STATS_M_DET : r->sampled ? STATS_M_SAMP : r->functional ? STATS_M_FUNC
+                                                                                                   : STATS_M_REF) |
+                          (r->functional && r->rs->f.kd ? STATS_M_KD : 0),
+                  .cfg = r->cfg, .run = &r->rs->run, .f = r->functional ? &r->rs->f : NULL,
+                  .t = r->detailed || r->sampled ? &r->rs->f.timing : NULL, .est = r->est};
+    return c;
+}
+
+static uint64_t report_rays(const Report *r) { return r->rs->run.primary + r->rs->run.shadow + r->rs->run.indirect; }
+
+/* report.json (docs/report.md); NULL when out of memory. */
+static cJSON *report_json(const Report *r)
+{
+    const RenderOptions *o = r->o;
+    const CfgMachine *cfg = r->cfg;
+    const Scene *sp = r->s;
+    const PackedScene *pp = r->p;
+    const RunStats *rsp = r->rs;
+    int functional = r->functional, sampled = r->sampled, threads = r->threads;
+    double secs = r->secs;
+    uint64_t total_rays = report_rays(r);
+    /* report.json: the names of ARCHITECTURE.md Sec. 1. The statistics come from the registry
+     * (sim/stats.def; the timing fields are null unless timed); the blocks below describe the run. */
+    StatsCtx sx = stats_ctx(r);
+    cJSON *root = cJSON_CreateObject();
+    if (!root || !cJSON_AddStringToObject(root, "mode", o->mode) || stats_json(root, &sx) != 0) {
+        cJSON_Delete(root);
+        return NULL;
+    }
+    if (functional)
+        add_kernel_json(root, &rsp->f, cfg);
+    if (sampled)
+        add_sample_json(root, o->sample, o->sample_seed);
+    if (functional && rsp->f.kd)
+        add_kd_json(root, rsp, cfg);
+    cJSON *sc = cJSON_AddObjectToObject(root, "scene");
+    cJSON_AddStringToObject(sc, "file", o->scene_path);
+    cJSON_AddNumberToObject(sc, "triangles", sp->ntris);
+    cJSON_AddNumberToObject(sc, "spheres", sp->nspheres);
+    cJSON_AddNumberToObject(sc, "lights", pp->nlights);
+    char needs[256];
+    scene_needs_string(sp->needs, needs, sizeof needs);
+    cJSON *nd = cJSON_AddArrayToObject(sc, "needs");
+    char needs_tok[256];
+    memcpy(needs_tok, needs, sizeof needs_tok);
+    for (char *save = NULL, *tok = strtok_r(needs_tok, ",", &save); tok; tok = strtok_r(NULL, ",", &save))
+        cJSON_AddItemToArray(nd, cJSON_CreateString(tok));
+    cJSON *bvh = cJSON_AddObjectToObject(sc, "bvh");
+    cJSON_AddNumberToObject(bvh, "nodes", pp->bvh.nnodes);
+    cJSON_AddNumberToObject(bvh, "leaves", pp->bvh.nleaves);
+    cJSON_AddNumberToObject(bvh, "depth", pp->bvh.depth);
+    add_sah_json(bvh, pp->bvh.sah_cost);
+    cJSON_AddNumberToObject(bvh, "leaf_size", r->bp->max_leaf_size);
+    cJSON_AddNumberToObject(bvh, "bins", r->bp->bins);
+    cJSON_AddNumberToObject(sc, "scene_memory_bytes", pp->size);
+    cJSON_AddNumberToObject(sc, "skipped_primitives", sp->skipped_primitives);
+    cJSON *warn = cJSON_AddArrayToObject(sc, "warnings");
+    for (uint32_t i = 0; i < sp->nwarnings; i++)
+        cJSON_AddItemToArray(warn, cJSON_CreateString(sp->warnings[i]));
+    /* The machine: every key of sim/config.def as used, in every mode (docs/report.md). */
+    cJSON_AddStringToObject(root, "config_file", o->config_path ? o->config_path : "built-in");
+    cfg_json(cfg, cJSON_AddObjectToObject(root, "config"));
+    cJSON *ren = cJSON_AddObjectToObject(root, "render");
+    cJSON_AddNumberToObject(ren, "width", sp->render.width);
+    cJSON_AddNumberToObject(ren, "height", sp->render.height);
+    cJSON_AddNumberToObject(ren, "spp", sp->render.spp);
+    cJSON_AddNumberToObject(ren, "max_depth", sp->render.max_depth);
+    cJSON_AddNumberToObject(ren, "seed", o->seed);
+    cJSON_AddNumberToObject(ren, "stream_rays", o->stream_rays);
+    int tile_w = functional ? (int)rsp->f.tile_w : r->tile, tile_h = functional ? (int)rsp->f.tile_h : r->tile;
+    cJSON_AddNumberToObject(ren, "tile", tile_w);
+    cJSON_AddNumberToObject(ren, "tile_height", tile_h);
+    cJSON *im = cJSON_AddObjectToObject(root, "image");
+    cJSON_AddNumberToObject(im, "mean", r->mean);
+    cJSON_AddNumberToObject(im, "nonfinite", (double)r->nonfinite);
+    cJSON *host = cJSON_AddObjectToObject(root, "host");
+    cJSON_AddNumberToObject(host, "seconds", secs);
+    cJSON_AddNumberToObject(host, "load_seconds", r->load_seconds);
+    cJSON_AddNumberToObject(host, "bvh_pack_seconds", r->pack_seconds);
+    cJSON_AddNumberToObject(host, "threads", threads);
+    cJSON_AddNumberToObject(host, "rays_per_second", secs > 0 ? (double)total_rays / secs : 0.0);
+    if (functional) {
+        cJSON_AddNumberToObject(host, "sim_instructions", (double)rsp->f.instructions);
+        cJSON_AddNumberToObject(host, "instructions_per_second", secs > 0 ? (double)rsp->f.instructions / secs : 0.0);
+    }
+    return root;
+}
+
+/* report.txt (docs/report.md) into txt. */
+static void report_txt(const Report *r, char *txt, size_t cap)
+{
+    const RenderOptions *o = r->o;
+    const CfgMachine *cfg = r->cfg;
+    const Scene *sp = r->s;
+    const PackedScene *pp = r->p;
+    const RunStats *rsp = r->rs;
+    int detailed = r->detailed, sampled = r->sampled, functional = r->functional, threads = r->threads;
+    double secs = r->secs;
+    uint64_t total_rays = report_rays(r);
+    StatsCtx sx = stats_ctx(r);
+    char needs[256];
+    scene_needs_string(sp->needs, needs, sizeof needs);
+    int tile_w = functional ? (int)rsp->f.tile_w : r->tile, tile_h = functional ? (int)rsp->f.tile_h : r->tile;
+    /* The tiles the image was cut into: a partial tile is said, since the tile size alone would
+     * suggest more pixels than there are. */
+    char tiles_txt[160], sah[64];
+    int tiles_x = (sp->render.width + tile_w - 1) / tile_w, tiles_y = (sp->render.height + tile_h - 1) / tile_h;
+    if (tiles_x * tiles_y == 1 && (sp->render.width < tile_w || sp->render.height < tile_h))
+        snprintf(tiles_txt, sizeof tiles_txt, "one partial tile (tiles are %d x %d pixels)", tile_w, tile_h);
+    else
+        snprintf(tiles_txt, sizeof tiles_txt, "%d tile%s of %d x %d pixels%s", tiles_x * tiles_y,
+                 tiles_x * tiles_y == 1 ? "" : "s", tile_w, tile_h,
+                 sp->render.width % tile_w && sp->render.height % tile_h ? ", the last column and row partial"
+                 : sp->render.width % tile_w                           ? ", the last column partial"
+                 : sp->render.height % tile_h                          ? ", the last row partial"
+                                                                     : "");
+    const char *thr = threads == 1 ? "thread" : "threads";
+    int len = snprintf(txt, cap,
+             "sfsim report -- mode %s (%s)\n"
+             "scene        %s\n"
+             "             %u triangles, %u spheres, %u lights; needs: %s\n"
+             "             BVH %u nodes, %u leaves, depth %u, SAH cost %s; %u bytes of scene memory\n"
+             "config       %s\n"
+             "image        %d x %d, %d spp, max depth %d, seed %u, %s\n"
+             "             mean %.5f, non-finite values %ld\n",
+             o->mode,
+             detailed     ? "the kernel on the timing model of the machine"
+             : sampled    ? "the kernel; sampled tiles on the timing model, the frame's cycles estimated"
+             : functional ? "the kernel on the functional core: no timing"
+                          : "golden model: no timing",
+             o->scene_path, sp->ntris, sp->nspheres, pp->nlights, needs[0] ? needs : "-", pp->bvh.nnodes,
+             pp->bvh.nleaves, pp->bvh.depth, sah_text(pp->bvh.sah_cost, sah, sizeof sah), pp->size,
+             o->config_path ? o->config_path : "built-in (the defaults of sim/config.def)", sp->render.width,
+             sp->render.height, sp->render.spp, sp->render.max_depth, o->seed, tiles_txt, r->mean,
+             r->nonfinite);
+    if (sp->skipped_primitives)
+        len += snprintf(txt + len, cap - (size_t)len, "skipped      %u glTF primitives that are not triangles\n",
+                        sp->skipped_primitives);
+    for (uint32_t i = 0; i < sp->nwarnings && len < (int)cap; i++)
+        len += snprintf(txt + len, cap - (size_t)len, "warning      %s\n", sp->warnings[i]);
+    if (len >= (int)cap) /* (truncated: the writes below stay inside txt) */
+        len = (int)cap - 1;
+    if (functional) {
+        const FuncStats *f = &rsp->f;
+        len += snprintf(txt + len, cap - (size_t)len,
+                        "machine      N = %d lanes, %s of %u x %u rays, workload %s; kernel %u instructions (%s)\n",
+                        cfg->core_simd_width, cfg->stream_mode == CFG_STREAM_MODE_PACKET ? "packets" : "streams",
+                        f->tile_w, f->tile_h, cfg_enum_name("workload", "kind", cfg->workload_kind),
+                        f->kernel_instructions, f->defines);
+        if (f->kd)
+            len += kd_text(txt + len, cap - (size_t)len, rsp, cfg);
+    }
+    if (len >= (int)cap)
+        len = (int)cap - 1;
+    size_t tlen = (size_t)len;   /* the statistics: sim/stats.def */
+    stats_text(txt, cap, &tlen, &sx);
+    len = (int)tlen;
+    if (functional)
+        len += snprintf(txt + len, cap - (size_t)len,
+                        "host         %.2f s on %d %s: %.2f M instructions/s, %.3f M rays/s; load %.2f s, BVH+pack %.2f s\n",
+                        secs, threads, thr, secs > 0 ? 1e-6 * (double)rsp->f.instructions / secs : 0.0,
+                        secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, r->load_seconds, r->pack_seconds);
+    else
+        len += snprintf(txt + len, cap - (size_t)len,
+                        "host         %.2f s rendering on %d %s (%.3f M rays/s); load %.2f s, BVH+pack %.2f s\n", secs,
+                        threads, thr, secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, r->load_seconds, r->pack_seconds);
+}
+
 /* Detailed and sampled modes: cost.png, simulated cycles per pixel of each tile (sampled mode:
  * tiles not sampled get the sample's cycles per instruction times their instructions). */
 static int write_cost_map(OutSet *set, const char *dir, const FuncStats *f, const SampleEstimate *est, int width,
@@ -457,76 +643,14 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         else
             sum += rgb[i];
     }
-    uint64_t total_rays = rs.run.primary + rs.run.shadow + rs.run.indirect;
-    double secs = t_render - t_kd;
-
-    /* report.json: the names of ARCHITECTURE.md Sec. 1. The statistics come from the registry
-     * (sim/stats.def; the timing fields are null unless timed); the blocks below describe the run. */
-    StatsCtx sx = {.mode = (detailed ? STATS_M_DET : sampled ? STATS_M_SAMP : functional ? STATS_M_FUNC : STATS_M_REF) |
-                           (functional && rs.f.kd ? STATS_M_KD : 0),
-                   .cfg = cfg, .run = &rs.run, .f = functional ? &rs.f : NULL,
-                   .t = detailed || sampled ? &rs.f.timing : NULL, .est = est};
-    root = cJSON_CreateObject();
-    cJSON_AddStringToObject(root, "mode", o->mode);
-    if (stats_json(root, &sx) != 0) {
+    Report rep = {.o = o, .cfg = cfg, .s = &s, .p = &p, .bp = &bp, .rs = &rs, .est = est, .detailed = detailed,
+                  .sampled = sampled, .functional = functional, .tile = tile, .threads = threads,
+                  .load_seconds = t_load - t0, .pack_seconds = t_pack - t_load, .secs = t_render - t_kd,
+                  .mean = npx ? sum / (3.0 * (double)npx) : 0.0, .nonfinite = nonfinite};
+    root = report_json(&rep);
+    if (!root) {
         snprintf(err, errlen, "%s/report.json: out of memory", o->out_dir);
         goto out;
-    }
-    if (functional)
-        add_kernel_json(root, &rs.f, cfg);
-    if (sampled)
-        add_sample_json(root, o->sample, o->sample_seed);
-    if (functional && rs.f.kd)
-        add_kd_json(root, &rs, cfg);
-    cJSON *sc = cJSON_AddObjectToObject(root, "scene");
-    cJSON_AddStringToObject(sc, "file", o->scene_path);
-    cJSON_AddNumberToObject(sc, "triangles", s.ntris);
-    cJSON_AddNumberToObject(sc, "spheres", s.nspheres);
-    cJSON_AddNumberToObject(sc, "lights", p.nlights);
-    char needs[256];
-    scene_needs_string(s.needs, needs, sizeof needs);
-    cJSON *nd = cJSON_AddArrayToObject(sc, "needs");
-    char needs_tok[256];
-    memcpy(needs_tok, needs, sizeof needs_tok);
-    for (char *save = NULL, *tok = strtok_r(needs_tok, ",", &save); tok; tok = strtok_r(NULL, ",", &save))
-        cJSON_AddItemToArray(nd, cJSON_CreateString(tok));
-    cJSON *bvh = cJSON_AddObjectToObject(sc, "bvh");
-    cJSON_AddNumberToObject(bvh, "nodes", p.bvh.nnodes);
-    cJSON_AddNumberToObject(bvh, "leaves", p.bvh.nleaves);
-    cJSON_AddNumberToObject(bvh, "depth", p.bvh.depth);
-    add_sah_json(bvh, p.bvh.sah_cost);
-    cJSON_AddNumberToObject(bvh, "leaf_size", bp.max_leaf_size);
-    cJSON_AddNumberToObject(bvh, "bins", bp.bins);
-    cJSON_AddNumberToObject(sc, "scene_memory_bytes", p.size);
-    cJSON_AddNumberToObject(sc, "skipped_primitives", s.skipped_primitives);
-    cJSON *warn = cJSON_AddArrayToObject(sc, "warnings");
-    for (uint32_t i = 0; i < s.nwarnings; i++)
-        cJSON_AddItemToArray(warn, cJSON_CreateString(s.warnings[i]));
-    /* The machine: every key of sim/config.def as used, in every mode (docs/report.md). */
-    cJSON_AddStringToObject(root, "config_file", o->config_path ? o->config_path : "built-in");
-    cfg_json(cfg, cJSON_AddObjectToObject(root, "config"));
-    cJSON *ren = cJSON_AddObjectToObject(root, "render");
-    cJSON_AddNumberToObject(ren, "width", s.render.width);
-    cJSON_AddNumberToObject(ren, "height", s.render.height);
-    cJSON_AddNumberToObject(ren, "spp", s.render.spp);
-    cJSON_AddNumberToObject(ren, "max_depth", s.render.max_depth);
-    cJSON_AddNumberToObject(ren, "seed", o->seed);
-    cJSON_AddNumberToObject(ren, "stream_rays", o->stream_rays);
-    int tile_w = functional ? (int)rs.f.tile_w : tile, tile_h = functional ? (int)rs.f.tile_h : tile;
-    cJSON_AddNumberToObject(ren, "tile", tile_w);
-    cJSON_AddNumberToObject(ren, "tile_height", tile_h);
-    cJSON *im = cJSON_AddObjectToObject(root, "image");
-    cJSON_AddNumberToObject(im, "mean", npx ? sum / (3.0 * (double)npx) : 0.0);
-    cJSON_AddNumberToObject(im, "nonfinite", (double)nonfinite);
-    cJSON *host = cJSON_AddObjectToObject(root, "host");
-    cJSON_AddNumberToObject(host, "seconds", secs);
-    cJSON_AddNumberToObject(host, "load_seconds", t_load - t0);
-    cJSON_AddNumberToObject(host, "bvh_pack_seconds", t_pack - t_load);
-    cJSON_AddNumberToObject(host, "threads", threads);
-    cJSON_AddNumberToObject(host, "rays_per_second", secs > 0 ? (double)total_rays / secs : 0.0);
-    if (functional) {
-        cJSON_AddNumberToObject(host, "sim_instructions", (double)rs.f.instructions);
-        cJSON_AddNumberToObject(host, "instructions_per_second", secs > 0 ? (double)rs.f.instructions / secs : 0.0);
     }
     json_text = cJSON_Print(root);
     snprintf(path, sizeof path, "%s/report.json", o->out_dir);
@@ -537,70 +661,8 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     if (outfile_write_file(set, path, json_text, strlen(json_text), err, errlen) != 0)
         goto out;
 
-    /* The tiles the image was cut into: a partial tile is said, since the tile size alone would
-     * suggest more pixels than there are. */
-    char tiles_txt[160], sah[64];
-    int tiles_x = (s.render.width + tile_w - 1) / tile_w, tiles_y = (s.render.height + tile_h - 1) / tile_h;
-    if (tiles_x * tiles_y == 1 && (s.render.width < tile_w || s.render.height < tile_h))
-        snprintf(tiles_txt, sizeof tiles_txt, "one partial tile (tiles are %d x %d pixels)", tile_w, tile_h);
-    else
-        snprintf(tiles_txt, sizeof tiles_txt, "%d tile%s of %d x %d pixels%s", tiles_x * tiles_y,
-                 tiles_x * tiles_y == 1 ? "" : "s", tile_w, tile_h,
-                 s.render.width % tile_w && s.render.height % tile_h ? ", the last column and row partial"
-                 : s.render.width % tile_w                           ? ", the last column partial"
-                 : s.render.height % tile_h                          ? ", the last row partial"
-                                                                     : "");
-    const char *thr = threads == 1 ? "thread" : "threads";
     char txt[16384];
-    int len = snprintf(txt, sizeof txt,
-             "sfsim report -- mode %s (%s)\n"
-             "scene        %s\n"
-             "             %u triangles, %u spheres, %u lights; needs: %s\n"
-             "             BVH %u nodes, %u leaves, depth %u, SAH cost %s; %u bytes of scene memory\n"
-             "config       %s\n"
-             "image        %d x %d, %d spp, max depth %d, seed %u, %s\n"
-             "             mean %.5f, non-finite values %ld\n",
-             o->mode,
-             detailed     ? "the kernel on the timing model of the machine"
-             : sampled    ? "the kernel; sampled tiles on the timing model, the frame's cycles estimated"
-             : functional ? "the kernel on the functional core: no timing"
-                          : "golden model: no timing",
-             o->scene_path, s.ntris, s.nspheres, p.nlights, needs[0] ? needs : "-", p.bvh.nnodes,
-             p.bvh.nleaves, p.bvh.depth, sah_text(p.bvh.sah_cost, sah, sizeof sah), p.size,
-             o->config_path ? o->config_path : "built-in (the defaults of sim/config.def)", s.render.width,
-             s.render.height, s.render.spp, s.render.max_depth, o->seed, tiles_txt, sum / (3.0 * (double)npx),
-             nonfinite);
-    if (s.skipped_primitives)
-        len += snprintf(txt + len, sizeof txt - (size_t)len, "skipped      %u glTF primitives that are not triangles\n",
-                        s.skipped_primitives);
-    for (uint32_t i = 0; i < s.nwarnings && len < (int)sizeof txt; i++)
-        len += snprintf(txt + len, sizeof txt - (size_t)len, "warning      %s\n", s.warnings[i]);
-    if (len >= (int)sizeof txt) /* (truncated: the writes below stay inside txt) */
-        len = (int)sizeof txt - 1;
-    if (functional) {
-        const FuncStats *f = &rs.f;
-        len += snprintf(txt + len, sizeof txt - (size_t)len,
-                        "machine      N = %d lanes, %s of %u x %u rays, workload %s; kernel %u instructions (%s)\n",
-                        cfg->core_simd_width, cfg->stream_mode == CFG_STREAM_MODE_PACKET ? "packets" : "streams",
-                        f->tile_w, f->tile_h, cfg_enum_name("workload", "kind", cfg->workload_kind),
-                        f->kernel_instructions, f->defines);
-        if (f->kd)
-            len += kd_text(txt + len, sizeof txt - (size_t)len, &rs, cfg);
-    }
-    if (len >= (int)sizeof txt)
-        len = (int)sizeof txt - 1;
-    size_t tlen = (size_t)len;   /* the statistics: sim/stats.def */
-    stats_text(txt, sizeof txt, &tlen, &sx);
-    len = (int)tlen;
-    if (functional)
-        len += snprintf(txt + len, sizeof txt - (size_t)len,
-                        "host         %.2f s on %d %s: %.2f M instructions/s, %.3f M rays/s; load %.2f s, BVH+pack %.2f s\n",
-                        secs, threads, thr, secs > 0 ? 1e-6 * (double)rs.f.instructions / secs : 0.0,
-                        secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, t_load - t0, t_pack - t_load);
-    else
-        len += snprintf(txt + len, sizeof txt - (size_t)len,
-                        "host         %.2f s rendering on %d %s (%.3f M rays/s); load %.2f s, BVH+pack %.2f s\n", secs,
-                        threads, thr, secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, t_load - t0, t_pack - t_load);
+    report_txt(&rep, txt, sizeof txt);
     snprintf(path, sizeof path, "%s/report.txt", o->out_dir);
     if (outfile_write_file(set, path, txt, strlen(txt), err, errlen) != 0)
         goto out;
