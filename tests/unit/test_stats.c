@@ -16,6 +16,12 @@
 #include "../../sim/stats.h"
 #include "../support/files.h"
 
+/* docs/report.md's statistics tables are what tools/gen_reportdoc.c makes of the table today. */
+Test(stats, docs_report_md_is_current)
+{
+    tu_expect_generated("gen_reportdoc", "SFSIM_GEN_REPORTDOC", "docs/report.md");
+}
+
 Test(stats, every_row_keeps_the_rules)
 {
     char err[256];
