@@ -438,7 +438,7 @@ static int write_cost_map(OutSet *set, const char *dir, const FuncStats *f, cons
     }
     for (uint32_t i = 0; i < f->ntiles; i++) {
         const FuncTile *t = &f->tiles[i];
-        double cyc = t->sampled || !est ? (double)t->cycles : est->ratio * (double)t->instructions;
+        double cyc = stats_tile_cycles(f, est, i);
         double per = t->w && t->h ? cyc / ((double)t->w * t->h) : 0.0;
         for (uint32_t y = t->y0; y < t->y0 + t->h && y < (uint32_t)height; y += (uint32_t)scale_y)
             for (uint32_t x = t->x0; x < t->x0 + t->w && x < (uint32_t)width; x += (uint32_t)scale_x)

@@ -242,6 +242,12 @@ int stats_sample_estimate(const FuncStats *f, SampleEstimate *est)
     return rc;
 }
 
+double stats_tile_cycles(const FuncStats *f, const SampleEstimate *est, uint32_t tile)
+{
+    const FuncTile *t = &f->tiles[tile];
+    return t->sampled || !est ? (double)t->cycles : est->ratio * (double)t->instructions;
+}
+
 /* ---- the rows' figures (FN in stats.def): fig_<name>(ctx, element, na) ----------------------- */
 
 #define FIG(name) static double fig_##name(const StatsCtx *c, const int *idx, int *na)

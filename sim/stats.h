@@ -220,6 +220,9 @@ typedef struct StatsFrame {
 StatsFrame stats_frame(const TimingStats *t, uint64_t instructions, double clock_mhz, const SampleEstimate *est);
 /* Sampled mode: the ratio estimate of the frame's cycles from f's sampled tiles. 0, or -1. */
 int stats_sample_estimate(const FuncStats *f, SampleEstimate *est);
+/* A tile's cycles: measured, or (a tile sampled mode did not time) the sample's cycles per
+ * instruction times its instructions. */
+double stats_tile_cycles(const FuncStats *f, const SampleEstimate *est, uint32_t tile);
 
 /* The table's rules for one row (path names the dimensions, sources and text styles fit, fields
  * inside their struct): 0, or -1 with the row and the rule in err. */
