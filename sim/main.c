@@ -343,7 +343,7 @@ static void print_state(Core *c)
     for (int s = 0; s < ISA_STAGE_COUNT; s++) {
         if (!st->instructions[s])
             continue;
-        double util = st->vec_instructions[s] ? (double)st->active_lanes[s] / ((double)n * (double)st->vec_instructions[s]) : 0.0;
+        double util = stats_utilization(st, n, s);
         printf("  %-13s %12llu %12llu %5.1f%%", isa_stage_keys[s], (unsigned long long)st->instructions[s],
                (unsigned long long)st->vec_instructions[s], 100.0 * util);
         for (int k = 0; k < ISA_C_COUNT; k++)
