@@ -12,6 +12,8 @@
  *
  * Adding a counter: its row in sim/stats.def and the code that counts it; report.json,
  * report.txt, the exec print-out, the CSV and docs/report.md follow from the row.
+ * Files: sim/stats.c (the table, the figures, the walk, report.json), sim/stats_text.c
+ * (report.txt, the exec print-out), sim/stats_csv.c (the CSV), sim/stats_walk.h (between them).
  */
 #ifndef SFSIM_STATS_H
 #define SFSIM_STATS_H
