@@ -57,7 +57,7 @@ help:
 	@echo "make fuzz       build the libFuzzer targets, assembler and scene loader (clang);"
 	@echo "                make fuzz-run FUZZ_SECONDS=600 runs each for that long"
 	@echo "make bench      build and run the benchmarks in bench/ (core, functional and detailed speed, Embree)"
-	@echo "make docs       regenerate docs/isa.md, docs/exit-codes.md, the layout include and docs, the kernel constants, the shipped Cornell box"
+	@echo "make docs       regenerate docs/isa.md, docs/exit-codes.md, docs/report.md's statistics, the layout include and docs, the kernel constants, the shipped Cornell box"
 	@echo "make check-outputs  the same-outputs table alone (tests/outputs/check.sh; part of make test)"
 	@echo "make install    install into PREFIX (default /usr/local; DESTDIR honoured): docs/install.md"
 
@@ -125,6 +125,10 @@ $(BUILD)/gen_layout: tools/gen_layout.c scenes/layout.def
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) tools/gen_layout.c -o $@
 
+# docs/report.md's statistics tables from the registry (sim/stats.def).
+$(BUILD)/gen_reportdoc: tools/gen_reportdoc.c $(BUILD)/libsfsim.a
+	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
+
 # The same-outputs table's digest of a run folder (tests/outputs/check.sh).
 $(BUILD)/outputs_digest: tools/outputs_digest.c $(BUILD)/libsfsim.a
 	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
@@ -139,16 +143,17 @@ $(BUILD)/gen_cornell: tools/gen_cornell.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) tools/gen_cornell.c -o $@ $(CJSON) -lm
 
-docs: $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_exitdoc $(BUILD)/gen_cornell
+docs: $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_exitdoc $(BUILD)/gen_reportdoc $(BUILD)/gen_cornell
 	$(BUILD)/gen_cornell scenes/cornell
 	$(BUILD)/gen_isadoc > docs/isa.md
 	$(BUILD)/gen_exitdoc > docs/exit-codes.md
+	$(BUILD)/gen_reportdoc docs/report.md > docs/report.md.tmp && mv docs/report.md.tmp docs/report.md
 	$(BUILD)/gen_layout inc > kernels/lib/layout.inc
 	$(BUILD)/gen_layout md > docs/scene-memory.md
 	$(BUILD)/gen_kconst > kernels/lib/kconst.inc
 
 # ---- tests ----------------------------------------------------------------------------------
-$(BUILD)/tests/unit: $(TEST_SRC) $(BUILD)/libsfsim.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_exitdoc
+$(BUILD)/tests/unit: $(TEST_SRC) $(BUILD)/libsfsim.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_exitdoc $(BUILD)/gen_reportdoc
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(LDAS) $(TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
 
@@ -156,7 +161,7 @@ $(BUILD)/tests/io: $(IO_TEST_SRC) $(BUILD)/libsfsim.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(LDAS) $(IO_TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(EMBREE) $(INIH) $(LDLIBS)
 
-$(BUILD)/tests/unit-asan: $(TEST_SRC) $(BUILD)/libsfsim-asan.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_exitdoc
+$(BUILD)/tests/unit-asan: $(TEST_SRC) $(BUILD)/libsfsim-asan.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_exitdoc $(BUILD)/gen_reportdoc
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(SAN) $(LDAS) $(TEST_SRC) $(BUILD)/libsfsim-asan.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
 

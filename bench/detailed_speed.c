@@ -23,6 +23,7 @@
 #include "../sim/config.h"
 #include "../sim/functional.h"
 #include "../sim/util.h"
+#include "../sim/stats.h"
 
 typedef struct Result {
     double secs;
@@ -45,7 +46,7 @@ static int render(const PackedScene *p, uint32_t needs, int timed, int threads, 
     }
     r->secs = util_now() - t0;
     r->instructions = st.instructions;
-    r->rays = st.rays_camera + st.rays_indirect + st.rays_shadow;
+    r->rays = stats_rays_total(&st);
     r->cycles = st.timing.cycles;
     func_stats_free(&st);
     return 0;

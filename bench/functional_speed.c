@@ -22,6 +22,7 @@
 #include "../scenes/scene.h"
 #include "../sim/config.h"
 #include "../sim/functional.h"
+#include "../sim/stats.h"
 #include "../sim/reference.h"
 #include "../sim/util.h"
 
@@ -68,7 +69,7 @@ int main(int argc, char **argv)
             return 1;
         }
         double t2 = util_now();
-        uint64_t rays = st.rays_camera + st.rays_indirect + st.rays_shadow;
+        uint64_t rays = stats_rays_total(&st);
         int same = memcmp(ref, fun, n * sizeof(float)) == 0;
         printf("%-34s %12llu %10llu %9.3f %9.3f %10.2f %10.3f %8.1fx%s\n", scenes[i],
                (unsigned long long)st.instructions, (unsigned long long)rays, t1 - t0, t2 - t1,

@@ -27,6 +27,7 @@
 #include "../sim/config.h"
 #include "../sim/functional.h"
 #include "../sim/sampling.h"
+#include "../sim/stats.h"
 #include "bench_scenes.h"
 #include "../sim/util.h"
 
@@ -51,19 +52,11 @@ static int render(const PackedScene *p, uint32_t needs, const CfgMachine *cfg, i
     return rc;
 }
 
-/* Timed utilization of the three ray stages over the timed tiles (as report.json's). */
+/* Timed utilization of the three ray stages over the timed tiles (report.json's, sim/stats.h). */
 static void util_timed(const FuncStats *f, int lanes, double u[3])
 {
-    for (int k = 1; k <= 3; k++) {
-        uint64_t act = 0, st = 0;
-        for (uint32_t i = 0; i < f->ntiles; i++)
-            if (f->tiles[i].sampled)
-                act += f->tiles[i].active_lanes[k];
-        for (int c = 0; c < TM_CAUSE_COUNT; c++)
-            st += f->timing.stage_stalls[k][c];
-        double den = (double)lanes * (double)(f->timing.stage_vec_busy[k] + st);
-        u[k - 1] = den > 0 ? (double)act / den : 0.0;
-    }
+    for (int k = 1; k <= 3; k++)
+        u[k - 1] = stats_utilization_timed(f, lanes, k);
 }
 
 static double max_abs_diff3(const double a[3], const double b[3])
@@ -136,10 +129,7 @@ int main(int argc, char **argv)
         /* functional: fps from instructions (no stalls), utilization per instruction */
         double fps_f = hz / (double)fun.st.instructions, u_f[3];
         for (int k = 1; k <= 3; k++)
-            u_f[k - 1] = fun.st.core.vec_instructions[k]
-                             ? (double)fun.st.core.active_lanes[k] /
-                                   ((double)cfg.core_simd_width * (double)fun.st.core.vec_instructions[k])
-                             : 0.0;
+            u_f[k - 1] = stats_utilization(&fun.st.core, cfg.core_simd_width, k);
         fprintf(md, "| %s | functional | 0 | %.2f | %.1fx | %.3f | %+.1f %% | %.1f pts | - | - | - |\n", names[si],
                 fun.secs, full.secs / fun.secs, fps_f, 100.0 * (fps_f - fps_true) / fps_true,
                 100.0 * max_abs_diff3(u_f, u_true));
@@ -159,20 +149,10 @@ int main(int argc, char **argv)
             Run sr;
             if (render(&p, s.needs, &cfg, 1, rates[ri], n, threads, &sr))
                 return 1;
-            SampleEstimate e;
-            double *ys = malloc(N * sizeof *ys);
-            uint8_t *ss = malloc(N);
-            if (!ys || !ss)
+            SampleEstimate e;   /* the estimate report.json gives (its tiles' instructions are the full run's) */
+            if (stats_sample_estimate(&sr.st, &e) != 0)
                 return 1;
-            for (uint32_t i = 0; i < N; i++) {
-                ys[i] = (double)sr.st.tiles[i].cycles;
-                ss[i] = sr.st.tiles[i].sampled;
-            }
-            if (sample_ratio_estimate(ys, x, ss, N, &e) != 0)
-                return 1;
-            free(ys);
-            free(ss);
-            double fps_s = hz / e.total, u_s[3];
+            double fps_s = stats_frame(&sr.st.timing, sr.st.instructions, cfg.core_clock_mhz, &e).fps, u_s[3];
             util_timed(&sr.st, cfg.core_simd_width, u_s);
             int covered = e.lo <= truth && truth <= e.hi;
             int cov100 = 0;

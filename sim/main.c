@@ -20,6 +20,7 @@
 #include "exithelp.h"
 #include "img.h"
 #include "render.h"
+#include "stats.h"
 #include "sweep/sweep.h"
 #include "timing.h"
 #include "trace.h"
@@ -335,7 +336,7 @@ static void print_state(Core *c)
     for (int s = 0; s < ISA_STAGE_COUNT; s++) {
         if (!st->instructions[s])
             continue;
-        double util = st->vec_instructions[s] ? (double)st->active_lanes[s] / ((double)n * (double)st->vec_instructions[s]) : 0.0;
+        double util = stats_utilization(st, n, s);
         printf("  %-13s %12llu %12llu %5.1f%%", isa_stage_keys[s], (unsigned long long)st->instructions[s],
                (unsigned long long)st->vec_instructions[s], 100.0 * util);
         for (int k = 0; k < ISA_C_COUNT; k++)
@@ -344,32 +345,12 @@ static void print_state(Core *c)
     }
 }
 
-/* The timing of one `exec --timing` run; non-zero when the model failed its own check. */
-static int print_timing(const TimingStats *s, const char *model_err)
+/* The timing of one `exec --timing` run (or a detailed trace) from the statistics registry
+ * (sim/stats.def); non-zero when the model failed its own check. */
+static int print_timing(const TimingStats *s, const CfgMachine *cfg, const char *model_err)
 {
-    uint64_t stalls = s->cycles - s->busy;
-    printf("timing: %llu cycles = %llu busy + %llu stall\n", (unsigned long long)s->cycles,
-           (unsigned long long)s->busy, (unsigned long long)stalls);
-    for (int c = 0; c < TM_CAUSE_COUNT; c++)
-        if (s->stalls[c])
-            printf("  stall %-16s %llu\n", tm_cause_keys[c], (unsigned long long)s->stalls[c]);
-    for (int g = 0; g < ISA_STAGE_COUNT; g++)
-        if (s->stage_cycles[g])
-            printf("  stage %-16s %llu cycles, %llu busy\n", isa_stage_keys[g], (unsigned long long)s->stage_cycles[g],
-                   (unsigned long long)s->stage_busy[g]);
-    printf("  raybuf accesses %llu, lines %llu, with a bank conflict %llu\n", (unsigned long long)s->rb_accesses,
-           (unsigned long long)s->rb_lines, (unsigned long long)s->rb_conflicted);
-    printf("  agu fetches %llu (%llu ahead); interconnect transfers %llu, unit waits %llu cycles\n",
-           (unsigned long long)s->agu_fetches, (unsigned long long)s->agu_ahead, (unsigned long long)s->icn_transfers,
-           (unsigned long long)s->icn_unit_delay);
-    printf("  partitions %llu (%llu IDs, %llu cycles); scratchpad accesses %llu (%llu lines)\n",
-           (unsigned long long)s->partitions, (unsigned long long)s->partition_ids,
-           (unsigned long long)s->partition_cycles, (unsigned long long)s->spad_accesses,
-           (unsigned long long)s->spad_lines);
-    printf("  scene lines %llu: %llu hits, %llu misses, %llu write-backs, %llu bus bytes\n",
-           (unsigned long long)s->scene.accesses, (unsigned long long)s->scene.hits,
-           (unsigned long long)s->scene.misses, (unsigned long long)s->scene.writebacks,
-           (unsigned long long)s->scene.bus_bytes);
+    StatsCtx sx = {.mode = STATS_M_EXEC, .cfg = cfg, .t = s};
+    stats_print_exec(stdout, &sx);
     char err[256];
     if (model_err || timing_check(s, err, sizeof err)) {
         fprintf(stderr, "sfsim exec: %s\n", model_err ? model_err : err);
@@ -478,7 +459,7 @@ static int cmd_exec(int argc, char **argv)
     for (int i = 0; i < ndumps; i++)
         dump_print(c, &dd[i]);
     if (tm) {
-        if (print_timing(timing_stats(tm), timing_error(tm)))
+        if (print_timing(timing_stats(tm), &cfg, timing_error(tm)))
             rc = EXIT_PROGRAM;
         timing_free(tm);
     }
@@ -794,7 +775,7 @@ static int cmd_trace(int argc, char **argv)
     if (sum.sim_instructions)
         printf(", %llu simulated instructions", (unsigned long long)sum.sim_instructions);
     printf("; wrote %s\n", o.out_path);
-    if (sum.timed && print_timing(&sum.timing, NULL))
+    if (sum.timed && print_timing(&sum.timing, &cfg, NULL))
         return EXIT_PROGRAM;
     return EXIT_OK;
 }

@@ -32,6 +32,7 @@
 #include "run/accel.h"
 #include "run/kernel.h"
 #include "sampling.h"
+#include "stats.h"
 #include "timing.h"
 #include "util.h"
 
@@ -131,8 +132,6 @@ static int remove_stale(const char *dir, const char *const *keep, char *err, siz
     return 0;
 }
 
-static double ratio(uint64_t a, uint64_t b) { return b ? (double)a / (double)b : 0.0; }
-
 /* A SAH cost for report.txt: "%.2f", or why there is none (a cost is a ratio of surface areas,
  * undefined when the scene's bounds are not finite). */
 static const char *sah_text(double cost, char *buf, size_t len)
@@ -153,56 +152,29 @@ static void add_sah_json(cJSON *o, double cost)
         cJSON_AddNullToObject(o, "sah_cost");
 }
 
-/* Statistics of either mode, in the report's terms. */
+/* Either renderer's figures. */
 typedef struct RunStats {
-    uint64_t primary, shadow, indirect, dropped;
-    uint64_t per_gen[REF_MAX_GENERATIONS];
-    uint64_t generations;
-    uint64_t nodes_visited, prims_tested;   /* reference only */
+    StatsRun run;                           /* rays, generations; the golden model's traversal */
     int functional;
     FuncStats f;
     AccelKdInfo kd;                          /* accel.structure = kd */
 } RunStats;
 
-/* One kd counter object: each counter's total and per ray of the kind. */
-static void add_kd_counts_json(cJSON *kd, const char *name, const uint64_t *counts, uint64_t rays)
+/* The object name of root, made if the statistics walk did not make it. */
+static cJSON *object_of(cJSON *root, const char *name)
 {
-    cJSON *o = cJSON_AddObjectToObject(kd, name);
-    cJSON_AddNumberToObject(o, "rays", (double)rays);
-    for (int c = 0; c < FUNC_KD_COUNTERS; c++) {
-        char key[64];
-        snprintf(key, sizeof key, "%s_per_ray", func_kd_counter_keys[c]);
-        cJSON_AddNumberToObject(o, func_kd_counter_keys[c], (double)counts[c]);
-        cJSON_AddNumberToObject(o, key, ratio(counts[c], rays));
-    }
+    cJSON *o = cJSON_GetObjectItemCaseSensitive(root, name);
+    return o ? o : cJSON_AddObjectToObject(root, name);
 }
 
-/* The counters of all kinds together, and the rays of each kind (FUNC_KD_* order). */
-static void kd_totals(const FuncStats *f, uint64_t rays[FUNC_KD_KINDS], uint64_t total[FUNC_KD_COUNTERS],
-                      uint64_t *all_rays)
-{
-    rays[FUNC_KD_CAMERA] = f->rays_camera;
-    rays[FUNC_KD_INDIRECT] = f->rays_indirect;
-    rays[FUNC_KD_SHADOW] = f->rays_shadow;
-    *all_rays = 0;
-    for (int c = 0; c < FUNC_KD_COUNTERS; c++)
-        total[c] = 0;
-    for (int k = 0; k < FUNC_KD_KINDS; k++) {
-        *all_rays += rays[k];
-        for (int c = 0; c < FUNC_KD_COUNTERS; c++)
-            total[c] += f->kd_counts[k][c];
-    }
-}
-
-/* accel.structure = kd: the tree and the kernel's kd counters (docs/report.md). */
+/* accel.structure = kd: the tree and the traversal (the kernel's counters: sim/stats.def). */
 static void add_kd_json(cJSON *root, const RunStats *rs, const CfgMachine *cfg)
 {
-    const FuncStats *f = &rs->f;
     const AccelKdInfo *t = &rs->kd;
-    cJSON *kd = cJSON_AddObjectToObject(root, "kd");
+    cJSON *kd = object_of(root, "kd");
     cJSON_AddStringToObject(kd, "structure", cfg_enum_name("accel", "structure", cfg->accel_structure));
     cJSON_AddStringToObject(kd, "traversal", cfg_enum_name("kd", "traversal", cfg->kd_traversal));
-    cJSON_AddNumberToObject(kd, "stack_depth", f->kd_stack_depth);
+    cJSON_AddNumberToObject(kd, "stack_depth", rs->f.kd_stack_depth);
     cJSON *tr = cJSON_AddObjectToObject(kd, "tree");
     cJSON_AddNumberToObject(tr, "nodes", t->nodes);
     cJSON_AddNumberToObject(tr, "leaves", t->leaves);
@@ -210,124 +182,28 @@ static void add_kd_json(cJSON *root, const RunStats *rs, const CfgMachine *cfg)
     cJSON_AddNumberToObject(tr, "depth", t->depth);
     cJSON_AddNumberToObject(tr, "primitives", t->prims);
     cJSON_AddNumberToObject(tr, "references", t->refs);
-    cJSON_AddNumberToObject(tr, "references_per_primitive", ratio(t->refs, t->prims));
+    cJSON_AddNumberToObject(tr, "references_per_primitive", stats_ratio(t->refs, t->prims));
     cJSON_AddNumberToObject(tr, "largest_leaf", t->largest_leaf);
     add_sah_json(tr, t->sah_cost);
     cJSON_AddNumberToObject(tr, "build_seconds", t->build_seconds);
-    uint64_t rays[FUNC_KD_KINDS], total[FUNC_KD_COUNTERS], all;
-    kd_totals(f, rays, total, &all);
-    for (int k = 0; k < FUNC_KD_KINDS; k++)
-        add_kd_counts_json(kd, func_kd_kind_keys[k], f->kd_counts[k], rays[k]);
-    add_kd_counts_json(kd, "total", total, all);
 }
 
-/* accel.structure = kd: report.txt lines for the tree and the counters per ray. */
+/* accel.structure = kd: report.txt's line for the tree (the counters per ray: sim/stats.def). */
 static int kd_text(char *txt, size_t cap, const RunStats *rs, const CfgMachine *cfg)
 {
-    const FuncStats *f = &rs->f;
     const AccelKdInfo *t = &rs->kd;
     char sah[64];
-    int len = snprintf(txt, cap,
-                       "kd-tree      %s traversal, stack depth %u; %u nodes, %u leaves (%u empty), depth %u, "
-                       "%.2f references per primitive, largest leaf %u, SAH cost %s; built in %.2f s\n"
-                       "kd per ray   %-8s",
-                       cfg_enum_name("kd", "traversal", cfg->kd_traversal), f->kd_stack_depth, t->nodes, t->leaves,
-                       t->empty_leaves, t->depth, ratio(t->refs, t->prims), t->largest_leaf, sah_text(t->sah_cost, sah, sizeof sah),
-                       t->build_seconds, "");
-    for (int c = 0; c < FUNC_KD_COUNTERS; c++)
-        len += snprintf(txt + len, cap - (size_t)len, " %10s", func_kd_counter_keys[c]);
-    len += snprintf(txt + len, cap - (size_t)len, "\n");
-    uint64_t rays[FUNC_KD_KINDS], total[FUNC_KD_COUNTERS], all;
-    kd_totals(f, rays, total, &all);
-    for (int k = 0; k <= FUNC_KD_KINDS; k++) {
-        const uint64_t *n = k < FUNC_KD_KINDS ? f->kd_counts[k] : total;
-        uint64_t r = k < FUNC_KD_KINDS ? rays[k] : all;
-        len += snprintf(txt + len, cap - (size_t)len, "             %-8s", k < FUNC_KD_KINDS ? func_kd_kind_keys[k] : "all");
-        for (int c = 0; c < FUNC_KD_COUNTERS; c++)
-            len += snprintf(txt + len, cap - (size_t)len, " %10.3f", ratio(n[c], r));
-        len += snprintf(txt + len, cap - (size_t)len, "\n");
-    }
-    return len;
+    return snprintf(txt, cap,
+                    "kd-tree      %s traversal, stack depth %u; %u nodes, %u leaves (%u empty), depth %u, "
+                    "%.2f references per primitive, largest leaf %u, SAH cost %s; built in %.2f s\n",
+                    cfg_enum_name("kd", "traversal", cfg->kd_traversal), rs->f.kd_stack_depth, t->nodes, t->leaves,
+                    t->empty_leaves, t->depth, stats_ratio(t->refs, t->prims), t->largest_leaf,
+                    sah_text(t->sah_cost, sah, sizeof sah), t->build_seconds);
 }
 
-static void add_functional_json(cJSON *root, const RunStats *rs, const CfgMachine *cfg)
+/* Kernel modes: the kernel that ran (its statistics: sim/stats.def). */
+static void add_kernel_json(cJSON *root, const FuncStats *f, const CfgMachine *cfg)
 {
-    const FuncStats *f = &rs->f;
-    cJSON *ops = cJSON_AddObjectToObject(root, "ops");
-    for (int c = 0; c < ISA_C_COUNT; c++) {
-        uint64_t n = 0;
-        for (int k = 0; k < ISA_STAGE_COUNT; k++)
-            n += f->core.ops[k][c];
-        cJSON_AddNumberToObject(ops, isa_category_keys[c], (double)n);
-    }
-    cJSON *opst = cJSON_AddObjectToObject(root, "ops_by_stage");
-    for (int k = 0; k < ISA_STAGE_COUNT; k++) {
-        cJSON *o = cJSON_AddObjectToObject(opst, isa_stage_keys[k]);
-        for (int c = 0; c < ISA_C_COUNT; c++)
-            cJSON_AddNumberToObject(o, isa_category_keys[c], (double)f->core.ops[k][c]);
-    }
-    cJSON *ut = cJSON_AddObjectToObject(root, "utilization");
-    int n = cfg->core_simd_width;
-    for (int k = 0; k < ISA_STAGE_COUNT; k++)
-        cJSON_AddNumberToObject(ut, isa_stage_keys[k],
-                                ratio(f->core.active_lanes[k], (uint64_t)n * f->core.vec_instructions[k]));
-    /* Primary rays are generation 0 (camera rays only); the rest are secondary (Tables 2, 3). */
-    cJSON *ug = cJSON_AddArrayToObject(root, "utilization_by_generation");
-    uint64_t sec_act[ISA_STAGE_COUNT] = {0}, sec_vec[ISA_STAGE_COUNT] = {0};
-    for (uint64_t g = 0; g < f->generations && g < CORE_GENERATIONS; g++) {
-        cJSON *o = cJSON_CreateObject();
-        for (int k = 0; k < ISA_STAGE_COUNT; k++) {
-            cJSON_AddNumberToObject(o, isa_stage_keys[k],
-                                    ratio(f->core.gen_active_lanes[g][k], (uint64_t)n * f->core.gen_vec_instructions[g][k]));
-            if (g > 0) {
-                sec_act[k] += f->core.gen_active_lanes[g][k];
-                sec_vec[k] += f->core.gen_vec_instructions[g][k];
-            }
-        }
-        cJSON_AddItemToArray(ug, o);
-    }
-    cJSON *up = cJSON_AddObjectToObject(root, "utilization_primary");
-    cJSON *us = cJSON_AddObjectToObject(root, "utilization_secondary");
-    for (int k = 0; k < ISA_STAGE_COUNT; k++) {
-        cJSON_AddNumberToObject(up, isa_stage_keys[k],
-                                ratio(f->core.gen_active_lanes[0][k], (uint64_t)n * f->core.gen_vec_instructions[0][k]));
-        cJSON_AddNumberToObject(us, isa_stage_keys[k], ratio(sec_act[k], (uint64_t)n * sec_vec[k]));
-    }
-    cJSON *sl = cJSON_AddObjectToObject(root, "stream_length");
-    cJSON_AddNumberToObject(sl, "traversal", ratio(f->trav_rays, f->trav_streams));
-    cJSON_AddNumberToObject(sl, "intersection", ratio(f->isect_rays, f->isect_streams));
-    cJSON_AddNumberToObject(sl, "shading", ratio(f->shade_rays, f->shade_streams));
-    static const char *const stage3[FUNC_STAGES] = {"traversal", "intersection", "shading"};
-    uint64_t ss[FUNC_STAGES] = {0}, sr[FUNC_STAGES] = {0};
-    cJSON *slg = cJSON_AddArrayToObject(root, "stream_length_by_generation");
-    for (uint64_t g = 0; g < f->generations && g < FUNC_MAX_GENERATIONS; g++) {
-        cJSON *o = cJSON_CreateObject();
-        for (int k = 0; k < FUNC_STAGES; k++) {
-            cJSON_AddNumberToObject(o, stage3[k], ratio(f->gen_rays[g][k], f->gen_streams[g][k]));
-            if (g > 0) {
-                ss[k] += f->gen_streams[g][k];
-                sr[k] += f->gen_rays[g][k];
-            }
-        }
-        cJSON_AddItemToArray(slg, o);
-    }
-    cJSON *sls = cJSON_AddObjectToObject(root, "stream_length_secondary");
-    for (int k = 0; k < FUNC_STAGES; k++)
-        cJSON_AddNumberToObject(sls, stage3[k], ratio(sr[k], ss[k]));
-    cJSON *sc = cJSON_AddObjectToObject(root, "streams");
-    cJSON_AddNumberToObject(sc, "traversal", (double)f->trav_streams);
-    cJSON_AddNumberToObject(sc, "intersection", (double)f->isect_streams);
-    cJSON_AddNumberToObject(sc, "shading", (double)f->shade_streams);
-    cJSON *ins = cJSON_AddObjectToObject(root, "instructions");
-    for (int k = 0; k < ISA_STAGE_COUNT; k++)
-        cJSON_AddNumberToObject(ins, isa_stage_keys[k], (double)f->core.instructions[k]);
-    cJSON *vi = cJSON_AddObjectToObject(root, "vector_instructions");
-    for (int k = 0; k < ISA_STAGE_COUNT; k++)
-        cJSON_AddNumberToObject(vi, isa_stage_keys[k], (double)f->core.vec_instructions[k]);
-    cJSON *byop = cJSON_AddObjectToObject(root, "by_opcode");
-    for (int o = 0; o < ISA_OP_COUNT; o++)
-        if (f->core.by_op[o])
-            cJSON_AddNumberToObject(byop, isa_ops[o].mnemonic, (double)f->core.by_op[o]);
     cJSON *k = cJSON_AddObjectToObject(root, "kernel");
     cJSON_AddStringToObject(k, "stream_mode", cfg_enum_name("stream", "mode", cfg->stream_mode));
     cJSON_AddStringToObject(k, "workload", cfg_enum_name("workload", "kind", cfg->workload_kind));
@@ -337,228 +213,201 @@ static void add_functional_json(cJSON *root, const RunStats *rs, const CfgMachin
     cJSON_AddNumberToObject(k, "tile_height", f->tile_h);
     cJSON_AddStringToObject(k, "defines", f->defines);
     cJSON_AddNumberToObject(k, "instructions", f->kernel_instructions);
-    cJSON *tiles = cJSON_AddArrayToObject(root, "tiles");
-    for (uint32_t t = 0; t < f->ntiles; t++) {
-        cJSON *o = cJSON_CreateObject();
-        cJSON_AddNumberToObject(o, "x", f->tiles[t].x0);
-        cJSON_AddNumberToObject(o, "y", f->tiles[t].y0);
-        cJSON_AddNumberToObject(o, "width", f->tiles[t].w);
-        cJSON_AddNumberToObject(o, "height", f->tiles[t].h);
-        cJSON_AddNumberToObject(o, "instructions", (double)f->tiles[t].instructions);
-        cJSON_AddNumberToObject(o, "rays", (double)f->tiles[t].rays);
-        cJSON_AddItemToArray(tiles, o);
-    }
 }
 
-/* Active lanes of a stage over the timed tiles (all tiles in detailed mode, the sample in sampled
- * mode), so that timed utilization compares like with like. */
-static uint64_t timed_lanes(const FuncStats *f, int stage)
+/* Sampled mode: how the sample was drawn and estimated (its figures: sim/stats.def). */
+static void add_sample_json(cJSON *root, double fraction, uint32_t seed)
 {
-    uint64_t s = 0;
-    for (uint32_t i = 0; i < f->ntiles; i++)
-        if (f->tiles[i].sampled)
-            s += f->tiles[i].active_lanes[stage];
-    return s;
+    cJSON *sm = object_of(root, "sample");
+    cJSON_AddNumberToObject(sm, "fraction", fraction);
+    cJSON_AddNumberToObject(sm, "seed", seed);
+    cJSON_AddStringToObject(sm, "estimator", "ratio of cycles to instructions (docs/sampling.md)");
+    cJSON_AddNumberToObject(sm, "confidence", 0.95);
 }
 
-/* The frame's timing figures: measured (detailed mode), or estimated from the sampled tiles
- * (sampled mode: est != NULL). Busy cycles are one per instruction, known for every tile. */
-typedef struct FrameTiming {
-    double cycles, busy, fps, fps_no_stall;
-    double cycles_lo, cycles_hi, fps_lo, fps_hi;   /* sampled mode: the 95 % intervals */
-} FrameTiming;
+/* What the report files say about a run (render_run fills it once the image is made). */
+typedef struct Report {
+    const RenderOptions *o;
+    const CfgMachine *cfg;
+    const Scene *s;
+    const PackedScene *p;
+    const RunStats *rs;
+    const SampleEstimate *est;     /* sampled mode */
+    int detailed, sampled, functional, tile, threads;
+    double load_seconds, pack_seconds, secs;   /* host: load, BVH + pack, rendering */
+    double mean;                   /* of the image's finite values */
+    long nonfinite;
+} Report;
 
-static FrameTiming frame_timing(const FuncStats *f, const CfgMachine *cfg, const SampleEstimate *est)
+/* The statistics walk's view of the run (sim/stats.h). */
+static StatsCtx stats_ctx(const Report *r)
 {
-    FrameTiming ft;
-    double hz = cfg->core_clock_mhz * 1e6;
-    ft.cycles = est ? est->total : (double)f->timing.cycles;
-    ft.busy = est ? (double)f->instructions : (double)f->timing.busy;
-    ft.cycles_lo = est ? est->lo : ft.cycles;
-    ft.cycles_hi = est ? est->hi : ft.cycles;
-    ft.fps = ft.cycles > 0 ? hz / ft.cycles : 0.0;
-    ft.fps_no_stall = ft.busy > 0 ? hz / ft.busy : 0.0;
-    ft.fps_lo = ft.cycles_hi > 0 ? hz / ft.cycles_hi : 0.0;
-    ft.fps_hi = ft.cycles_lo > 0 ? hz / ft.cycles_lo : 0.0;
-    return ft;
+    StatsCtx c = {.mode = (r->detailed ? STATS_M_DET : r->sampled ? STATS_M_SAMP : r->functional ? STATS_M_FUNC
+                                                                                                   : STATS_M_REF) |
+                          (r->functional && r->rs->f.kd ? STATS_M_KD : 0),
+                  .cfg = r->cfg, .run = &r->rs->run, .f = r->functional ? &r->rs->f : NULL,
+                  .t = r->detailed || r->sampled ? &r->rs->f.timing : NULL, .est = r->est};
+    return c;
 }
 
-/* Detailed and sampled modes: the timing fields of report.json (names: ARCHITECTURE.md Sec. 1;
- * docs/report.md). In sampled mode the frame figures are estimates and the breakdowns (stages,
- * generations, units) are those of the sampled tiles; stall cycles are the sample's shares of the
- * estimated cycles. */
-static void add_timing_json(cJSON *root, const FuncStats *f, const CfgMachine *cfg, const SampleEstimate *est,
-                            double fraction, uint32_t seed)
+static uint64_t report_rays(const Report *r) { return r->rs->run.primary + r->rs->run.shadow + r->rs->run.indirect; }
+
+/* report.json (docs/report.md); NULL when out of memory. */
+static cJSON *report_json(const Report *r)
 {
-    const TimingStats *t = &f->timing;
-    FrameTiming ft = frame_timing(f, cfg, est);
-    cJSON_ReplaceItemInObject(root, "cycles", cJSON_CreateNumber(round(ft.cycles)));
-    cJSON_ReplaceItemInObject(root, "busy_cycles", cJSON_CreateNumber(ft.busy));
-    cJSON_ReplaceItemInObject(root, "fps", cJSON_CreateNumber(ft.fps));
-    cJSON_ReplaceItemInObject(root, "fps_no_stall", cJSON_CreateNumber(ft.fps_no_stall));
-    cJSON_AddNumberToObject(root, "clock_mhz", cfg->core_clock_mhz);
-    if (est) {
-        cJSON *cc = cJSON_AddArrayToObject(root, "cycles_ci95");
-        cJSON_AddItemToArray(cc, cJSON_CreateNumber(round(ft.cycles_lo)));
-        cJSON_AddItemToArray(cc, cJSON_CreateNumber(round(ft.cycles_hi)));
-        cJSON *fc = cJSON_AddArrayToObject(root, "fps_ci95");
-        cJSON_AddItemToArray(fc, cJSON_CreateNumber(ft.fps_lo));
-        cJSON_AddItemToArray(fc, cJSON_CreateNumber(ft.fps_hi));
-        cJSON *sm = cJSON_AddObjectToObject(root, "sample");
-        cJSON_AddNumberToObject(sm, "fraction", fraction);
-        cJSON_AddNumberToObject(sm, "seed", seed);
-        cJSON_AddNumberToObject(sm, "tiles", est->N);
-        cJSON_AddNumberToObject(sm, "tiles_sampled", est->n);
-        cJSON_AddStringToObject(sm, "estimator", "ratio of cycles to instructions (docs/sampling.md)");
-        cJSON_AddNumberToObject(sm, "confidence", 0.95);
-        cJSON_AddNumberToObject(sm, "t", est->t);
-        cJSON_AddNumberToObject(sm, "std_error_cycles", est->std_error);
-        cJSON_AddNumberToObject(sm, "cycles_per_instruction", est->ratio);
-        cJSON_AddNumberToObject(sm, "sampled_cycles", (double)t->cycles);
+    const RenderOptions *o = r->o;
+    const CfgMachine *cfg = r->cfg;
+    const Scene *sp = r->s;
+    const PackedScene *pp = r->p;
+    const RunStats *rsp = r->rs;
+    int functional = r->functional, sampled = r->sampled, threads = r->threads;
+    double secs = r->secs;
+    uint64_t total_rays = report_rays(r);
+    /* report.json: the names of ARCHITECTURE.md Sec. 1. The statistics come from the registry
+     * (sim/stats.def; the timing fields are null unless timed); the blocks below describe the run. */
+    StatsCtx sx = stats_ctx(r);
+    cJSON *root = cJSON_CreateObject();
+    if (!root || !cJSON_AddStringToObject(root, "mode", o->mode) || stats_json(root, &sx) != 0) {
+        cJSON_Delete(root);
+        return NULL;
     }
-    cJSON *st = cJSON_AddObjectToObject(root, "stalls");
-    cJSON *sh = cJSON_AddObjectToObject(root, "stall_shares");
-    for (int c = 0; c < TM_CAUSE_COUNT; c++) {
-        double share = ratio(t->stalls[c], t->cycles);
-        cJSON_AddNumberToObject(st, tm_cause_keys[c], est ? round(share * ft.cycles) : (double)t->stalls[c]);
-        cJSON_AddNumberToObject(sh, tm_cause_keys[c], share);
+    if (functional)
+        add_kernel_json(root, &rsp->f, cfg);
+    if (sampled)
+        add_sample_json(root, o->sample, o->sample_seed);
+    if (functional && rsp->f.kd)
+        add_kd_json(root, rsp, cfg);
+    cJSON *sc = cJSON_AddObjectToObject(root, "scene");
+    cJSON_AddStringToObject(sc, "file", o->scene_path);
+    cJSON_AddNumberToObject(sc, "triangles", sp->ntris);
+    cJSON_AddNumberToObject(sc, "spheres", sp->nspheres);
+    cJSON_AddNumberToObject(sc, "lights", pp->nlights);
+    char needs[256];
+    scene_needs_string(sp->needs, needs, sizeof needs);
+    cJSON *nd = cJSON_AddArrayToObject(sc, "needs");
+    char needs_tok[256];
+    memcpy(needs_tok, needs, sizeof needs_tok);
+    for (char *save = NULL, *tok = strtok_r(needs_tok, ",", &save); tok; tok = strtok_r(NULL, ",", &save))
+        cJSON_AddItemToArray(nd, cJSON_CreateString(tok));
+    cJSON *bvh = cJSON_AddObjectToObject(sc, "bvh");
+    cJSON_AddNumberToObject(bvh, "nodes", pp->bvh.nnodes);
+    cJSON_AddNumberToObject(bvh, "leaves", pp->bvh.nleaves);
+    cJSON_AddNumberToObject(bvh, "depth", pp->bvh.depth);
+    add_sah_json(bvh, pp->bvh.sah_cost);
+    cJSON_AddNumberToObject(bvh, "leaf_size", r->cfg->bvh_leaf_size);
+    cJSON_AddNumberToObject(bvh, "bins", r->cfg->bvh_bins);
+    cJSON_AddNumberToObject(sc, "scene_memory_bytes", pp->size);
+    cJSON_AddNumberToObject(sc, "skipped_primitives", sp->skipped_primitives);
+    cJSON *warn = cJSON_AddArrayToObject(sc, "warnings");
+    for (uint32_t i = 0; i < sp->nwarnings; i++)
+        cJSON_AddItemToArray(warn, cJSON_CreateString(sp->warnings[i]));
+    /* The machine: every key of sim/config.def as used, in every mode (docs/report.md). */
+    cJSON_AddStringToObject(root, "config_file", o->config_path ? o->config_path : "built-in");
+    cfg_json(cfg, cJSON_AddObjectToObject(root, "config"));
+    cJSON *ren = cJSON_AddObjectToObject(root, "render");
+    cJSON_AddNumberToObject(ren, "width", sp->render.width);
+    cJSON_AddNumberToObject(ren, "height", sp->render.height);
+    cJSON_AddNumberToObject(ren, "spp", sp->render.spp);
+    cJSON_AddNumberToObject(ren, "max_depth", sp->render.max_depth);
+    cJSON_AddNumberToObject(ren, "seed", o->seed);
+    cJSON_AddNumberToObject(ren, "stream_rays", o->stream_rays);
+    int tile_w = functional ? (int)rsp->f.tile_w : r->tile, tile_h = functional ? (int)rsp->f.tile_h : r->tile;
+    cJSON_AddNumberToObject(ren, "tile", tile_w);
+    cJSON_AddNumberToObject(ren, "tile_height", tile_h);
+    cJSON *im = cJSON_AddObjectToObject(root, "image");
+    cJSON_AddNumberToObject(im, "mean", r->mean);
+    cJSON_AddNumberToObject(im, "nonfinite", (double)r->nonfinite);
+    cJSON *host = cJSON_AddObjectToObject(root, "host");
+    cJSON_AddNumberToObject(host, "seconds", secs);
+    cJSON_AddNumberToObject(host, "load_seconds", r->load_seconds);
+    cJSON_AddNumberToObject(host, "bvh_pack_seconds", r->pack_seconds);
+    cJSON_AddNumberToObject(host, "threads", threads);
+    cJSON_AddNumberToObject(host, "rays_per_second", secs > 0 ? (double)total_rays / secs : 0.0);
+    if (functional) {
+        cJSON_AddNumberToObject(host, "sim_instructions", (double)rsp->f.instructions);
+        cJSON_AddNumberToObject(host, "instructions_per_second", secs > 0 ? (double)rsp->f.instructions / secs : 0.0);
     }
-    cJSON *cs = cJSON_AddObjectToObject(root, "cycles_by_stage");
-    cJSON *ss = cJSON_AddObjectToObject(root, "stalls_by_stage");
-    cJSON *ut = cJSON_AddObjectToObject(root, "utilization_timed");
-    int n = cfg->core_simd_width;
-    for (int k = 0; k < ISA_STAGE_COUNT; k++) {
-        cJSON *o = cJSON_AddObjectToObject(cs, isa_stage_keys[k]);
-        cJSON_AddNumberToObject(o, "cycles", (double)t->stage_cycles[k]);
-        cJSON_AddNumberToObject(o, "busy", (double)t->stage_busy[k]);
-        cJSON *so = cJSON_AddObjectToObject(ss, isa_stage_keys[k]);
-        uint64_t stalls = 0;
-        for (int c = 0; c < TM_CAUSE_COUNT; c++) {
-            cJSON_AddNumberToObject(so, tm_cause_keys[c], (double)t->stage_stalls[k][c]);
-            stalls += t->stage_stalls[k][c];
-        }
-        /* Lanes doing work over the lane-cycles of the stage's vector issue and stall cycles:
-         * the paper's utilization with the overheads of address fetch, alignment, partition. */
-        cJSON_AddNumberToObject(ut, isa_stage_keys[k],
-                                ratio(timed_lanes(f, k), (uint64_t)n * (t->stage_vec_busy[k] + stalls)));
-    }
-    cJSON *cg = cJSON_AddArrayToObject(root, "cycles_by_generation");
-    cJSON *tg = cJSON_AddArrayToObject(root, "timing_by_generation");
-    for (uint64_t g = 0; g < f->generations && g < CORE_GENERATIONS; g++) {
-        cJSON_AddItemToArray(cg, cJSON_CreateNumber((double)t->gen_cycles[g]));
-        cJSON *o = cJSON_CreateObject();
-        cJSON_AddNumberToObject(o, "cycles", (double)t->gen_cycles[g]);
-        cJSON_AddNumberToObject(o, "busy_cycles", (double)t->gen_busy[g]);
-        cJSON *gs = cJSON_AddObjectToObject(o, "stalls");
-        for (int c = 0; c < TM_CAUSE_COUNT; c++)
-            cJSON_AddNumberToObject(gs, tm_cause_keys[c], (double)t->gen_stalls[g][c]);
-        cJSON_AddItemToArray(tg, o);
-    }
-    cJSON *u = cJSON_AddObjectToObject(root, "units");
-    cJSON *rb = cJSON_AddObjectToObject(u, "ray_buffers");
-    cJSON_AddNumberToObject(rb, "accesses", (double)t->rb_accesses);
-    cJSON_AddNumberToObject(rb, "lines", (double)t->rb_lines);
-    cJSON_AddNumberToObject(rb, "accesses_with_bank_conflict", (double)t->rb_conflicted);
-    cJSON_AddNumberToObject(rb, "bank_conflict_cycles", (double)t->stalls[TM_BANK_CONFLICT]);
-    cJSON *ag = cJSON_AddObjectToObject(u, "agu");
-    cJSON_AddNumberToObject(ag, "id_vectors", (double)t->agu_fetches);
-    cJSON_AddNumberToObject(ag, "fetched_ahead", (double)t->agu_ahead);
-    cJSON *ic = cJSON_AddObjectToObject(u, "interconnect");
-    cJSON_AddNumberToObject(ic, "data_path_transfers", (double)t->icn_transfers);
-    cJSON_AddNumberToObject(ic, "contention_stall_cycles", (double)t->stalls[TM_INTERCONNECT]);
-    cJSON_AddNumberToObject(ic, "unit_wait_cycles", (double)t->icn_unit_delay);
-    cJSON *pa = cJSON_AddObjectToObject(u, "partition");
-    cJSON_AddNumberToObject(pa, "partitions", (double)t->partitions);
-    cJSON_AddNumberToObject(pa, "ids", (double)t->partition_ids);
-    cJSON_AddNumberToObject(pa, "busy_cycles", (double)t->partition_cycles);
-    cJSON *sp = cJSON_AddObjectToObject(u, "scratchpad");
-    cJSON_AddNumberToObject(sp, "accesses", (double)t->spad_accesses);
-    cJSON_AddNumberToObject(sp, "lines", (double)t->spad_lines);
-    cJSON *sm = cJSON_AddObjectToObject(u, "scene_memory");
-    cJSON_AddBoolToObject(sm, "cache", cfg->scene_cache_kb > 0);
-    cJSON_AddNumberToObject(sm, "instructions", (double)t->scene_instr);
-    cJSON_AddNumberToObject(sm, "line_accesses", (double)t->scene.accesses);
-    cJSON_AddNumberToObject(sm, "hits", (double)t->scene.hits);
-    cJSON_AddNumberToObject(sm, "misses", (double)t->scene.misses);
-    cJSON_AddNumberToObject(sm, "hit_rate", ratio(t->scene.hits, t->scene.accesses));
-    cJSON_AddNumberToObject(sm, "writebacks", (double)t->scene.writebacks);
-    cJSON_AddNumberToObject(sm, "bus_bytes", (double)t->scene.bus_bytes);
-    /* What the kernel exercised: a unit no instruction used was never stepped (docs/model.md). */
-    cJSON *mod = cJSON_AddArrayToObject(root, "units_exercised");
-    cJSON *nmod = cJSON_AddArrayToObject(root, "units_not_exercised");
-    for (int k = 0; k < ISA_U_COUNT; k++)
-        cJSON_AddItemToArray(t->unit_uses[k] ? mod : nmod, cJSON_CreateString(isa_unit_names[k]));
-    cJSON *tiles = cJSON_GetObjectItem(root, "tiles");
-    for (uint32_t i = 0; tiles && i < f->ntiles; i++) {
-        cJSON *o = cJSON_GetArrayItem(tiles, (int)i);
-        cJSON_AddNumberToObject(o, "cycles", (double)f->tiles[i].cycles);
-        cJSON_AddNumberToObject(o, "busy_cycles", (double)f->tiles[i].busy);
-        cJSON *tsl = cJSON_AddObjectToObject(o, "stalls");
-        for (int c = 0; c < TM_CAUSE_COUNT; c++)
-            cJSON_AddNumberToObject(tsl, tm_cause_keys[c], (double)f->tiles[i].stalls[c]);
-    }
+    return root;
 }
 
-/* Detailed and sampled modes: report.txt lines for the timing. */
-static int timing_text(char *txt, size_t cap, const FuncStats *f, const CfgMachine *cfg, const SampleEstimate *est)
+/* report.txt (docs/report.md) into txt. */
+static void report_txt(const Report *r, char *txt, size_t cap)
 {
-    const TimingStats *t = &f->timing;
-    FrameTiming ft = frame_timing(f, cfg, est);
-    int len;
-    if (est)
-        len = snprintf(txt, cap,
-                       "cycles       ~%.0f (95%%: %.0f .. %.0f) = %.0f busy + ~%.0f stalled; estimated from %u of %u tiles\n"
-                       "fps          ~%.2f (95%%: %.2f .. %.2f) at %g MHz (%.2f fps with no stalls)\n"
-                       "sample       the shares and unit lines below are those of the %u sampled tiles (docs/sampling.md)\n"
-                       "stalls      ",
-                       ft.cycles, ft.cycles_lo, ft.cycles_hi, ft.busy, ft.cycles - ft.busy, est->n, est->N, ft.fps,
-                       ft.fps_lo, ft.fps_hi, cfg->core_clock_mhz, ft.fps_no_stall, est->n);
+    const RenderOptions *o = r->o;
+    const CfgMachine *cfg = r->cfg;
+    const Scene *sp = r->s;
+    const PackedScene *pp = r->p;
+    const RunStats *rsp = r->rs;
+    int detailed = r->detailed, sampled = r->sampled, functional = r->functional, threads = r->threads;
+    double secs = r->secs;
+    uint64_t total_rays = report_rays(r);
+    StatsCtx sx = stats_ctx(r);
+    char needs[256];
+    scene_needs_string(sp->needs, needs, sizeof needs);
+    int tile_w = functional ? (int)rsp->f.tile_w : r->tile, tile_h = functional ? (int)rsp->f.tile_h : r->tile;
+    /* The tiles the image was cut into: a partial tile is said, since the tile size alone would
+     * suggest more pixels than there are. */
+    char tiles_txt[160], sah[64];
+    int tiles_x = (sp->render.width + tile_w - 1) / tile_w, tiles_y = (sp->render.height + tile_h - 1) / tile_h;
+    if (tiles_x * tiles_y == 1 && (sp->render.width < tile_w || sp->render.height < tile_h))
+        snprintf(tiles_txt, sizeof tiles_txt, "one partial tile (tiles are %d x %d pixels)", tile_w, tile_h);
     else
-        len = snprintf(txt, cap,
-                       "cycles       %llu = %llu busy + %llu stalled; %.2f fps at %g MHz (%.2f fps with no stalls)\n"
-                       "stalls      ",
-                       (unsigned long long)t->cycles, (unsigned long long)t->busy,
-                       (unsigned long long)(t->cycles - t->busy), ft.fps, cfg->core_clock_mhz, ft.fps_no_stall);
-    for (int c = 0; c < TM_CAUSE_COUNT; c++)
-        len += snprintf(txt + len, cap - (size_t)len, " %s %.1f%%%s", tm_cause_keys[c],
-                        100.0 * ratio(t->stalls[c], t->cycles), c + 1 < TM_CAUSE_COUNT ? "," : "  (of all cycles)\n");
-    len += snprintf(txt + len, cap - (size_t)len, "cycles by   ");
-    for (int k = 0; k < ISA_STAGE_COUNT; k++)
-        len += snprintf(txt + len, cap - (size_t)len, " %s %.1f%%%s", isa_stage_keys[k],
-                        100.0 * ratio(t->stage_cycles[k], t->cycles), k + 1 < ISA_STAGE_COUNT ? "," : " (stage)\n");
-    len += snprintf(txt + len, cap - (size_t)len, "utilization ");
-    for (int k = 0; k < ISA_STAGE_COUNT; k++) {
-        uint64_t stalls = 0;
-        for (int c = 0; c < TM_CAUSE_COUNT; c++)
-            stalls += t->stage_stalls[k][c];
-        len += snprintf(txt + len, cap - (size_t)len, " %s %.1f%%%s", isa_stage_keys[k],
-                        100.0 * ratio(timed_lanes(f, k),
-                                      (uint64_t)cfg->core_simd_width * (t->stage_vec_busy[k] + stalls)),
-                        k + 1 < ISA_STAGE_COUNT ? "," : "  (timed: stall cycles count as idle lanes)\n");
+        snprintf(tiles_txt, sizeof tiles_txt, "%d tile%s of %d x %d pixels%s", tiles_x * tiles_y,
+                 tiles_x * tiles_y == 1 ? "" : "s", tile_w, tile_h,
+                 sp->render.width % tile_w && sp->render.height % tile_h ? ", the last column and row partial"
+                 : sp->render.width % tile_w                           ? ", the last column partial"
+                 : sp->render.height % tile_h                          ? ", the last row partial"
+                                                                     : "");
+    const char *thr = threads == 1 ? "thread" : "threads";
+    int len = snprintf(txt, cap,
+             "sfsim report -- mode %s (%s)\n"
+             "scene        %s\n"
+             "             %u triangles, %u spheres, %u lights; needs: %s\n"
+             "             BVH %u nodes, %u leaves, depth %u, SAH cost %s; %u bytes of scene memory\n"
+             "config       %s\n"
+             "image        %d x %d, %d spp, max depth %d, seed %u, %s\n"
+             "             mean %.5f, non-finite values %ld\n",
+             o->mode,
+             detailed     ? "the kernel on the timing model of the machine"
+             : sampled    ? "the kernel; sampled tiles on the timing model, the frame's cycles estimated"
+             : functional ? "the kernel on the functional core: no timing"
+                          : "golden model: no timing",
+             o->scene_path, sp->ntris, sp->nspheres, pp->nlights, needs[0] ? needs : "-", pp->bvh.nnodes,
+             pp->bvh.nleaves, pp->bvh.depth, sah_text(pp->bvh.sah_cost, sah, sizeof sah), pp->size,
+             o->config_path ? o->config_path : "built-in (the defaults of sim/config.def)", sp->render.width,
+             sp->render.height, sp->render.spp, sp->render.max_depth, o->seed, tiles_txt, r->mean,
+             r->nonfinite);
+    if (sp->skipped_primitives)
+        len += snprintf(txt + len, cap - (size_t)len, "skipped      %u glTF primitives that are not triangles\n",
+                        sp->skipped_primitives);
+    for (uint32_t i = 0; i < sp->nwarnings && len < (int)cap; i++)
+        len += snprintf(txt + len, cap - (size_t)len, "warning      %s\n", sp->warnings[i]);
+    if (len >= (int)cap) /* (truncated: the writes below stay inside txt) */
+        len = (int)cap - 1;
+    if (functional) {
+        const FuncStats *f = &rsp->f;
+        len += snprintf(txt + len, cap - (size_t)len,
+                        "machine      N = %d lanes, %s of %u x %u rays, workload %s; kernel %u instructions (%s)\n",
+                        cfg->core_simd_width, cfg->stream_mode == CFG_STREAM_MODE_PACKET ? "packets" : "streams",
+                        f->tile_w, f->tile_h, cfg_enum_name("workload", "kind", cfg->workload_kind),
+                        f->kernel_instructions, f->defines);
+        if (f->kd)
+            len += kd_text(txt + len, cap - (size_t)len, rsp, cfg);
     }
-    len += snprintf(txt + len, cap - (size_t)len,
-                    "ray buffers  %llu gathers/scatters over %llu lines; %llu with a bank conflict (%llu cycles)\n"
-                    "AGUs         %llu ID vectors, %llu of them fetched ahead of the data path\n"
-                    "interconnect %llu data-path transfers; contention: %llu stall cycles, units waited %llu cycles\n"
-                    "partition    %llu partitions of %llu IDs, %llu unit cycles\n"
-                    "scene memory %llu line accesses, hit rate %.1f%% (%s), %llu bytes over the bus\n",
-                    (unsigned long long)t->rb_accesses, (unsigned long long)t->rb_lines,
-                    (unsigned long long)t->rb_conflicted, (unsigned long long)t->stalls[TM_BANK_CONFLICT],
-                    (unsigned long long)t->agu_fetches, (unsigned long long)t->agu_ahead,
-                    (unsigned long long)t->icn_transfers, (unsigned long long)t->stalls[TM_INTERCONNECT],
-                    (unsigned long long)t->icn_unit_delay, (unsigned long long)t->partitions,
-                    (unsigned long long)t->partition_ids, (unsigned long long)t->partition_cycles,
-                    (unsigned long long)t->scene.accesses, 100.0 * ratio(t->scene.hits, t->scene.accesses),
-                    cfg->scene_cache_kb > 0 ? "cached" : "no cache", (unsigned long long)t->scene.bus_bytes);
-    len += snprintf(txt + len, cap - (size_t)len, "not used    ");
-    int any = 0;
-    for (int k = 0; k < ISA_U_COUNT; k++)
-        if (!t->unit_uses[k]) {
-            len += snprintf(txt + len, cap - (size_t)len, " %s", isa_unit_names[k]);
-            any = 1;
-        }
-    len += snprintf(txt + len, cap - (size_t)len, "%s\n", any ? " (no instruction of the kernel used them)" : " -");
-    return len;
+    if (len >= (int)cap)
+        len = (int)cap - 1;
+    size_t tlen = (size_t)len;   /* the statistics: sim/stats.def */
+    stats_text(txt, cap, &tlen, &sx);
+    len = (int)tlen;
+    if (functional)
+        len += snprintf(txt + len, cap - (size_t)len,
+                        "host         %.2f s on %d %s: %.2f M instructions/s, %.3f M rays/s; load %.2f s, BVH+pack %.2f s\n",
+                        secs, threads, thr, secs > 0 ? 1e-6 * (double)rsp->f.instructions / secs : 0.0,
+                        secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, r->load_seconds, r->pack_seconds);
+    else
+        len += snprintf(txt + len, cap - (size_t)len,
+                        "host         %.2f s rendering on %d %s (%.3f M rays/s); load %.2f s, BVH+pack %.2f s\n", secs,
+                        threads, thr, secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, r->load_seconds, r->pack_seconds);
 }
 
 /* Detailed and sampled modes: cost.png, simulated cycles per pixel of each tile (sampled mode:
@@ -581,7 +430,7 @@ static int write_cost_map(OutSet *set, const char *dir, const FuncStats *f, cons
     }
     for (uint32_t i = 0; i < f->ntiles; i++) {
         const FuncTile *t = &f->tiles[i];
-        double cyc = t->sampled || !est ? (double)t->cycles : est->ratio * (double)t->instructions;
+        double cyc = stats_tile_cycles(f, est, i);
         double per = t->w && t->h ? cyc / ((double)t->w * t->h) : 0.0;
         for (uint32_t y = t->y0; y < t->y0 + t->h && y < (uint32_t)height; y += (uint32_t)scale_y)
             for (uint32_t x = t->x0; x < t->x0 + t->w && x < (uint32_t)width; x += (uint32_t)scale_x)
@@ -728,35 +577,14 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         rs.functional = 1;
         if (sampled) {
             /* The frame's cycles from the sampled tiles (sim/sampling.h). */
-            uint32_t nt = rs.f.ntiles;
-            double *y = calloc(nt ? nt : 1, sizeof *y), *x = calloc(nt ? nt : 1, sizeof *x);
-            uint8_t *sel = calloc(nt ? nt : 1, 1);
-            int erc = -1;
-            if (y && x && sel) {
-                for (uint32_t i = 0; i < nt; i++) {
-                    y[i] = (double)rs.f.tiles[i].cycles;
-                    x[i] = (double)rs.f.tiles[i].instructions;
-                    sel[i] = rs.f.tiles[i].sampled;
-                }
-                erc = sample_ratio_estimate(y, x, sel, nt, &est_store);
-            }
-            free(y);
-            free(x);
-            free(sel);
-            if (erc != 0) {
+            if (stats_sample_estimate(&rs.f, &est_store) != 0) {
                 snprintf(err, errlen, "sampled mode: cannot estimate from %u sampled of %u tiles (the frame needs at "
-                         "least 2 tiles; render more pixels or use --mode detailed)", rs.f.tiles_timed, nt);
+                         "least 2 tiles; render more pixels or use --mode detailed)", rs.f.tiles_timed, rs.f.ntiles);
                 goto out;
             }
             est = &est_store;
         }
-        rs.primary = rs.f.rays_camera;
-        rs.shadow = rs.f.rays_shadow;
-        rs.indirect = rs.f.rays_indirect;
-        rs.dropped = rs.f.dropped;
-        rs.generations = rs.f.generations;
-        for (int g = 0; g < REF_MAX_GENERATIONS && g < FUNC_MAX_GENERATIONS; g++)
-            rs.per_gen[g] = rs.f.rays_per_generation[g];
+        stats_run_from_func(&rs.run, &rs.f);
     } else {
         /* The golden model renders the path tracer and the Phong workload; the forced specular and
          * diffuse workloads exist only as kernel variants (docs/kernel.md). */
@@ -771,14 +599,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         RefStats st;
         if (ref_render(&p, &rp, rgb, &st, err, errlen) != 0)
             goto out;
-        rs.primary = st.rays[REF_RAY_CAMERA];
-        rs.shadow = st.rays[REF_RAY_SHADOW];
-        rs.indirect = st.rays[REF_RAY_INDIRECT];
-        rs.dropped = st.dropped;
-        rs.generations = st.generations;
-        memcpy(rs.per_gen, st.rays_per_generation, sizeof rs.per_gen);
-        rs.nodes_visited = st.nodes_visited;
-        rs.prims_tested = st.prims_tested;
+        stats_run_from_ref(&rs.run, &st);
     }
     double t_render = util_now();
 
@@ -808,85 +629,14 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         else
             sum += rgb[i];
     }
-    uint64_t total_rays = rs.primary + rs.shadow + rs.indirect;
-    double secs = t_render - t_kd;
-
-    /* report.json: the names of ARCHITECTURE.md Sec. 1; the timing fields stay null unless detailed. */
-    root = cJSON_CreateObject();
-    cJSON_AddStringToObject(root, "mode", o->mode);
-    cJSON_AddNullToObject(root, "cycles");
-    cJSON_AddNullToObject(root, "busy_cycles");
-    cJSON_AddNullToObject(root, "fps");
-    cJSON_AddNullToObject(root, "fps_no_stall");
-    cJSON *rays = cJSON_AddObjectToObject(root, "rays");
-    cJSON_AddNumberToObject(rays, "primary", (double)rs.primary);
-    cJSON_AddNumberToObject(rays, "shadow", (double)rs.shadow);
-    cJSON_AddNumberToObject(rays, "indirect", (double)rs.indirect);
-    cJSON_AddNumberToObject(rays, "total", (double)total_rays);
-    cJSON_AddNumberToObject(rays, "dropped", (double)rs.dropped);
-    cJSON *gens = cJSON_AddArrayToObject(root, "rays_per_generation");
-    for (uint64_t g = 0; g < rs.generations && g < REF_MAX_GENERATIONS; g++)
-        cJSON_AddItemToArray(gens, cJSON_CreateNumber((double)rs.per_gen[g]));
-    if (functional) {
-        add_functional_json(root, &rs, cfg);
-        if (detailed || sampled)
-            add_timing_json(root, &rs.f, cfg, est, o->sample, o->sample_seed);
-        if (rs.f.kd)
-            add_kd_json(root, &rs, cfg);
-    } else {
-        cJSON *trav = cJSON_AddObjectToObject(root, "traversal");
-        cJSON_AddNumberToObject(trav, "nodes_visited", (double)rs.nodes_visited);
-        cJSON_AddNumberToObject(trav, "primitives_tested", (double)rs.prims_tested);
-    }
-    cJSON *sc = cJSON_AddObjectToObject(root, "scene");
-    cJSON_AddStringToObject(sc, "file", o->scene_path);
-    cJSON_AddNumberToObject(sc, "triangles", s.ntris);
-    cJSON_AddNumberToObject(sc, "spheres", s.nspheres);
-    cJSON_AddNumberToObject(sc, "lights", p.nlights);
-    char needs[256];
-    scene_needs_string(s.needs, needs, sizeof needs);
-    cJSON *nd = cJSON_AddArrayToObject(sc, "needs");
-    char needs_tok[256];
-    memcpy(needs_tok, needs, sizeof needs_tok);
-    for (char *save = NULL, *tok = strtok_r(needs_tok, ",", &save); tok; tok = strtok_r(NULL, ",", &save))
-        cJSON_AddItemToArray(nd, cJSON_CreateString(tok));
-    cJSON *bvh = cJSON_AddObjectToObject(sc, "bvh");
-    cJSON_AddNumberToObject(bvh, "nodes", p.bvh.nnodes);
-    cJSON_AddNumberToObject(bvh, "leaves", p.bvh.nleaves);
-    cJSON_AddNumberToObject(bvh, "depth", p.bvh.depth);
-    add_sah_json(bvh, p.bvh.sah_cost);
-    cJSON_AddNumberToObject(bvh, "leaf_size", cfg->bvh_leaf_size);
-    cJSON_AddNumberToObject(bvh, "bins", cfg->bvh_bins);
-    cJSON_AddNumberToObject(sc, "scene_memory_bytes", p.size);
-    cJSON_AddNumberToObject(sc, "skipped_primitives", s.skipped_primitives);
-    cJSON *warn = cJSON_AddArrayToObject(sc, "warnings");
-    for (uint32_t i = 0; i < s.nwarnings; i++)
-        cJSON_AddItemToArray(warn, cJSON_CreateString(s.warnings[i]));
-    /* The machine: every key of sim/config.def as used, in every mode (docs/report.md). */
-    cJSON_AddStringToObject(root, "config_file", o->config_path ? o->config_path : "built-in");
-    cfg_json(cfg, cJSON_AddObjectToObject(root, "config"));
-    cJSON *ren = cJSON_AddObjectToObject(root, "render");
-    cJSON_AddNumberToObject(ren, "width", s.render.width);
-    cJSON_AddNumberToObject(ren, "height", s.render.height);
-    cJSON_AddNumberToObject(ren, "spp", s.render.spp);
-    cJSON_AddNumberToObject(ren, "max_depth", s.render.max_depth);
-    cJSON_AddNumberToObject(ren, "seed", o->seed);
-    cJSON_AddNumberToObject(ren, "stream_rays", o->stream_rays);
-    int tile_w = functional ? (int)rs.f.tile_w : tile, tile_h = functional ? (int)rs.f.tile_h : tile;
-    cJSON_AddNumberToObject(ren, "tile", tile_w);
-    cJSON_AddNumberToObject(ren, "tile_height", tile_h);
-    cJSON *im = cJSON_AddObjectToObject(root, "image");
-    cJSON_AddNumberToObject(im, "mean", npx ? sum / (3.0 * (double)npx) : 0.0);
-    cJSON_AddNumberToObject(im, "nonfinite", (double)nonfinite);
-    cJSON *host = cJSON_AddObjectToObject(root, "host");
-    cJSON_AddNumberToObject(host, "seconds", secs);
-    cJSON_AddNumberToObject(host, "load_seconds", t_load - t0);
-    cJSON_AddNumberToObject(host, "bvh_pack_seconds", accel.pack_seconds);
-    cJSON_AddNumberToObject(host, "threads", threads);
-    cJSON_AddNumberToObject(host, "rays_per_second", secs > 0 ? (double)total_rays / secs : 0.0);
-    if (functional) {
-        cJSON_AddNumberToObject(host, "sim_instructions", (double)rs.f.instructions);
-        cJSON_AddNumberToObject(host, "instructions_per_second", secs > 0 ? (double)rs.f.instructions / secs : 0.0);
+    Report rep = {.o = o, .cfg = cfg, .s = &s, .p = &p, .rs = &rs, .est = est, .detailed = detailed,
+                  .sampled = sampled, .functional = functional, .tile = tile, .threads = threads,
+                  .load_seconds = t_load - t0, .pack_seconds = accel.pack_seconds, .secs = t_render - t_kd,
+                  .mean = npx ? sum / (3.0 * (double)npx) : 0.0, .nonfinite = nonfinite};
+    root = report_json(&rep);
+    if (!root) {
+        snprintf(err, errlen, "%s/report.json: out of memory", o->out_dir);
+        goto out;
     }
     json_text = cJSON_Print(root);
     snprintf(path, sizeof path, "%s/report.json", o->out_dir);
@@ -897,96 +647,8 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     if (outfile_write_file(set, path, json_text, strlen(json_text), err, errlen) != 0)
         goto out;
 
-    /* The tiles the image was cut into: a partial tile is said, since the tile size alone would
-     * suggest more pixels than there are. */
-    char tiles_txt[160], sah[64];
-    int tiles_x = (s.render.width + tile_w - 1) / tile_w, tiles_y = (s.render.height + tile_h - 1) / tile_h;
-    if (tiles_x * tiles_y == 1 && (s.render.width < tile_w || s.render.height < tile_h))
-        snprintf(tiles_txt, sizeof tiles_txt, "one partial tile (tiles are %d x %d pixels)", tile_w, tile_h);
-    else
-        snprintf(tiles_txt, sizeof tiles_txt, "%d tile%s of %d x %d pixels%s", tiles_x * tiles_y,
-                 tiles_x * tiles_y == 1 ? "" : "s", tile_w, tile_h,
-                 s.render.width % tile_w && s.render.height % tile_h ? ", the last column and row partial"
-                 : s.render.width % tile_w                           ? ", the last column partial"
-                 : s.render.height % tile_h                          ? ", the last row partial"
-                                                                     : "");
-    const char *thr = threads == 1 ? "thread" : "threads";
     char txt[16384];
-    int len = snprintf(txt, sizeof txt,
-             "sfsim report -- mode %s (%s)\n"
-             "scene        %s\n"
-             "             %u triangles, %u spheres, %u lights; needs: %s\n"
-             "             BVH %u nodes, %u leaves, depth %u, SAH cost %s; %u bytes of scene memory\n"
-             "config       %s\n"
-             "image        %d x %d, %d spp, max depth %d, seed %u, %s\n"
-             "             mean %.5f, non-finite values %ld\n"
-             "rays         %llu total: %llu primary, %llu shadow, %llu indirect; %llu dropped\n",
-             o->mode,
-             detailed     ? "the kernel on the timing model of the machine"
-             : sampled    ? "the kernel; sampled tiles on the timing model, the frame's cycles estimated"
-             : functional ? "the kernel on the functional core: no timing"
-                          : "golden model: no timing",
-             o->scene_path, s.ntris, s.nspheres, p.nlights, needs[0] ? needs : "-", p.bvh.nnodes,
-             p.bvh.nleaves, p.bvh.depth, sah_text(p.bvh.sah_cost, sah, sizeof sah), p.size,
-             o->config_path ? o->config_path : "built-in (the defaults of sim/config.def)", s.render.width,
-             s.render.height, s.render.spp, s.render.max_depth, o->seed, tiles_txt, sum / (3.0 * (double)npx),
-             nonfinite, (unsigned long long)total_rays, (unsigned long long)rs.primary,
-             (unsigned long long)rs.shadow, (unsigned long long)rs.indirect, (unsigned long long)rs.dropped);
-    if (s.skipped_primitives)
-        len += snprintf(txt + len, sizeof txt - (size_t)len, "skipped      %u glTF primitives that are not triangles\n",
-                        s.skipped_primitives);
-    for (uint32_t i = 0; i < s.nwarnings && len < (int)sizeof txt; i++)
-        len += snprintf(txt + len, sizeof txt - (size_t)len, "warning      %s\n", s.warnings[i]);
-    if (len >= (int)sizeof txt) /* (truncated: the writes below stay inside txt) */
-        len = (int)sizeof txt - 1;
-    if (functional) {
-        const FuncStats *f = &rs.f;
-        uint64_t opsum[ISA_C_COUNT] = {0}, all = 0;
-        for (int c = 0; c < ISA_C_COUNT; c++) {
-            for (int k = 0; k < ISA_STAGE_COUNT; k++)
-                opsum[c] += f->core.ops[k][c];
-            all += opsum[c];
-        }
-        len += snprintf(txt + len, sizeof txt - (size_t)len,
-                        "machine      N = %d lanes, %s of %u x %u rays, workload %s; kernel %u instructions (%s)\n"
-                        "instructions %llu executed\n"
-                        "ops          ",
-                        cfg->core_simd_width, cfg->stream_mode == CFG_STREAM_MODE_PACKET ? "packets" : "streams",
-                        f->tile_w, f->tile_h, cfg_enum_name("workload", "kind", cfg->workload_kind),
-                        f->kernel_instructions, f->defines,
-                        (unsigned long long)f->instructions);
-        for (int c = 0; c < ISA_C_COUNT; c++)
-            len += snprintf(txt + len, sizeof txt - (size_t)len, "%s %.1f%%%s", isa_category_keys[c],
-                            100.0 * ratio(opsum[c], all), c + 1 < ISA_C_COUNT ? ", " : "\n");
-        len += snprintf(txt + len, sizeof txt - (size_t)len, "utilization  ");
-        for (int k = 0; k < ISA_STAGE_COUNT; k++)
-            len += snprintf(txt + len, sizeof txt - (size_t)len, "%s %.1f%%%s", isa_stage_keys[k],
-                            100.0 * ratio(f->core.active_lanes[k],
-                                          (uint64_t)cfg->core_simd_width * f->core.vec_instructions[k]),
-                            k + 1 < ISA_STAGE_COUNT ? ", " : "  (active lanes / (N x vector instructions))\n");
-        if (detailed || sampled)
-            len += timing_text(txt + len, sizeof txt - (size_t)len, f, cfg, est);
-        if (f->kd)
-            len += kd_text(txt + len, sizeof txt - (size_t)len, &rs, cfg);
-        char trav_len[32] = "-", isect_len[32] = "-"; /* per-lane kd-tree traversals filter no streams */
-        if (f->trav_streams)
-            snprintf(trav_len, sizeof trav_len, "%.1f", ratio(f->trav_rays, f->trav_streams));
-        if (f->isect_streams)
-            snprintf(isect_len, sizeof isect_len, "%.1f", ratio(f->isect_rays, f->isect_streams));
-        len += snprintf(txt + len, sizeof txt - (size_t)len,
-                        "streams      mean length: traversal %s, intersection %s, shading %.1f rays%s\n"
-                        "host         %.2f s on %d %s: %.2f M instructions/s, %.3f M rays/s; load %.2f s, BVH+pack %.2f s\n",
-                        trav_len, isect_len, ratio(f->shade_rays, f->shade_streams),
-                        f->trav_streams ? "" : " (traversal one ray per lane: no stream filters)", secs, threads, thr,
-                        secs > 0 ? 1e-6 * (double)f->instructions / secs : 0.0,
-                        secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, t_load - t0, accel.pack_seconds);
-    } else {
-        len += snprintf(txt + len, sizeof txt - (size_t)len,
-                        "traversal    %llu nodes visited, %llu primitive tests\n"
-                        "host         %.2f s rendering on %d %s (%.3f M rays/s); load %.2f s, BVH+pack %.2f s\n",
-                        (unsigned long long)rs.nodes_visited, (unsigned long long)rs.prims_tested, secs, threads, thr,
-                        secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, t_load - t0, accel.pack_seconds);
-    }
+    report_txt(&rep, txt, sizeof txt);
     snprintf(path, sizeof path, "%s/report.txt", o->out_dir);
     if (outfile_write_file(set, path, txt, strlen(txt), err, errlen) != 0)
         goto out;

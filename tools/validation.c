@@ -23,6 +23,7 @@
 #include "../sim/ref_kd.h"
 #include "../sim/run/accel.h"
 #include "../sim/ref_trace.h"
+#include "../sim/stats.h"
 #include "../sim/timing.h"
 #include "../sim/util.h"
 
@@ -98,25 +99,15 @@ static void run(Loaded *l, int lanes, int rays, int packet, int workload, int bo
     free(rgb);
 }
 
-/* Utilization (percent) of a stage over generations [g0, g1). */
+/* Utilization (percent) of a stage over generations [g0, g1) (sim/stats.h). */
 static double util(const Run *r, int stage, int g0, int g1)
 {
-    uint64_t act = 0, vec = 0;
-    for (int g = g0; g < g1 && g < CORE_GENERATIONS; g++) {
-        act += r->st.core.gen_active_lanes[g][stage];
-        vec += r->st.core.gen_vec_instructions[g][stage];
-    }
-    return vec ? 100.0 * (double)act / ((double)r->lanes * (double)vec) : 0.0;
+    return 100.0 * stats_utilization_gens(&r->st.core, r->lanes, stage, g0, g1);
 }
 
 static double stream_len(const Run *r, int stage3, int g0)
 {
-    uint64_t s = 0, n = 0;
-    for (int g = g0; g < FUNC_MAX_GENERATIONS; g++) {
-        s += r->st.gen_streams[g][stage3];
-        n += r->st.gen_rays[g][stage3];
-    }
-    return s ? (double)n / (double)s : 0.0;
+    return stats_stream_length(&r->st, stage3, g0, FUNC_MAX_GENERATIONS);
 }
 
 /* ---- seed 001 Table 2 (primary rays, T / I) and seed 000 Tables 1-2 ------------------------- */
@@ -311,7 +302,7 @@ static const char *t5_paper[3] = {"24.1 / 14.9 / 35.4 / 19.6 / 5.0", "23.2 / 19.
 static const char *paper_name[3] = {"rtrt", "kala", "conf"}; /* beside cornell, sponza, conference */
 static const int paper_col[3] = {0, 2, 1};                   /* column in the paper's tables */
 
-static double pct(uint64_t a, uint64_t b) { return b ? 100.0 * (double)a / (double)b : 0.0; }
+static double pct(uint64_t a, uint64_t b) { return 100.0 * stats_ratio(a, b); }
 
 static void timing_tables(void)
 {
@@ -361,7 +352,7 @@ static void timing_tables(void)
             for (int wi = 0; wi < 6; wi++) {
                 Run *r = &runs[wi];
                 const TimingStats *t = &r->st.timing;
-                uint64_t nrays = r->st.rays_camera + r->st.rays_indirect + r->st.rays_shadow;
+                uint64_t nrays = stats_rays_total(&r->st);
                 char prel[16] = "", prk[16] = "", pst[16] = "";
                 if (paper_fps[wi] > 0) {
                     snprintf(prel, sizeof prel, "%.2f", paper_fps[wi] / paper_fps[3]);
@@ -370,17 +361,16 @@ static void timing_tables(void)
                 }
                 uint64_t ops[ISA_C_COUNT] = {0}, all = 0;
                 for (int c = 0; c < ISA_C_COUNT; c++) {
-                    for (int k = 0; k < ISA_STAGE_COUNT; k++)
-                        ops[c] += r->st.core.ops[k][c];
+                    ops[c] = stats_ops(&r->st.core, c);
                     all += ops[c];
                 }
                 printf("| %s | %d | %llu | %.1f | %.2f | %s | %.1f | %s | %.0f | %s |", mi ? "64x64" : "32x32",
-                       widths[wi], (unsigned long long)t->cycles, t->cycles ? 500e6 / (double)t->cycles : 0.0,
+                       widths[wi], (unsigned long long)t->cycles, stats_frame(t, r->st.instructions, 500, NULL).fps,
                        t->cycles ? (double)c16 / (double)t->cycles : 0.0, prel,
                        t->cycles ? 1000.0 * (double)nrays / (double)t->cycles : 0.0, prk,
                        pct(t->cycles - t->busy, t->cycles), pst);
                 for (int c = 0; c < TM_CAUSE_COUNT; c++)
-                    printf(" %.1f |", pct(t->stalls[c], t->cycles));
+                    printf(" %.1f |", 100.0 * stats_stall_share(t, c));
                 printf(" %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %s |\n", pct(ops[ISA_C_LOAD], all),
                        pct(ops[ISA_C_STORE], all), pct(ops[ISA_C_COMPUTE], all), pct(ops[ISA_C_SCATGATH], all),
                        pct(ops[ISA_C_PARTITION], all), pct(ops[ISA_C_INTEGER], all), pct(ops[ISA_C_CONTROL], all),
@@ -530,39 +520,31 @@ static void kd_kernel_scene(const char *name, const char *path, int w, int h, in
         const TimingStats *t = &st.timing;
         if (i == 0)
             bvh_cycles = t->cycles;
-        double tu = t->stage_cycles[ISA_STAGE_TRAVERSAL]
-                        ? 100.0 * (double)st.core.active_lanes[ISA_STAGE_TRAVERSAL] /
-                              ((double)c.core_simd_width * (double)t->stage_cycles[ISA_STAGE_TRAVERSAL])
-                        : 0.0;
+        double tu = 100.0 * stats_utilization_cycles(&st, c.core_simd_width, ISA_STAGE_TRAVERSAL);
         const char *same = i == 0 ? "-" : memcmp(ref, rgb, n * sizeof(float)) == 0 ? "same" : "DIFFERS";
         double rel = bvh_cycles ? (double)t->cycles / (double)bvh_cycles : 0.0;
-        uint64_t all[FUNC_KD_COUNTERS] = {0};
-        for (int k = 0; k < FUNC_KD_KINDS; k++)
-            for (int q = 0; q < FUNC_KD_COUNTERS; q++)
-                all[q] += st.kd_counts[k][q];
-        double rays = (double)(st.rays_camera + st.rays_indirect + st.rays_shadow);
+        double fps = stats_frame(t, st.instructions, 500, NULL).fps;
         if (workload == CFG_WORKLOAD_PHONG) {
-            printf("| %s | %llu | %.2f | %.2f | %s | %.1f |", row->label, (unsigned long long)t->cycles,
-                   t->cycles ? 500e6 / (double)t->cycles : 0.0, rel, same, tu);
+            printf("| %s | %llu | %.2f | %.2f | %s | %.1f |", row->label, (unsigned long long)t->cycles, fps, rel,
+                   same, tu);
             char bounce[32] = "-";
             if (st.rays_indirect)
-                snprintf(bounce, sizeof bounce, "%.1f",
-                         (double)st.kd_counts[FUNC_KD_INDIRECT][FUNC_KD_NODES] / (double)st.rays_indirect);
+                snprintf(bounce, sizeof bounce, "%.1f", stats_kd_per_ray(&st, FUNC_KD_INDIRECT, FUNC_KD_NODES));
             if (st.kd)
-                printf(" %.1f | %.1f | %s | %.3f |\n",
-                       (double)st.kd_counts[FUNC_KD_CAMERA][FUNC_KD_NODES] / (double)st.rays_camera,
-                       (double)st.kd_counts[FUNC_KD_SHADOW][FUNC_KD_NODES] / (double)st.rays_shadow, bounce,
-                       (double)all[FUNC_KD_RESTARTS] / rays);
+                printf(" %.1f | %.1f | %s | %.3f |\n", stats_kd_per_ray(&st, FUNC_KD_CAMERA, FUNC_KD_NODES),
+                       stats_kd_per_ray(&st, FUNC_KD_SHADOW, FUNC_KD_NODES), bounce,
+                       stats_kd_per_ray(&st, FUNC_KD_KINDS, FUNC_KD_RESTARTS));
             else
                 printf(" | | | |\n");
         } else {
             printf("| %s | %llu | %llu | %.2f | %.2f | %s | %.1f |", row->label, (unsigned long long)st.instructions,
-                   (unsigned long long)t->cycles, t->cycles ? 500e6 / (double)t->cycles : 0.0, rel, same, tu);
+                   (unsigned long long)t->cycles, fps, rel, same, tu);
             if (st.kd)
-                printf(" %.1f | %.1f | %.1f | %.3f | %.3f |\n",
-                       (double)st.kd_counts[FUNC_KD_CAMERA][FUNC_KD_NODES] / (double)st.rays_camera,
-                       (double)all[FUNC_KD_NODES] / rays, (double)all[FUNC_KD_PRIMS] / rays,
-                       (double)all[FUNC_KD_RESTARTS] / rays, (double)all[FUNC_KD_OVERFLOWS] / rays);
+                printf(" %.1f | %.1f | %.1f | %.3f | %.3f |\n", stats_kd_per_ray(&st, FUNC_KD_CAMERA, FUNC_KD_NODES),
+                       stats_kd_per_ray(&st, FUNC_KD_KINDS, FUNC_KD_NODES),
+                       stats_kd_per_ray(&st, FUNC_KD_KINDS, FUNC_KD_PRIMS),
+                       stats_kd_per_ray(&st, FUNC_KD_KINDS, FUNC_KD_RESTARTS),
+                       stats_kd_per_ray(&st, FUNC_KD_KINDS, FUNC_KD_OVERFLOWS));
             else
                 printf(" | | | | |\n");
         }

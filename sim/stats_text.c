@@ -1,0 +1,206 @@
+/* sim/stats_text.c -- the statistics registry's text: report.txt's statistics lines and the
+ * `sfsim exec --timing` print-out, from the walk over sim/stats.def.
+ *
+ * Owns: the layout (a line per row group, a table for 2-D rows, the headline sentences) and the
+ * number format of each unit. Must not: compute a figure (sim/stats.c does) or name a counter.
+ */
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "stats.h"
+#include "stats_walk.h"
+
+typedef struct TextW {
+    const StatsCtx *c;
+    FILE *fp;              /* the exec print-out; else buf */
+    char *buf;
+    size_t cap, *len;
+    int open, items;       /* a line is open; values on it */
+} TextW;
+
+static void out(TextW *w, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void out(TextW *w, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    if (w->fp) {
+        vfprintf(w->fp, fmt, ap);
+    } else if (*w->len < w->cap) {
+        int n = vsnprintf(w->buf + *w->len, w->cap - *w->len, fmt, ap);
+        *w->len = n < 0 ? *w->len : *w->len + (size_t)n < w->cap ? *w->len + (size_t)n : w->cap - 1;
+    }
+    va_end(ap);
+}
+
+/* A value in its unit's format; "-" where it has no meaning. */
+static const char *fmt_value(const StatsRow *r, double v, int na, char *buf, size_t len)
+{
+    if (na)
+        return "-";
+    switch (r->unit) {
+    case STATS_U_RATIO: snprintf(buf, len, "%.1f%%", 100.0 * v); break;
+    case STATS_U_PER_RAY: case STATS_U_CPI: snprintf(buf, len, "%.3f", v); break;
+    case STATS_U_RAYS_PER_STREAM: snprintf(buf, len, "%.1f", v); break;
+    case STATS_U_FPS: snprintf(buf, len, "%.2f", v); break;
+    case STATS_U_MHZ: case STATS_U_NUMBER: snprintf(buf, len, "%g", v); break;
+    case STATS_U_FLAG: snprintf(buf, len, "%s", v != 0 ? "yes" : "no"); break;
+    default: snprintf(buf, len, "%.0f", v); break;
+    }
+    return buf;
+}
+
+static const char *elem_text(TextW *w, const StatsRow *r, const int *idx, char *buf, size_t len)
+{
+    int na;
+    double v = stats_row_value(w->c, r, idx, &na);
+    return fmt_value(r, v, na, buf, len);
+}
+
+static void line_end(TextW *w)
+{
+    if (w->open)
+        out(w, "\n");
+    w->open = w->items = 0;
+}
+
+static void line_start(TextW *w, const char *head)
+{
+    line_end(w);
+    out(w, "%-12s", head);
+    w->open = 1;
+}
+
+static void line_item(TextW *w, const char *name, const char *value)
+{
+    out(w, "%s %s %s", w->items++ ? "," : "", name, value);
+}
+
+/* The headline: report.txt's first timing lines, the exec print-out's first line. */
+static void headline(TextW *w, const StatsRow *r)
+{
+    const StatsCtx *c = w->c;
+    const TimingStats *t = c->t;
+    line_end(w);
+    if (c->mode & STATS_M_EXEC) {
+        out(w, "timing: %llu cycles = %llu busy + %llu stall\n", (unsigned long long)t->cycles,
+            (unsigned long long)t->busy, (unsigned long long)(t->cycles - t->busy));
+        return;
+    }
+    StatsFrame s = stats_frame_of(c);
+    double mhz = c->cfg->core_clock_mhz;
+    if (c->est)
+        out(w, "%-12s ~%.0f (95%%: %.0f .. %.0f) = %.0f busy + ~%.0f stalled; estimated from %u of %u tiles\n"
+            "fps          ~%.2f (95%%: %.2f .. %.2f) at %g MHz (%.2f fps with no stalls)\n"
+            "sample       the shares and unit lines below are those of the %u sampled tiles (docs/sampling.md)\n",
+            r->label, s.cycles, s.cycles_lo, s.cycles_hi, s.busy, s.cycles - s.busy, c->est->n, c->est->N, s.fps,
+            s.fps_lo, s.fps_hi, mhz, s.fps_no_stall, c->est->n);
+    else
+        out(w, "%-12s %llu = %llu busy + %llu stalled; %.2f fps at %g MHz (%.2f fps with no stalls)\n", r->label,
+            (unsigned long long)t->cycles, (unsigned long long)t->busy, (unsigned long long)(t->cycles - t->busy),
+            s.fps, mhz, s.fps_no_stall);
+}
+
+/* A 2-D row as a table (kd counters per ray: a line per ray kind), or one more line of it. */
+static void text_table(TextW *w, const StatsRow *r)
+{
+    char v[64];
+    int idx[STATS_MAX_DIMS] = {0};
+    StatsDim col = r->dims[r->ndims - 1];
+    line_end(w);
+    if (r->text == STATS_T_TABLE) {
+        out(w, "%-12s %-8s", r->label, "");
+        for (int j = 0; j < stats_dim_len(w->c, col); j++)
+            out(w, " %10s", stats_dim_key(col, j));
+        out(w, "\n");
+    }
+    int rows = r->text == STATS_T_TABLE ? stats_dim_len(w->c, r->dims[0]) : 1;
+    for (int i = 0; i < rows; i++) {
+        out(w, "%13s%-8s", "", r->text == STATS_T_TABLE ? stats_dim_key(r->dims[0], i) : r->label);
+        for (int j = 0; j < stats_dim_len(w->c, col); j++) {
+            idx[0] = r->text == STATS_T_TABLE ? i : j;
+            idx[1] = j;
+            out(w, " %10s", elem_text(w, r, idx, v, sizeof v));
+        }
+        out(w, "\n");
+    }
+}
+
+static void text_row(void *wp, const StatsRow *r)
+{
+    TextW *w = wp;
+    char name[96], v[64];
+    if (!stats_row_present(r, w->c->mode) || r->text == STATS_T_NONE)
+        return;
+    if (r->text == STATS_T_HEAD) {
+        headline(w, r);
+        return;
+    }
+    if (r->text == STATS_T_TABLE || r->text == STATS_T_TROW) {
+        text_table(w, r);
+        return;
+    }
+    stats_leaf_name(r, name, sizeof name);
+    int idx[STATS_MAX_DIMS] = {0}, na;
+    if (r->text == STATS_T_LINE || !w->open) {
+        char head[160];
+        int named = r->ndims && name[0] && !(r->flags & (STATS_F_LIST_NZ | STATS_F_LIST_Z));
+        snprintf(head, sizeof head, "%s%s%s", r->label, named ? " " : "", named ? name : "");
+        line_start(w, head);
+    }
+    if (r->flags & (STATS_F_LIST_NZ | STATS_F_LIST_Z)) {
+        int any = 0;
+        for (int ok = stats_idx_first(w->c, r, idx); ok; ok = stats_idx_next(w->c, r, idx))
+            if ((stats_row_value(w->c, r, idx, &na) != 0) == !!(r->flags & STATS_F_LIST_NZ)) {
+                out(w, " %s", stats_dim_key(r->dims[0], idx[0]));
+                any = 1;
+            }
+        if (!any)
+            out(w, " -");
+    } else if (r->ndims == 0) {
+        line_item(w, r->path ? name : r->label, elem_text(w, r, idx, v, sizeof v));
+    } else {
+        for (int ok = stats_idx_first(w->c, r, idx); ok; ok = stats_idx_next(w->c, r, idx))
+            if (!(r->flags & STATS_F_SPARSE) || stats_row_value(w->c, r, idx, &na) != 0)
+                line_item(w, stats_dim_key(r->dims[0], idx[0]), elem_text(w, r, idx, v, sizeof v));
+    }
+}
+
+void stats_text(char *buf, size_t cap, size_t *len, const StatsCtx *c)
+{
+    TextW w = {.c = c, .buf = buf, .cap = cap, .len = len};
+    stats_walk(c, text_row, &w);
+    line_end(&w);
+}
+
+/* The exec print-out: a line per value, "  label [keys] [name]  value"; elements that are 0 left out. */
+static void exec_row(void *wp, const StatsRow *r)
+{
+    TextW *w = wp;
+    if (!stats_row_present(r, w->c->mode))
+        return;
+    if (r->text == STATS_T_HEAD) {
+        headline(w, r);
+        return;
+    }
+    char name[96], v[64], left[256];
+    stats_leaf_name(r, name, sizeof name);
+    int idx[STATS_MAX_DIMS] = {0}, na;
+    for (int ok = stats_idx_first(w->c, r, idx); ok; ok = stats_idx_next(w->c, r, idx)) {
+        double x = stats_row_value(w->c, r, idx, &na);
+        if (r->ndims && x == 0)
+            continue;
+        int n = snprintf(left, sizeof left, "%s", r->label);
+        for (int k = 0; k < r->ndims; k++)
+            n += snprintf(left + n, sizeof left - (size_t)n, " %s", stats_dim_key(r->dims[k], idx[k]));
+        if (name[0])
+            snprintf(left + n, sizeof left - (size_t)n, " %s", name);
+        out(w, "  %-40s %12s\n", left, fmt_value(r, x, na, v, sizeof v));
+    }
+}
+
+void stats_print_exec(FILE *fp, const StatsCtx *c)
+{
+    TextW w = {.c = c, .fp = fp};
+    stats_walk(c, exec_row, &w);
+}
