@@ -37,7 +37,8 @@ endif
 # Two Criterion binaries: tests/io (image files, Embree, scene files: they link OpenImageIO,
 # Embree and tinygltf, whose ~270 shared libraries make every forked test process start slowly)
 # and tests/unit (everything else, linked --as-needed so it starts fast). unit runs last.
-TEST_SRC := $(wildcard tests/unit/*.c) tests/support/numerics.c tests/support/shared.c tests/support/files.c
+TEST_SRC := $(wildcard tests/unit/*.c) tests/support/numerics.c tests/support/shared.c tests/support/files.c \
+            tests/support/isa_expect.c tests/support/core_prog.c
 IO_TEST_SRC := $(wildcard tests/io/*.c) tests/support/xcheck.c tests/support/shared.c tests/support/files.c
 LDAS    := -Wl,--as-needed
 
