@@ -37,7 +37,8 @@ endif
 # Two Criterion binaries: tests/io (image files, Embree, scene files: they link OpenImageIO,
 # Embree and tinygltf, whose ~270 shared libraries make every forked test process start slowly)
 # and tests/unit (everything else, linked --as-needed so it starts fast). unit runs last.
-TEST_SRC := $(wildcard tests/unit/*.c) tests/support/numerics.c tests/support/shared.c tests/support/files.c
+TEST_SRC := $(wildcard tests/unit/*.c) tests/support/numerics.c tests/support/shared.c tests/support/files.c \
+            tests/support/isa_expect.c tests/support/core_prog.c tests/support/scene_fixture.c
 IO_TEST_SRC := $(wildcard tests/io/*.c) tests/support/xcheck.c tests/support/shared.c tests/support/files.c
 LDAS    := -Wl,--as-needed
 
@@ -209,14 +210,16 @@ $(BUILD)/fuzz/fuzz_asm: tests/fuzz/fuzz_asm.c $(ISA_SRC) $(ASM_SRC)
 	@mkdir -p $(dir $@)
 	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ -lm
 
-# The scene-loader fuzzer compiles tinygltf and stb_image into the shim so the sanitizers see
-# inside them (the project's normal build links Debian's libtinygltf).
-$(BUILD)/fuzz/gltf_shim.o: scenes/gltf_shim.cpp scenes/gltf.h scenes/scene.h
+# The scene-loader fuzzer compiles tinygltf and stb_image into the shim (scenes/gltf_load.cpp
+# acts on SFSIM_TINYGLTF_IMPLEMENTATION) so the sanitizers see inside them (the project's
+# normal build links Debian's libtinygltf).
+FUZZ_GLTF_OBJ := $(patsubst scenes/%.cpp,$(BUILD)/fuzz/%.o,$(wildcard scenes/gltf_*.cpp))
+$(BUILD)/fuzz/gltf_%.o: scenes/gltf_%.cpp scenes/gltf_internal.hpp scenes/gltf.h scenes/scene.h
 	@mkdir -p $(dir $@)
 	$(CLANG)++ -std=c++17 -g -O1 -fsanitize=fuzzer-no-link,address,undefined -isystem /usr/include/stb \
 	    -DSFSIM_TINYGLTF_IMPLEMENTATION -c $< -o $@
 
-$(BUILD)/fuzz/fuzz_scene: tests/fuzz/fuzz_scene.c scenes/scene.c scenes/scene_file.c sim/ini.c $(BUILD)/fuzz/gltf_shim.o
+$(BUILD)/fuzz/fuzz_scene: tests/fuzz/fuzz_scene.c scenes/scene.c scenes/scene_file.c sim/ini.c $(FUZZ_GLTF_OBJ)
 	@mkdir -p $(dir $@)
 	$(CLANG)++ -x c -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined \
 	    $(filter %.c,$^) -x none $(filter %.o,$^) -o $@ -linih -lcjson -lm

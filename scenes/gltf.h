@@ -1,4 +1,5 @@
-/* scenes/gltf.h -- the C face of the tinygltf shim (scenes/gltf_shim.cpp).
+/* scenes/gltf.h -- the C face of the tinygltf shim (scenes/gltf_*.cpp; gltf_load.cpp
+ * holds these two functions, scenes/gltf_internal.hpp says what the other files read).
  *
  * Owns: reading glTF 2.0 (.gltf/.glb) into a Scene. Must not: decide defaults, bounds or needs
  * (scenes/scene.c does, once every source is loaded).

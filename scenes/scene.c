@@ -1,8 +1,8 @@
 /* scenes/scene.c -- scene_load: dispatch to the glTF shim or the scene.ini reader, then the
  * defaults, bounds, emissive-triangle list, default camera and needs of the loaded scene.
  *
- * Owns: what a loaded scene looks like once complete. Must not: parse files itself (gltf_shim.cpp,
- * scene_file.c) or build acceleration structures.
+ * Owns: what a loaded scene looks like once complete. Must not: parse files itself (the glTF shim
+ * scenes/gltf_*.cpp, scene_file.c) or build acceleration structures.
  */
 #include "scene.h"
 

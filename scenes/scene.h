@@ -2,7 +2,7 @@
  * spheres, camera and render settings, and what the scene needs.
  *
  * Owns: the in-memory scene every later stage (BVH builder, scene-memory packing, golden model,
- * kernel selection) reads. Loaders fill it: scenes/gltf_shim.cpp (glTF 2.0 through tinygltf) and
+ * kernel selection) reads. Loaders fill it: scenes/gltf_*.cpp (glTF 2.0 through tinygltf) and
  * scenes/scene_file.c (scene.ini: a glTF reference plus camera, render, lights, spheres,
  * material overrides). Must not: build acceleration structures or know the simulated machine.
  *

@@ -3,7 +3,7 @@
  *
  * Owns: reading and checking scene.ini. Every problem is reported as "FILE:LINE: key
  * 'section.key': message" (or "section [name]: message"), all of them in one run. Must not:
- * finish the scene (scene_finish) or read glTF itself (gltf_shim.cpp).
+ * finish the scene (scene_finish) or read glTF itself (scenes/gltf_*.cpp).
  *
  * The syntax (comments, sections, keys, a section or key given twice, a UTF-8 BOM, size and line
  * limits) is sim/ini.c's, the INI reader of every sfsim file (docs/ini.md); this file knows the

@@ -1,4 +1,9 @@
-/* sim/ref_kd.c -- kd-tree traversal variants of seed 004, Appendix A (see ref_kd.h). */
+/* sim/ref_kd.c -- kd-tree traversal variants of seed 004, Appendix A (see ref_kd.h).
+ *
+ * Owns: the single-ray traversals (A.1-A.4, one loop with the variant's choices) and the
+ * packetized short stack (A.5: start, next entry or restart, descent, leaf, advance), with their
+ * counters. Must not: build or pack trees (scenes/kdtree.c, sim/run/accel.c), shade, or know the
+ * simulated machine. */
 #include "ref_kd.h"
 
 #include <math.h>
@@ -192,6 +197,240 @@ typedef struct PEntry {
     float tmin[KD_PACKET], tmax[KD_PACKET], texit[KD_PACKET];
 } PEntry;
 
+/* One packet's traversal: its rays, its short stack (cap entries, a ring from `bottom`), each
+ * ray's progress point (where its next restart starts) and segment end, and the restart state. */
+typedef struct Packet {
+    const PackedScene *p;
+    const KdTree *t;
+    const RefRay *rays;
+    RefHit *hits;
+    RefKdStats *st;
+    int n, cap, bottom, depth;
+    PEntry *stack;
+    RefRay q[KD_PACKET];          /* the rays, directions sanitized */
+    float inv[KD_PACKET][3], t1[KD_PACKET], prog[KD_PACKET];
+    uint64_t done, all;           /* rays finished; every ray of the packet */
+    uint32_t root;                /* the push-down root restarts begin at */
+    int first;                    /* no descent made yet */
+    float last_prog[KD_PACKET];   /* prog and done at the last restart */
+    uint64_t last_done;
+} Packet;
+
+/* Every hit empty, every ray clipped to the scene box (the slab test of the BVH traversal); a
+ * ray that misses the box is done. */
+static void packet_start(Packet *k)
+{
+    const KdTree *t = k->t;
+    for (int i = 0; i < k->n; i++) {
+        RefHit *h = &k->hits[i];
+        h->prim = REF_NO_HIT;
+        h->t = k->rays[i].tmax;
+        h->u = h->v = 0.0f;
+        k->q[i] = k->rays[i];
+        ref_sanitize_dir(k->q[i].dir);
+        ref_inv_dir(k->q[i].dir, k->inv[i]);
+        float a0 = 0.0f, a1 = k->q[i].tmax * REF_HIT_SCALE;
+        for (int c = 0; c < 3; c++) {
+            float a = (t->bmin[c] - k->q[i].org[c]) * k->inv[i][c], b = (t->bmax[c] - k->q[i].org[c]) * k->inv[i][c];
+            a0 = ref_fmax(a0, ref_fmin(a, b));
+            a1 = ref_fmin(a1, ref_fmax(a, b) * 1.00000072f);
+        }
+        k->prog[i] = a0;
+        k->t1[i] = a1;
+        if (!(a0 <= a1) || t->nnodes == 0)
+            k->done |= 1ull << i;
+    }
+    k->last_done = k->done;
+    memcpy(k->last_prog, k->prog, sizeof k->prog);
+}
+
+/* The next entry to descend from into *cur: the top of the stack, or, on an empty stack, a
+ * restart from the push-down root (*pushdown = 1) for every unfinished ray. Returns 1 to descend,
+ * 0 when the popped entry has no live ray left, -1 when the packet is finished. */
+static int packet_next(Packet *k, PEntry *cur, int *pushdown)
+{
+    *pushdown = 0;
+    if (k->depth > 0) {
+        k->depth--;
+        *cur = k->stack[(k->bottom + k->depth) % k->cap];
+        cur->live &= ~k->done;
+        if (!cur->live)
+            return 0;
+    } else {
+        cur->node = k->root;
+        cur->live = 0;
+        for (int i = 0; i < k->n; i++)
+            if (!((k->done >> i) & 1u) && (k->first || k->prog[i] < k->t1[i])) {
+                cur->live |= 1ull << i;
+                cur->tmin[i] = k->prog[i];
+                cur->tmax[i] = cur->texit[i] = k->t1[i];
+            } else if (!((k->done >> i) & 1u)) {
+                k->done |= 1ull << i; /* the whole segment was visited */
+            }
+        if (!cur->live)
+            return -1;
+        if (!k->first) {
+            if (k->st) {
+                k->st->restarts += live_rays(cur->live);
+                k->st->stack_underflows += live_rays(cur->live);
+            }
+            /* No ray advanced since the last restart (rays of opposite directions keep pushing
+             * each other's near sides off a short stack): the rays left finish one by one,
+             * each continuing from its hit so far. */
+            if (memcmp(k->last_prog, k->prog, sizeof k->prog) == 0 && k->last_done == k->done) {
+                for (int i = 0; i < k->n; i++)
+                    if ((cur->live >> i) & 1u)
+                        trace(k->p, k->t, REF_KD_SHORTSTACK, k->cap, &k->rays[i], &k->hits[i], 1, 1, k->st);
+                return -1;
+            }
+        }
+        memcpy(k->last_prog, k->prog, sizeof k->prog);
+        k->last_done = k->done;
+        *pushdown = 1;
+    }
+    k->first = 0;
+    return 1;
+}
+
+/* Sorts the live rays of *cur at inner node nd into the packet's first child (fe: the lead ray's
+ * near child) and second (se), each with its segment; returns 1 when some ray's far side was left
+ * to a restart. */
+static int packet_split(const Packet *k, const KdNode *nd, const PEntry *cur, int lead_below, PEntry *fe, PEntry *se)
+{
+    uint32_t a = nd->axis;
+    int deferred = 0;
+    for (int i = 0; i < k->n; i++) {
+        if (!((cur->live >> i) & 1u))
+            continue;
+        float o = k->q[i].org[a], d = k->q[i].dir[a], tmin = cur->tmin[i], tmax = cur->tmax[i], tx = cur->texit[i];
+        int below = o < nd->split || (o == nd->split && d < 0.0f);
+        int near_is_first = below == lead_below;
+        float ts = (nd->split - o) * k->inv[i][a];
+        float eps = fabsf(ts) * KD_WIDEN + KD_WIDEN_FLOOR, lo = ts - eps, hi = ts + eps;
+        int want_near = 1, want_far = 1;
+        float nmax = tmax;
+        if (below == (d < 0.0f) || lo > tmax)
+            want_far = 0;
+        else if (hi <= tmin)
+            want_near = 0;
+        else
+            nmax = hi < tmax ? hi : tmax;
+        PEntry *ne = near_is_first ? fe : se, *fa = near_is_first ? se : fe;
+        if (want_near) {
+            ne->live |= 1ull << i;
+            ne->tmin[i] = tmin;
+            ne->tmax[i] = want_far ? nmax : tmax;
+            ne->texit[i] = want_far ? (lo < tx ? lo : tx) : tx;
+        }
+        /* A ray whose near child is the packet's second goes there only: its far side
+         * is left to a restart, so every ray still meets its space front to back. */
+        if (want_far && (near_is_first || !want_near)) {
+            fa->live |= 1ull << i;
+            fa->tmin[i] = want_near ? nmax : tmin;
+            fa->tmax[i] = tmax;
+            fa->texit[i] = tx;
+        } else if (want_far) {
+            deferred = 1;
+        }
+    }
+    return deferred;
+}
+
+/* Descends from *cur to a leaf, following the first live ray's near child and pushing the other
+ * child when rays go both ways (a full stack drops its bottom entry); moves the push-down root
+ * while no ray has a side left behind. Returns the leaf; *cur holds its rays. */
+static const KdNode *packet_descend(Packet *k, PEntry *cur, int pushdown)
+{
+    RefKdStats *st = k->st;
+    const KdNode *nd = &k->t->nodes[cur->node];
+    while (nd->axis != KD_LEAF) {
+        if (st) {
+            st->nodes_visited += live_rays(cur->live);
+            st->packet_steps++;
+        }
+        uint32_t a = nd->axis;
+        int lead = __builtin_ctzll(cur->live);
+        int lead_below = k->q[lead].org[a] < nd->split || (k->q[lead].org[a] == nd->split && k->q[lead].dir[a] < 0.0f);
+        uint32_t firstc = lead_below ? nd->a : nd->a + 1, second = lead_below ? nd->a + 1 : nd->a;
+        PEntry fe, se;
+        fe.live = se.live = 0;
+        int deferred = packet_split(k, nd, cur, lead_below, &fe, &se); /* some ray's far side was left to a restart */
+        if (!se.live) {
+            fe.node = firstc;
+            *cur = fe;
+        } else if (!fe.live) {
+            se.node = second;
+            *cur = se;
+        } else {
+            se.node = second;
+            if (k->depth == k->cap) { /* full: drop the bottom entry */
+                k->bottom = (k->bottom + 1) % k->cap;
+                k->depth--;
+                if (st)
+                    st->stack_overflows += live_rays(cur->live);
+            }
+            k->stack[(k->bottom + k->depth) % k->cap] = se;
+            k->depth++;
+            fe.node = firstc;
+            *cur = fe;
+            pushdown = 0;
+        }
+        if (deferred) /* a restart must be able to reach the deferred side */
+            pushdown = 0;
+        nd = &k->t->nodes[cur->node];
+        if (pushdown)
+            k->root = cur->node;
+    }
+    return nd;
+}
+
+/* Leaf nd's primitives against every live ray of *cur (closest hit, the lower primitive at equal t). */
+static void packet_leaf(Packet *k, const KdNode *nd, const PEntry *cur)
+{
+    RefKdStats *st = k->st;
+    if (st) {
+        st->nodes_visited += live_rays(cur->live);
+        st->leaves_visited += live_rays(cur->live);
+        st->packet_steps++;
+    }
+    for (uint32_t c = nd->a; c < nd->a + nd->count; c++) {
+        uint32_t pr = k->t->prims[c];
+        for (int i = 0; i < k->n; i++) {
+            if (!((cur->live >> i) & 1u))
+                continue;
+            RefHit *h = &k->hits[i];
+            float th, u, w;
+            if (st)
+                st->prims_tested++;
+            RefRay probe = k->q[i];
+            if (h->prim != REF_NO_HIT)
+                probe.tmax = ref_tie_probe(h->t);
+            if (!ref_hit_prim(k->p, pr, &probe, &th, &u, &w))
+                continue;
+            if (h->prim == REF_NO_HIT || th < h->t || (th == h->t && pr < h->prim)) {
+                h->t = th;
+                h->u = u;
+                h->v = w;
+                h->prim = pr;
+            }
+        }
+    }
+}
+
+/* A ray whose segment started at its progress point has visited everything before the
+ * segment's end: it advances, and is done when its hit lies before the segment's (lower) end. */
+static void packet_advance(Packet *k, const PEntry *cur)
+{
+    for (int i = 0; i < k->n; i++) {
+        if (!((cur->live >> i) & 1u) || cur->tmin[i] > k->prog[i])
+            continue;
+        if (cur->tmax[i] > k->prog[i])
+            k->prog[i] = cur->tmax[i];
+        if (k->hits[i].prim != REF_NO_HIT && k->hits[i].t * REF_HIT_SCALE < cur->texit[i])
+            k->done |= 1ull << i;
+    }
+}
+
 void ref_kd_packet_closest_hit(const PackedScene *p, const KdTree *t, int stack_depth, const RefRay *rays, int n,
                                RefHit *hits, RefKdStats *st)
 {
@@ -199,189 +438,23 @@ void ref_kd_packet_closest_hit(const PackedScene *p, const KdTree *t, int stack_
         return;
     if (n > KD_PACKET)
         n = KD_PACKET;
-    int cap = stack_depth < 1 ? 1 : stack_depth > KD_MAX_STACK ? KD_MAX_STACK : stack_depth;
-    PEntry *stack = malloc((size_t)cap * sizeof *stack), cur;
-    if (!stack)
+    Packet k = {.p = p, .t = t, .rays = rays, .hits = hits, .st = st, .n = n, .first = 1};
+    k.cap = stack_depth < 1 ? 1 : stack_depth > KD_MAX_STACK ? KD_MAX_STACK : stack_depth;
+    k.stack = malloc((size_t)k.cap * sizeof *k.stack);
+    if (!k.stack)
         abort(); /* out of memory for a few kilobytes of stack: nothing sensible to return */
-    int bottom = 0, depth = 0;
-    RefRay q[KD_PACKET];
-    float inv[KD_PACKET][3], t1[KD_PACKET], prog[KD_PACKET];
-    uint64_t done = 0, all = n >= 64 ? ~0ull : (1ull << n) - 1;
-    for (int i = 0; i < n; i++) {
-        RefHit *h = &hits[i];
-        h->prim = REF_NO_HIT;
-        h->t = rays[i].tmax;
-        h->u = h->v = 0.0f;
-        q[i] = rays[i];
-        ref_sanitize_dir(q[i].dir);
-        ref_inv_dir(q[i].dir, inv[i]);
-        float a0 = 0.0f, a1 = q[i].tmax * REF_HIT_SCALE;
-        for (int k = 0; k < 3; k++) {
-            float a = (t->bmin[k] - q[i].org[k]) * inv[i][k], b = (t->bmax[k] - q[i].org[k]) * inv[i][k];
-            a0 = ref_fmax(a0, ref_fmin(a, b));
-            a1 = ref_fmin(a1, ref_fmax(a, b) * 1.00000072f);
-        }
-        prog[i] = a0;
-        t1[i] = a1;
-        if (!(a0 <= a1) || t->nnodes == 0)
-            done |= 1ull << i;
+    k.all = n >= 64 ? ~0ull : (1ull << n) - 1;
+    packet_start(&k);
+    PEntry cur;
+    while (k.done != k.all || k.depth > 0) {
+        int pushdown, next = packet_next(&k, &cur, &pushdown);
+        if (next < 0)
+            break;
+        if (next == 0)
+            continue;
+        const KdNode *nd = packet_descend(&k, &cur, pushdown);
+        packet_leaf(&k, nd, &cur);
+        packet_advance(&k, &cur);
     }
-    uint32_t root = 0;
-    int first = 1;
-    float last_prog[KD_PACKET];
-    uint64_t last_done = done;
-    memcpy(last_prog, prog, sizeof prog);
-    while (done != all || depth > 0) {
-        int pushdown = 0;
-        if (depth > 0) {
-            depth--;
-            cur = stack[(bottom + depth) % cap];
-            cur.live &= ~done;
-            if (!cur.live)
-                continue;
-        } else {
-            cur.node = root;
-            cur.live = 0;
-            for (int i = 0; i < n; i++)
-                if (!((done >> i) & 1u) && (first || prog[i] < t1[i])) {
-                    cur.live |= 1ull << i;
-                    cur.tmin[i] = prog[i];
-                    cur.tmax[i] = cur.texit[i] = t1[i];
-                } else if (!((done >> i) & 1u)) {
-                    done |= 1ull << i; /* the whole segment was visited */
-                }
-            if (!cur.live)
-                break;
-            if (!first) {
-                if (st) {
-                    st->restarts += live_rays(cur.live);
-                    st->stack_underflows += live_rays(cur.live);
-                }
-                /* No ray advanced since the last restart (rays of opposite directions keep pushing
-                 * each other's near sides off a short stack): the rays left finish one by one,
-                 * each continuing from its hit so far. */
-                if (memcmp(last_prog, prog, sizeof prog) == 0 && last_done == done) {
-                    for (int i = 0; i < n; i++)
-                        if ((cur.live >> i) & 1u)
-                            trace(p, t, REF_KD_SHORTSTACK, cap, &rays[i], &hits[i], 1, 1, st);
-                    break;
-                }
-            }
-            memcpy(last_prog, prog, sizeof prog);
-            last_done = done;
-            pushdown = 1;
-        }
-        first = 0;
-        const KdNode *nd = &t->nodes[cur.node];
-        while (nd->axis != KD_LEAF) {
-            if (st) {
-                st->nodes_visited += live_rays(cur.live);
-                st->packet_steps++;
-            }
-            uint32_t a = nd->axis;
-            int lead = __builtin_ctzll(cur.live);
-            int lead_below = q[lead].org[a] < nd->split || (q[lead].org[a] == nd->split && q[lead].dir[a] < 0.0f);
-            uint32_t firstc = lead_below ? nd->a : nd->a + 1, second = lead_below ? nd->a + 1 : nd->a;
-            PEntry fe, se;
-            fe.live = se.live = 0;
-            int deferred = 0; /* some ray's far side was left to a restart */
-            for (int i = 0; i < n; i++) {
-                if (!((cur.live >> i) & 1u))
-                    continue;
-                float o = q[i].org[a], d = q[i].dir[a], tmin = cur.tmin[i], tmax = cur.tmax[i], tx = cur.texit[i];
-                int below = o < nd->split || (o == nd->split && d < 0.0f);
-                int near_is_first = below == lead_below;
-                float ts = (nd->split - o) * inv[i][a];
-                float eps = fabsf(ts) * KD_WIDEN + KD_WIDEN_FLOOR, lo = ts - eps, hi = ts + eps;
-                int want_near = 1, want_far = 1;
-                float nmax = tmax;
-                if (below == (d < 0.0f) || lo > tmax)
-                    want_far = 0;
-                else if (hi <= tmin)
-                    want_near = 0;
-                else
-                    nmax = hi < tmax ? hi : tmax;
-                PEntry *ne = near_is_first ? &fe : &se, *fa = near_is_first ? &se : &fe;
-                if (want_near) {
-                    ne->live |= 1ull << i;
-                    ne->tmin[i] = tmin;
-                    ne->tmax[i] = want_far ? nmax : tmax;
-                    ne->texit[i] = want_far ? (lo < tx ? lo : tx) : tx;
-                }
-                /* A ray whose near child is the packet's second goes there only: its far side
-                 * is left to a restart, so every ray still meets its space front to back. */
-                if (want_far && (near_is_first || !want_near)) {
-                    fa->live |= 1ull << i;
-                    fa->tmin[i] = want_near ? nmax : tmin;
-                    fa->tmax[i] = tmax;
-                    fa->texit[i] = tx;
-                } else if (want_far) {
-                    deferred = 1;
-                }
-            }
-            if (!se.live) {
-                fe.node = firstc;
-                cur = fe;
-            } else if (!fe.live) {
-                se.node = second;
-                cur = se;
-            } else {
-                se.node = second;
-                if (depth == cap) { /* full: drop the bottom entry */
-                    bottom = (bottom + 1) % cap;
-                    depth--;
-                    if (st)
-                        st->stack_overflows += live_rays(cur.live);
-                }
-                stack[(bottom + depth) % cap] = se;
-                depth++;
-                fe.node = firstc;
-                cur = fe;
-                pushdown = 0;
-            }
-            if (deferred) /* a restart must be able to reach the deferred side */
-                pushdown = 0;
-            nd = &t->nodes[cur.node];
-            if (pushdown)
-                root = cur.node;
-        }
-        if (st) {
-            st->nodes_visited += live_rays(cur.live);
-            st->leaves_visited += live_rays(cur.live);
-            st->packet_steps++;
-        }
-        for (uint32_t k = nd->a; k < nd->a + nd->count; k++) {
-            uint32_t pr = t->prims[k];
-            for (int i = 0; i < n; i++) {
-                if (!((cur.live >> i) & 1u))
-                    continue;
-                RefHit *h = &hits[i];
-                float th, u, w;
-                if (st)
-                    st->prims_tested++;
-                RefRay probe = q[i];
-                if (h->prim != REF_NO_HIT)
-                    probe.tmax = ref_tie_probe(h->t);
-                if (!ref_hit_prim(p, pr, &probe, &th, &u, &w))
-                    continue;
-                if (h->prim == REF_NO_HIT || th < h->t || (th == h->t && pr < h->prim)) {
-                    h->t = th;
-                    h->u = u;
-                    h->v = w;
-                    h->prim = pr;
-                }
-            }
-        }
-        /* A ray whose segment started at its progress point has visited everything before the
-         * segment's end: it advances, and is done when its hit lies before the segment's (lower) end. */
-        for (int i = 0; i < n; i++) {
-            if (!((cur.live >> i) & 1u) || cur.tmin[i] > prog[i])
-                continue;
-            if (cur.tmax[i] > prog[i])
-                prog[i] = cur.tmax[i];
-            if (hits[i].prim != REF_NO_HIT && hits[i].t * REF_HIT_SCALE < cur.texit[i])
-                done |= 1ull << i;
-        }
-    }
-    free(stack);
+    free(k.stack);
 }

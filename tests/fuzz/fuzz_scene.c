@@ -7,10 +7,10 @@
  * must not crash, leak, or read past a buffer.
  *
  * Build (clang; tinygltf and stb_image compiled in, so the sanitizers see inside them):
- *   clang++ -std=c++17 -g -O1 -fsanitize=fuzzer-no-link,address,undefined -isystem /usr/include/stb \
- *     -DSFSIM_TINYGLTF_IMPLEMENTATION -c scenes/gltf_shim.cpp -o build/fuzz/gltf_shim.o
+ *   for f in scenes/gltf_*.cpp; do clang++ -std=c++17 -g -O1 -fsanitize=fuzzer-no-link,address,undefined \
+ *     -isystem /usr/include/stb -DSFSIM_TINYGLTF_IMPLEMENTATION -c $f -o build/fuzz/$(basename $f .cpp).o; done
  *   clang -std=c11 -g -O1 -D_GNU_SOURCE -fsanitize=fuzzer,address,undefined tests/fuzz/fuzz_scene.c \
- *     scenes/scene.c scenes/scene_file.c build/fuzz/gltf_shim.o -o build/fuzz/fuzz_scene -linih -lstdc++ -lm
+ *     scenes/scene.c scenes/scene_file.c build/fuzz/gltf_*.o -o build/fuzz/fuzz_scene -linih -lstdc++ -lm
  * Run:  build/fuzz/fuzz_scene -max_len=65536 -timeout=10 build/fuzz/scene_corpus tests/scenes
  * Must not: depend on the working directory, or read devices (inputs naming /dev, /proc or /sys
  * are not read as ini files).

@@ -2,7 +2,7 @@
  * key = value, blanks, continuation lines, a UTF-8 BOM and CRLF, a section or key given twice,
  * line and size limits, files that are no regular files, the order and cap of the messages, and
  * lookups. Machine configs, scene.ini and sweep files are each tested through their own loader
- * (test_config.c, test_scene.c, tests/cli/sweep.sh); this is the syntax they share.
+ * (test_config.c, test_scene_ini.c, tests/cli/sweep.sh); this is the syntax they share.
  *
  * Suites: ini_syntax, ini_errors, ini_files.
  */

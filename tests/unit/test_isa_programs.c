@@ -11,48 +11,7 @@
  * instructions. A failure names file, line, N and lane:
  *     tests/isa/vfadd.s:12 N=4 lane 3: v2 = 0x40000000 (2) expected 0x3fc00000 (1.5)
  *
- * Expectation syntax:
- *
- *     ;! [if COND:] CHECK
- *
- * CHECK is one of
- *     rK OP EXPR             scalar register K
- *     vK[IDX] OP EXPR        lane IDX of vector register K
- *     mK[IDX] OP EXPR        bit IDX of mask register K (0 or 1)
- *     mK OP EXPR             the whole mask as an integer (bit l = lane l)
- *     mem M[ADDR] OP EXPR    32-bit little-endian word at byte ADDR of memory M: rb0 rb1 idm spad
- *                            scene fb, or rbc / rbn for the current / next ray buffer
- *     stat KEY OP EXPR       a core counter: total, instr.STAGE, vec.STAGE, lanes.STAGE,
- *                            op.MNEMONIC, cat.STAGE.CATEGORY (stage keys: other traversal ...),
- *                            genG.instr.STAGE, genG.vec.STAGE, genG.lanes.STAGE (generation G)
- *     pc OP EXPR             the pc after the run
- *     trap "TEXT" ...        the run must trap, and the message contain every TEXT
- *     limit                  the run must stop at the instruction limit
- *     max EXPR               the instruction limit (no guard; default 1000000)
- * A run must end in halt unless an applicable `trap` or `limit` says otherwise; the other checks
- * are made in every case, on the state the run stopped in.
- *
- * A check whose text (IDX, ADDR, EXPR or COND) uses the lane variable `l` is made for every lane
- * l = 0..N-1. Guards (`if COND:`) make a check apply only where COND is non-zero.
- *
- * OP:
- *     ==  !=        32-bit integer (in)equality (EXPR must be an integer; -1 matches 0xffffffff);
- *                   masks and counters compare as 64-bit integers
- *     ==f           binary32: the register's bits equal those of EXPR rounded to binary32;
- *                   an expected NaN matches any NaN
- *     ~= TOL        binary32 within an absolute tolerance: |value - EXPR| <= TOL (as `~= 1.5 1e-6`);
- *                   equal infinities and NaN/NaN match
- *
- * EXPR: C-like expressions over 64-bit integers and doubles (a double operand makes the operation
- * double): numbers (decimal, 0x hex, floats like 1.5 / 1e-6), ( ), unary - + ! ~, * / % + - << >>
- * < <= > >= == != & ^ | && || ?:, the names l (lane), N (width), nan, inf, any symbol of the
- * program (labels give instruction indices, `NAME = value` constants their value), and functions
- *     f(x)       binary32 bits of x            fl(x)      binary32 value of the bits x
- *     float(x)   x rounded to binary32         int(x)     x truncated to an integer
- *     u32(x) s32(x)  32-bit unsigned / sign-extended value of x
- *     popcount(x) min(a,b) max(a,b) abs(x) floor(x) sqrt(x) exp2(x) log2(x) sin(x) cos(x)
- * `float(float(a) + float(b))` is the binary32 sum of two binary32 values (the exact double sum
- * rounded once), so rounding cases can be written out without the core.
+ * The expectation syntax is tests/support/isa_expect.h's.
  */
 #include <criterion/criterion.h>
 #include <criterion/parameterized.h>
@@ -70,699 +29,12 @@
 #include "../../asm/asm.h"
 #include "../../isa/isa.h"
 #include "../../sim/core.h"
+#include "../support/isa_expect.h"
 
 #define ISA_PROG_DIR "tests/isa"
-#define DEFAULT_LIMIT 1000000ull
 
 static const int widths[] = {1, 4, 12, 16, 64};
 #define N_WIDTHS (int)(sizeof widths / sizeof widths[0])
-
-/* ---- expressions ------------------------------------------------------------------------ */
-
-typedef enum { E_INT, E_FLT, E_NAME, E_UN, E_BIN, E_TERN, E_CALL } ExprKind;
-
-typedef struct Expr {
-    ExprKind kind;
-    int op;                   /* operator token for E_UN/E_BIN */
-    int64_t i;
-    double f;
-    char name[48];            /* E_NAME, E_CALL */
-    struct Expr *a, *b, *c;   /* operands / arguments */
-} Expr;
-
-typedef struct Val {
-    int isf;
-    int64_t i;
-    double f;
-} Val;
-
-/* Tokens beyond single characters. */
-enum { T_EOF = 256, T_NUM, T_NAME, T_STR, T_EQ, T_NE, T_LE, T_GE, T_SHL, T_SHR, T_AND, T_OR, T_FEQ, T_APPROX };
-
-typedef struct Lexer {
-    const char *s;
-    int tok;
-    int64_t ival;
-    double fval;
-    int isf;
-    char text[256];
-    char err[160];
-} Lexer;
-
-static void lex_next(Lexer *lx)
-{
-    while (*lx->s == ' ' || *lx->s == '\t')
-        lx->s++;
-    const char *s = lx->s;
-    if (*s == '\0' || *s == '\n' || *s == '\r') {
-        lx->tok = T_EOF;
-        return;
-    }
-    if (isdigit((unsigned char)*s) || (*s == '.' && isdigit((unsigned char)s[1]))) {
-        char *end;
-        if (s[0] == '0' && (s[1] == 'x' || s[1] == 'X')) {
-            lx->ival = (int64_t)strtoull(s, &end, 16);
-            lx->isf = 0;
-        } else {
-            size_t n = strspn(s, "0123456789");
-            int isfloat = s[n] == '.' || s[n] == 'e' || s[n] == 'E';
-            if (isfloat) {
-                lx->fval = strtod(s, &end);
-                lx->isf = 1;
-            } else {
-                lx->ival = (int64_t)strtoull(s, &end, 10);
-                lx->isf = 0;
-            }
-        }
-        lx->s = end;
-        lx->tok = T_NUM;
-        return;
-    }
-    if (isalpha((unsigned char)*s) || *s == '_' || *s == '.') {
-        size_t n = 0;
-        while (isalnum((unsigned char)s[n]) || s[n] == '_' || s[n] == '.')
-            n++;
-        if (n >= sizeof lx->text)
-            n = sizeof lx->text - 1;
-        memcpy(lx->text, s, n);
-        lx->text[n] = '\0';
-        lx->s = s + n;
-        lx->tok = T_NAME;
-        return;
-    }
-    if (*s == '"') {
-        const char *e = strchr(s + 1, '"');
-        if (!e) {
-            snprintf(lx->err, sizeof lx->err, "unterminated string");
-            lx->tok = T_EOF;
-            return;
-        }
-        size_t n = (size_t)(e - s - 1);
-        if (n >= sizeof lx->text)
-            n = sizeof lx->text - 1;
-        memcpy(lx->text, s + 1, n);
-        lx->text[n] = '\0';
-        lx->s = e + 1;
-        lx->tok = T_STR;
-        return;
-    }
-    static const struct { const char *t; int tok; } two[] = {
-        {"==f", T_FEQ}, {"==", T_EQ}, {"!=", T_NE}, {"<=", T_LE}, {">=", T_GE}, {"<<", T_SHL},
-        {">>", T_SHR},  {"&&", T_AND}, {"||", T_OR}, {"~=", T_APPROX}};
-    for (size_t k = 0; k < sizeof two / sizeof two[0]; k++) {
-        size_t n = strlen(two[k].t);
-        if (strncmp(s, two[k].t, n) == 0) {
-            /* `==f` only when the f is not the start of a name or call such as f(1.5) */
-            if (two[k].tok == T_FEQ && (isalnum((unsigned char)s[3]) || s[3] == '_' || s[3] == '('))
-                continue;
-            lx->s = s + n;
-            lx->tok = two[k].tok;
-            return;
-        }
-    }
-    lx->s = s + 1;
-    lx->tok = (unsigned char)*s;
-}
-
-static Expr *expr_new(ExprKind k)
-{
-    Expr *e = calloc(1, sizeof *e);
-    cr_assert_not_null(e);
-    e->kind = k;
-    return e;
-}
-
-static void expr_free(Expr *e)
-{
-    if (!e)
-        return;
-    expr_free(e->a);
-    expr_free(e->b);
-    expr_free(e->c);
-    free(e);
-}
-
-static Expr *parse_ternary(Lexer *lx);
-
-static Expr *parse_primary(Lexer *lx)
-{
-    if (lx->err[0])
-        return NULL;
-    if (lx->tok == T_NUM) {
-        Expr *e = expr_new(lx->isf ? E_FLT : E_INT);
-        e->i = lx->ival;
-        e->f = lx->fval;
-        lex_next(lx);
-        return e;
-    }
-    if (lx->tok == T_NAME) {
-        Expr *e = expr_new(E_NAME);
-        snprintf(e->name, sizeof e->name, "%.47s", lx->text);
-        lex_next(lx);
-        if (lx->tok == '(') {
-            e->kind = E_CALL;
-            lex_next(lx);
-            Expr **slot[3] = {&e->a, &e->b, &e->c};
-            int n = 0;
-            if (lx->tok != ')')
-                for (;;) {
-                    if (n == 3) {
-                        snprintf(lx->err, sizeof lx->err, "too many arguments to %s", e->name);
-                        expr_free(e);
-                        return NULL;
-                    }
-                    *slot[n++] = parse_ternary(lx);
-                    if (lx->err[0]) {
-                        expr_free(e);
-                        return NULL;
-                    }
-                    if (lx->tok != ',')
-                        break;
-                    lex_next(lx);
-                }
-            e->i = n;
-            if (lx->tok != ')') {
-                snprintf(lx->err, sizeof lx->err, "expected ')' after the arguments of %s", e->name);
-                expr_free(e);
-                return NULL;
-            }
-            lex_next(lx);
-        }
-        return e;
-    }
-    if (lx->tok == '(') {
-        lex_next(lx);
-        Expr *e = parse_ternary(lx);
-        if (!lx->err[0] && lx->tok != ')')
-            snprintf(lx->err, sizeof lx->err, "expected ')'");
-        if (lx->err[0]) {
-            expr_free(e);
-            return NULL;
-        }
-        lex_next(lx);
-        return e;
-    }
-    snprintf(lx->err, sizeof lx->err, "expected a value at \"%.20s\"", lx->s);
-    return NULL;
-}
-
-static Expr *parse_unary(Lexer *lx)
-{
-    if (lx->tok == '-' || lx->tok == '+' || lx->tok == '!' || lx->tok == '~') {
-        int op = lx->tok;
-        lex_next(lx);
-        Expr *e = expr_new(E_UN);
-        e->op = op;
-        e->a = parse_unary(lx);
-        if (lx->err[0]) {
-            expr_free(e);
-            return NULL;
-        }
-        return e;
-    }
-    return parse_primary(lx);
-}
-
-/* Binary levels, loosest first. */
-static const int levels[][5] = {
-    {T_OR}, {T_AND}, {'|'}, {'^'}, {'&'}, {T_EQ, T_NE}, {'<', T_LE, '>', T_GE}, {T_SHL, T_SHR}, {'+', '-'},
-    {'*', '/', '%'},
-};
-#define N_LEVELS (int)(sizeof levels / sizeof levels[0])
-
-static Expr *parse_level(Lexer *lx, int lv)
-{
-    if (lv == N_LEVELS)
-        return parse_unary(lx);
-    Expr *left = parse_level(lx, lv + 1);
-    for (;;) {
-        if (lx->err[0]) {
-            expr_free(left);
-            return NULL;
-        }
-        int hit = 0;
-        for (int k = 0; k < 5 && levels[lv][k]; k++)
-            hit |= lx->tok == levels[lv][k];
-        if (!hit)
-            return left;
-        Expr *e = expr_new(E_BIN);
-        e->op = lx->tok;
-        lex_next(lx);
-        e->a = left;
-        e->b = parse_level(lx, lv + 1);
-        left = e;
-    }
-}
-
-static Expr *parse_ternary(Lexer *lx)
-{
-    Expr *cond = parse_level(lx, 0);
-    if (lx->err[0] || lx->tok != '?')
-        return cond;
-    lex_next(lx);
-    Expr *e = expr_new(E_TERN);
-    e->a = cond;
-    e->b = parse_ternary(lx);
-    if (!lx->err[0] && lx->tok != ':')
-        snprintf(lx->err, sizeof lx->err, "expected ':' in ?:");
-    if (lx->err[0]) {
-        expr_free(e);
-        return NULL;
-    }
-    lex_next(lx);
-    e->c = parse_ternary(lx);
-    if (lx->err[0]) {
-        expr_free(e);
-        return NULL;
-    }
-    return e;
-}
-
-static int expr_uses_lane(const Expr *e)
-{
-    if (!e)
-        return 0;
-    if (e->kind == E_NAME && strcmp(e->name, "l") == 0)
-        return 1;
-    return expr_uses_lane(e->a) || expr_uses_lane(e->b) || expr_uses_lane(e->c);
-}
-
-/* Evaluation environment. */
-typedef struct Env {
-    int lanes;
-    int lane;                  /* -1 outside per-lane checks */
-    const AsmObject *obj;
-    char err[160];
-} Env;
-
-static double as_f(Val v) { return v.isf ? v.f : (double)v.i; }
-
-static Val vi(int64_t i) { return (Val){0, i, 0}; }
-static Val vf(double f) { return (Val){1, 0, f}; }
-
-static uint32_t f32_bits(double d)
-{
-    float x = (float)d;
-    uint32_t u;
-    memcpy(&u, &x, 4);
-    return u;
-}
-
-static float bits_f32(uint32_t u)
-{
-    float x;
-    memcpy(&x, &u, 4);
-    return x;
-}
-
-static Val eval(const Expr *e, Env *env);
-
-static Val eval_call(const Expr *e, Env *env)
-{
-    int n = (int)e->i;
-    Val a = n > 0 ? eval(e->a, env) : vi(0), b = n > 1 ? eval(e->b, env) : vi(0);
-    if (env->err[0])
-        return vi(0);
-    static const struct { const char *name; int nargs; } fns[] = {
-        {"f", 1},     {"fl", 1},  {"float", 1}, {"int", 1},  {"u32", 1},  {"s32", 1},  {"popcount", 1},
-        {"min", 2},   {"max", 2}, {"abs", 1},   {"floor", 1}, {"sqrt", 1}, {"exp2", 1}, {"log2", 1},
-        {"sin", 1},   {"cos", 1}};
-    int known = -1;
-    for (size_t k = 0; k < sizeof fns / sizeof fns[0]; k++)
-        if (strcmp(e->name, fns[k].name) == 0)
-            known = (int)k;
-    if (known < 0) {
-        snprintf(env->err, sizeof env->err, "unknown function %s", e->name);
-        return vi(0);
-    }
-    if (fns[known].nargs != n) {
-        snprintf(env->err, sizeof env->err, "%s takes %d argument(s)", e->name, fns[known].nargs);
-        return vi(0);
-    }
-    const char *f = e->name;
-    if (!strcmp(f, "f"))
-        return vi(f32_bits(as_f(a)));
-    if (!strcmp(f, "fl"))
-        return vf(bits_f32((uint32_t)a.i));
-    if (!strcmp(f, "float"))
-        return vf((float)as_f(a));
-    if (!strcmp(f, "int"))
-        return vi(a.isf ? (int64_t)a.f : a.i);
-    if (!strcmp(f, "u32"))
-        return vi((int64_t)(uint32_t)(a.isf ? (int64_t)a.f : a.i));
-    if (!strcmp(f, "s32"))
-        return vi((int64_t)(int32_t)(uint32_t)(a.isf ? (int64_t)a.f : a.i));
-    if (!strcmp(f, "popcount"))
-        return vi(__builtin_popcountll((unsigned long long)a.i));
-    if (!strcmp(f, "min") || !strcmp(f, "max")) {
-        int lt = (a.isf || b.isf) ? as_f(a) < as_f(b) : a.i < b.i;
-        int pick_a = !strcmp(f, "min") ? lt : !lt;
-        return pick_a ? a : b;
-    }
-    if (!strcmp(f, "abs"))
-        return a.isf ? vf(fabs(a.f)) : vi(a.i < 0 ? -a.i : a.i);
-    if (!strcmp(f, "floor"))
-        return vf(floor(as_f(a)));
-    if (!strcmp(f, "sqrt"))
-        return vf(sqrt(as_f(a)));
-    if (!strcmp(f, "exp2"))
-        return vf(exp2(as_f(a)));
-    if (!strcmp(f, "log2"))
-        return vf(log2(as_f(a)));
-    if (!strcmp(f, "sin"))
-        return vf(sin(as_f(a)));
-    return vf(cos(as_f(a)));
-}
-
-static Val eval(const Expr *e, Env *env)
-{
-    if (env->err[0] || !e)
-        return vi(0);
-    switch (e->kind) {
-    case E_INT: return vi(e->i);
-    case E_FLT: return vf(e->f);
-    case E_NAME:
-        if (!strcmp(e->name, "l")) {
-            if (env->lane < 0)
-                snprintf(env->err, sizeof env->err, "l outside a per-lane check");
-            return vi(env->lane);
-        }
-        if (!strcmp(e->name, "N"))
-            return vi(env->lanes);
-        if (!strcmp(e->name, "nan"))
-            return vf(NAN);
-        if (!strcmp(e->name, "inf"))
-            return vf(INFINITY);
-        for (uint32_t k = 0; env->obj && k < env->obj->nsyms; k++)
-            if (env->obj->syms[k].name && !strcmp(env->obj->syms[k].name, e->name))
-                return vi((int64_t)env->obj->syms[k].value);
-        snprintf(env->err, sizeof env->err, "unknown name %s", e->name);
-        return vi(0);
-    case E_CALL: return eval_call(e, env);
-    case E_TERN: {
-        Val c = eval(e->a, env);
-        int t = c.isf ? c.f != 0 : c.i != 0;
-        return eval(t ? e->b : e->c, env);
-    }
-    case E_UN: {
-        Val a = eval(e->a, env);
-        switch (e->op) {
-        case '-': return a.isf ? vf(-a.f) : vi((int64_t)(0 - (uint64_t)a.i));
-        case '+': return a;
-        case '!': return vi(a.isf ? a.f == 0 : a.i == 0);
-        default:
-            if (a.isf)
-                snprintf(env->err, sizeof env->err, "~ of a float");
-            return vi(~a.i);
-        }
-    }
-    case E_BIN: {
-        Val a = eval(e->a, env);
-        if (e->op == T_AND || e->op == T_OR) {
-            int ta = a.isf ? a.f != 0 : a.i != 0;
-            if (e->op == T_AND && !ta)
-                return vi(0);
-            if (e->op == T_OR && ta)
-                return vi(1);
-            Val b = eval(e->b, env);
-            return vi(b.isf ? b.f != 0 : b.i != 0);
-        }
-        Val b = eval(e->b, env);
-        if (env->err[0])
-            return vi(0);
-        if (a.isf || b.isf) {
-            double x = as_f(a), y = as_f(b);
-            switch (e->op) {
-            case '+': return vf(x + y);
-            case '-': return vf(x - y);
-            case '*': return vf(x * y);
-            case '/': return vf(x / y);
-            case '<': return vi(x < y);
-            case '>': return vi(x > y);
-            case T_LE: return vi(x <= y);
-            case T_GE: return vi(x >= y);
-            case T_EQ: return vi(x == y);
-            case T_NE: return vi(x != y);
-            default: snprintf(env->err, sizeof env->err, "integer operator on a float"); return vi(0);
-            }
-        }
-        int64_t x = a.i, y = b.i;
-        uint64_t ux = (uint64_t)x, uy = (uint64_t)y;
-        switch (e->op) {
-        case '+': return vi((int64_t)(ux + uy));
-        case '-': return vi((int64_t)(ux - uy));
-        case '*': return vi((int64_t)(ux * uy));
-        case '/':
-        case '%':
-            if (y == 0) {
-                snprintf(env->err, sizeof env->err, "division by zero in an expectation");
-                return vi(0);
-            }
-            return vi(e->op == '/' ? x / y : x % y);
-        case T_SHL: return vi((int64_t)(ux << (y & 63)));
-        case T_SHR: return vi(x >> (y & 63));
-        case '&': return vi(x & y);
-        case '|': return vi(x | y);
-        case '^': return vi(x ^ y);
-        case '<': return vi(x < y);
-        case '>': return vi(x > y);
-        case T_LE: return vi(x <= y);
-        case T_GE: return vi(x >= y);
-        case T_EQ: return vi(x == y);
-        case T_NE: return vi(x != y);
-        default: snprintf(env->err, sizeof env->err, "bad operator"); return vi(0);
-        }
-    }
-    }
-    return vi(0);
-}
-
-/* ---- expectations ------------------------------------------------------------------------ */
-
-typedef enum { X_SREG, X_VREG, X_MBIT, X_MASK, X_MEM, X_STAT, X_PC, X_TRAP, X_LIMIT, X_MAX } CheckKind;
-typedef enum { OP_EQ, OP_NE, OP_FEQ, OP_APPROX } CmpOp;
-
-typedef struct Check {
-    int line;
-    CheckKind kind;
-    int reg;                 /* register number, or CoreMem (-1 rbc, -2 rbn) for X_MEM */
-    char key[64];            /* X_STAT key; X_TRAP: substrings joined by '\0', count in nsub */
-    char subs[4][128];
-    int nsub;
-    Expr *guard, *index, *expect, *tol;
-    CmpOp op;
-    int per_lane;
-} Check;
-
-typedef struct Spec {
-    Check *checks;
-    int n, cap;
-    uint64_t limit;
-} Spec;
-
-static void spec_free(Spec *s)
-{
-    for (int i = 0; i < s->n; i++) {
-        expr_free(s->checks[i].guard);
-        expr_free(s->checks[i].index);
-        expr_free(s->checks[i].expect);
-        expr_free(s->checks[i].tol);
-    }
-    free(s->checks);
-    memset(s, 0, sizeof *s);
-}
-
-static int reg_number(const char *text, char kind, int max)
-{
-    if (text[0] != kind || !isdigit((unsigned char)text[1]))
-        return -1;
-    char *end;
-    long r = strtol(text + 1, &end, 10);
-    return (*end == '\0' && r >= 0 && r <= max) ? (int)r : -1;
-}
-
-/* Parse one ";!" line body; returns 0, or -1 with a message in err. */
-static int parse_check(const char *body, int line, Check *ck, char *err, size_t errlen)
-{
-    memset(ck, 0, sizeof *ck);
-    ck->line = line;
-    Lexer lx;
-    memset(&lx, 0, sizeof lx);
-    lx.s = body;
-    lex_next(&lx);
-    if (lx.tok == T_NAME && !strcmp(lx.text, "if")) {
-        lex_next(&lx);
-        ck->guard = parse_ternary(&lx);
-        if (!lx.err[0] && lx.tok != ':')
-            snprintf(lx.err, sizeof lx.err, "expected ':' after the condition of if");
-        if (lx.err[0])
-            goto fail;
-        lex_next(&lx);
-    }
-    if (lx.tok != T_NAME) {
-        snprintf(lx.err, sizeof lx.err, "expected a register, mem, stat, pc, trap, limit or max");
-        goto fail;
-    }
-    char word[256];
-    snprintf(word, sizeof word, "%s", lx.text);
-    lex_next(&lx);
-    if (!strcmp(word, "trap")) {
-        ck->kind = X_TRAP;
-        while (lx.tok == T_STR && ck->nsub < 4) {
-            snprintf(ck->subs[ck->nsub++], sizeof ck->subs[0], "%.127s", lx.text);
-            lex_next(&lx);
-        }
-        if (lx.tok != T_EOF && !lx.err[0])
-            snprintf(lx.err, sizeof lx.err, "trap takes quoted strings only");
-        if (lx.err[0])
-            goto fail;
-        return 0;
-    }
-    if (!strcmp(word, "limit")) {
-        ck->kind = X_LIMIT;
-        if (lx.tok != T_EOF)
-            snprintf(lx.err, sizeof lx.err, "limit takes no argument");
-        if (lx.err[0])
-            goto fail;
-        return 0;
-    }
-    if (!strcmp(word, "max")) {
-        ck->kind = X_MAX;
-        if (ck->guard)
-            snprintf(lx.err, sizeof lx.err, "max cannot be conditional");
-        else
-            ck->expect = parse_ternary(&lx);
-        if (!lx.err[0] && lx.tok != T_EOF)
-            snprintf(lx.err, sizeof lx.err, "junk after max");
-        if (lx.err[0])
-            goto fail;
-        return 0;
-    }
-    int r;
-    if ((r = reg_number(word, 'r', 31)) >= 0) {
-        ck->kind = X_SREG;
-        ck->reg = r;
-    } else if ((r = reg_number(word, 'v', 31)) >= 0) {
-        ck->kind = X_VREG;
-        ck->reg = r;
-    } else if ((r = reg_number(word, 'm', 7)) >= 0) {
-        ck->kind = lx.tok == '[' ? X_MBIT : X_MASK;
-        ck->reg = r;
-    } else if (!strcmp(word, "pc")) {
-        ck->kind = X_PC;
-    } else if (!strcmp(word, "stat")) {
-        ck->kind = X_STAT;
-        if (lx.tok != T_NAME) {
-            snprintf(lx.err, sizeof lx.err, "stat needs a key");
-            goto fail;
-        }
-        snprintf(ck->key, sizeof ck->key, "%.63s", lx.text);
-        lex_next(&lx);
-    } else if (!strcmp(word, "mem")) {
-        ck->kind = X_MEM;
-        if (lx.tok != T_NAME) {
-            snprintf(lx.err, sizeof lx.err, "mem needs a memory name");
-            goto fail;
-        }
-        ck->reg = -99;
-        if (!strcmp(lx.text, "rbc"))
-            ck->reg = -1;
-        else if (!strcmp(lx.text, "rbn"))
-            ck->reg = -2;
-        for (int m = 0; m < CORE_MEM_COUNT; m++)
-            if (!strcmp(lx.text, core_mem_names[m]))
-                ck->reg = m;
-        if (ck->reg == -99) {
-            snprintf(lx.err, sizeof lx.err, "unknown memory %.100s", lx.text);
-            goto fail;
-        }
-        lex_next(&lx);
-    } else {
-        snprintf(lx.err, sizeof lx.err, "unknown check \"%.100s\"", word);
-        goto fail;
-    }
-    if (ck->kind == X_VREG || ck->kind == X_MBIT || ck->kind == X_MEM) {
-        if (lx.tok != '[') {
-            snprintf(lx.err, sizeof lx.err, "expected '[' after %.100s", word);
-            goto fail;
-        }
-        lex_next(&lx);
-        ck->index = parse_ternary(&lx);
-        if (!lx.err[0] && lx.tok != ']')
-            snprintf(lx.err, sizeof lx.err, "expected ']'");
-        if (lx.err[0])
-            goto fail;
-        lex_next(&lx);
-    }
-    switch (lx.tok) {
-    case T_EQ: ck->op = OP_EQ; break;
-    case T_NE: ck->op = OP_NE; break;
-    case T_FEQ: ck->op = OP_FEQ; break;
-    case T_APPROX: ck->op = OP_APPROX; break;
-    default: snprintf(lx.err, sizeof lx.err, "expected ==, !=, ==f or ~="); goto fail;
-    }
-    if ((ck->op == OP_FEQ || ck->op == OP_APPROX) && ck->kind != X_SREG && ck->kind != X_VREG && ck->kind != X_MEM) {
-        snprintf(lx.err, sizeof lx.err, "float comparison of a mask or counter");
-        goto fail;
-    }
-    lex_next(&lx);
-    ck->expect = parse_ternary(&lx);
-    if (!lx.err[0] && ck->op == OP_APPROX) {
-        if (lx.tok == T_EOF)
-            snprintf(lx.err, sizeof lx.err, "~= needs a tolerance: ~= VALUE TOL");
-        else
-            ck->tol = parse_ternary(&lx);
-    }
-    if (!lx.err[0] && lx.tok != T_EOF)
-        snprintf(lx.err, sizeof lx.err, "junk at \"%.20s\"", lx.s);
-    if (lx.err[0])
-        goto fail;
-    ck->per_lane = expr_uses_lane(ck->guard) || expr_uses_lane(ck->index) || expr_uses_lane(ck->expect) ||
-                   expr_uses_lane(ck->tol);
-    return 0;
-fail:
-    snprintf(err, errlen, "%s", lx.err);
-    expr_free(ck->guard);
-    expr_free(ck->index);
-    expr_free(ck->expect);
-    expr_free(ck->tol);
-    memset(ck, 0, sizeof *ck);
-    return -1;
-}
-
-/* Collect the ";!" lines of path. Parse errors are test failures. Returns the number of errors. */
-static int spec_load(const char *path, Spec *spec)
-{
-    memset(spec, 0, sizeof *spec);
-    spec->limit = DEFAULT_LIMIT;
-    FILE *f = fopen(path, "r");
-    cr_assert_not_null(f, "cannot open %s", path);
-    char buf[1024];
-    int line = 0, errors = 0;
-    while (fgets(buf, sizeof buf, f)) {
-        line++;
-        const char *p = buf;
-        while (*p == ' ' || *p == '\t')
-            p++;
-        if (p[0] != ';' || p[1] != '!')
-            continue;
-        Check ck;
-        char err[200];
-        if (parse_check(p + 2, line, &ck, err, sizeof err) != 0) {
-            cr_expect_fail("%s:%d: bad expectation: %s", path, line, err);
-            errors++;
-            continue;
-        }
-        if (spec->n == spec->cap) {
-            spec->cap = spec->cap ? 2 * spec->cap : 32;
-            spec->checks = realloc(spec->checks, (size_t)spec->cap * sizeof *spec->checks);
-            cr_assert_not_null(spec->checks);
-        }
-        spec->checks[spec->n++] = ck;
-    }
-    fclose(f);
-    return errors;
-}
 
 /* ---- running ------------------------------------------------------------------------------ */
 
@@ -885,7 +157,7 @@ static int truthy(Val v) { return v.isf ? v.f != 0 : v.i != 0; }
 static void fmt_word(char *buf, size_t len, uint32_t w, int as_float)
 {
     if (as_float)
-        snprintf(buf, len, "0x%08" PRIx32 " (%.9g)", w, (double)bits_f32(w));
+        snprintf(buf, len, "0x%08" PRIx32 " (%.9g)", w, (double)ie_bits_f32(w));
     else
         snprintf(buf, len, "0x%08" PRIx32 " (%" PRId32 ")", w, (int32_t)w);
 }
@@ -893,8 +165,8 @@ static void fmt_word(char *buf, size_t len, uint32_t w, int as_float)
 /* Compare a 32-bit value; 0 when it matches. */
 static int compare_word(Run *run, const Check *ck, int lane, Env *env, const char *what, uint32_t actual)
 {
-    Val ex = eval(ck->expect, env);
-    Val tol = ck->tol ? eval(ck->tol, env) : vi(0);
+    Val ex = ie_eval(ck->expect, env);
+    Val tol = ck->tol ? ie_eval(ck->tol, env) : ie_vi(0);
     if (env->err[0]) {
         report(run, ck, lane, "%s", env->err);
         return -1;
@@ -917,9 +189,9 @@ static int compare_word(Run *run, const Check *ck, int lane, Env *env, const cha
         return -1;
     }
     case OP_FEQ: {
-        uint32_t w = f32_bits(as_f(ex));
-        float a = bits_f32(actual);
-        if (actual == w || (isnan(a) && isnan(as_f(ex))))
+        uint32_t w = ie_f32_bits(ie_as_f(ex));
+        float a = ie_bits_f32(actual);
+        if (actual == w || (isnan(a) && isnan(ie_as_f(ex))))
             return 0;
         fmt_word(got, sizeof got, actual, 1);
         fmt_word(want, sizeof want, w, 1);
@@ -927,7 +199,7 @@ static int compare_word(Run *run, const Check *ck, int lane, Env *env, const cha
         return -1;
     }
     case OP_APPROX: {
-        double a = bits_f32(actual), e = as_f(ex), t = as_f(tol);
+        double a = ie_bits_f32(actual), e = ie_as_f(ex), t = ie_as_f(tol);
         if ((isnan(a) && isnan(e)) || a == e || fabs(a - e) <= t)
             return 0;
         fmt_word(got, sizeof got, actual, 1);
@@ -940,7 +212,7 @@ static int compare_word(Run *run, const Check *ck, int lane, Env *env, const cha
 
 static int compare_u64(Run *run, const Check *ck, int lane, Env *env, const char *what, uint64_t actual)
 {
-    Val ex = eval(ck->expect, env);
+    Val ex = ie_eval(ck->expect, env);
     if (env->err[0]) {
         report(run, ck, lane, "%s", env->err);
         return -1;
@@ -961,7 +233,7 @@ static void check_one(Run *run, const Check *ck, int lane)
 {
     Env env = {run->lanes, lane, run->obj, ""};
     if (ck->guard) {
-        Val g = eval(ck->guard, &env);
+        Val g = ie_eval(ck->guard, &env);
         if (env.err[0]) {
             report(run, ck, lane, "%s", env.err);
             return;
@@ -971,7 +243,7 @@ static void check_one(Run *run, const Check *ck, int lane)
     }
     int64_t idx = 0;
     if (ck->index) {
-        Val iv = eval(ck->index, &env);
+        Val iv = ie_eval(ck->index, &env);
         if (env.err[0] || iv.isf) {
             report(run, ck, lane, "%s", env.err[0] ? env.err : "index is not an integer");
             return;
@@ -1051,7 +323,7 @@ static int applies(Run *run, const Check *ck)
     if (!ck->guard)
         return 1;
     Env env = {run->lanes, -1, run->obj, ""};
-    Val g = eval(ck->guard, &env);
+    Val g = ie_eval(ck->guard, &env);
     if (env.err[0]) {
         report(run, ck, -1, "%s", env.err);
         return 0;
@@ -1139,16 +411,16 @@ static int op_of_path(const char *path)
 static void run_program(const char *path)
 {
     Spec spec;
-    int bad = spec_load(path, &spec);
+    int bad = ie_spec_load(path, &spec);
     if (bad) {
-        spec_free(&spec);
+        ie_spec_free(&spec);
         return;
     }
     int has_checks = 0;
     for (int i = 0; i < spec.n; i++) {
         if (spec.checks[i].kind == X_MAX) {
             Env env = {1, -1, NULL, ""};
-            Val v = eval(spec.checks[i].expect, &env);
+            Val v = ie_eval(spec.checks[i].expect, &env);
             spec.limit = (uint64_t)(v.isf ? v.f : (double)v.i);
         } else {
             has_checks = 1;
@@ -1173,7 +445,7 @@ static void run_program(const char *path)
         asm_object_free(&obj);
     }
     free(diag_buf);
-    spec_free(&spec);
+    ie_spec_free(&spec);
 }
 
 /* ---- tests -------------------------------------------------------------------------------- */
@@ -1233,48 +505,48 @@ Test(isa_programs, expectation_language)
         Lexer lx;
         memset(&lx, 0, sizeof lx);
         lx.s = ints[i].text;
-        lex_next(&lx);
-        Expr *e = parse_ternary(&lx);
+        ie_lex_next(&lx);
+        Expr *e = ie_parse_expr(&lx);
         cr_assert_eq(lx.err[0], 0, "\"%s\": %s", ints[i].text, lx.err);
         cr_assert_eq(lx.tok, T_EOF, "\"%s\": not fully parsed", ints[i].text);
         Env env = {4, 2, NULL, ""};
-        Val v = eval(e, &env);
+        Val v = ie_eval(e, &env);
         cr_expect_eq(env.err[0], 0, "\"%s\": %s", ints[i].text, env.err);
         cr_expect(!v.isf && v.i == ints[i].want, "\"%s\" = %lld, expected %lld", ints[i].text, (long long)v.i,
                   (long long)ints[i].want);
-        expr_free(e);
+        ie_expr_free(e);
     }
     Check ck;
     char err[200];
-    cr_expect_eq(parse_check(" v2[l] ==f l * 0.5", 3, &ck, err, sizeof err), 0, "%s", err);
+    cr_expect_eq(ie_parse_check(" v2[l] ==f l * 0.5", 3, &ck, err, sizeof err), 0, "%s", err);
     cr_expect_eq(ck.kind, X_VREG);
     cr_expect_eq(ck.op, OP_FEQ);
     cr_expect(ck.per_lane);
-    expr_free(ck.index);
-    expr_free(ck.expect);
-    cr_expect_eq(parse_check(" if N >= 4: r3 ~= 1.5 1e-6", 3, &ck, err, sizeof err), 0, "%s", err);
+    ie_expr_free(ck.index);
+    ie_expr_free(ck.expect);
+    cr_expect_eq(ie_parse_check(" if N >= 4: r3 ~= 1.5 1e-6", 3, &ck, err, sizeof err), 0, "%s", err);
     cr_expect_eq(ck.kind, X_SREG);
     cr_expect_eq(ck.op, OP_APPROX);
     cr_expect_not_null(ck.tol);
     cr_expect_not_null(ck.guard);
     cr_expect(!ck.per_lane);
-    expr_free(ck.guard);
-    expr_free(ck.expect);
-    expr_free(ck.tol);
-    cr_expect_eq(parse_check(" trap \"divu\" \"x.s:3\"", 3, &ck, err, sizeof err), 0, "%s", err);
+    ie_expr_free(ck.guard);
+    ie_expr_free(ck.expect);
+    ie_expr_free(ck.tol);
+    cr_expect_eq(ie_parse_check(" trap \"divu\" \"x.s:3\"", 3, &ck, err, sizeof err), 0, "%s", err);
     cr_expect_eq(ck.nsub, 2);
     cr_expect_str_eq(ck.subs[1], "x.s:3");
-    cr_expect_eq(parse_check(" mem idm[4*l] == l", 3, &ck, err, sizeof err), 0, "%s", err);
+    cr_expect_eq(ie_parse_check(" mem idm[4*l] == l", 3, &ck, err, sizeof err), 0, "%s", err);
     cr_expect_eq(ck.kind, X_MEM);
     cr_expect_eq(ck.reg, CORE_MEM_IDM);
-    expr_free(ck.index);
-    expr_free(ck.expect);
-    cr_expect_eq(parse_check(" m1 == 3", 3, &ck, err, sizeof err), 0, "%s", err);
+    ie_expr_free(ck.index);
+    ie_expr_free(ck.expect);
+    cr_expect_eq(ie_parse_check(" m1 == 3", 3, &ck, err, sizeof err), 0, "%s", err);
     cr_expect_eq(ck.kind, X_MASK);
-    expr_free(ck.expect);
-    cr_expect_eq(parse_check(" r3 = 7", 3, &ck, err, sizeof err), -1);
-    cr_expect_eq(parse_check(" r32 == 7", 3, &ck, err, sizeof err), -1);
-    cr_expect_eq(parse_check(" m1 ==f 1.0", 3, &ck, err, sizeof err), -1);
-    cr_expect_eq(parse_check(" r3 ~= 1.5", 3, &ck, err, sizeof err), -1);
-    cr_expect_eq(parse_check(" r3 == (1", 3, &ck, err, sizeof err), -1);
+    ie_expr_free(ck.expect);
+    cr_expect_eq(ie_parse_check(" r3 = 7", 3, &ck, err, sizeof err), -1);
+    cr_expect_eq(ie_parse_check(" r32 == 7", 3, &ck, err, sizeof err), -1);
+    cr_expect_eq(ie_parse_check(" m1 ==f 1.0", 3, &ck, err, sizeof err), -1);
+    cr_expect_eq(ie_parse_check(" r3 ~= 1.5", 3, &ck, err, sizeof err), -1);
+    cr_expect_eq(ie_parse_check(" r3 == (1", 3, &ck, err, sizeof err), -1);
 }
