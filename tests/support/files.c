@@ -91,3 +91,17 @@ void tu_remove_tree(const char *dir)
 {
     nftw(dir, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
 }
+
+void tu_make_tmpdir(char *dir, size_t len, const char *tag)
+{
+    snprintf(dir, len, "/tmp/sfsim-%s-XXXXXX", tag);
+    cr_assert_not_null(mkdtemp(dir), "cannot create a temporary folder from %s", dir);
+}
+
+void tu_write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    cr_assert_not_null(f, "cannot create %s", path);
+    cr_assert_geq(fputs(text, f), 0, "cannot write %s", path);
+    cr_assert_eq(fclose(f), 0, "cannot write %s", path);
+}

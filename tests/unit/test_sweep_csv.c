@@ -18,20 +18,6 @@
 
 /* ---- helpers ------------------------------------------------------------------------------------ */
 
-static void make_tmpdir(char *dir, size_t len)
-{
-    snprintf(dir, len, "/tmp/sfsim-sweepcsv-XXXXXX");
-    cr_assert_not_null(mkdtemp(dir));
-}
-
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    cr_assert_not_null(f, "cannot create %s", path);
-    fputs(text, f);
-    fclose(f);
-}
-
 static char *name_of(int m)
 {
     static char buf[8][64];
@@ -70,7 +56,7 @@ static SweepRow read_report(const char *dir, const char *json)
 {
     char path[256], err[512] = "";
     snprintf(path, sizeof path, "%s/report.json", dir);
-    write_file(path, json);
+    tu_write_file(path, json);
     SweepRow row;
     memset(&row, 0, sizeof row);
     cr_assert_eq(sweep_row_read_report(&row, path, err, sizeof err), 0, "%s", err);
@@ -160,7 +146,7 @@ Test(sweep_columns, every_name_is_different)
 Test(sweep_report, figures_are_read_at_their_paths)
 {
     char dir[64];
-    make_tmpdir(dir, sizeof dir);
+    tu_make_tmpdir(dir, sizeof dir, "sweepcsv");
     SweepRow row = read_report(dir, "{\"cycles\": 123456, \"busy_cycles\": 100000, \"fps\": 12.5,"
                                     " \"fps_ci95\": [11, 14],"
                                     " \"utilization\": {\"traversal\": 0.5, \"shading\": 0.25, \"other\": 1},"
@@ -197,7 +183,7 @@ Test(sweep_report, figures_are_read_at_their_paths)
 Test(sweep_report, operation_counts_become_shares)
 {
     char dir[64];
-    make_tmpdir(dir, sizeof dir);
+    tu_make_tmpdir(dir, sizeof dir, "sweepcsv");
     SweepRow row = read_report(dir, "{\"ops\": {\"load\": 10, \"store\": 30, \"compute\": 60}}");
     cr_expect_float_eq(row.m[column("ops_share_load")], 0.1, 1e-15);
     cr_expect_float_eq(row.m[column("ops_share_store")], 0.3, 1e-15);
@@ -213,7 +199,7 @@ Test(sweep_report, operation_counts_become_shares)
 Test(sweep_report, values_of_the_wrong_kind_are_left_out)
 {
     char dir[64];
-    make_tmpdir(dir, sizeof dir);
+    tu_make_tmpdir(dir, sizeof dir, "sweepcsv");
     /* an interval of 3 numbers is not one; a string or null is no number; utilization not an object */
     SweepRow row = read_report(dir, "{\"cycles\": \"12\", \"fps\": null, \"fps_ci95\": [1, 2, 3], \"utilization\": 0.5,"
                                     " \"rays\": [10]}");
@@ -225,9 +211,9 @@ Test(sweep_report, values_of_the_wrong_kind_are_left_out)
 Test(sweep_report, a_report_that_is_no_object_is_an_error)
 {
     char dir[64], path[256], err[512] = "", want[512];
-    make_tmpdir(dir, sizeof dir);
+    tu_make_tmpdir(dir, sizeof dir, "sweepcsv");
     snprintf(path, sizeof path, "%s/report.json", dir);
-    write_file(path, "[1, 2]");
+    tu_write_file(path, "[1, 2]");
     SweepRow row;
     memset(&row, 0, sizeof row);
     cr_expect_eq(sweep_row_read_report(&row, path, err, sizeof err), -1);
@@ -276,22 +262,22 @@ static void csv_sweep(const char *dir, SweepPlan *pl)
         cr_assert_eq(util_mkdir_p(path, err, sizeof err), 0, "%s", err);
     }
     snprintf(path, sizeof path, "%s/points/000/done", dir);
-    write_file(path, "exit_status 0\nhost_seconds 1.5\n");
+    tu_write_file(path, "exit_status 0\nhost_seconds 1.5\n");
     snprintf(path, sizeof path, "%s/points/000/report.json", dir);
-    write_file(path, "{\"cycles\": 1234567, \"fps\": 12.345678901234, \"utilization\": {\"traversal\": 0.5},"
+    tu_write_file(path, "{\"cycles\": 1234567, \"fps\": 12.345678901234, \"utilization\": {\"traversal\": 0.5},"
                      " \"ops\": {\"load\": 1, \"store\": 3}, \"host\": {\"seconds\": 1.25}}");
     snprintf(path, sizeof path, "%s/points/001/failed", dir);
-    write_file(path, "exit_status 1\nhost_seconds 0.5\nerror exit 1: bad value, \"8\" is no width\n");
+    tu_write_file(path, "exit_status 1\nhost_seconds 0.5\nerror exit 1: bad value, \"8\" is no width\n");
     snprintf(path, sizeof path, "%s/points/001/report.json", dir); /* a failed point's figures are not read */
-    write_file(path, "{\"cycles\": 99}");
+    tu_write_file(path, "{\"cycles\": 99}");
     snprintf(path, sizeof path, "%s/points/003/done", dir);
-    write_file(path, "exit_status 0\nhost_seconds 1\n");
+    tu_write_file(path, "exit_status 0\nhost_seconds 1\n");
 }
 
 Test(sweep_csv, rows_hold_keys_status_error_and_figures)
 {
     char dir[64], path[256], err[512] = "";
-    make_tmpdir(dir, sizeof dir);
+    tu_make_tmpdir(dir, sizeof dir, "sweepcsv");
     SweepPlan pl;
     csv_sweep(dir, &pl);
     int nd, nf, nu;
@@ -358,7 +344,7 @@ Test(sweep_csv, named_points_give_their_name_and_numbers_keep_their_precision)
     cr_expect_str_eq(buf, "1e+15", "integers from 1e15 on are printed as other numbers");
 
     char dir[64], path[256], err[512] = "";
-    make_tmpdir(dir, sizeof dir);
+    tu_make_tmpdir(dir, sizeof dir, "sweepcsv");
     cJSON *m = cJSON_Parse("{\"format\": \"sfsim sweep 1\", \"config\": null, \"config_contents\": null,"
                            " \"sweep_file\": \"/s.ini\", \"sweep_contents\": \"\", \"scene\": \"/x\", \"mode\": \"detailed\","
                            " \"sample\": null, \"sets\": [], \"kind\": \"points\", \"points\": ["

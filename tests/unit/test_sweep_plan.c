@@ -49,27 +49,13 @@ static char *settings_line(const cJSON *points, int p)
     return buf;
 }
 
-static void make_tmpdir(char *dir, size_t len)
-{
-    snprintf(dir, len, "/tmp/sfsim-sweeptest-XXXXXX");
-    cr_assert_not_null(mkdtemp(dir));
-}
-
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    cr_assert_not_null(f, "cannot create %s", path);
-    fputs(text, f);
-    fclose(f);
-}
-
 /* The manifest `sfsim sweep --sweep DIR/s.ini -s DIR/s.ini` builds for a sweep file's text, with
  * mode and --sets as given (the scene is only resolved to its path, so the sweep file serves). */
 static cJSON *manifest(const char *dir, const char *text, const char *mode, const char **sets, int nsets)
 {
     char path[256];
     snprintf(path, sizeof path, "%s/s.ini", dir);
-    write_file(path, text);
+    tu_write_file(path, text);
     SweepArgs a;
     memset(&a, 0, sizeof a);
     a.sweep = path;
@@ -203,7 +189,7 @@ Test(sweep_expand, too_many_points_is_refused_before_any_value_is_made)
 Test(sweep_plan, keys_in_order_of_appearance_and_values_per_point)
 {
     char dir[64];
-    make_tmpdir(dir, sizeof dir);
+    tu_make_tmpdir(dir, sizeof dir, "sweeptest");
     SweepPlan pl;
     load(manifest(dir, "[point.a]\nstream.rays = 4096\n[point.b]\ncore.simd_width = 8\nstream.rays = 1024\n", "detailed",
                   NULL, 0),
@@ -230,7 +216,7 @@ Test(sweep_plan, keys_in_order_of_appearance_and_values_per_point)
 Test(sweep_plan, point_folders_have_enough_digits)
 {
     char dir[64];
-    make_tmpdir(dir, sizeof dir);
+    tu_make_tmpdir(dir, sizeof dir, "sweeptest");
     SweepPlan pl;
     load(manifest(dir, "[sweep]\nrender.seed = 1..1000\n", "functional", NULL, 0), &pl);
     cr_assert_eq(pl.npoints, 1000);
@@ -270,7 +256,7 @@ Test(sweep_plan, a_manifest_of_another_kind_is_refused)
 Test(sweep_diff, the_same_sweep_has_no_differences)
 {
     char dir[64];
-    make_tmpdir(dir, sizeof dir);
+    tu_make_tmpdir(dir, sizeof dir, "sweeptest");
     const char *text = "[sweep]\ncore.simd_width = 4, 8\n";
     const char *sets[] = {"render.spp=1"};
     SweepPlan a, b;
@@ -285,7 +271,7 @@ Test(sweep_diff, the_same_sweep_has_no_differences)
 Test(sweep_diff, each_defining_argument_is_named)
 {
     char dir[64];
-    make_tmpdir(dir, sizeof dir);
+    tu_make_tmpdir(dir, sizeof dir, "sweeptest");
     const char *text = "[sweep]\ncore.simd_width = 4, 8\n";
     const char *sets[] = {"render.spp=1", "render.width=32"};
     SweepPlan a, b;
@@ -310,7 +296,7 @@ Test(sweep_diff, each_defining_argument_is_named)
 Test(sweep_diff, changed_points_alone_are_named_too)
 {
     char dir[64];
-    make_tmpdir(dir, sizeof dir);
+    tu_make_tmpdir(dir, sizeof dir, "sweeptest");
     SweepPlan a, b;
     cJSON *m = manifest(dir, "[sweep]\ncore.simd_width = 4, 8\n", "detailed", NULL, 0);
     cJSON *m2 = cJSON_Duplicate(m, 1);
@@ -329,7 +315,7 @@ Test(sweep_diff, changed_points_alone_are_named_too)
 Test(sweep_diff, a_folder_holding_another_sweep_is_refused)
 {
     char dir[64], out[128];
-    make_tmpdir(dir, sizeof dir);
+    tu_make_tmpdir(dir, sizeof dir, "sweeptest");
     snprintf(out, sizeof out, "%s/out", dir);
     const char *text = "[sweep]\ncore.simd_width = 4, 8\n";
     SweepPlan a, b;
@@ -372,22 +358,22 @@ static void resume_folder(const char *dir, SweepPlan *pl)
         cr_assert_eq(util_mkdir_p(path, err, sizeof err), 0, "%s", err);
     }
     snprintf(path, sizeof path, "%s/points/000/done", dir);
-    write_file(path, "exit_status 0\nhost_seconds 2.500\n");
+    tu_write_file(path, "exit_status 0\nhost_seconds 2.500\n");
     snprintf(path, sizeof path, "%s/points/001/failed", dir);
-    write_file(path, "exit_status 1\nhost_seconds 1.000\nerror exit 1: boom\n--- the last lines of log.txt ---\n"
+    tu_write_file(path, "exit_status 1\nhost_seconds 1.000\nerror exit 1: boom\n--- the last lines of log.txt ---\n"
                      "error not this line\n");
     snprintf(path, sizeof path, "%s/points/002/log.txt", dir);
-    write_file(path, "rendering...\n");
+    tu_write_file(path, "rendering...\n");
     snprintf(path, sizeof path, "%s/points/004/done", dir);
-    write_file(path, "exit_status 0\nhost_seconds 3.500\n");
+    tu_write_file(path, "exit_status 0\nhost_seconds 3.500\n");
     snprintf(path, sizeof path, "%s/points/005/failed", dir);
-    write_file(path, "exit_status signal 9\n");
+    tu_write_file(path, "exit_status signal 9\n");
 }
 
 Test(sweep_resume, each_point_state_is_read_from_its_markers)
 {
     char dir[64];
-    make_tmpdir(dir, sizeof dir);
+    tu_make_tmpdir(dir, sizeof dir, "sweeptest");
     SweepPlan pl;
     resume_folder(dir, &pl);
     static const int want[] = {SWEEP_DONE, SWEEP_FAILED, SWEEP_UNFINISHED, SWEEP_UNFINISHED, SWEEP_DONE, SWEEP_FAILED};
@@ -412,7 +398,7 @@ Test(sweep_resume, each_point_state_is_read_from_its_markers)
 Test(sweep_resume, unfinished_and_new_points_run_finished_ones_are_kept)
 {
     char dir[64];
-    make_tmpdir(dir, sizeof dir);
+    tu_make_tmpdir(dir, sizeof dir, "sweeptest");
     SweepPlan pl;
     resume_folder(dir, &pl);
     int todo[6];
@@ -432,7 +418,7 @@ Test(sweep_resume, unfinished_and_new_points_run_finished_ones_are_kept)
 Test(sweep_resume, retry_failed_runs_the_failed_points_again)
 {
     char dir[64];
-    make_tmpdir(dir, sizeof dir);
+    tu_make_tmpdir(dir, sizeof dir, "sweeptest");
     SweepPlan pl;
     resume_folder(dir, &pl);
     int todo[6];
@@ -453,11 +439,11 @@ Test(sweep_resume, retry_failed_runs_the_failed_points_again)
 Test(sweep_resume, a_done_marker_wins_over_a_failed_one)
 {
     char dir[64], path[256];
-    make_tmpdir(dir, sizeof dir);
+    tu_make_tmpdir(dir, sizeof dir, "sweeptest");
     SweepPlan pl;
     resume_folder(dir, &pl);
     snprintf(path, sizeof path, "%s/points/001/done", dir);
-    write_file(path, "exit_status 0\nhost_seconds 4\n");
+    tu_write_file(path, "exit_status 0\nhost_seconds 4\n");
     double secs;
     cr_expect_eq(sweep_point_state(&pl, dir, 1, &secs, NULL), SWEEP_DONE);
     cr_expect_float_eq(secs, 4.0, 1e-9);
