@@ -21,6 +21,7 @@
 
 #include "run/kernel.h"
 #include "run/tiles.h"
+#include "run/timedcore.h"
 
 const char *const func_kd_kind_keys[FUNC_KD_KINDS] = {"camera", "indirect", "shadow"};
 const char *const func_kd_counter_keys[FUNC_KD_COUNTERS] = {"nodes", "leaves", "prims", "restarts", "overflows",
@@ -43,9 +44,8 @@ typedef struct Job {
 
 typedef struct Worker {
     Job *job;
-    Core *core;
+    TimedCore tc;              /* the core; its timing model in the timed modes */
     FuncStats st;
-    Timing *tm;                /* detailed mode */
     int tile_timed;            /* the current tile is timed (every tile, or the sample) */
 } Worker;
 
@@ -90,12 +90,12 @@ static void fail(Job *j, const char *msg, int trapped)
 /* Detailed mode: start a cold machine for one tile or batch. */
 static void timing_begin(Worker *w, Core *c, uint32_t t, TimingStats *before)
 {
-    w->tile_timed = w->tm && (!w->job->sel || w->job->sel[t]);
-    if (w->tm)
-        core_set_hook(c, w->tile_timed ? timing_hook : NULL, w->tile_timed ? w->tm : NULL);
+    w->tile_timed = w->tc.tm && (!w->job->sel || w->job->sel[t]);
+    if (w->tc.tm)
+        core_set_hook(c, w->tile_timed ? timing_hook : NULL, w->tile_timed ? w->tc.tm : NULL);
     if (w->tile_timed) {
-        timing_reset(w->tm);
-        *before = *timing_stats(w->tm);
+        timing_reset(w->tc.tm);
+        *before = *timing_stats(w->tc.tm);
     }
 }
 
@@ -105,16 +105,16 @@ static int timing_close(Worker *w, const TimingStats *before, FuncTile *ft)
     if (!w->tile_timed)
         return 0;
     ft->sampled = 1;
-    timing_end(w->tm);
-    const TimingStats *s = timing_stats(w->tm);
+    timing_end(w->tc.tm);
+    const TimingStats *s = timing_stats(w->tc.tm);
     if (ft) {
         ft->cycles = s->cycles - before->cycles;
         ft->busy = s->busy - before->busy;
         for (int c = 0; c < TM_CAUSE_COUNT; c++)
             ft->stalls[c] = s->stalls[c] - before->stalls[c];
     }
-    if (timing_error(w->tm)) {
-        fail(w->job, timing_error(w->tm), 0);
+    if (timing_error(w->tc.tm)) {
+        fail(w->job, timing_error(w->tc.tm), 0);
         return -1;
     }
     return 0;
@@ -290,25 +290,14 @@ static int worker_begin(void *ctx, int index)
     Worker *w = &j->workers[index];
     char err[512], msg[600];
     w->job = j;
-    w->core = core_new(&j->k->cp, &j->k->obj, err, sizeof err);
-    if (!w->core) {
-        snprintf(msg, sizeof msg, "kernel: %s", err);
+    int rc = timedcore_open(&w->tc, j->fp->cfg, &j->k->obj, j->fp->timed, err, sizeof err);
+    if (rc != 0) {
+        snprintf(msg, sizeof msg, "%s: %s", rc == -2 ? "timing model" : "kernel", err);
         fail(j, msg, 0);
         return -1;
     }
-    if (j->fp->timed) {
-        TimingParams tp;
-        timing_params(j->fp->cfg, &tp);
-        w->tm = timing_new(&tp, err, sizeof err);
-        if (!w->tm) {
-            snprintf(msg, sizeof msg, "timing model: %s", err);
-            fail(j, msg, 0);
-            return -1;
-        }
-        core_set_hook(w->core, timing_hook, w->tm);
-    }
     uint32_t size;
-    uint8_t *sm = core_mem(w->core, CORE_MEM_SCENE, &size);
+    uint8_t *sm = core_mem(w->tc.core, CORE_MEM_SCENE, &size);
     memcpy(sm, j->p->mem, j->p->size);
     return 0;
 }
@@ -317,24 +306,20 @@ static int worker_tile(void *ctx, int index, uint32_t t)
 {
     Job *j = ctx;
     Worker *w = &j->workers[index];
-    return run_tile(w, w->core, t, &w->st);
+    return run_tile(w, w->tc.core, t, &w->st);
 }
 
 static void worker_end(void *ctx, int index)
 {
     Job *j = ctx;
     Worker *w = &j->workers[index];
-    if (w->core) {
-        w->st.core = *core_stats(w->core);
-        w->st.instructions = core_instructions(w->core);
+    if (w->tc.core) {
+        w->st.core = *core_stats(w->tc.core);
+        w->st.instructions = core_instructions(w->tc.core);
     }
-    if (w->tm) {
-        w->st.timing = *timing_stats(w->tm);
-        timing_free(w->tm);
-        w->tm = NULL;
-    }
-    core_free(w->core);
-    w->core = NULL;
+    if (w->tc.tm)
+        w->st.timing = *timing_stats(w->tc.tm);
+    timedcore_close(&w->tc);
 }
 
 /* The workers' counters, summed in worker order (the totals do not depend on which thread ran

@@ -20,6 +20,7 @@
 #include "exithelp.h"
 #include "img.h"
 #include "render.h"
+#include "run/timedcore.h"
 #include "stats.h"
 #include "sweep/sweep.h"
 #include "timing.h"
@@ -425,25 +426,18 @@ static int cmd_exec(int argc, char **argv)
         fprintf(stderr, "sfsim exec: %s\n", err);
         return EXIT_INPUT;
     }
-    Core *c = core_new(&cp, &obj, err, sizeof err);
-    if (!c) {
-        fprintf(stderr, "sfsim exec: %s: %s\n", prog, err);
+    TimedCore tc;
+    int orc = timedcore_open(&tc, &cfg, &obj, timed, err, sizeof err);
+    if (orc != 0) {
+        if (orc == -2)
+            fprintf(stderr, "sfsim exec: %s\n", err);
+        else
+            fprintf(stderr, "sfsim exec: %s: %s\n", prog, err);
         asm_object_free(&obj);
         return EXIT_INPUT;
     }
-    Timing *tm = NULL;
-    if (timed) {
-        TimingParams tp;
-        timing_params(&cfg, &tp);
-        tm = timing_new(&tp, err, sizeof err);
-        if (!tm) {
-            fprintf(stderr, "sfsim exec: %s\n", err);
-            core_free(c);
-            asm_object_free(&obj);
-            return EXIT_INPUT;
-        }
-        core_set_hook(c, timing_hook, tm);
-    }
+    Core *c = tc.core;
+    Timing *tm = tc.tm;
     double t0 = util_now();
     CoreExit ex = run_with_progress(c, (uint64_t)cfg.sim_max_instructions, progress);
     double secs = util_now() - t0;
@@ -461,7 +455,6 @@ static int cmd_exec(int argc, char **argv)
     if (tm) {
         if (print_timing(timing_stats(tm), &cfg, timing_error(tm)))
             rc = EXIT_PROGRAM;
-        timing_free(tm);
     }
     if (ex == CORE_EXIT_LIMIT) {
         fprintf(stderr, "sfsim exec: %s\n", core_trap_message(c));
@@ -470,7 +463,7 @@ static int cmd_exec(int argc, char **argv)
         fprintf(stderr, "sfsim exec: %s\n", core_trap_message(c));
         rc = EXIT_PROGRAM;
     }
-    core_free(c);
+    timedcore_close(&tc);
     asm_object_free(&obj);
     return rc;
 }
@@ -677,7 +670,6 @@ static int cmd_run(int argc, char **argv)
     CfgMachine cfg;
     if (build_config(&ca, &cfg))
         return EXIT_INPUT;
-    o.stream_rays = cfg.stream_rays;
     o.cfg = &cfg;
     o.config_path = ca.path;
     static char err[65536];

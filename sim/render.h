@@ -13,7 +13,6 @@
 typedef struct RenderOptions {
     const char *scene_path;    /* .gltf/.glb or scene.ini */
     const char *out_dir;       /* created if missing, once there is something to write */
-    int stream_rays;           /* M: 1024 or 4096; the tile is sqrt(M) x sqrt(M) pixels */
     uint32_t seed;
     int threads;               /* host threads; 0 = all cores */
     int width, height, spp, max_depth; /* overrides of the scene's [render]; -1 = keep */

@@ -11,7 +11,6 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "../scenes/pack.h"
 #include "config.h"
 #include "raybatch.h"
 #include "timing.h"
@@ -32,13 +31,6 @@ typedef struct TraceSummary {
     int timed;                    /* detailed mode: timing holds the cycles of all batches */
     TimingStats timing;
 } TraceSummary;
-
-/* Trace a batch with either engine (no files): hits[i] for batch ray i. In detailed mode the
- * kernel is timed and *timing (if not NULL) receives the cycles. 0, -1 (input) or -2 (the kernel
- * failed). */
-int trace_batch_run(const PackedScene *p, uint32_t needs, const RayBatch *b, BatchHit *hits, const char *mode,
-                    const CfgMachine *cfg, const char *kernel_path, int threads, uint64_t *sim_instructions,
-                    TimingStats *timing, char *err, size_t errlen);
 
 /* The whole command: 0, -1 with a message naming the file or key, -2 when the kernel failed, -3
  * when the hit file could not be written (checked before any work; written whole or not at all). */

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "../../sim/config.h"
+#include "../../sim/run/run.h"
 #include "../../sim/trace.h"
 
 void mesh_init(Mesh *m) { memset(m, 0, sizeof *m); }
@@ -277,9 +278,10 @@ uint32_t trace_both(const PackedScene *p, uint32_t needs, const RayBatch *b, int
     *rh = calloc(b->count ? b->count : 1, sizeof(BatchHit));
     cr_assert(*kh && *rh);
     static char err[65536];
-    cr_assert_eq(trace_batch_run(p, needs, b, *kh, "functional", &cfg, "kernels/pathtrace.s", 2, NULL, NULL, err, sizeof err),
-                 0, "%s", err);
-    cr_assert_eq(trace_batch_run(p, needs, b, *rh, "reference", &cfg, NULL, 1, NULL, NULL, err, sizeof err), 0, "%s", err);
+    RunSpec kspec = {.mode = RUN_FUNCTIONAL, .cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .threads = 2};
+    RunSpec rspec = {.mode = RUN_REFERENCE, .cfg = &cfg, .threads = 1};
+    cr_assert_eq(run_trace(p, needs, &kspec, b, *kh, NULL, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(run_trace(p, needs, &rspec, b, *rh, NULL, err, sizeof err), 0, "%s", err);
     uint32_t differ = 0;
     for (uint32_t i = 0; i < b->count; i++)
         if (memcmp(&(*kh)[i], &(*rh)[i], sizeof(BatchHit)) != 0)

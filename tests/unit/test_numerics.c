@@ -14,6 +14,7 @@
 #include "../../sim/reference.h"
 #include "../../sim/ref_trace.h"
 #include "../../sim/run/accel.h"
+#include "../../sim/run/run.h"
 #include "../../sim/trace.h"
 #include "../support/numerics.h"
 
@@ -398,8 +399,8 @@ Test(numerics, rays_leaving_a_large_triangle_do_not_hit_it, .timeout = 120)
                           "kd.traversal=packet", "kd.traversal=stream"};
     for (int v = 0; v < 5; v++) {
         cr_assert_eq(cfg_set(&cfg, trav[v], &ce), 0);
-        cr_assert_eq(trace_batch_run(&p, s.needs, &bt, kh, "functional", &cfg, "kernels/pathtrace.s", 2, NULL, NULL, err,
-                                     sizeof err), 0, "%s", err);
+        RunSpec spec = {.mode = RUN_FUNCTIONAL, .cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .threads = 2};
+        cr_assert_eq(run_trace(&p, s.needs, &spec, &bt, kh, NULL, err, sizeof err), 0, "%s", err);
         for (uint32_t i = 0; i < bt.count; i++)
             kdhits += bt.rays[i].query == RAY_ANY ? kh[i].prim == 1 : kh[i].prim != UINT32_MAX;
     }

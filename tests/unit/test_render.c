@@ -17,6 +17,7 @@
 #include "../../scenes/scene.h"
 #include "../../sim/config.h"
 #include "../../sim/render.h"
+#include "../../sim/run/run.h"
 #include "../../sim/trace.h"
 #include "../support/files.h"
 
@@ -56,7 +57,6 @@ static cJSON *run(const CfgMachine *cfg, const char *kernel, char **txt)
     o.mode = "functional";
     o.cfg = cfg;
     o.kernel_path = kernel;
-    o.stream_rays = cfg->stream_rays;
     o.width = 128;
     o.height = 64;
     o.spp = 1;
@@ -286,7 +286,7 @@ Test(render, trace_of_zero_rays_in_every_mode, .timeout = 120)
     cfg_defaults(&cfg);
     static const unsigned char header[16] = "SFRAYS1";
     static const char *const sources[] = {"", "# comments only\n\n  # and blanks\n"};
-    static const char *const modes[] = {"functional", "detailed", "reference"};
+    static const RunMode modes[] = {RUN_FUNCTIONAL, RUN_DETAILED, RUN_REFERENCE};
     for (int k = 0; k < 3; k++) {
         RayBatch b;
         memset(&b, 0, sizeof b);
@@ -296,15 +296,16 @@ Test(render, trace_of_zero_rays_in_every_mode, .timeout = 120)
         cr_assert_eq(b.count, 0u);
         BatchHit hit;
         for (int m = 0; m < 3; m++) {
-            uint64_t ninstr = 1;
-            TimingStats ts;
-            memset(&ts, 0xff, sizeof ts);
-            int rc = trace_batch_run(&p, s.needs, &b, &hit, modes[m], &cfg, "kernels/pathtrace.s", 2, &ninstr, &ts,
-                                     err, sizeof err);
-            cr_expect_eq(rc, 0, "input %d, %s: %s", k, modes[m], err);
-            cr_expect_eq(ninstr, 0u, "input %d, %s: %llu instructions", k, modes[m], (unsigned long long)ninstr);
+            RunTrace rt;
+            memset(&rt, 0xff, sizeof rt);
+            RunSpec spec = {.mode = modes[m], .cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .threads = 2};
+            int rc = run_trace(&p, s.needs, &spec, &b, &hit, &rt, err, sizeof err);
+            const char *mn = run_mode_names[modes[m]];
+            cr_expect_eq(rc, 0, "input %d, %s: %s", k, mn, err);
+            cr_expect_eq(rt.instructions, 0u, "input %d, %s: %llu instructions", k, mn,
+                         (unsigned long long)rt.instructions);
             if (m == 1)
-                cr_expect_eq(ts.cycles, 0u, "0 rays, %llu cycles", (unsigned long long)ts.cycles);
+                cr_expect_eq(rt.timing.cycles, 0u, "0 rays, %llu cycles", (unsigned long long)rt.timing.cycles);
         }
         raybatch_free(&b);
     }

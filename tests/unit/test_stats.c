@@ -191,7 +191,6 @@ Test(stats, csv_reads_a_real_report)
     o.mode = "detailed";
     o.cfg = &cfg;
     o.kernel_path = "tests/unit/kd_stub.s";
-    o.stream_rays = 1024;
     o.width = o.height = 64;
     o.spp = 1;
     o.threads = 2;

@@ -1,0 +1,32 @@
+/* sim/report.h -- report.json and report.txt of one `sfsim run` (docs/report.md).
+ *
+ * Owns: their content. Must not: write files (sim/render.c stages and commits them).
+ */
+#ifndef SFSIM_REPORT_H
+#define SFSIM_REPORT_H
+
+#include <stddef.h>
+
+#include "config.h"
+#include "render.h"
+#include "run/run.h"
+
+struct cJSON;
+
+/* A finished run, as the report files describe it. */
+typedef struct Report {
+    const RenderOptions *o;    /* as the user asked: mode name, scene and config paths, seed, sample */
+    RunMode mode;
+    const CfgMachine *cfg;     /* the machine as used */
+    const RunScene *sc;
+    const RunFrame *fr;
+    double mean;               /* of the image's finite values */
+    long nonfinite;
+} Report;
+
+/* report.json; NULL when out of memory. */
+struct cJSON *report_json(const Report *r);
+/* report.txt into txt (truncated to cap). */
+void report_txt(const Report *r, char *txt, size_t cap);
+
+#endif

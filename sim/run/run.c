@@ -1,0 +1,254 @@
+/* sim/run/run.c -- the entry point of every simulation (run.h): a scene opened for a machine, then
+ * a frame or a ray batch in one of the modes.
+ *
+ * Owns: the mode names, the render settings' checks, the engine for each mode, and the defaults.
+ * Must not: write files, or render or trace itself (sim/functional.c, sim/reference.c and
+ * sim/ref_trace.c do).
+ */
+#include "run.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "../reference.h"
+#include "../ref_trace.h"
+#include "../util.h"
+#include "kernel.h"
+#include "tiles.h"
+
+const char *const run_mode_names[RUN_MODE_COUNT] = {"reference", "functional", "detailed", "sampled"};
+
+int run_mode_parse(const char *name, RunMode *mode)
+{
+    for (int m = 0; m < RUN_MODE_COUNT; m++)
+        if (name && !strcmp(name, run_mode_names[m])) {
+            *mode = (RunMode)m;
+            return 0;
+        }
+    return -1;
+}
+
+/* The caller's size over the scene's [render], and the ranges a frame needs. */
+static int impose_size(Scene *s, const RunSize *z, char *err, size_t errlen)
+{
+    if (z->width > 0)
+        s->render.width = z->width;
+    if (z->height > 0)
+        s->render.height = z->height;
+    if (z->spp > 0)
+        s->render.spp = z->spp;
+    if (z->max_depth >= 0)
+        s->render.max_depth = z->max_depth;
+    if (s->render.width < 1 || s->render.height < 1 || s->render.width > 16384 || s->render.height > 16384) {
+        snprintf(err, errlen, "render size %d x %d out of range (1..16384)", s->render.width, s->render.height);
+        return -1;
+    }
+    if (s->render.spp < 1 || s->render.spp > 1 << 20) {
+        snprintf(err, errlen, "render.spp %d out of range (1..1048576)", s->render.spp);
+        return -1;
+    }
+    if (s->render.max_depth < 0 || s->render.max_depth >= REF_MAX_GENERATIONS) {
+        snprintf(err, errlen, "render.max_depth %d out of range (0..%d)", s->render.max_depth,
+                 REF_MAX_GENERATIONS - 1);
+        return -1;
+    }
+    return 0;
+}
+
+int run_scene_open(RunScene *sc, const char *path, const RunSize *size, const CfgMachine *cfg, RunMode mode,
+                   const char *who, char *err, size_t errlen)
+{
+    memset(sc, 0, sizeof *sc);
+    CfgMachine defcfg;
+    if (!cfg) {
+        cfg_defaults(&defcfg);
+        cfg = &defcfg;
+    }
+    double t0 = util_now();
+    if (scene_load(path, &sc->s, err, errlen) != 0)
+        return -1;
+    for (uint32_t i = 0; who && i < sc->s.nwarnings; i++) /* what the scene left out (docs/scenes.md) */
+        fprintf(stderr, "%s: warning: %s\n", who, sc->s.warnings[i]);
+    if (size && impose_size(&sc->s, size, err, errlen) != 0)
+        return -1;
+    sc->load_seconds = util_now() - t0;
+    return accel_pack(&sc->s, cfg, run_mode_kernel(mode), &sc->p, &sc->accel, err, errlen);
+}
+
+void run_scene_close(RunScene *sc)
+{
+    pack_free(&sc->p);
+    scene_free(&sc->s);
+    memset(sc, 0, sizeof *sc);
+}
+
+/* The golden model's frame. */
+static int golden_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg, RunFrame *fr, char *err,
+                        size_t errlen)
+{
+    /* The golden model renders the path tracer and the Phong workload; the forced specular and
+     * diffuse workloads exist only as kernel variants (docs/kernel.md). */
+    if (cfg->workload_kind != CFG_WORKLOAD_PATH && cfg->workload_kind != CFG_WORKLOAD_PHONG) {
+        snprintf(err, errlen, "--mode reference: workload.kind = %s has no golden model (path and phong do)",
+                 cfg_enum_name("workload", "kind", cfg->workload_kind));
+        return -1;
+    }
+    RefParams rp = {.tile = fr->tile, .seed = spec->seed, .threads = fr->threads, .progress = spec->progress,
+                    .progress_ctx = spec->progress_ctx, .bounces = cfg->workload_bounces,
+                    .workload = cfg->workload_kind == CFG_WORKLOAD_PHONG ? REF_WORKLOAD_PHONG : REF_WORKLOAD_PATH};
+    RefStats st;
+    if (ref_render(&sc->p, &rp, fr->rgb, &st, err, errlen) != 0)
+        return -1;
+    stats_run_from_ref(&fr->run, &st);
+    return 0;
+}
+
+/* The kernel's frame, timed as the mode says. */
+static int kernel_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg, RunFrame *fr, char *err,
+                        size_t errlen)
+{
+    char kpath[4200];
+    FuncParams fp = {.cfg = cfg,
+                     .kernel_path = spec->kernel_path ? spec->kernel_path : kernel_default_path(kpath, sizeof kpath),
+                     .needs = sc->s.needs,
+                     .seed = spec->seed,
+                     .threads = fr->threads,
+                     .progress = spec->progress,
+                     .progress_ctx = spec->progress_ctx,
+                     .timed = run_mode_timed(spec->mode),
+                     .sample = spec->mode == RUN_SAMPLED ? spec->sample : 0.0,
+                     .sample_seed = spec->sample_seed};
+    int rc = func_render(&sc->p, &fp, fr->rgb, &fr->f, err, errlen);
+    if (rc != 0)
+        return rc;
+    if (spec->mode == RUN_SAMPLED) {
+        /* The frame's cycles from the sampled tiles (sim/sampling.h). */
+        if (stats_sample_estimate(&fr->f, &fr->est) != 0) {
+            snprintf(err, errlen, "sampled mode: cannot estimate from %u sampled of %u tiles (the frame needs at "
+                     "least 2 tiles; render more pixels or use --mode detailed)", fr->f.tiles_timed, fr->f.ntiles);
+            return -1;
+        }
+        fr->has_est = 1;
+    }
+    stats_run_from_func(&fr->run, &fr->f);
+    return 0;
+}
+
+int run_frame(const RunScene *sc, const RunSpec *spec, RunFrame *fr, char *err, size_t errlen)
+{
+    memset(fr, 0, sizeof *fr);
+    CfgMachine defcfg;
+    const CfgMachine *cfg = spec->cfg;
+    if (!cfg) {
+        cfg_defaults(&defcfg);
+        cfg = &defcfg;
+    }
+    if ((unsigned)spec->mode >= RUN_MODE_COUNT) {
+        snprintf(err, errlen, "run mode %d: no such mode", (int)spec->mode);
+        return -1;
+    }
+    if (spec->mode == RUN_SAMPLED && !(spec->sample > 0.0 && spec->sample <= 1.0)) {
+        snprintf(err, errlen, "--sample %g: expected a fraction of the tiles in (0, 1]", spec->sample);
+        return -1;
+    }
+    if (cfg->stream_rays != 1024 && cfg->stream_rays != 4096) {
+        snprintf(err, errlen, "stream.rays %d: must be 1024 or 4096", cfg->stream_rays);
+        return -1;
+    }
+    size_t npx = (size_t)sc->s.render.width * (size_t)sc->s.render.height;
+    fr->rgb = calloc(3 * npx, sizeof(float));
+    if (!fr->rgb) {
+        snprintf(err, errlen, "out of memory for a %d x %d image", sc->s.render.width, sc->s.render.height);
+        return -1;
+    }
+    fr->threads = spec->threads > 0 ? spec->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
+    fr->tile = (int)lrint(sqrt((double)cfg->stream_rays));
+    double t0 = util_now();
+    int rc = run_mode_kernel(spec->mode) ? kernel_frame(sc, spec, cfg, fr, err, errlen)
+                                         : golden_frame(sc, spec, cfg, fr, err, errlen);
+    fr->seconds = util_now() - t0;
+    return rc;
+}
+
+void run_frame_free(RunFrame *fr)
+{
+    free(fr->rgb);
+    func_stats_free(&fr->f);
+    memset(fr, 0, sizeof *fr);
+}
+
+/* The golden model's answer for each ray of the batch. */
+static void golden_trace(const PackedScene *p, const RayBatch *b, BatchHit *hits)
+{
+    for (uint32_t i = 0; i < b->count; i++) {
+        const BatchRay *r = &b->rays[i];
+        BatchHit *h = &hits[i];
+        memset(h, 0, sizeof *h);
+        h->invalid = (uint32_t)raybatch_ray_invalid(r);
+        if (h->invalid) {
+            h->prim = r->query == RAY_ANY ? 0 : UINT32_MAX;
+            continue;
+        }
+        RefRay q = {{r->org[0], r->org[1], r->org[2]}, {r->dir[0], r->dir[1], r->dir[2]}, r->tmax};
+        if (r->query == RAY_ANY) {
+            h->prim = (uint32_t)ref_any_hit(p, &q, NULL);
+        } else {
+            RefHit rh;
+            ref_closest_hit(p, &q, &rh, NULL);
+            h->prim = rh.prim;
+            if (rh.prim != REF_NO_HIT) {
+                h->t = rh.t;
+                h->u = rh.u;
+                h->v = rh.v;
+            }
+        }
+    }
+}
+
+int run_trace(const PackedScene *p, uint32_t needs, const RunSpec *spec, const RayBatch *b, BatchHit *hits,
+              RunTrace *out, char *err, size_t errlen)
+{
+    RunTrace local;
+    if (!out)
+        out = &local;
+    memset(out, 0, sizeof *out);
+    double t0 = util_now();
+    if (spec->mode == RUN_REFERENCE) {
+        golden_trace(p, b, hits);
+        out->seconds = util_now() - t0;
+        return 0;
+    }
+    if (spec->mode != RUN_FUNCTIONAL && spec->mode != RUN_DETAILED) {
+        snprintf(err, errlen, "--mode %s: expected functional, detailed or reference",
+                 (unsigned)spec->mode < RUN_MODE_COUNT ? run_mode_names[spec->mode] : "?");
+        return -1;
+    }
+    CfgMachine defcfg;
+    const CfgMachine *cfg = spec->cfg;
+    if (!cfg) {
+        cfg_defaults(&defcfg);
+        cfg = &defcfg;
+    }
+    char kpath[4200];
+    FuncParams fp = {.cfg = cfg,
+                     .kernel_path = spec->kernel_path ? spec->kernel_path : kernel_default_path(kpath, sizeof kpath),
+                     .needs = needs,
+                     .seed = spec->seed ? spec->seed : 1,
+                     .threads = spec->threads,
+                     .batch = b,
+                     .hits = hits,
+                     .timed = spec->mode == RUN_DETAILED};
+    FuncStats st;
+    int rc = func_trace(p, &fp, &st, err, errlen);
+    out->seconds = util_now() - t0;
+    if (rc == 0) {
+        out->instructions = st.instructions;
+        out->timed = fp.timed;
+        out->timing = st.timing;
+    }
+    func_stats_free(&st);
+    return rc;
+}

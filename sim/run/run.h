@@ -1,0 +1,113 @@
+/* sim/run/run.h -- THE ENTRY POINT of every simulation: a scene opened for a machine (loaded, sized,
+ * its acceleration structure built and packed), then a frame rendered or a batch of rays traced in
+ * one of the modes.
+ *
+ * `sfsim run` (sim/render.c), `sfsim trace` (sim/trace.c), tools/validation.c and bench/ go through
+ * these calls; the pieces behind them are sim/run/accel.c (the structures), sim/run/kernel.c (the
+ * kernel build), sim/run/tiles.c (the tile launcher), sim/run/timedcore.c (a core with its timing
+ * model: the kernel modes' workers and `sfsim exec`), sim/functional.c (the kernel modes),
+ * sim/reference.c and sim/ref_trace.c (the golden model).
+ *
+ * Owns: choosing the engine for a mode, the defaults every caller would otherwise repeat (the
+ * machine, the kernel's path, the host threads), and the figures common to all modes.
+ * Must not: write files (render.c and trace.c do), parse the command line, or render itself.
+ */
+#ifndef SFSIM_RUN_RUN_H
+#define SFSIM_RUN_RUN_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../../scenes/pack.h"
+#include "../../scenes/scene.h"
+#include "../config.h"
+#include "../functional.h"
+#include "../raybatch.h"
+#include "../sampling.h"
+#include "../stats.h"
+#include "../timing.h"
+#include "accel.h"
+
+/* The modes (docs/modes.md): the golden model, the kernel on the functional core, the kernel
+ * timed on the machine, and the kernel with a sample of its tiles timed. */
+typedef enum RunMode { RUN_REFERENCE, RUN_FUNCTIONAL, RUN_DETAILED, RUN_SAMPLED, RUN_MODE_COUNT } RunMode;
+extern const char *const run_mode_names[RUN_MODE_COUNT]; /* "reference", "functional", ... */
+
+/* name as a mode: 0, or -1 when it names none. */
+int run_mode_parse(const char *name, RunMode *mode);
+/* The kernel runs (every mode but the golden model's). */
+static inline int run_mode_kernel(RunMode m) { return m != RUN_REFERENCE; }
+/* The timing model runs (on every tile, or on the sample). */
+static inline int run_mode_timed(RunMode m) { return m == RUN_DETAILED || m == RUN_SAMPLED; }
+
+/* The render size a caller imposes over the scene file's [render]; -1 (or 0 for the sizes) keeps
+ * the scene's value. */
+typedef struct RunSize {
+    int width, height, spp, max_depth;
+} RunSize;
+#define RUN_SIZE_KEEP ((RunSize){-1, -1, -1, -1})
+
+/* A scene opened for one machine. */
+typedef struct RunScene {
+    Scene s;
+    PackedScene p;
+    AccelInfo accel;           /* what was built, and its host time */
+    double load_seconds;       /* reading the scene file */
+} RunScene;
+
+/* Load path, print the scene's warnings on stderr as "<who>: warning: ..." (who NULL: not printed;
+ * they stay in s.warnings), impose size and check the render settings a frame needs (size NULL: the
+ * scene as it is, for ray batches, which have no frame), and build and pack
+ * the acceleration structures of cfg (NULL: the defaults) for the engines of mode. 0, or -1 with a
+ * message naming the file or the setting; sc must be closed with run_scene_close either way. */
+int run_scene_open(RunScene *sc, const char *path, const RunSize *size, const CfgMachine *cfg, RunMode mode,
+                   const char *who, char *err, size_t errlen);
+void run_scene_close(RunScene *sc);
+
+/* How to run: the mode, the machine and the host. Zero-initialised fields take the defaults. */
+typedef struct RunSpec {
+    RunMode mode;
+    const CfgMachine *cfg;     /* NULL: the defaults of sim/config.def */
+    const char *kernel_path;   /* NULL: kernels/pathtrace.s beside the binary (sim/run/kernel.h) */
+    uint32_t seed;             /* the path tracer's random stream */
+    int threads;               /* host threads; 0: every core */
+    double sample;             /* RUN_SAMPLED: the fraction of tiles timed, (0, 1] */
+    uint32_t sample_seed;      /* RUN_SAMPLED: which tiles */
+    void (*progress)(void *ctx, uint32_t tiles_done, uint32_t tiles_total);
+    void *progress_ctx;
+} RunSpec;
+
+/* A rendered frame and its figures. */
+typedef struct RunFrame {
+    float *rgb;                /* 3 x width x height, linear radiance */
+    StatsRun run;              /* rays and generations, from either engine */
+    FuncStats f;               /* the kernel modes' counters (zero for the golden model) */
+    SampleEstimate est;        /* RUN_SAMPLED: the frame's cycles estimated from the sample */
+    int has_est;
+    int tile;                  /* the stream's tile side for the golden model: sqrt(stream.rays) */
+    int threads;               /* host threads used */
+    double seconds;            /* host time rendering */
+} RunFrame;
+
+/* Render sc's frame as spec says. 0; -1 with a message (bad settings, a kernel that does not
+ * assemble, memories too small, too few tiles to estimate from); -2 when the simulated program
+ * failed in a tile: then fr->rgb holds the tiles that finished (fr->f.tiles_done of fr->f.ntiles)
+ * and the rest black. fr must be freed with run_frame_free either way. */
+int run_frame(const RunScene *sc, const RunSpec *spec, RunFrame *fr, char *err, size_t errlen);
+void run_frame_free(RunFrame *fr);
+
+/* A traced batch's figures. */
+typedef struct RunTrace {
+    uint64_t instructions;     /* simulated (the kernel modes) */
+    int timed;                 /* RUN_DETAILED: timing holds the cycles of every batch */
+    TimingStats timing;
+    double seconds;            /* host time tracing */
+} RunTrace;
+
+/* Trace batch b against p (a scene of needs) as spec says: RUN_REFERENCE (the golden model),
+ * RUN_FUNCTIONAL or RUN_DETAILED (the kernel's traversal and intersection); hits[i] for ray i.
+ * 0, -1 (input) or -2 (the kernel failed). out may be NULL. */
+int run_trace(const PackedScene *p, uint32_t needs, const RunSpec *spec, const RayBatch *b, BatchHit *hits,
+              RunTrace *out, char *err, size_t errlen);
+
+#endif
