@@ -3,8 +3,9 @@
  *
  * Owns: which plots a sweep gets (lines and stacked bars against each numeric swept key, or bar
  * charts against the point), their .gp and .dat files, titles, axis units and colours, and
- * running gnuplot (a missing or failing gnuplot is a warning). Must not: read reports (csv.c
- * gives the rows), or change the exit status of a sweep.
+ * running gnuplot (a missing or failing gnuplot is a warning), and the figure columns they draw,
+ * found by their sweep.csv names once (sweep_plot_cols). Must not: read reports (csv.c gives the
+ * rows), index a figure column by a number of its own, or change the exit status of a sweep.
  */
 #include "../outfile.h"
 #include "sweep_int.h"
@@ -15,9 +16,19 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+/* Series of a stacked plot: stall causes or operation categories; m0 the column of the first. */
+typedef struct Series {
+    int m0, n;
+    const char *const *names;
+    const char *what, *ylabel, *base;
+    int unit_range;
+} Series;
+
 typedef struct Plotter {
     const SweepPlan *pl;
     const SweepRow *rows;
+    SweepPlotCols c;
+    Series stall, ops;
     const char *dir; /* DIR/plots */
     char *subtitle;  /* scene, mode and fixed keys, gnuplot-escaped, lines joined by \n */
     int made;
@@ -268,18 +279,60 @@ static void gp_palette(UtilBuf *g, int n)
         util_buf_printf(g, "set linetype %d lc rgb \"%s\"\n", i + 1, palette[i % N_PALETTE]);
 }
 
-/* Series of a stacked plot: stall causes or operation categories. */
-typedef struct Series {
-    int m0, n;
-    const char *const *names;
-    const char *what, *ylabel, *base;
-    int unit_range;
-} Series;
-
-static const Series stall_series = {SWEEP_M_STALL, TM_CAUSE_COUNT, tm_cause_keys, "stall cycles by cause",
+/* The column m0 is filled in by sweep_plots_make. */
+static const Series stall_series = {-1, TM_CAUSE_COUNT, tm_cause_keys, "stall cycles by cause",
                                     "share of all cycles", "stalls", 0};
-static const Series ops_series = {SWEEP_M_OPS, ISA_C_COUNT, isa_category_keys, "operation mix",
+static const Series ops_series = {-1, ISA_C_COUNT, isa_category_keys, "operation mix",
                                   "share of executed instructions", "ops", 1};
+
+/* The stages the utilization plots draw, in the order of their columns and panels. */
+static const int plot_stages[3] = {ISA_STAGE_TRAVERSAL, ISA_STAGE_INTERSECTION, ISA_STAGE_SHADING};
+
+/* The columns named prefix + keys[i], found by name; they must follow each other. */
+static int group_cols(const char *prefix, const char *const *keys, int n, int *first, char *err, size_t errlen)
+{
+    for (int i = 0; i < n; i++) {
+        char name[128];
+        snprintf(name, sizeof name, "%s%s", prefix, keys[i]);
+        int m = sweep_col(name, err, errlen);
+        if (m < 0)
+            return -1;
+        if (i == 0) {
+            *first = m;
+        } else if (m != *first + i) {
+            snprintf(err, errlen, "sweep.csv's column '%s' is not %d after '%s%s' (the plots draw a group in order)",
+                     name, i, prefix, keys[0]);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+int sweep_plot_cols(SweepPlotCols *cols, char *err, size_t errlen)
+{
+    const char *stages[3];
+    for (int s = 0; s < 3; s++)
+        stages[s] = isa_stage_keys[plot_stages[s]];
+    if ((cols->fps = sweep_col("fps", err, errlen)) < 0 ||
+        (cols->fps_lo = sweep_col("fps_lo", err, errlen)) < 0 ||
+        (cols->fps_hi = sweep_col("fps_hi", err, errlen)) < 0 ||
+        (cols->kd = sweep_col("kd_nodes_per_ray", err, errlen)) < 0 ||
+        (cols->kd_camera = sweep_col("kd_camera_nodes_per_ray", err, errlen)) < 0)
+        return -1;
+    if (group_cols("utilization_", stages, 3, &cols->util, err, errlen) ||
+        group_cols("stall_share_", tm_cause_keys, TM_CAUSE_COUNT, &cols->stall, err, errlen) ||
+        group_cols("ops_share_", isa_category_keys, ISA_C_COUNT, &cols->ops, err, errlen))
+        return -1;
+    return 0;
+}
+
+/* " name" for each of the n columns from m0 on: a .dat file's column heads. */
+static void dat_heads(UtilBuf *b, int m0, int n)
+{
+    char name[128];
+    for (int m = m0; m < m0 + n; m++)
+        util_buf_printf(b, " %s", stats_csv_name(m, name, sizeof name));
+}
 
 /* fps (lines, with the confidence interval as error bars when every point has one), SIMD
  * utilization (three panels) or, for kd-tree runs, nodes visited per ray against a numeric key.
@@ -287,7 +340,8 @@ static const Series ops_series = {SWEEP_M_OPS, ISA_C_COUNT, isa_category_keys, "
 static void plot_lines(Plotter *p, const char *xkey, int what)
 {
     const int util = what == 1, kd = what == 2;
-    int m0 = util ? SWEEP_M_UTIL : kd ? SWEEP_M_KD : SWEEP_M_FPS, nm = util ? 3 : 1;
+    const SweepPlotCols *cols = &p->c;
+    int m0 = util ? cols->util : kd ? cols->kd : cols->fps, nm = util ? 3 : 1;
     Group *g;
     int ng = groups_make(p, xkey, m0, nm, &g);
     if (!ng) {
@@ -297,26 +351,35 @@ static void plot_lines(Plotter *p, const char *xkey, int what)
     int ci = !util && !kd;
     for (int i = 0; i < ng && ci; i++)
         for (int j = 0; j < g[i].n && ci; j++)
-            ci = p->rows[g[i].rows[j]].has[SWEEP_M_FPS_LO] && p->rows[g[i].rows[j]].has[SWEEP_M_FPS_HI];
+            ci = p->rows[g[i].rows[j]].has[cols->fps_lo] && p->rows[g[i].rows[j]].has[cols->fps_hi];
     char *base = xasprintf("%s_%s", util ? "utilization" : kd ? "kd_nodes" : "fps", xkey);
     UtilBuf gp = {0}, dat = {0};
     for (int i = 0; i < ng; i++) {
-        util_buf_printf(&dat, "%s# %s\n# %s %s\n", i ? "\n\n" : "", g[i].label[0] ? g[i].label : "all points", xkey,
-                        util ? "utilization_traversal utilization_intersection utilization_shading"
-                        : kd ? "kd_camera_nodes_per_ray kd_nodes_per_ray" : "fps fps_lo fps_hi");
+        util_buf_printf(&dat, "%s# %s\n# %s", i ? "\n\n" : "", g[i].label[0] ? g[i].label : "all points", xkey);
+        if (util) {
+            dat_heads(&dat, cols->util, 3);
+        } else if (kd) {
+            dat_heads(&dat, cols->kd_camera, 1);
+            dat_heads(&dat, cols->kd, 1);
+        } else {
+            dat_heads(&dat, cols->fps, 1);
+            dat_heads(&dat, cols->fps_lo, 1);
+            dat_heads(&dat, cols->fps_hi, 1);
+        }
+        util_buf_puts(&dat, "\n");
         for (int j = 0; j < g[i].n; j++) {
             const SweepRow *row = &p->rows[g[i].rows[j]];
             util_buf_printf(&dat, "%s", sweep_plan_value(p->pl, g[i].rows[j], xkey));
             if (util) {
                 for (int s = 0; s < 3; s++)
-                    dat_num(&dat, row, SWEEP_M_UTIL + s);
+                    dat_num(&dat, row, cols->util + s);
             } else if (kd) {
-                dat_num(&dat, row, SWEEP_M_KD_CAMERA_NODES);
-                dat_num(&dat, row, SWEEP_M_KD);
+                dat_num(&dat, row, cols->kd_camera);
+                dat_num(&dat, row, cols->kd);
             } else {
-                dat_num(&dat, row, SWEEP_M_FPS);
-                dat_num(&dat, row, SWEEP_M_FPS_LO);
-                dat_num(&dat, row, SWEEP_M_FPS_HI);
+                dat_num(&dat, row, cols->fps);
+                dat_num(&dat, row, cols->fps_lo);
+                dat_num(&dat, row, cols->fps_hi);
             }
             util_buf_puts(&dat, "\n");
         }
@@ -369,7 +432,7 @@ static void plot_lines(Plotter *p, const char *xkey, int what)
     }
     for (int s = 0; s < (util ? 3 : 1); s++) {
         if (util)
-            util_buf_printf(&gp, "set title \"%s\"\n", isa_stage_keys[sweep_stages[s]]);
+            util_buf_printf(&gp, "set title \"%s\"\n", isa_stage_keys[plot_stages[s]]);
         util_buf_puts(&gp, "plot ");
         for (int i = 0; i < ng && kd; i++)
             for (int c = 0; c < 2; c++) {
@@ -455,8 +518,9 @@ static void plot_stacked(Plotter *p, const char *xkey, const Series *se)
 static void plot_bars(Plotter *p, int kind)
 {
     const SweepPlan *pl = p->pl;
-    const Series *se = kind == 2 ? &stall_series : kind == 3 ? &ops_series : NULL;
-    int m0 = se ? se->m0 : kind == 1 ? SWEEP_M_UTIL : kind == 4 ? SWEEP_M_KD : SWEEP_M_FPS;
+    const SweepPlotCols *cols = &p->c;
+    const Series *se = kind == 2 ? &p->stall : kind == 3 ? &p->ops : NULL;
+    int m0 = se ? se->m0 : kind == 1 ? cols->util : kind == 4 ? cols->kd : cols->fps;
     int nm = se ? se->n : kind == 1 ? 3 : 1;
     static const char *const bases[] = {"fps_point", "utilization_point", "stalls_point", "ops_point",
                                         "kd_nodes_point"};
@@ -481,13 +545,13 @@ static void plot_bars(Plotter *p, int kind)
         gp_str(&dat, sweep_buf_text(&label));
         util_buf_free(&label);
         if (kind == 0) {
-            dat_num(&dat, &p->rows[r], SWEEP_M_FPS);
-            dat_num(&dat, &p->rows[r], SWEEP_M_FPS_LO);
-            dat_num(&dat, &p->rows[r], SWEEP_M_FPS_HI);
-            ci = ci && p->rows[r].has[SWEEP_M_FPS_LO] && p->rows[r].has[SWEEP_M_FPS_HI];
+            dat_num(&dat, &p->rows[r], cols->fps);
+            dat_num(&dat, &p->rows[r], cols->fps_lo);
+            dat_num(&dat, &p->rows[r], cols->fps_hi);
+            ci = ci && p->rows[r].has[cols->fps_lo] && p->rows[r].has[cols->fps_hi];
         } else if (kind == 4) {
-            dat_num(&dat, &p->rows[r], SWEEP_M_KD_CAMERA_NODES);
-            dat_num(&dat, &p->rows[r], SWEEP_M_KD);
+            dat_num(&dat, &p->rows[r], cols->kd_camera);
+            dat_num(&dat, &p->rows[r], cols->kd);
         } else {
             for (int m = m0; m < m0 + nm; m++)
                 dat_num(&dat, &p->rows[r], m);
@@ -527,7 +591,7 @@ static void plot_bars(Plotter *p, int kind)
         gp_palette(&gp, 3);
         for (int s = 0; s < 3; s++)
             util_buf_printf(&gp, "%s\"%s.dat\" using %d%s title \"%s\"", s ? ", \\\n     " : "plot ", bases[kind],
-                            s + 2, s ? "" : ":xtic(1)", isa_stage_keys[sweep_stages[s]]);
+                            s + 2, s ? "" : ":xtic(1)", isa_stage_keys[plot_stages[s]]);
         util_buf_puts(&gp, "\n");
     } else {
         util_buf_printf(&gp, "set style data histograms\nset style histogram rowstacked\nset boxwidth 0.7 relative\n"
@@ -595,9 +659,18 @@ int sweep_plots_make(const SweepPlan *pl, const SweepRow *rows, const char *dir,
     Plotter p = {0};
     p.pl = pl;
     p.rows = rows;
+    *failed = 0;
+    if (sweep_plot_cols(&p.c, err, sizeof err)) {
+        fprintf(stderr, "sfsim sweep: warning: %s; no plots\n", err);
+        *failed = 1;
+        return 0;
+    }
+    p.stall = stall_series;
+    p.stall.m0 = p.c.stall;
+    p.ops = ops_series;
+    p.ops.m0 = p.c.ops;
     char *pdir = xasprintf("%s/plots", dir);
     p.dir = pdir;
-    *failed = 0;
     if (util_mkdir_p(pdir, err, sizeof err)) {
         fprintf(stderr, "sfsim sweep: warning: %s; no plots\n", err);
         free(pdir);
@@ -616,8 +689,8 @@ int sweep_plots_make(const SweepPlan *pl, const SweepRow *rows, const char *dir,
         plot_lines(&p, pl->keys[k], 0);
         plot_lines(&p, pl->keys[k], 1);
         plot_lines(&p, pl->keys[k], 2); /* only when some point ran on a kd-tree */
-        plot_stacked(&p, pl->keys[k], &stall_series);
-        plot_stacked(&p, pl->keys[k], &ops_series);
+        plot_stacked(&p, pl->keys[k], &p.stall);
+        plot_stacked(&p, pl->keys[k], &p.ops);
     }
     if (!lines)
         for (int kind = 0; kind < 5; kind++)

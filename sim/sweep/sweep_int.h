@@ -5,8 +5,9 @@
  * and folder helpers), sweepfile.c (reading and checking a sweep file, expanding its points),
  * plan.c (sweep.json: building it, taking it apart, comparing two, which points still run),
  * folder.c (the sweep folder, its lock, point folders and their markers), runner.c (running
- * points as child processes), csv.c (sweep.csv, its columns listed in csv_columns.def), plot.c
- * (gnuplot), emit.c (Slurm / GNU parallel scripts), sweep.c (the two commands).
+ * points as child processes), csv.c (sweep.csv; its figure columns are the statistics registry's,
+ * sim/stats.def, read back through stats_csv_*), plot.c (gnuplot), emit.c (Slurm / GNU parallel
+ * scripts), sweep.c (the two commands).
  * Must not: simulate (a point is an `sfsim run`), or know what a machine key means (cfg_set
  * checks values). Like sim/main.c these are a command's parts: they print their messages, and
  * running out of memory ends the process (the x* helpers below, sweep_buf_text): nothing useful is
@@ -26,6 +27,7 @@
 
 #include "../../isa/isa.h"
 #include "../functional.h"
+#include "../stats.h"
 #include "../timing.h"
 #include "../util.h"
 
@@ -232,43 +234,21 @@ void sweep_fmt_duration(double s, char *buf, size_t len);
 
 /* ---- csv.c: sweep.csv ---------------------------------------------------------------------- */
 
-/* The dimensions a group of columns spans (csv_columns.def), and their sizes. */
-typedef enum { SWEEP_D_ONE, SWEEP_D_CI95, SWEEP_D_STAGE, SWEEP_D_CAUSE, SWEEP_D_CATEGORY, SWEEP_D_KD_KIND,
-               SWEEP_D_KD_COUNTER } SweepDim;
-#define SWEEP_N_ONE 1
-#define SWEEP_N_CI95 2
-#define SWEEP_N_STAGE 4
-#define SWEEP_N_CAUSE TM_CAUSE_COUNT
-#define SWEEP_N_CATEGORY ISA_C_COUNT
-#define SWEEP_N_KD_KIND FUNC_KD_KINDS
-#define SWEEP_N_KD_COUNTER FUNC_KD_COUNTERS
-
-/* The figure columns: SWEEP_M_<ID> is the first column of each group of csv_columns.def. */
-enum {
-#define SWEEP_COLUMN(id, name, path, outer, inner, how) \
-    SWEEP_M_##id, SWEEP_M_##id##_LAST_ = SWEEP_M_##id + SWEEP_N_##outer * SWEEP_N_##inner - 1,
-#include "csv_columns.def"
-#undef SWEEP_COLUMN
-    SWEEP_M_COUNT
-};
-/* Columns the plots name. */
-#define SWEEP_M_FPS_LO (SWEEP_M_FPS_CI + 0)
-#define SWEEP_M_FPS_HI (SWEEP_M_FPS_CI + 1)
-#define SWEEP_M_KD_CAMERA_NODES (SWEEP_M_KD_KIND + FUNC_KD_CAMERA * FUNC_KD_COUNTERS + FUNC_KD_NODES)
-
-/* The report's stages, in the CSV's order (the STAGE dimension). */
-extern const int sweep_stages[SWEEP_N_STAGE];
-
-/* A point's row: its state, a failed point's error, the figures it has. */
+/* A point's row: its state, a failed point's error, the figures it has. m[] and has[] hold one
+ * entry per figure column, stats_csv_count() of them (the rows of sim/stats.def with a CSV name,
+ * in the CSV's order; sweep_row_init allocates them). */
 typedef struct SweepRow {
     int state;
     char *error;
-    double m[SWEEP_M_COUNT];
-    unsigned char has[SWEEP_M_COUNT];
+    double *m;
+    unsigned char *has;
 } SweepRow;
 
-/* The name of figure column m. */
-void sweep_metric_name(int m, char *buf, size_t len);
+/* An empty row (no error, no figures), its arrays allocated; sweep_row_clear frees them. */
+void sweep_row_init(SweepRow *row);
+void sweep_row_clear(SweepRow *row);
+/* The index of the figure column called name, or -1 with an error naming it in err. */
+int sweep_col(const char *name, char *err, size_t errlen);
 /* The figures of a point's report.json into row; -1 with err when it cannot be read. */
 int sweep_row_read_report(SweepRow *row, const char *path, char *err, size_t errlen);
 /* Every point's state and figures (a report that cannot be read is a warning, its row empty). */
@@ -281,6 +261,18 @@ void sweep_fmt_num(double v, char *buf, size_t len);
 
 /* ---- plot.c, emit.c ------------------------------------------------------------------------ */
 
+/* The figure columns the plots draw, found by name (sweep_col) once. The groups' columns follow
+ * their first in the registry's order: utilization_traversal, _intersection, _shading; a
+ * stall_share_<cause> per cause and an ops_share_<category> per category, in tm_cause_keys and
+ * isa_category_keys order. */
+typedef struct SweepPlotCols {
+    int fps, fps_lo, fps_hi;
+    int util;          /* utilization_traversal, then _intersection and _shading */
+    int kd, kd_camera; /* kd_nodes_per_ray, kd_camera_nodes_per_ray */
+    int stall, ops;    /* stall_share_<first cause>, ops_share_<first category> */
+} SweepPlotCols;
+/* 0, or -1 with the column that is missing or out of its group's order in err. */
+int sweep_plot_cols(SweepPlotCols *cols, char *err, size_t errlen);
 /* Every plot of the sweep into DIR/plots; returns how many were drawn, *failed when gnuplot is
  * missing or failed on one. */
 int sweep_plots_make(const SweepPlan *pl, const SweepRow *rows, const char *dir, int *failed);

@@ -1,8 +1,9 @@
-/* tests/unit/test_sweep_csv.c -- sweep.csv (sim/sweep/csv.c, csv_columns.def): the figure
- * columns and their order, figures read back from a report.json written in a temporary folder
- * (shares, the confidence interval, values of the wrong type), and the whole file: key columns,
- * status and error, quoting, number formats, and the rows of failed, unfinished and report-less
- * points. docs/sweep.md, "sweep.csv", is the contract.
+/* tests/unit/test_sweep_csv.c -- sweep.csv (sim/sweep/csv.c; its figure columns are the rows of
+ * sim/stats.def with a CSV name): the figure columns and their order as the sweep writes them,
+ * finding them by name (sweep_col, the plots' columns), figures read back from a report.json
+ * written in a temporary folder (shares, the confidence interval, values of the wrong type), and
+ * the whole file: key columns, status and error, quoting, number formats, and the rows of failed,
+ * unfinished and report-less points. docs/sweep.md, "sweep.csv", is the contract.
  *
  * Suites: sweep_columns, sweep_report, sweep_csv.
  */
@@ -23,8 +24,7 @@ static char *name_of(int m)
     static char buf[8][64];
     static int next;
     char *b = buf[next++ % 8];
-    sweep_metric_name(m, b, 64);
-    return b;
+    return (char *)stats_csv_name(m, b, 64);
 }
 
 static int starts_with(const char *s, const char *prefix)
@@ -32,33 +32,34 @@ static int starts_with(const char *s, const char *prefix)
     return !strncmp(s, prefix, strlen(prefix));
 }
 
-/* SWEEP_M_COUNT commas: the figure cells of a row that has none. */
+/* One comma per figure column: the figure cells of a row that has none. */
 static const char *no_figures(void)
 {
     static char buf[512];
-    buf[0] = 0;
-    for (int m = 0; m < SWEEP_M_COUNT; m++)
-        strcat(buf, ",");
+    int n = stats_csv_count();
+    cr_assert_lt(n, (int)sizeof buf);
+    memset(buf, ',', (size_t)n);
+    buf[n] = 0;
     return buf;
 }
 
-/* The column named name, or -1. */
+/* The column named name (a test fails when there is none). */
 static int column(const char *name)
 {
-    for (int m = 0; m < SWEEP_M_COUNT; m++)
-        if (!strcmp(name_of(m), name))
-            return m;
-    return -1;
+    char err[256] = "";
+    int m = sweep_col(name, err, sizeof err);
+    cr_assert_geq(m, 0, "%s", err);
+    return m;
 }
 
-/* A report.json in dir, read into a fresh row. */
+/* A report.json in dir, read into a fresh row (sweep_row_clear it). */
 static SweepRow read_report(const char *dir, const char *json)
 {
     char path[256], err[512] = "";
     snprintf(path, sizeof path, "%s/report.json", dir);
     tu_write_file(path, json);
     SweepRow row;
-    memset(&row, 0, sizeof row);
+    sweep_row_init(&row);
     cr_assert_eq(sweep_row_read_report(&row, path, err, sizeof err), 0, "%s", err);
     return row;
 }
@@ -117,27 +118,49 @@ Test(sweep_columns, names_in_the_documented_order)
     cr_expect_str_eq(name_of(rays + 7), "kd_underflows_per_ray");
     cr_expect_str_eq(name_of(rays + 8), "kd_camera_nodes_per_ray");
     cr_expect_str_eq(name_of(rays + 8 + 6), "kd_indirect_nodes_per_ray");
-    cr_expect_str_eq(name_of(SWEEP_M_COUNT - 1), "kd_shadow_underflows_per_ray");
-    cr_expect_eq(SWEEP_M_COUNT, rays + 2 + 6 + 3 * 6);
+    cr_expect_str_eq(name_of(stats_csv_count() - 1), "kd_shadow_underflows_per_ray");
+    cr_expect_eq(stats_csv_count(), rays + 2 + 6 + 3 * 6);
 }
 
-Test(sweep_columns, the_named_indices_are_the_named_columns)
+/* The plots find their columns by name, once; each group's columns follow its first. */
+Test(sweep_columns, the_plots_find_their_columns_by_name)
 {
-    cr_expect_eq(column("fps"), SWEEP_M_FPS);
-    cr_expect_eq(column("fps_lo"), SWEEP_M_FPS_LO);
-    cr_expect_eq(column("fps_hi"), SWEEP_M_FPS_HI);
-    cr_expect_eq(column("utilization_traversal"), SWEEP_M_UTIL);
-    cr_expect_eq(column("stall_share_address_fetch"), SWEEP_M_STALL);
-    cr_expect_eq(column("ops_share_load"), SWEEP_M_OPS);
-    cr_expect_eq(column("kd_nodes_per_ray"), SWEEP_M_KD);
-    cr_expect_eq(column("kd_camera_nodes_per_ray"), SWEEP_M_KD_CAMERA_NODES);
-    cr_expect_eq(column("host_seconds"), SWEEP_M_HOST);
+    SweepPlotCols c;
+    char err[256] = "";
+    cr_assert_eq(sweep_plot_cols(&c, err, sizeof err), 0, "%s", err);
+    cr_expect_eq(c.fps, column("fps"));
+    cr_expect_eq(c.fps_lo, column("fps_lo"));
+    cr_expect_eq(c.fps_hi, column("fps_hi"));
+    cr_expect_eq(c.util, column("utilization_traversal"));
+    cr_expect_eq(c.util + 1, column("utilization_intersection"));
+    cr_expect_eq(c.util + 2, column("utilization_shading"));
+    cr_expect_eq(c.kd, column("kd_nodes_per_ray"));
+    cr_expect_eq(c.kd_camera, column("kd_camera_nodes_per_ray"));
+    char want[64];
+    for (int i = 0; i < TM_CAUSE_COUNT; i++) {
+        snprintf(want, sizeof want, "stall_share_%s", tm_cause_keys[i]);
+        cr_expect_str_eq(name_of(c.stall + i), want);
+    }
+    for (int i = 0; i < ISA_C_COUNT; i++) {
+        snprintf(want, sizeof want, "ops_share_%s", isa_category_keys[i]);
+        cr_expect_str_eq(name_of(c.ops + i), want);
+    }
+}
+
+Test(sweep_columns, a_missing_column_is_an_error_that_names_it)
+{
+    char err[256] = "";
+    cr_expect_eq(sweep_col("fps_per_watt", err, sizeof err), -1);
+    cr_expect(strstr(err, "'fps_per_watt'") != NULL, "%s", err);
+    cr_expect_eq(sweep_col("", err, sizeof err), -1);
+    cr_expect_eq(sweep_col("fps", err, sizeof err), 2);
 }
 
 Test(sweep_columns, every_name_is_different)
 {
-    for (int a = 0; a < SWEEP_M_COUNT; a++)
-        for (int b = a + 1; b < SWEEP_M_COUNT; b++)
+    int n = stats_csv_count();
+    for (int a = 0; a < n; a++)
+        for (int b = a + 1; b < n; b++)
             cr_expect_str_neq(name_of(a), name_of(b), "columns %d and %d", a, b);
 }
 
@@ -157,10 +180,10 @@ Test(sweep_report, figures_are_read_at_their_paths)
     cr_expect_eq(row.has[column("cycles")], 1);
     cr_expect_float_eq(row.m[column("cycles")], 123456, 0);
     cr_expect_float_eq(row.m[column("busy_cycles")], 100000, 0);
-    cr_expect_float_eq(row.m[SWEEP_M_FPS], 12.5, 0);
+    cr_expect_float_eq(row.m[column("fps")], 12.5, 0);
     cr_expect_eq(row.has[column("fps_no_stall")], 0, "not in the report: no value");
-    cr_expect_float_eq(row.m[SWEEP_M_FPS_LO], 11, 0);
-    cr_expect_float_eq(row.m[SWEEP_M_FPS_HI], 14, 0);
+    cr_expect_float_eq(row.m[column("fps_lo")], 11, 0);
+    cr_expect_float_eq(row.m[column("fps_hi")], 14, 0);
     cr_expect_float_eq(row.m[column("utilization_traversal")], 0.5, 0);
     cr_expect_eq(row.has[column("utilization_intersection")], 0);
     cr_expect_float_eq(row.m[column("utilization_shading")], 0.25, 0);
@@ -174,9 +197,10 @@ Test(sweep_report, figures_are_read_at_their_paths)
     cr_expect_float_eq(row.m[column("kd_camera_leaves_per_ray")], 2, 0);
     cr_expect_eq(row.has[column("kd_shadow_nodes_per_ray")], 0);
     int n = 0;
-    for (int m = 0; m < SWEEP_M_COUNT; m++)
+    for (int m = 0; m < stats_csv_count(); m++)
         n += row.has[m];
     cr_expect_eq(n, 14, "figures the report does not hold have no value"); /* the 14 checked above */
+    sweep_row_clear(&row);
     tu_remove_tree(dir);
 }
 
@@ -189,10 +213,15 @@ Test(sweep_report, operation_counts_become_shares)
     cr_expect_float_eq(row.m[column("ops_share_store")], 0.3, 1e-15);
     cr_expect_float_eq(row.m[column("ops_share_compute")], 0.6, 1e-15);
     cr_expect_eq(row.has[column("ops_share_control")], 0, "a category the report lacks stays empty");
+    sweep_row_clear(&row);
     /* no operations at all: no shares */
     row = read_report(dir, "{\"ops\": {\"load\": 0, \"store\": 0}}");
-    for (int c = 0; c < ISA_C_COUNT; c++)
-        cr_expect_eq(row.has[SWEEP_M_OPS + c], 0, "ops_share_%s", isa_category_keys[c]);
+    for (int c = 0; c < ISA_C_COUNT; c++) {
+        char name[64];
+        snprintf(name, sizeof name, "ops_share_%s", isa_category_keys[c]);
+        cr_expect_eq(row.has[column(name)], 0, "%s", name);
+    }
+    sweep_row_clear(&row);
     tu_remove_tree(dir);
 }
 
@@ -203,8 +232,9 @@ Test(sweep_report, values_of_the_wrong_kind_are_left_out)
     /* an interval of 3 numbers is not one; a string or null is no number; utilization not an object */
     SweepRow row = read_report(dir, "{\"cycles\": \"12\", \"fps\": null, \"fps_ci95\": [1, 2, 3], \"utilization\": 0.5,"
                                     " \"rays\": [10]}");
-    for (int m = 0; m < SWEEP_M_COUNT; m++)
+    for (int m = 0; m < stats_csv_count(); m++)
         cr_expect_eq(row.has[m], 0, "%s has a value", name_of(m));
+    sweep_row_clear(&row);
     tu_remove_tree(dir);
 }
 
@@ -215,7 +245,7 @@ Test(sweep_report, a_report_that_is_no_object_is_an_error)
     snprintf(path, sizeof path, "%s/report.json", dir);
     tu_write_file(path, "[1, 2]");
     SweepRow row;
-    memset(&row, 0, sizeof row);
+    sweep_row_init(&row);
     cr_expect_eq(sweep_row_read_report(&row, path, err, sizeof err), -1);
     snprintf(want, sizeof want, "%s: not a JSON object", path);
     cr_expect_str_eq(err, want);
@@ -223,6 +253,9 @@ Test(sweep_report, a_report_that_is_no_object_is_an_error)
     cr_expect_eq(sweep_row_read_report(&row, path, err, sizeof err), -1);
     snprintf(want, sizeof want, "%s: cannot open: No such file or directory", path);
     cr_expect_str_eq(err, want);
+    for (int m = 0; m < stats_csv_count(); m++)
+        cr_expect_eq(row.has[m], 0, "%s has a value", name_of(m));
+    sweep_row_clear(&row);
     tu_remove_tree(dir);
 }
 
@@ -301,12 +334,12 @@ Test(sweep_csv, rows_hold_keys_status_error_and_figures)
     }
     cr_assert_eq(nl, 5, "%d lines", nl);
     static char cells[5][200][256];
-    int want_cells = 1 + 2 + 2 + SWEEP_M_COUNT;
+    int want_cells = 1 + 2 + 2 + stats_csv_count();
     for (int i = 0; i < 5; i++)
         cr_expect_eq(split_csv(line[i], cells[i], 200), want_cells, "line %d: %s", i, line[i]);
     cr_expect(starts_with(line[0], "point,k.a,k.b,status,error,cycles,busy_cycles,fps,fps_no_stall,fps_lo,fps_hi,"),
               "%s", line[0]);
-    for (int m = 0; m < SWEEP_M_COUNT; m++)
+    for (int m = 0; m < stats_csv_count(); m++)
         cr_expect_str_eq(cells[0][5 + m], name_of(m));
 
     /* point 0: done; its value with a quote is quoted, its figures read and formatted */
