@@ -392,6 +392,7 @@ const StatsRow stats_rows[] = {
 #include "stats.def"
 };
 const int stats_nrows = (int)(sizeof stats_rows / sizeof stats_rows[0]);
+_Static_assert(sizeof stats_rows / sizeof stats_rows[0] <= STATS_MAX_ROWS, "stats.def has more rows than STATS_MAX_ROWS");
 
 #undef STAT
 #undef RUN

@@ -167,6 +167,7 @@ typedef struct StatsRow {
     const char *desc;
 } StatsRow;
 
+#define STATS_MAX_ROWS 512   /* a bound on stats.def's rows, checked where the table is built */
 extern const StatsRow stats_rows[];
 extern const int stats_nrows;
 extern const char *const stats_dim_names[STATS_D_COUNT];

@@ -3,7 +3,7 @@
  *
  * Owns: the column names and order (the rows' CSV numbers, each row's dimensions expanded) and
  * the reading rules (a finite number, or nothing; shares normalized). Must not: format the CSV
- * file or know the sweep's points (sim/sweep.c does).
+ * file or know the sweep's points (sim/sweep/csv.c does).
  */
 #include <cjson/cJSON.h>
 #include <math.h>
@@ -53,7 +53,7 @@ static void csv_element(const StatsRow *r, int e, int *idx)
 
 int stats_csv_count(void)
 {
-    int rows[512], n = csv_rows(rows), cols = 0;
+    int rows[STATS_MAX_ROWS], n = csv_rows(rows), cols = 0;
     for (int i = 0; i < n; i++)
         cols += row_elements(&stats_rows[rows[i]]);
     return cols;
@@ -83,7 +83,7 @@ static void csv_name(const StatsRow *r, const int *idx, char *buf, size_t len)
 
 const char *stats_csv_name(int col, char *buf, size_t len)
 {
-    int rows[512], n = csv_rows(rows);
+    int rows[STATS_MAX_ROWS], n = csv_rows(rows);
     buf[0] = '\0';
     for (int i = 0; i < n && col >= 0; i++) {
         const StatsRow *r = &stats_rows[rows[i]];
@@ -121,7 +121,7 @@ static const cJSON *json_find(const cJSON *report, const StatsRow *r, const int 
 
 void stats_csv_read(const cJSON *report, double *value, unsigned char *has)
 {
-    int rows[512], n = csv_rows(rows), col = 0;
+    int rows[STATS_MAX_ROWS], n = csv_rows(rows), col = 0;
     for (int i = 0; i < n; i++) {
         const StatsRow *r = &stats_rows[rows[i]];
         int ne = row_elements(r);
