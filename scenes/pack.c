@@ -116,15 +116,10 @@ static int32_t emissive_texture(const Scene *s, const SceneMaterial *m)
                                                                                               : -1;
 }
 
-int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *out, char *err,
-               size_t errlen)
+/* The BVH over the triangles' and spheres' bounding boxes, its invariants checked. */
+static int pack_build_bvh(const Scene *s, const BvhParams *bp, uint32_t nprims, Bvh *bvh, char *err,
+                          size_t errlen)
 {
-    memset(out, 0, sizeof *out);
-    if (base % 64) {
-        snprintf(err, errlen, "pack: base address 0x%x is not a multiple of 64", base);
-        return -1;
-    }
-    uint32_t nprims = s->ntris + s->nspheres;
     float *lo = malloc(sizeof(float) * 3 * (nprims ? nprims : 1));
     float *hi = malloc(sizeof(float) * 3 * (nprims ? nprims : 1));
     if (!lo || !hi) {
@@ -147,210 +142,282 @@ int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *
             hi[3 * (s->ntris + j) + k] = sp->center[k] + sp->radius;
         }
     }
-    int rc = bvh_build(bp, lo, hi, nprims, &out->bvh, err, errlen);
+    int rc = bvh_build(bp, lo, hi, nprims, bvh, err, errlen);
     /* The invariants are checked on every build, not only in tests: O(n), and a broken tree
      * would silently lose geometry. */
-    if (rc == 0 && bvh_check(&out->bvh, lo, hi, err, errlen) != 0) {
-        bvh_free(&out->bvh);
+    if (rc == 0 && bvh_check(bvh, lo, hi, err, errlen) != 0) {
+        bvh_free(bvh);
         rc = -1;
     }
     free(lo);
     free(hi);
-    if (rc)
-        return -1;
+    return rc ? -1 : 0;
+}
 
-    /* Emissive triangles and file lights become light records. */
-    uint32_t nlights = s->nlights + s->nemissive;
-    Writer w = {NULL, 0, 0, base, 0};
-    uint32_t h = w_alloc(&w, SM_HDR_WORDS);
-    uint32_t nodes = w_alloc(&w, (size_t)SM_NODE_WORDS * out->bvh.nnodes);
-    uint32_t prims = w_alloc(&w, (size_t)SM_PRIM_WORDS * nprims);
-    uint32_t mats = w_alloc(&w, (size_t)SM_MAT_WORDS * s->nmaterials);
-    uint32_t texs = w_alloc(&w, (size_t)SM_TEX_WORDS * s->ntextures);
-    uint32_t lights = w_alloc(&w, (size_t)SM_LIGHT_WORDS * nlights);
-    uint32_t normals = s->nrm ? w_alloc(&w, (size_t)9 * s->ntris) : 0;
-    uint32_t uvs = s->uv ? w_alloc(&w, (size_t)6 * s->ntris) : 0;
+/* Where each table of the image starts (scene-memory addresses; 0 for an absent table). */
+typedef struct Layout {
+    uint32_t nprims, nnodes, nlights;
+    int emit_tex; /* emissive textures are packed (the scene needs them and has their UVs) */
+    uint32_t h, nodes, prims, mats, texs, lights, normals, uvs, emit_uvs, matx, colors, lut;
+    uint32_t *texels; /* per texture: its texel array (malloc'ed) */
+} Layout;
+
+/* Reserves every table in w, in image order. 0, or -1 with a message (and nothing to free). */
+static int pack_lay_out(Writer *w, const Scene *s, Layout *l, char *err, size_t errlen)
+{
+    l->h = w_alloc(w, SM_HDR_WORDS);
+    l->nodes = w_alloc(w, (size_t)SM_NODE_WORDS * l->nnodes);
+    l->prims = w_alloc(w, (size_t)SM_PRIM_WORDS * l->nprims);
+    l->mats = w_alloc(w, (size_t)SM_MAT_WORDS * s->nmaterials);
+    l->texs = w_alloc(w, (size_t)SM_TEX_WORDS * s->ntextures);
+    l->lights = w_alloc(w, (size_t)SM_LIGHT_WORDS * l->nlights);
+    l->normals = s->nrm ? w_alloc(w, (size_t)9 * s->ntris) : 0;
+    l->uvs = s->uv ? w_alloc(w, (size_t)6 * s->ntris) : 0;
     /* emissive textures and vertex colours only when the scene needs them, so a reader sees one
      * answer in the header and the needs */
-    int emit_tex = (s->needs & SCENE_NEED_EMISSIVE_TEXTURES) && s->uv_emit;
-    uint32_t emit_uvs = emit_tex ? w_alloc(&w, (size_t)6 * s->ntris) : 0;
-    uint32_t matx = emit_tex ? w_alloc(&w, (size_t)SM_MATX_WORDS * s->nmaterials) : 0;
-    uint32_t colors = (s->needs & SCENE_NEED_VERTEX_COLORS) && s->col ? w_alloc(&w, (size_t)9 * s->ntris) : 0;
-    uint32_t lut = w_alloc(&w, 256);
-    uint32_t *texels = calloc(s->ntextures ? s->ntextures : 1, sizeof(uint32_t));
-    for (uint32_t t = 0; texels && t < s->ntextures; t++)
-        texels[t] = w_alloc(&w, (size_t)s->textures[t].width * (size_t)s->textures[t].height);
-    if (w.oom || !texels || w.size > (size_t)UINT32_MAX - base) {
-        snprintf(err, errlen, "pack: scene does not fit in memory (%zu bytes)", w.size);
-        free(texels);
-        free(w.mem);
-        bvh_free(&out->bvh);
+    l->emit_tex = (s->needs & SCENE_NEED_EMISSIVE_TEXTURES) && s->uv_emit;
+    l->emit_uvs = l->emit_tex ? w_alloc(w, (size_t)6 * s->ntris) : 0;
+    l->matx = l->emit_tex ? w_alloc(w, (size_t)SM_MATX_WORDS * s->nmaterials) : 0;
+    l->colors = (s->needs & SCENE_NEED_VERTEX_COLORS) && s->col ? w_alloc(w, (size_t)9 * s->ntris) : 0;
+    l->lut = w_alloc(w, 256);
+    l->texels = calloc(s->ntextures ? s->ntextures : 1, sizeof(uint32_t));
+    for (uint32_t t = 0; l->texels && t < s->ntextures; t++)
+        l->texels[t] = w_alloc(w, (size_t)s->textures[t].width * (size_t)s->textures[t].height);
+    if (w->oom || !l->texels || w->size > (size_t)UINT32_MAX - w->base) {
+        snprintf(err, errlen, "pack: scene does not fit in memory (%zu bytes)", w->size);
+        free(l->texels);
+        l->texels = NULL;
         return -1;
     }
+    return 0;
+}
 
-    put_u32(&w, hdr(h, SM_HDR_MAGIC), SM_MAGIC);
-    put_u32(&w, hdr(h, SM_HDR_VERSION), SM_VERSION);
-    put_u32(&w, hdr(h, SM_HDR_NPRIMS), nprims);
-    put_u32(&w, hdr(h, SM_HDR_NNODES), out->bvh.nnodes);
-    put_u32(&w, hdr(h, SM_HDR_NMATS), s->nmaterials);
-    put_u32(&w, hdr(h, SM_HDR_NTEX), s->ntextures);
-    put_u32(&w, hdr(h, SM_HDR_NLIGHTS), nlights);
-    put_u32(&w, hdr(h, SM_HDR_NODES), nodes);
-    put_u32(&w, hdr(h, SM_HDR_PRIMS), prims);
-    put_u32(&w, hdr(h, SM_HDR_MATS), mats);
-    put_u32(&w, hdr(h, SM_HDR_TEXS), texs);
-    put_u32(&w, hdr(h, SM_HDR_LIGHTS), lights);
-    put_u32(&w, hdr(h, SM_HDR_NORMALS), normals);
-    put_u32(&w, hdr(h, SM_HDR_UVS), uvs);
-    put_u32(&w, hdr(h, SM_HDR_SRGB_LUT), lut);
-    put_u32(&w, hdr(h, SM_HDR_EMIT_UVS), emit_uvs);
-    put_u32(&w, hdr(h, SM_HDR_COLORS), colors);
-    put_u32(&w, hdr(h, SM_HDR_MATX), matx);
-    put_u32(&w, hdr(h, SM_HDR_WIDTH), (uint32_t)s->render.width);
-    put_u32(&w, hdr(h, SM_HDR_HEIGHT), (uint32_t)s->render.height);
-    put_u32(&w, hdr(h, SM_HDR_SPP), (uint32_t)s->render.spp);
-    put_u32(&w, hdr(h, SM_HDR_MAX_DEPTH), (uint32_t)s->render.max_depth);
-    put_vec(&w, hdr(h, SM_HDR_BACKGROUND), s->render.background, 3);
-    put_vec(&w, hdr(h, SM_HDR_AMBIENT), s->render.ambient, 3);
-    put_vec(&w, hdr(h, SM_HDR_CAM_POS), s->camera.position, 3);
+/* The header: counts, table addresses, render settings, camera, bounds. */
+static void pack_header(Writer *w, const Scene *s, const Layout *l)
+{
+    uint32_t h = l->h;
+    put_u32(w, hdr(h, SM_HDR_MAGIC), SM_MAGIC);
+    put_u32(w, hdr(h, SM_HDR_VERSION), SM_VERSION);
+    put_u32(w, hdr(h, SM_HDR_NPRIMS), l->nprims);
+    put_u32(w, hdr(h, SM_HDR_NNODES), l->nnodes);
+    put_u32(w, hdr(h, SM_HDR_NMATS), s->nmaterials);
+    put_u32(w, hdr(h, SM_HDR_NTEX), s->ntextures);
+    put_u32(w, hdr(h, SM_HDR_NLIGHTS), l->nlights);
+    put_u32(w, hdr(h, SM_HDR_NODES), l->nodes);
+    put_u32(w, hdr(h, SM_HDR_PRIMS), l->prims);
+    put_u32(w, hdr(h, SM_HDR_MATS), l->mats);
+    put_u32(w, hdr(h, SM_HDR_TEXS), l->texs);
+    put_u32(w, hdr(h, SM_HDR_LIGHTS), l->lights);
+    put_u32(w, hdr(h, SM_HDR_NORMALS), l->normals);
+    put_u32(w, hdr(h, SM_HDR_UVS), l->uvs);
+    put_u32(w, hdr(h, SM_HDR_SRGB_LUT), l->lut);
+    put_u32(w, hdr(h, SM_HDR_EMIT_UVS), l->emit_uvs);
+    put_u32(w, hdr(h, SM_HDR_COLORS), l->colors);
+    put_u32(w, hdr(h, SM_HDR_MATX), l->matx);
+    put_u32(w, hdr(h, SM_HDR_WIDTH), (uint32_t)s->render.width);
+    put_u32(w, hdr(h, SM_HDR_HEIGHT), (uint32_t)s->render.height);
+    put_u32(w, hdr(h, SM_HDR_SPP), (uint32_t)s->render.spp);
+    put_u32(w, hdr(h, SM_HDR_MAX_DEPTH), (uint32_t)s->render.max_depth);
+    put_vec(w, hdr(h, SM_HDR_BACKGROUND), s->render.background, 3);
+    put_vec(w, hdr(h, SM_HDR_AMBIENT), s->render.ambient, 3);
+    put_vec(w, hdr(h, SM_HDR_CAM_POS), s->camera.position, 3);
     float cw[3], cu[3], cv[3], lu[3], lv[3];
     camera(s, cw, cu, cv, lu, lv);
-    put_vec(&w, hdr(h, SM_HDR_CAM_W), cw, 3);
-    put_vec(&w, hdr(h, SM_HDR_CAM_U), cu, 3);
-    put_vec(&w, hdr(h, SM_HDR_CAM_V), cv, 3);
-    put_vec(&w, hdr(h, SM_HDR_LENS_U), lu, 3);
-    put_vec(&w, hdr(h, SM_HDR_LENS_V), lv, 3);
+    put_vec(w, hdr(h, SM_HDR_CAM_W), cw, 3);
+    put_vec(w, hdr(h, SM_HDR_CAM_U), cu, 3);
+    put_vec(w, hdr(h, SM_HDR_CAM_V), cv, 3);
+    put_vec(w, hdr(h, SM_HDR_LENS_U), lu, 3);
+    put_vec(w, hdr(h, SM_HDR_LENS_V), lv, 3);
     float eps = 0.0f;
     for (int k = 0; k < 3; k++)
         eps = fmaxf(eps, fmaxf(fabsf(s->bounds_min[k]), fabsf(s->bounds_max[k])));
-    put_f32(&w, hdr(h, SM_HDR_EPSILON), eps);
-    put_u32(&w, hdr(h, SM_HDR_NEEDS), s->needs);
-    put_vec(&w, hdr(h, SM_HDR_BOUNDS_MIN), s->bounds_min, 3);
-    put_vec(&w, hdr(h, SM_HDR_BOUNDS_MAX), s->bounds_max, 3);
+    put_f32(w, hdr(h, SM_HDR_EPSILON), eps);
+    put_u32(w, hdr(h, SM_HDR_NEEDS), s->needs);
+    put_vec(w, hdr(h, SM_HDR_BOUNDS_MIN), s->bounds_min, 3);
+    put_vec(w, hdr(h, SM_HDR_BOUNDS_MAX), s->bounds_max, 3);
+}
 
-    for (uint32_t i = 0; i < out->bvh.nnodes; i++) {
-        const BvhNode *n = &out->bvh.nodes[i];
-        put_vec(&w, sm_rec(nodes, SM_NODE_WORDS, i, SM_NODE_BMIN), n->bmin, 3);
-        put_vec(&w, sm_rec(nodes, SM_NODE_WORDS, i, SM_NODE_BMAX), n->bmax, 3);
-        put_u32(&w, sm_rec(nodes, SM_NODE_WORDS, i, SM_NODE_FIRST), n->first);
-        put_u32(&w, sm_rec(nodes, SM_NODE_WORDS, i, SM_NODE_INFO),
+/* The BVH nodes, then the primitives in leaf order, so a leaf's primitives are one contiguous run. */
+static void pack_geometry(Writer *w, const Scene *s, const Bvh *bvh, const Layout *l)
+{
+    uint32_t nodes = l->nodes, prims = l->prims;
+    for (uint32_t i = 0; i < bvh->nnodes; i++) {
+        const BvhNode *n = &bvh->nodes[i];
+        put_vec(w, sm_rec(nodes, SM_NODE_WORDS, i, SM_NODE_BMIN), n->bmin, 3);
+        put_vec(w, sm_rec(nodes, SM_NODE_WORDS, i, SM_NODE_BMAX), n->bmax, 3);
+        put_u32(w, sm_rec(nodes, SM_NODE_WORDS, i, SM_NODE_FIRST), n->first);
+        put_u32(w, sm_rec(nodes, SM_NODE_WORDS, i, SM_NODE_INFO),
                 n->count > 0 ? n->count : (SM_NODE_INNER | n->axis));
     }
-    /* Primitives in leaf order, so a leaf's primitives are one contiguous run. */
-    for (uint32_t i = 0; i < nprims; i++) {
-        uint32_t src = out->bvh.prim_index[i];
+    for (uint32_t i = 0; i < l->nprims; i++) {
+        uint32_t src = bvh->prim_index[i];
         if (src < s->ntris) {
-            put_vec(&w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_V0), &s->pos[9 * src], 9);
-            put_u32(&w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_MAT), s->tri_material[src]);
-            put_u32(&w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_KIND), 0);
-            put_u32(&w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_SRC), src);
+            put_vec(w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_V0), &s->pos[9 * src], 9);
+            put_u32(w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_MAT), s->tri_material[src]);
+            put_u32(w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_KIND), 0);
+            put_u32(w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_SRC), src);
         } else {
             const SceneSphere *sp = &s->spheres[src - s->ntris];
-            put_vec(&w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_V0), sp->center, 3);
-            put_f32(&w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_V1), sp->radius);
-            put_u32(&w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_MAT), (uint32_t)sp->material);
-            put_u32(&w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_KIND), 1);
-            put_u32(&w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_SRC), src - s->ntris);
+            put_vec(w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_V0), sp->center, 3);
+            put_f32(w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_V1), sp->radius);
+            put_u32(w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_MAT), (uint32_t)sp->material);
+            put_u32(w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_KIND), 1);
+            put_u32(w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_SRC), src - s->ntris);
         }
     }
+}
+
+/* The material records (and their extension records when emissive textures are packed). */
+static void pack_materials(Writer *w, const Scene *s, const Layout *l)
+{
+    uint32_t mats = l->mats, matx = l->matx;
     for (uint32_t i = 0; i < s->nmaterials; i++) {
         const SceneMaterial *m = &s->materials[i];
-        put_u32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_KIND), (uint32_t)m->kind);
-        put_vec(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_BASE), m->base_color, 3);
-        put_u32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_TEX), (uint32_t)m->base_texture);
-        put_f32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_ROUGHNESS), m->roughness);
-        put_f32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_METALLIC), m->metallic);
-        put_f32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_IOR), m->ior);
-        put_vec(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_EMISSION), m->emission, 3);
-        put_u32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_ALPHA_MODE), (uint32_t)m->alpha_mode);
-        put_f32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_ALPHA_CUT), m->alpha_cutoff);
-        put_f32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_ALPHA), m->alpha);
-        put_f32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_TRANSMISSION), m->transmission);
-        put_u32(&w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_DOUBLE_SIDED), m->double_sided ? 1u : 0u);
+        put_u32(w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_KIND), (uint32_t)m->kind);
+        put_vec(w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_BASE), m->base_color, 3);
+        put_u32(w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_TEX), (uint32_t)m->base_texture);
+        put_f32(w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_ROUGHNESS), m->roughness);
+        put_f32(w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_METALLIC), m->metallic);
+        put_f32(w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_IOR), m->ior);
+        put_vec(w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_EMISSION), m->emission, 3);
+        put_u32(w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_ALPHA_MODE), (uint32_t)m->alpha_mode);
+        put_f32(w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_ALPHA_CUT), m->alpha_cutoff);
+        put_f32(w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_ALPHA), m->alpha);
+        put_f32(w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_TRANSMISSION), m->transmission);
+        put_u32(w, sm_rec(mats, SM_MAT_WORDS, i, SM_MAT_DOUBLE_SIDED), m->double_sided ? 1u : 0u);
         if (matx)
-            put_u32(&w, sm_rec(matx, SM_MATX_WORDS, i, SM_MATX_EMIT_TEX), (uint32_t)emissive_texture(s, m));
+            put_u32(w, sm_rec(matx, SM_MATX_WORDS, i, SM_MATX_EMIT_TEX), (uint32_t)emissive_texture(s, m));
     }
+}
+
+/* The texture records and their texels, sRGB-encoded 8-bit RGBA words. */
+static void pack_textures(Writer *w, const Scene *s, const Layout *l)
+{
+    uint32_t texs = l->texs;
     for (uint32_t t = 0; t < s->ntextures; t++) {
         const SceneTexture *tx = &s->textures[t];
-        put_u32(&w, sm_rec(texs, SM_TEX_WORDS, t, SM_TEX_WIDTH), (uint32_t)tx->width);
-        put_u32(&w, sm_rec(texs, SM_TEX_WORDS, t, SM_TEX_HEIGHT), (uint32_t)tx->height);
-        put_u32(&w, sm_rec(texs, SM_TEX_WORDS, t, SM_TEX_TEXELS), texels[t]);
+        put_u32(w, sm_rec(texs, SM_TEX_WORDS, t, SM_TEX_WIDTH), (uint32_t)tx->width);
+        put_u32(w, sm_rec(texs, SM_TEX_WORDS, t, SM_TEX_HEIGHT), (uint32_t)tx->height);
+        put_u32(w, sm_rec(texs, SM_TEX_WORDS, t, SM_TEX_TEXELS), l->texels[t]);
         size_t n = (size_t)tx->width * (size_t)tx->height;
         for (size_t i = 0; i < n; i++) {
             const float *c = &tx->rgba[4 * i];
             float a = c[3] <= 0.0f ? 0.0f : (c[3] >= 1.0f ? 1.0f : c[3]);
             uint32_t word = (uint32_t)srgb_encode8(c[0]) | (uint32_t)srgb_encode8(c[1]) << 8 |
                             (uint32_t)srgb_encode8(c[2]) << 16 | (uint32_t)lrintf(a * 255.0f) << 24;
-            put_u32(&w, texels[t] + 4u * (uint32_t)i, word);
+            put_u32(w, l->texels[t] + 4u * (uint32_t)i, word);
         }
     }
-    free(texels);
-    uint32_t li = 0;
-    for (uint32_t i = 0; i < s->nlights; i++, li++) {
-        const SceneLight *l = &s->lights[i];
-        float rad[3] = {l->color[0] * l->intensity, l->color[1] * l->intensity, l->color[2] * l->intensity};
-        uint32_t kind = l->kind == SCENE_LIGHT_POINT ? SM_LIGHT_POINT
-                      : l->kind == SCENE_LIGHT_SPOT ? SM_LIGHT_SPOT
-                      : l->kind == SCENE_LIGHT_DIRECTIONAL ? SM_LIGHT_DIRECTIONAL : SM_LIGHT_QUAD;
-        put_u32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_KIND), kind);
-        put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_RADIANCE), rad, 3);
-        put_u32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_TEX), (uint32_t)-1);
+}
+
+/* The file's lights: records 0 .. nlights-1 of the light table. */
+static void pack_file_lights(Writer *w, const Scene *s, const Layout *l)
+{
+    uint32_t lights = l->lights;
+    for (uint32_t li = 0; li < s->nlights; li++) {
+        const SceneLight *sl = &s->lights[li];
+        float rad[3] = {sl->color[0] * sl->intensity, sl->color[1] * sl->intensity, sl->color[2] * sl->intensity};
+        uint32_t kind = sl->kind == SCENE_LIGHT_POINT ? SM_LIGHT_POINT
+                      : sl->kind == SCENE_LIGHT_SPOT ? SM_LIGHT_SPOT
+                      : sl->kind == SCENE_LIGHT_DIRECTIONAL ? SM_LIGHT_DIRECTIONAL : SM_LIGHT_QUAD;
+        put_u32(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_KIND), kind);
+        put_vec(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_RADIANCE), rad, 3);
+        put_u32(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_TEX), (uint32_t)-1);
         if (kind == SM_LIGHT_DIRECTIONAL) {
-            put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_P), l->direction, 3);
+            put_vec(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_P), sl->direction, 3);
         } else {
-            put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_P), l->position, 3);
+            put_vec(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_P), sl->position, 3);
         }
         if (kind == SM_LIGHT_SPOT) {
-            put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_E1), l->direction, 3);
-            put_f32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_COS_INNER), cosf(l->inner_cone));
-            put_f32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_COS_OUTER), cosf(l->outer_cone));
+            put_vec(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_E1), sl->direction, 3);
+            put_f32(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_COS_INNER), cosf(sl->inner_cone));
+            put_f32(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_COS_OUTER), cosf(sl->outer_cone));
         }
         if (kind == SM_LIGHT_QUAD) {
-            put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_E1), l->edge_u, 3);
-            put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_E2), l->edge_v, 3);
-            float cx = l->edge_u[1] * l->edge_v[2] - l->edge_u[2] * l->edge_v[1];
-            float cy = l->edge_u[2] * l->edge_v[0] - l->edge_u[0] * l->edge_v[2];
-            float cz = l->edge_u[0] * l->edge_v[1] - l->edge_u[1] * l->edge_v[0];
-            put_f32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_AREA), sqrtf(cx * cx + cy * cy + cz * cz));
+            put_vec(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_E1), sl->edge_u, 3);
+            put_vec(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_E2), sl->edge_v, 3);
+            float cx = sl->edge_u[1] * sl->edge_v[2] - sl->edge_u[2] * sl->edge_v[1];
+            float cy = sl->edge_u[2] * sl->edge_v[0] - sl->edge_u[0] * sl->edge_v[2];
+            float cz = sl->edge_u[0] * sl->edge_v[1] - sl->edge_u[1] * sl->edge_v[0];
+            put_f32(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_AREA), sqrtf(cx * cx + cy * cy + cz * cz));
         }
     }
+}
+
+/* Emissive triangles become triangle lights, after the file's lights. */
+static void pack_emissive_lights(Writer *w, const Scene *s, const Layout *l)
+{
+    uint32_t lights = l->lights, li = s->nlights;
     for (uint32_t e = 0; e < s->nemissive; e++, li++) {
         uint32_t t = s->emissive_tris[e];
         const float *p = &s->pos[9 * t];
+        const SceneMaterial *m = &s->materials[s->tri_material[t]];
         float e1[3] = {p[3] - p[0], p[4] - p[1], p[5] - p[2]}, e2[3] = {p[6] - p[0], p[7] - p[1], p[8] - p[2]};
-        put_u32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_KIND), SM_LIGHT_TRIANGLE);
-        put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_P), p, 3);
-        put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_E1), e1, 3);
-        put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_E2), e2, 3);
-        put_vec(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_RADIANCE),
-                s->materials[s->tri_material[t]].emission, 3);
-        put_f32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_AREA), tri_area(p));
-        put_u32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_TWO_SIDED),
-                s->materials[s->tri_material[t]].double_sided ? 1u : 0u);
-        put_u32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_TEX),
-                emit_tex ? (uint32_t)emissive_texture(s, &s->materials[s->tri_material[t]]) : (uint32_t)-1);
-        put_u32(&w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_SRC), t);
+        put_u32(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_KIND), SM_LIGHT_TRIANGLE);
+        put_vec(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_P), p, 3);
+        put_vec(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_E1), e1, 3);
+        put_vec(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_E2), e2, 3);
+        put_vec(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_RADIANCE), m->emission, 3);
+        put_f32(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_AREA), tri_area(p));
+        put_u32(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_TWO_SIDED), m->double_sided ? 1u : 0u);
+        put_u32(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_TEX),
+                l->emit_tex ? (uint32_t)emissive_texture(s, m) : (uint32_t)-1);
+        put_u32(w, sm_rec(lights, SM_LIGHT_WORDS, li, SM_LIGHT_SRC), t);
     }
-    if (normals)
-        for (uint32_t i = 0; i < 9 * s->ntris; i++)
-            put_f32(&w, normals + 4 * i, s->nrm[i]);
-    if (uvs)
-        for (uint32_t i = 0; i < 6 * s->ntris; i++)
-            put_f32(&w, uvs + 4 * i, s->uv[i]);
-    if (emit_uvs)
-        for (uint32_t i = 0; i < 6 * s->ntris; i++)
-            put_f32(&w, emit_uvs + 4 * i, s->uv_emit[i]);
-    if (colors)
-        for (uint32_t i = 0; i < 9 * s->ntris; i++)
-            put_f32(&w, colors + 4 * i, s->col[i]);
+}
+
+/* n floats from src at address at, when the table is present (at != 0). */
+static void pack_floats(Writer *w, uint32_t at, const float *src, uint32_t n)
+{
+    if (at)
+        for (uint32_t i = 0; i < n; i++)
+            put_f32(w, at + 4 * i, src[i]);
+}
+
+/* Per-vertex attributes (normals, UVs, emissive UVs, colours) and the sRGB decoding table. */
+static void pack_attributes(Writer *w, const Scene *s, const Layout *l)
+{
+    pack_floats(w, l->normals, s->nrm, 9 * s->ntris);
+    pack_floats(w, l->uvs, s->uv, 6 * s->ntris);
+    pack_floats(w, l->emit_uvs, s->uv_emit, 6 * s->ntris);
+    pack_floats(w, l->colors, s->col, 9 * s->ntris);
     for (int c = 0; c < 256; c++)
-        put_f32(&w, lut + 4u * (uint32_t)c, srgb_decode8(c));
+        put_f32(w, l->lut + 4u * (uint32_t)c, srgb_decode8(c));
+}
+
+int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *out, char *err,
+               size_t errlen)
+{
+    memset(out, 0, sizeof *out);
+    if (base % 64) {
+        snprintf(err, errlen, "pack: base address 0x%x is not a multiple of 64", base);
+        return -1;
+    }
+    uint32_t nprims = s->ntris + s->nspheres;
+    if (pack_build_bvh(s, bp, nprims, &out->bvh, err, errlen) != 0)
+        return -1;
+    /* Emissive triangles and file lights become light records. */
+    Layout l = {.nprims = nprims, .nnodes = out->bvh.nnodes, .nlights = s->nlights + s->nemissive};
+    Writer w = {NULL, 0, 0, base, 0};
+    if (pack_lay_out(&w, s, &l, err, errlen) != 0) {
+        free(w.mem);
+        bvh_free(&out->bvh);
+        return -1;
+    }
+    pack_header(&w, s, &l);
+    pack_geometry(&w, s, &out->bvh, &l);
+    pack_materials(&w, s, &l);
+    pack_textures(&w, s, &l);
+    free(l.texels);
+    pack_file_lights(&w, s, &l);
+    pack_emissive_lights(&w, s, &l);
+    pack_attributes(&w, s, &l);
 
     out->mem = w.mem;
     out->size = (uint32_t)w.size;
     out->base = base;
     out->nprims = nprims;
-    out->nlights = nlights;
+    out->nlights = l.nlights;
     return 0;
 }
 
