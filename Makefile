@@ -47,7 +47,7 @@ ASMLIB_OBJ = $(patsubst %.c,$(BUILD)/obj/%.o,$(ISA_SRC) $(ASM_SRC))
 LIB_OBJ  = $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/obj/%.o,$(CXX_SRC))
 ASAN_OBJ = $(patsubst %.c,$(BUILD)/asan/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/asan/%.o,$(CXX_SRC))
 
-.PHONY: all deps install run test test-standalone test-asan test-unit test-hard fuzz fuzz-run bench validation docs check-docs clean run-built test-built check-outputs help
+.PHONY: all deps install run test test-standalone test-asan test-unit test-hard test-slurm fuzz fuzz-run bench validation docs check-docs clean run-built test-built check-outputs help
 
 all: bin/sfasm bin/sfsim
 
@@ -56,6 +56,7 @@ help:
 	@echo "make test       install deps, build, run the whole test suite"
 	@echo "make test-asan  the unit tests under AddressSanitizer + UBSan"
 	@echo "make test-standalone  make run and make test in a clone with no ../shared beside it"
+	@echo "make test-slurm the sweep's Slurm path on a real one-node Slurm started on localhost"
 	@echo "make fuzz       build the libFuzzer targets, assembler and scene loader (clang);"
 	@echo "                make fuzz-run FUZZ_SECONDS=600 runs each for that long"
 	@echo "make bench      build and run the benchmarks in bench/ (core, functional and detailed speed, Embree)"
@@ -197,6 +198,15 @@ test-built: all $(BUILD)/tests/unit $(BUILD)/tests/io $(BUILD)/gen_cornell $(BUI
 # with reasons what needs ../shared. CI runs it (a few minutes).
 test-standalone: deps
 	@bash tests/standalone_clone.sh
+
+# The sweep's Slurm path against a real Slurm: installs slurmctld, slurmd, the client commands and
+# munge (scripts/deps.sh slurm), starts them as a one-node cluster on localhost in a temporary
+# folder, runs a 4-point sweep as an array job and checks it against a local run (tests/slurm/run.sh,
+# docs/sweep.md). CI runs it; about 20 s once the packages are installed.
+test-slurm: deps
+	@bash scripts/deps.sh slurm
+	@$(MAKE) --no-print-directory all
+	@bash tests/slurm/run.sh
 
 ASAN_ENV = ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp
 

@@ -1,16 +1,29 @@
 #!/usr/bin/env bash
 # Installs, from Debian's packages, whatever sfsim needs to build, test and run and is missing.
 # Used by `make run`, `make test` and CI alike; does nothing when everything is present.
+# `scripts/deps.sh slurm` installs instead the optional group for `make test-slurm`: Slurm's
+# controller, node daemon and client commands, and munge (tests/slurm/run.sh).
 set -euo pipefail
 
-PKGS=(
-  build-essential pkg-config clang libclang-rt-14-dev
-  libtinygltf-dev nlohmann-json3-dev libstb-dev
-  libopenimageio-dev openimageio-tools
-  fonts-dejavu-core
-  libinih-dev libcjson-dev libcriterion-dev
-  libembree-dev gnuplot-nox parallel
-)
+case "${1:-}" in
+"")
+  PKGS=(
+    build-essential pkg-config clang libclang-rt-14-dev
+    libtinygltf-dev nlohmann-json3-dev libstb-dev
+    libopenimageio-dev openimageio-tools
+    fonts-dejavu-core
+    libinih-dev libcjson-dev libcriterion-dev
+    libembree-dev gnuplot-nox parallel
+  )
+  ;;
+slurm)
+  PKGS=(slurmctld slurmd slurm-client munge)
+  ;;
+*)
+  echo "usage: scripts/deps.sh [slurm]" >&2
+  exit 2
+  ;;
+esac
 
 missing=()
 for p in "${PKGS[@]}"; do

@@ -37,6 +37,18 @@ static void task_command(UtilBuf *b, const char *exe, const SweepPlan *pl, const
     sweep_shell_word(b, dir, 1);
 }
 
+/* DIR on the `#SBATCH --output=` line. Slurm expands that path as a filename pattern (%A, %a, %x,
+ * %j, ...), so a '%' of the folder's own name is written "%%", or the tasks' logs would go to a
+ * folder that does not exist and every task would fail before running. */
+static void output_dir(UtilBuf *b, const char *dir)
+{
+    UtilBuf d = {0};
+    for (const char *c = dir; *c; c++)
+        util_buf_add(&d, *c == '%' ? "%%" : c, *c == '%' ? 2 : 1);
+    sweep_shell_word(b, sweep_buf_text(&d), 0);
+    util_buf_free(&d);
+}
+
 int sweep_emit_scripts(const SweepPlan *pl, const SweepArgs *a, const char *exe, const char *dir)
 {
     char err[PATH_MAX + 256];
@@ -47,7 +59,7 @@ int sweep_emit_scripts(const SweepPlan *pl, const SweepArgs *a, const char *exe,
         util_buf_printf(&b, "#!/bin/bash\n#SBATCH --job-name=sfsim-sweep\n#SBATCH --array=0-%d\n"
                             "#SBATCH --cpus-per-task=%d\n", pl->npoints - 1, a->threads);
         util_buf_puts(&b, "#SBATCH --output=");
-        sweep_shell_word(&b, dir, 0);
+        output_dir(&b, dir);
         util_buf_puts(&b, "/points/slurm-%A_%a.out\n");
         util_buf_printf(&b, "# Written by sfsim sweep --emit slurm: one array task per point of the sweep in %s.\n"
                             "# A task whose point is done already exits at once; after the tasks: sfsim merge %s\n",

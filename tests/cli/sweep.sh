@@ -398,6 +398,13 @@ SLURM_ARRAY_TASK_ID=5 bash "$s" >"$T/slurm.log" 2>&1 || no "a task whose point i
 grep -q "already" "$T/slurm.log" || no "a second task for a done point ran it again"
 end
 
+begin "--emit slurm: a '%' in the folder's name is written %% on the --output line (Slurm expands it)"
+run "$SFSIM" sweep --sweep "$T/kill.ini" -o "$T/slurm 100%x" "${TINY[@]}" --emit slurm
+want_rc 0
+grep -qF '#SBATCH --output="'"$T"'/slurm 100%%x"/points/slurm-%A_%a.out' "$T/slurm 100%x/sweep.slurm" 2>/dev/null ||
+    no "the --output line: $(grep -e --output "$T/slurm 100%x/sweep.slurm" 2>/dev/null)"
+end
+
 begin "without gnuplot: a warning, the CSV is written, exit status unchanged"
 run env PATH=/nonexistent "$SFSIM" merge "$T/par"
 want_rc 0
