@@ -1,10 +1,10 @@
 /* bench/core_speed.c -- speed of the functional core: simulated instructions per host second.
  *
- * Four instruction mixes, each an endless loop built with isa_encode, run on the default machine
- * (sim/config.def) at N = 4, 16 and 64 in slices of CHUNK instructions until at least the target
- * time has passed (default 0.3 s; `core_speed SECONDS` changes it). Each point is measured REPS
- * times on a fresh core and the fastest run is reported (best of 3: a shared host only ever
- * slows a run down):
+ * Four instruction mixes, each an endless loop built with isa_encode, run on a core of the default
+ * machine (sim/config.def; set up by sim/run/timedcore.h, untimed) at N = 4, 16 and 64 in slices
+ * of CHUNK instructions until at least the target time has passed (default 0.3 s; `core_speed
+ * SECONDS` changes it). Each point is measured REPS times on a fresh core and the fastest run is
+ * reported (best of 3: a shared host only ever slows a run down):
  *
  *   vfloat   vector float arithmetic: vfma, vfadd, vfmul, vfsub, vfmin, vfmax (8 vector ops + jmp)
  *   filter   the stream filter of Gribble & Ramani 2008, Fig. 5, over a 4096-ID stream: sfetch,
@@ -24,6 +24,7 @@
 #include "../isa/isa.h"
 #include "../sim/config.h"
 #include "../sim/core.h"
+#include "../sim/run/timedcore.h"
 #include "../sim/util.h"
 
 #define X(OP, a, b, c, d, m, imm) {ISA_OP_##OP, (a), (b), (c), (d), (m), (uint32_t)(imm)}
@@ -158,16 +159,15 @@ static int time_once(const Mix *m, int lanes, double target, uint64_t *instr, ui
         obj.text[i] = isa_encode(&m->prog[i]);
     CfgMachine cfg;
     cfg_defaults(&cfg);
-    CoreParams p;
-    cfg_core_params(&cfg, &p);
-    p.lanes = lanes;
+    cfg.core_simd_width = lanes;
     char err[512];
-    Core *c = core_new(&p, &obj, err, sizeof err);
-    if (!c) {
+    TimedCore tc; /* untimed: the functional core alone is measured */
+    if (timedcore_open(&tc, &cfg, &obj, 0, err, sizeof err) != 0) {
         fprintf(stderr, "core_speed: %s: %s\n", m->name, err);
         free(obj.text);
         return -1;
     }
+    Core *c = tc.core;
     if (m->setup)
         m->setup(c);
     double t0 = util_now(), t = 0;
@@ -187,7 +187,7 @@ static int time_once(const Mix *m, int lanes, double target, uint64_t *instr, ui
     for (int s = 0; s < ISA_STAGE_COUNT; s++)
         *active += st->active_lanes[s];
     *secs = t;
-    core_free(c);
+    timedcore_close(&tc);
     free(obj.text);
     return rc;
 }

@@ -12,43 +12,24 @@
  * Not a test: numbers depend on the host. The closing notes and docs/model.md quote runs.
  */
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
-#include "../scenes/pack.h"
+#include "../sim/run/run.h"
+#include "../sim/stats.h"
 #include "bench_args.h"
 #include "bench_scenes.h"
-#include "../scenes/scene.h"
-#include "../sim/config.h"
-#include "../sim/functional.h"
-#include "../sim/util.h"
-#include "../sim/stats.h"
 
-typedef struct Result {
-    double secs;
-    uint64_t instructions, rays, cycles;
-    float *rgb;
-} Result;
-
-static int render(const PackedScene *p, uint32_t needs, int timed, int threads, size_t n, Result *r)
+/* sc's frame through the kernel on the default machine, in mode (functional or detailed). 0, or -1
+ * after printing why; fr must be freed with run_frame_free either way. */
+static int render(const RunScene *sc, RunMode mode, int threads, RunFrame *fr)
 {
     static char err[65536];
-    CfgMachine cfg;
-    cfg_defaults(&cfg);
-    FuncParams fp = {.cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .needs = needs, .seed = 1, .threads = threads, .timed = timed};
-    FuncStats st;
-    r->rgb = calloc(n, sizeof(float));
-    double t0 = util_now();
-    if (!r->rgb || func_render(p, &fp, r->rgb, &st, err, sizeof err) != 0) {
+    RunSpec spec = {.mode = mode, .kernel_path = "kernels/pathtrace.s", .seed = 1, .threads = threads};
+    if (run_frame(sc, &spec, fr, err, sizeof err) != 0) {
         fprintf(stderr, "%s\n", err);
         return -1;
     }
-    r->secs = util_now() - t0;
-    r->instructions = st.instructions;
-    r->rays = stats_rays_total(&st);
-    r->cycles = st.timing.cycles;
-    func_stats_free(&st);
     return 0;
 }
 
@@ -74,9 +55,9 @@ int main(int argc, char **argv)
         if (!ok)
             continue;
         char err[65536];
-        Scene s;
-        PackedScene p;
-        if (pack_load_file(scenes[i], w, h, spp, &s, &p, err, sizeof err) != 0) {
+        RunScene sc;
+        RunSize size = {w, h, spp, -1};
+        if (run_scene_open(&sc, scenes[i], &size, NULL, RUN_DETAILED, NULL, err, sizeof err) != 0) {
             fprintf(stderr, "%s\n", err);
             return 1;
         }
@@ -84,27 +65,28 @@ int main(int argc, char **argv)
         uint64_t cycles1 = 0;
         for (int ti = 0; ti < 2; ti++) {
             int threads = ti ? all : 1;
-            Result f, d;
-            if (render(&p, s.needs, 0, threads, n, &f) || render(&p, s.needs, 1, threads, n, &d))
+            RunFrame f, d;
+            if (render(&sc, RUN_FUNCTIONAL, threads, &f) || render(&sc, RUN_DETAILED, threads, &d))
                 return 1;
             int same = memcmp(f.rgb, d.rgb, n * sizeof(float)) == 0;
+            uint64_t cycles = d.f.timing.cycles;
             if (ti == 0)
-                cycles1 = d.cycles;
-            int same_cycles = d.cycles == cycles1;
+                cycles1 = cycles;
+            int same_cycles = cycles == cycles1;
             printf("%-34s %7d %11s %12llu %9.3f %9.2f %10.3f %9s %9s\n", scenes[i], threads, "functional",
-                   (unsigned long long)f.instructions, f.secs, 1e-6 * (double)f.instructions / f.secs,
-                   1e-6 * (double)f.rays / f.secs, "", "");
+                   (unsigned long long)f.f.instructions, f.seconds, 1e-6 * (double)f.f.instructions / f.seconds,
+                   1e-6 * (double)stats_rays_total(&f.f) / f.seconds, "", "");
             printf("%-34s %7d %11s %12llu %9.3f %9.2f %10.3f %8.2fx %9llu%s%s\n", scenes[i], threads, "detailed",
-                   (unsigned long long)d.instructions, d.secs, 1e-6 * (double)d.instructions / d.secs,
-                   1e-6 * (double)d.rays / d.secs, d.secs / f.secs, (unsigned long long)d.cycles,
-                   same ? "" : "  IMAGES DIFFER", same_cycles ? "" : "  CYCLES DIFFER FROM 1 THREAD");
+                   (unsigned long long)d.f.instructions, d.seconds, 1e-6 * (double)d.f.instructions / d.seconds,
+                   1e-6 * (double)stats_rays_total(&d.f) / d.seconds, d.seconds / f.seconds,
+                   (unsigned long long)cycles, same ? "" : "  IMAGES DIFFER",
+                   same_cycles ? "" : "  CYCLES DIFFER FROM 1 THREAD");
             if (!same || !same_cycles)
                 rc = 1;
-            free(f.rgb);
-            free(d.rgb);
+            run_frame_free(&f);
+            run_frame_free(&d);
         }
-        pack_free(&p);
-        scene_free(&s);
+        run_scene_close(&sc);
     }
     bench_scenes_summary("detailed_speed", skipped, (int)(sizeof scenes / sizeof scenes[0]));
     return rc;

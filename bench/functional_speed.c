@@ -11,20 +11,13 @@
  * usage: functional_speed [WIDTH HEIGHT SPP]   (default 128 96 4)
  * Not a test: numbers depend on the host. The closing notes and docs/kernel.md quote runs.
  */
-#include <math.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
-#include "../scenes/pack.h"
+#include "../sim/run/run.h"
+#include "../sim/stats.h"
 #include "bench_args.h"
 #include "bench_scenes.h"
-#include "../scenes/scene.h"
-#include "../sim/config.h"
-#include "../sim/functional.h"
-#include "../sim/stats.h"
-#include "../sim/reference.h"
-#include "../sim/util.h"
 
 int main(int argc, char **argv)
 {
@@ -45,43 +38,30 @@ int main(int argc, char **argv)
         if (!ok)
             continue;
         char err[65536];
-        Scene s;
-        PackedScene p;
-        if (pack_load_file(scenes[i], w, h, spp, &s, &p, err, sizeof err) != 0) {
+        RunScene sc;
+        RunSize size = {w, h, spp, -1};
+        if (run_scene_open(&sc, scenes[i], &size, NULL, RUN_FUNCTIONAL, NULL, err, sizeof err) != 0) {
             fprintf(stderr, "%s\n", err);
             return 1;
         }
-        size_t n = 3 * (size_t)w * h;
-        float *ref = calloc(n, sizeof(float)), *fun = calloc(n, sizeof(float));
-        RefParams rp = {.tile = 64, .seed = 1, .threads = 1};
-        double t0 = util_now();
-        if (!ref || !fun || ref_render(&p, &rp, ref, NULL, err, sizeof err) != 0) {
+        /* The default machine: the golden model's tile is sqrt(stream.rays) = 64. */
+        RunSpec golden = {.mode = RUN_REFERENCE, .seed = 1, .threads = 1};
+        RunSpec kernel = {.mode = RUN_FUNCTIONAL, .kernel_path = "kernels/pathtrace.s", .seed = 1, .threads = 1};
+        RunFrame ref, fun;
+        if (run_frame(&sc, &golden, &ref, err, sizeof err) != 0 || run_frame(&sc, &kernel, &fun, err, sizeof err) != 0) {
             fprintf(stderr, "%s: %s\n", scenes[i], err);
             return 1;
         }
-        double t1 = util_now();
-        CfgMachine cfg;
-        cfg_defaults(&cfg);
-        FuncParams fp = {.cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .needs = s.needs, .seed = 1, .threads = 1};
-        FuncStats st;
-        if (func_render(&p, &fp, fun, &st, err, sizeof err) != 0) {
-            fprintf(stderr, "%s: %s\n", scenes[i], err);
-            return 1;
-        }
-        double t2 = util_now();
-        uint64_t rays = stats_rays_total(&st);
-        int same = memcmp(ref, fun, n * sizeof(float)) == 0;
-        printf("%-34s %12llu %10llu %9.3f %9.3f %10.2f %10.3f %8.1fx%s\n", scenes[i],
-               (unsigned long long)st.instructions, (unsigned long long)rays, t1 - t0, t2 - t1,
-               1e-6 * (double)st.instructions / (t2 - t1), 1e-6 * (double)rays / (t2 - t1), (t2 - t1) / (t1 - t0),
-               same ? "" : "  IMAGES DIFFER");
+        uint64_t instr = fun.f.instructions, rays = stats_rays_total(&fun.f);
+        int same = memcmp(ref.rgb, fun.rgb, 3 * (size_t)w * h * sizeof(float)) == 0;
+        printf("%-34s %12llu %10llu %9.3f %9.3f %10.2f %10.3f %8.1fx%s\n", scenes[i], (unsigned long long)instr,
+               (unsigned long long)rays, ref.seconds, fun.seconds, 1e-6 * (double)instr / fun.seconds,
+               1e-6 * (double)rays / fun.seconds, fun.seconds / ref.seconds, same ? "" : "  IMAGES DIFFER");
         if (!same)
             rc = 1;
-        free(ref);
-        free(fun);
-        func_stats_free(&st);
-        pack_free(&p);
-        scene_free(&s);
+        run_frame_free(&ref);
+        run_frame_free(&fun);
+        run_scene_close(&sc);
     }
     bench_scenes_summary("functional_speed", skipped, (int)(sizeof scenes / sizeof scenes[0]));
     return rc;

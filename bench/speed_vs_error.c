@@ -19,34 +19,36 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
-#include "../scenes/pack.h"
-#include "../scenes/scene.h"
 #include "../sim/config.h"
-#include "../sim/functional.h"
+#include "../sim/run/run.h"
 #include "../sim/sampling.h"
 #include "../sim/stats.h"
 #include "bench_scenes.h"
-#include "../sim/util.h"
 
-typedef struct Run {
-    FuncStats st;
-    double secs;
-} Run;
+static const double rates[] = {0.01, 0.02, 0.05, 0.10, 0.25, 1.00};
+#define NRATES (sizeof rates / sizeof rates[0])
 
-static int render(const PackedScene *p, uint32_t needs, const CfgMachine *cfg, int timed, double sample, size_t n,
-                  int threads, Run *r)
+/* What every row of one scene needs: the machine, the truth (the detailed run) and the files. */
+typedef struct SceneRun {
+    const char *name;
+    const RunScene *sc;
+    const CfgMachine *cfg;
+    int threads;
+    RunFrame full;             /* the detailed run: the truth */
+    double truth, fps_true, u_true[3];
+    FILE *md, *dat;
+} SceneRun;
+
+/* sc's frame in mode (sample: RUN_SAMPLED's fraction of tiles, seed 1). 0, or -1 after printing
+ * why; fr must be freed with run_frame_free either way. */
+static int render(const SceneRun *r, RunMode mode, double sample, RunFrame *fr)
 {
     static char err[65536];
-    FuncParams fp = {.cfg = cfg, .kernel_path = "kernels/pathtrace.s", .needs = needs, .seed = 1, .threads = threads,
-                     .timed = timed, .sample = sample, .sample_seed = 1};
-    float *rgb = calloc(n, sizeof *rgb);
-    double t0 = util_now();
-    int rc = rgb ? func_render(p, &fp, rgb, &r->st, err, sizeof err) : -1;
-    r->secs = util_now() - t0;
-    free(rgb);
+    RunSpec spec = {.mode = mode, .cfg = r->cfg, .kernel_path = "kernels/pathtrace.s", .seed = 1,
+                    .threads = r->threads, .sample = sample, .sample_seed = 1};
+    int rc = run_frame(r->sc, &spec, fr, err, sizeof err);
     if (rc != 0)
         fprintf(stderr, "%s\n", err);
     return rc;
@@ -68,131 +70,140 @@ static double max_abs_diff3(const double a[3], const double b[3])
     return m;
 }
 
-int main(int argc, char **argv)
+/* The functional run's row: fps from instructions (no stalls), utilization per instruction. */
+static int functional_row(const SceneRun *r)
 {
-    const char *outdir = argc > 1 ? argv[1] : "out/bench";
-    char cmd[4200];
-    snprintf(cmd, sizeof cmd, "mkdir -p '%s'", outdir);
-    if (system(cmd) != 0) {
-        fprintf(stderr, "speed_vs_error: cannot create %s\n", outdir);
-        return 1;
+    RunFrame fun;
+    if (render(r, RUN_FUNCTIONAL, 0.0, &fun) != 0) {
+        run_frame_free(&fun);
+        return -1;
     }
-    char path[4200];
-    snprintf(path, sizeof path, "%s/speed_vs_error.md", outdir);
-    FILE *md = fopen(path, "w");
-    snprintf(path, sizeof path, "%s/speed_vs_error.dat", outdir);
-    FILE *dat = fopen(path, "w");
-    if (!md || !dat) {
-        fprintf(stderr, "speed_vs_error: cannot write into %s\n", outdir);
-        return 1;
+    const double hz = r->cfg->core_clock_mhz * 1e6;
+    double fps_f = hz / (double)fun.f.instructions, u_f[3];
+    for (int k = 1; k <= 3; k++)
+        u_f[k - 1] = stats_utilization(&fun.f.core, r->cfg->core_simd_width, k);
+    fprintf(r->md, "| %s | functional | 0 | %.2f | %.1fx | %.3f | %+.1f %% | %.1f pts | - | - | - |\n", r->name,
+            fun.seconds, r->full.seconds / fun.seconds, fps_f, 100.0 * (fps_f - r->fps_true) / r->fps_true,
+            100.0 * max_abs_diff3(u_f, r->u_true));
+    fprintf(r->dat, "%s 0 %.3f %.4f %.3f 0 0 0\n", r->name, r->full.seconds / fun.seconds,
+            100.0 * fabs(fps_f - r->fps_true) / r->fps_true, 100.0 * max_abs_diff3(u_f, r->u_true));
+    run_frame_free(&fun);
+    return 0;
+}
+
+/* How many of seeds 1..100 give an interval covering the truth at this rate, from the detailed
+ * run's per-tile cycles (y) and instructions (x). */
+static int coverage100(const SceneRun *r, const double *y, const double *x, uint8_t *sel, double rate)
+{
+    uint32_t N = r->full.f.ntiles;
+    int cov = 0;
+    for (uint32_t seed = 1; seed <= 100; seed++) {
+        SampleEstimate es;
+        sample_select(N, rate, seed, sel);
+        if (sample_ratio_estimate(y, x, sel, N, &es) == 0)
+            cov += es.lo <= r->truth && r->truth <= es.hi;
     }
-    int threads = (int)sysconf(_SC_NPROCESSORS_ONLN);
-    if (threads < 1)
-        threads = 1;
-    static const char *const names[] = {"cornell", "sponza", "conference"};
-    static const char *const paths[] = {"scenes/cornell/scene.ini", "scenes/sponza-dabrovic/scene.ini",
-                                        "scenes/conference/scene.ini"};
-    static const double rates[] = {0.01, 0.02, 0.05, 0.10, 0.25, 1.00};
-    const int w = 512, h = 512, spp = 1;
-    fprintf(md, "512 x 512, 1 spp, N = 16, M = 1024 (256 tiles), %d host threads; sampled runs use seed 1.\n\n", threads);
-    fprintf(md, "| scene | mode | tiles timed | host s | speed-up | fps | fps error | util. error | covered | "
-                "coverage (100 seeds) | interval (+-) |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
-    fprintf(dat, "# scene rate speedup fps_error_pct util_error_pts covered coverage100 halfwidth_pct\n");
+    return cov;
+}
+
+/* One sampled run's row. 0; 1 when sampling every tile misses the detailed cycles; -1 when the
+ * run fails. */
+static int sampled_row(const SceneRun *r, double rate, const double *y, const double *x, uint8_t *sel)
+{
+    RunFrame sr;
+    if (render(r, RUN_SAMPLED, rate, &sr) != 0) {
+        run_frame_free(&sr);
+        return -1;
+    }
+    const SampleEstimate *e = &sr.est; /* the estimate report.json gives (its tiles' instructions are the full run's) */
+    double fps_s = stats_frame(&sr.f.timing, sr.f.instructions, r->cfg->core_clock_mhz, e).fps, u_s[3];
+    util_timed(&sr.f, r->cfg->core_simd_width, u_s);
+    int covered = e->lo <= r->truth && r->truth <= e->hi;
+    int cov100 = coverage100(r, y, x, sel, rate);
+    double half = 100.0 * 0.5 * (e->hi - e->lo) / e->total;
+    double speedup = r->full.seconds / sr.seconds, fps_err = 100.0 * (fps_s - r->fps_true) / r->fps_true;
+    double util_err = 100.0 * max_abs_diff3(u_s, r->u_true);
+    fprintf(r->md, "| %s | sampled %g %% | %u | %.2f | %.1fx | %.3f | %+.2f %% | %.2f pts | %s | %d %% | %.2f %% |\n",
+            r->name, 100.0 * rate, e->n, sr.seconds, speedup, fps_s, fps_err, util_err, covered ? "yes" : "no",
+            cov100, half);
+    fprintf(r->dat, "%s %g %.3f %.4f %.3f %d %d %.4f\n", r->name, 100.0 * rate, speedup, fabs(fps_err), util_err,
+            covered, cov100, half);
     int rc = 0;
-    int skipped = 0;
-    for (int si = 0; si < 3; si++) {
-        int ok = bench_scene_ok("speed_vs_error", paths[si], &skipped);
-        if (ok < 0)
-            return 1;
-        if (!ok)
-            continue;
-        char err[65536];
-        Scene s;
-        PackedScene p;
-        if (pack_load_file(paths[si], w, h, spp, &s, &p, err, sizeof err) != 0) {
-            fprintf(stderr, "%s\n", err);
-            return 1;
-        }
-        CfgMachine cfg;
-        cfg_defaults(&cfg);
-        cfg.stream_rays = 1024;
-        const double hz = cfg.core_clock_mhz * 1e6;
-        size_t n = 3 * (size_t)w * h;
-        Run full, fun;
-        if (render(&p, s.needs, &cfg, 1, 0.0, n, threads, &full) || render(&p, s.needs, &cfg, 0, 0.0, n, threads, &fun))
-            return 1;
-        const double truth = (double)full.st.timing.cycles, fps_true = hz / truth;
-        double u_true[3];
-        util_timed(&full.st, cfg.core_simd_width, u_true);
-        fprintf(md, "| %s | detailed | %u | %.2f | 1.0x | %.3f | - | - | - | - | - |\n", names[si], full.st.ntiles,
-                full.secs, fps_true);
-        /* functional: fps from instructions (no stalls), utilization per instruction */
-        double fps_f = hz / (double)fun.st.instructions, u_f[3];
-        for (int k = 1; k <= 3; k++)
-            u_f[k - 1] = stats_utilization(&fun.st.core, cfg.core_simd_width, k);
-        fprintf(md, "| %s | functional | 0 | %.2f | %.1fx | %.3f | %+.1f %% | %.1f pts | - | - | - |\n", names[si],
-                fun.secs, full.secs / fun.secs, fps_f, 100.0 * (fps_f - fps_true) / fps_true,
-                100.0 * max_abs_diff3(u_f, u_true));
-        fprintf(dat, "%s 0 %.3f %.4f %.3f 0 0 0\n", names[si], full.secs / fun.secs,
-                100.0 * fabs(fps_f - fps_true) / fps_true, 100.0 * max_abs_diff3(u_f, u_true));
-        /* the detailed run's tiles, for coverage over seeds */
-        uint32_t N = full.st.ntiles;
-        double *y = malloc(N * sizeof *y), *x = malloc(N * sizeof *x);
-        uint8_t *sel = malloc(N);
-        if (!y || !x || !sel)
-            return 1;
-        for (uint32_t i = 0; i < N; i++) {
-            y[i] = (double)full.st.tiles[i].cycles;
-            x[i] = (double)full.st.tiles[i].instructions;
-        }
-        for (size_t ri = 0; ri < sizeof rates / sizeof rates[0]; ri++) {
-            Run sr;
-            if (render(&p, s.needs, &cfg, 1, rates[ri], n, threads, &sr))
-                return 1;
-            SampleEstimate e;   /* the estimate report.json gives (its tiles' instructions are the full run's) */
-            if (stats_sample_estimate(&sr.st, &e) != 0)
-                return 1;
-            double fps_s = stats_frame(&sr.st.timing, sr.st.instructions, cfg.core_clock_mhz, &e).fps, u_s[3];
-            util_timed(&sr.st, cfg.core_simd_width, u_s);
-            int covered = e.lo <= truth && truth <= e.hi;
-            int cov100 = 0;
-            for (uint32_t seed = 1; seed <= 100; seed++) {
-                SampleEstimate es;
-                sample_select(N, rates[ri], seed, sel);
-                if (sample_ratio_estimate(y, x, sel, N, &es) == 0)
-                    cov100 += es.lo <= truth && truth <= es.hi;
-            }
-            double half = 100.0 * 0.5 * (e.hi - e.lo) / e.total;
-            fprintf(md, "| %s | sampled %g %% | %u | %.2f | %.1fx | %.3f | %+.2f %% | %.2f pts | %s | %d %% | %.2f %% |\n",
-                    names[si], 100.0 * rates[ri], e.n, sr.secs, full.secs / sr.secs, fps_s,
-                    100.0 * (fps_s - fps_true) / fps_true, 100.0 * max_abs_diff3(u_s, u_true), covered ? "yes" : "no",
-                    cov100, half);
-            fprintf(dat, "%s %g %.3f %.4f %.3f %d %d %.4f\n", names[si], 100.0 * rates[ri], full.secs / sr.secs,
-                    100.0 * fabs(fps_s - fps_true) / fps_true, 100.0 * max_abs_diff3(u_s, u_true), covered, cov100,
-                    half);
-            if (rates[ri] >= 1.0 && (e.total != truth || sr.st.timing.cycles != full.st.timing.cycles)) {
-                fprintf(stderr, "%s: sampling every tile does not give the detailed cycles\n", names[si]);
-                rc = 1;
-            }
-            func_stats_free(&sr.st);
-            fflush(md);
-        }
-        fprintf(dat, "\n\n");
-        free(y);
-        free(x);
-        free(sel);
-        func_stats_free(&full.st);
-        func_stats_free(&fun.st);
-        pack_free(&p);
-        scene_free(&s);
+    if (rate >= 1.0 && (e->total != r->truth || sr.f.timing.cycles != r->full.f.timing.cycles)) {
+        fprintf(stderr, "%s: sampling every tile does not give the detailed cycles\n", r->name);
+        rc = 1;
     }
-    fclose(md);
-    fclose(dat);
-    /* The plot: speed-up against fps error, one line per scene, points by sampling rate. */
+    run_frame_free(&sr);
+    fflush(r->md);
+    return rc;
+}
+
+/* The sampled rows of one scene, against the detailed run's tiles. 0, 1 (a check failed) or -1. */
+static int sampled_rows(const SceneRun *r)
+{
+    uint32_t N = r->full.f.ntiles;
+    double *y = malloc(N * sizeof *y), *x = malloc(N * sizeof *x);
+    uint8_t *sel = malloc(N);
+    int rc = 0;
+    if (!y || !x || !sel)
+        rc = -1;
+    for (uint32_t i = 0; rc == 0 && i < N; i++) {
+        y[i] = (double)r->full.f.tiles[i].cycles;
+        x[i] = (double)r->full.f.tiles[i].instructions;
+    }
+    for (size_t ri = 0; rc >= 0 && ri < NRATES; ri++) {
+        int k = sampled_row(r, rates[ri], y, x, sel);
+        rc = k < 0 ? -1 : k ? 1 : rc;
+    }
+    free(y);
+    free(x);
+    free(sel);
+    return rc;
+}
+
+/* Every row of one scene at 512 x 512, 1 spp, M = 1024. 0, 1 (a check failed) or -1 (a run failed). */
+static int scene_rows(const char *name, const char *path, int threads, FILE *md, FILE *dat)
+{
+    CfgMachine cfg;
+    cfg_defaults(&cfg);
+    cfg.stream_rays = 1024;
+    static char err[65536];
+    RunScene sc;
+    RunSize size = {512, 512, 1, -1};
+    if (run_scene_open(&sc, path, &size, &cfg, RUN_DETAILED, NULL, err, sizeof err) != 0) {
+        fprintf(stderr, "%s\n", err);
+        run_scene_close(&sc);
+        return -1;
+    }
+    SceneRun r = {.name = name, .sc = &sc, .cfg = &cfg, .threads = threads, .md = md, .dat = dat};
+    int rc = render(&r, RUN_DETAILED, 0.0, &r.full);
+    if (rc == 0) {
+        r.truth = (double)r.full.f.timing.cycles;
+        r.fps_true = cfg.core_clock_mhz * 1e6 / r.truth;
+        util_timed(&r.full.f, cfg.core_simd_width, r.u_true);
+        fprintf(md, "| %s | detailed | %u | %.2f | 1.0x | %.3f | - | - | - | - | - |\n", name, r.full.f.ntiles,
+                r.full.seconds, r.fps_true);
+        rc = functional_row(&r);
+    }
+    if (rc == 0)
+        rc = sampled_rows(&r);
+    fprintf(dat, "\n\n");
+    run_frame_free(&r.full);
+    run_scene_close(&sc);
+    return rc;
+}
+
+/* The plot: speed-up against fps error, one line per scene, points by sampling rate. 0, or -1
+ * when the script cannot be written (gnuplot's own failure is only said). */
+static int write_plot(const char *outdir)
+{
+    char path[4200], cmd[4300];
     snprintf(path, sizeof path, "%s/speed_vs_error.gp", outdir);
     FILE *gp = fopen(path, "w");
-    if (!gp)
-        return 1;
+    if (!gp) {
+        fprintf(stderr, "speed_vs_error: cannot write %s\n", path);
+        return -1;
+    }
     fprintf(gp,
             "set terminal pngcairo size 900,600 font 'DejaVu Sans,11'\n"
             "set output '%s/speed_vs_error.png'\n"
@@ -209,14 +220,78 @@ int main(int argc, char **argv)
     snprintf(cmd, sizeof cmd, "gnuplot '%s/speed_vs_error.gp'", outdir);
     if (system(cmd) != 0)
         fprintf(stderr, "speed_vs_error: gnuplot failed; the table and data are in %s\n", outdir);
-    bench_scenes_summary("speed_vs_error", skipped, 3);
+    return 0;
+}
+
+/* OUTDIR/speed_vs_error.md and .dat, opened with their headings. 0, or -1 after saying why. */
+static int open_outputs(const char *outdir, int threads, FILE **md, FILE **dat)
+{
+    char cmd[4200], path[4200];
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s'", outdir);
+    if (system(cmd) != 0) {
+        fprintf(stderr, "speed_vs_error: cannot create %s\n", outdir);
+        return -1;
+    }
+    snprintf(path, sizeof path, "%s/speed_vs_error.md", outdir);
+    *md = fopen(path, "w");
+    snprintf(path, sizeof path, "%s/speed_vs_error.dat", outdir);
+    *dat = fopen(path, "w");
+    if (!*md || !*dat) {
+        fprintf(stderr, "speed_vs_error: cannot write into %s\n", outdir);
+        return -1;
+    }
+    fprintf(*md, "512 x 512, 1 spp, N = 16, M = 1024 (256 tiles), %d host threads; sampled runs use seed 1.\n\n",
+            threads);
+    fprintf(*md, "| scene | mode | tiles timed | host s | speed-up | fps | fps error | util. error | covered | "
+                 "coverage (100 seeds) | interval (+-) |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+    fprintf(*dat, "# scene rate speedup fps_error_pct util_error_pts covered coverage100 halfwidth_pct\n");
+    return 0;
+}
+
+/* The table, from the file (what a reader of OUTDIR gets). */
+static void print_table(const char *outdir)
+{
+    char path[4200];
     snprintf(path, sizeof path, "%s/speed_vs_error.md", outdir);
     FILE *in = fopen(path, "r");
-    if (in) {
-        int ch;
-        while ((ch = fgetc(in)) != EOF)
-            putchar(ch);
-        fclose(in);
+    if (!in)
+        return;
+    int ch;
+    while ((ch = fgetc(in)) != EOF)
+        putchar(ch);
+    fclose(in);
+}
+
+int main(int argc, char **argv)
+{
+    const char *outdir = argc > 1 ? argv[1] : "out/bench";
+    int threads = (int)sysconf(_SC_NPROCESSORS_ONLN);
+    if (threads < 1)
+        threads = 1;
+    FILE *md, *dat;
+    if (open_outputs(outdir, threads, &md, &dat) != 0)
+        return 1;
+    static const char *const names[] = {"cornell", "sponza", "conference"};
+    static const char *const paths[] = {"scenes/cornell/scene.ini", "scenes/sponza-dabrovic/scene.ini",
+                                        "scenes/conference/scene.ini"};
+    int rc = 0;
+    int skipped = 0;
+    for (int si = 0; si < 3; si++) {
+        int ok = bench_scene_ok("speed_vs_error", paths[si], &skipped);
+        if (ok < 0)
+            return 1;
+        if (!ok)
+            continue;
+        int k = scene_rows(names[si], paths[si], threads, md, dat);
+        if (k < 0)
+            return 1;
+        rc |= k;
     }
+    fclose(md);
+    fclose(dat);
+    if (write_plot(outdir) != 0)
+        return 1;
+    bench_scenes_summary("speed_vs_error", skipped, 3);
+    print_table(outdir);
     return rc;
 }

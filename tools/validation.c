@@ -1,7 +1,8 @@
 /* tools/validation.c -- the utilization and stream-length experiments of docs/validation.md:
  * the kernel on the functional core, measured the way Gribble & Ramani 2008 (seed 001,
  * Tables 2-4) and Wald et al. 2007 (seed 000, Tables 1-4) measure, printed as markdown tables
- * with the papers' figures beside ours. `make validation` writes docs/validation-data.md.
+ * with the papers' figures beside ours. `make validation` writes docs/validation-data.md. Scenes are
+ * opened and frames rendered through the entry point every command uses (sim/run/run.h).
  *
  * usage: validation [--quick] [--timing-only | --kd-only]   (--quick: smaller images, for a smoke
  *        run; --timing-only: only the detailed-mode and kd-tree tables; --kd-only: only the kd-tree table)
@@ -16,58 +17,58 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../scenes/pack.h"
-#include "../scenes/scene.h"
 #include "../sim/config.h"
-#include "../sim/functional.h"
 #include "../sim/ref_kd.h"
-#include "../sim/run/accel.h"
 #include "../sim/ref_trace.h"
+#include "../sim/run/accel.h"
+#include "../sim/run/run.h"
 #include "../sim/stats.h"
 #include "../sim/timing.h"
 #include "../sim/util.h"
 
 typedef struct Loaded {
     const char *name, *path;
-    Scene s;
-    PackedScene p;
+    RunScene sc;
+    int open;
 } Loaded;
 
 static Loaded scenes[] = {
-    {"cornell", "scenes/cornell/mcguire.ini", {0}, {0}},
-    {"sponza", "scenes/sponza-dabrovic/scene.ini", {0}, {0}},
-    {"conference", "scenes/conference/scene.ini", {0}, {0}},
+    {.name = "cornell", .path = "scenes/cornell/mcguire.ini"},
+    {.name = "sponza", .path = "scenes/sponza-dabrovic/scene.ini"},
+    {.name = "conference", .path = "scenes/conference/scene.ini"},
 };
 #define NSCENES 3
 
 static int quick;
 
-static void load(Loaded *l, int w, int h, int spp, int max_depth)
+static void unload(Loaded *l)
 {
-    char err[4096];
-    if (l->p.mem) {
-        pack_free(&l->p);
-        scene_free(&l->s);
-    }
-    if (scene_load(l->path, &l->s, err, sizeof err) != 0) {
-        fprintf(stderr, "%s\n", err);
-        exit(1);
-    }
-    l->s.render.width = w;
-    l->s.render.height = h;
-    l->s.render.spp = spp;
-    if (max_depth >= 0)
-        l->s.render.max_depth = max_depth;
-    BvhParams bp;
-    bvh_default_params(&bp);
-    if (pack_scene(&l->s, &bp, 0, &l->p, err, sizeof err) != 0) {
-        fprintf(stderr, "%s\n", err);
+    if (l->open)
+        run_scene_close(&l->sc);
+    l->open = 0;
+}
+
+/* (Re)open l at w x h pixels, spp (max_depth < 0: the scene's), with the default BVH and, when cfg
+ * (NULL: the defaults) says accel.structure = kd, its kd-tree (sim/run/run.h). Exits on failure. */
+static void load_cfg(Loaded *l, int w, int h, int spp, int max_depth, const CfgMachine *cfg)
+{
+    static char err[65536];
+    unload(l);
+    RunSize size = {w, h, spp, max_depth};
+    l->open = 1;
+    if (run_scene_open(&l->sc, l->path, &size, cfg, RUN_DETAILED, NULL, err, sizeof err) != 0) {
+        fprintf(stderr, "%s: %s\n", l->name, err);
         exit(1);
     }
 }
 
+static void load(Loaded *l, int w, int h, int spp, int max_depth)
+{
+    load_cfg(l, w, h, spp, max_depth, NULL);
+}
+
 typedef struct Run {
-    FuncStats st;
+    RunFrame fr;
     int lanes;
 } Run;
 
@@ -76,7 +77,20 @@ static int order = CFG_STREAM_ORDER_FIRST;
 
 static int timed; /* detailed mode for the runs of Tables 5-6 */
 
-static void run(Loaded *l, int lanes, int rays, int packet, int workload, int bounces, Run *r)
+/* l's frame through the kernel on the machine of cfg, in detailed mode when detailed, else
+ * functional; 2 host threads. Exits on failure. */
+static void run_cfg(const Loaded *l, const CfgMachine *cfg, int detailed, RunFrame *fr)
+{
+    static char err[65536];
+    RunSpec spec = {.mode = detailed ? RUN_DETAILED : RUN_FUNCTIONAL, .cfg = cfg,
+                    .kernel_path = "kernels/pathtrace.s", .seed = 1, .threads = 2};
+    if (run_frame(&l->sc, &spec, fr, err, sizeof err) != 0) {
+        fprintf(stderr, "%s: %s\n", l->name, err);
+        exit(1);
+    }
+}
+
+static void run(const Loaded *l, int lanes, int rays, int packet, int workload, int bounces, Run *r)
 {
     CfgMachine cfg;
     cfg_defaults(&cfg);
@@ -87,27 +101,19 @@ static void run(Loaded *l, int lanes, int rays, int packet, int workload, int bo
     cfg.workload_kind = workload;
     if (bounces > 0)
         cfg.workload_bounces = bounces;
-    size_t n = 3 * (size_t)l->s.render.width * l->s.render.height;
-    float *rgb = calloc(n, sizeof(float));
-    static char err[65536];
-    FuncParams fp = {.cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .needs = l->s.needs, .seed = 1, .threads = 2, .timed = timed};
-    if (!rgb || func_render(&l->p, &fp, rgb, &r->st, err, sizeof err) != 0) {
-        fprintf(stderr, "%s: %s\n", l->name, err);
-        exit(1);
-    }
+    run_cfg(l, &cfg, timed, &r->fr);
     r->lanes = lanes;
-    free(rgb);
 }
 
 /* Utilization (percent) of a stage over generations [g0, g1) (sim/stats.h). */
 static double util(const Run *r, int stage, int g0, int g1)
 {
-    return 100.0 * stats_utilization_gens(&r->st.core, r->lanes, stage, g0, g1);
+    return 100.0 * stats_utilization_gens(&r->fr.f.core, r->lanes, stage, g0, g1);
 }
 
 static double stream_len(const Run *r, int stage3, int g0)
 {
-    return stats_stream_length(&r->st, stage3, g0, FUNC_MAX_GENERATIONS);
+    return stats_stream_length(&r->fr.f, stage3, g0, FUNC_MAX_GENERATIONS);
 }
 
 /* ---- seed 001 Table 2 (primary rays, T / I) and seed 000 Tables 1-2 ------------------------- */
@@ -135,7 +141,7 @@ static void table2(void)
                 Run r;
                 run(&scenes[i], ns[a], b == 2 ? 4096 : 1024, b == 0, CFG_WORKLOAD_PATH, 0, &r);
                 printf(" %.0f / %.0f |", util(&r, ISA_STAGE_TRAVERSAL, 0, 1), util(&r, ISA_STAGE_INTERSECTION, 0, 1));
-                func_stats_free(&r.st);
+                run_frame_free(&r.fr);
             }
             printf(" %s |\n", t2_paper[a][b]);
             fflush(stdout);
@@ -184,7 +190,7 @@ static void table3(void)
                            util(&r, ISA_STAGE_INTERSECTION, 1, 64), util(&r, ISA_STAGE_SHADING, 1, 64));
                     for (int k = 0; k < 3; k++)
                         len[o][i][b][k] = stream_len(&r, k, 1);
-                    func_stats_free(&r.st);
+                    run_frame_free(&r.fr);
                 }
                 printf(" %s |\n", o ? "" : t3_paper[a][b]);
                 fflush(stdout);
@@ -250,7 +256,7 @@ static void specular(void)
             }
         for (int m = 0; m < 2; m++)
             for (int i = 0; i < NSCENES; i++)
-                func_stats_free(&r[m][i].st);
+                run_frame_free(&r[m][i].fr);
         fflush(stdout);
     }
     printf("\n");
@@ -281,7 +287,7 @@ static void diffuse(void)
                 Run r;
                 run(&scenes[i], ns[a], m == 2 ? 4096 : 1024, m == 0, CFG_WORKLOAD_DIFFUSE, 0, &r);
                 printf(" %.0f / %.0f |", util(&r, ISA_STAGE_TRAVERSAL, 1, 2), util(&r, ISA_STAGE_INTERSECTION, 1, 2));
-                func_stats_free(&r.st);
+                run_frame_free(&r.fr);
             }
             printf(" %s |\n", s4_paper[a][m]);
             fflush(stdout);
@@ -348,11 +354,12 @@ static void timing_tables(void)
                     tok = strtok_r(NULL, "/", &save);
                 paper_fps[wi] = tok ? atof(tok) : 0.0;
             }
-            const uint64_t c16 = runs[3].st.timing.cycles;
+            const uint64_t c16 = runs[3].fr.f.timing.cycles;
             for (int wi = 0; wi < 6; wi++) {
                 Run *r = &runs[wi];
-                const TimingStats *t = &r->st.timing;
-                uint64_t nrays = stats_rays_total(&r->st);
+                const FuncStats *f = &r->fr.f;
+                const TimingStats *t = &f->timing;
+                uint64_t nrays = stats_rays_total(f);
                 char prel[16] = "", prk[16] = "", pst[16] = "";
                 if (paper_fps[wi] > 0) {
                     snprintf(prel, sizeof prel, "%.2f", paper_fps[wi] / paper_fps[3]);
@@ -361,11 +368,11 @@ static void timing_tables(void)
                 }
                 uint64_t ops[ISA_C_COUNT] = {0}, all = 0;
                 for (int c = 0; c < ISA_C_COUNT; c++) {
-                    ops[c] = stats_ops(&r->st.core, c);
+                    ops[c] = stats_ops(&f->core, c);
                     all += ops[c];
                 }
                 printf("| %s | %d | %llu | %.1f | %.2f | %s | %.1f | %s | %.0f | %s |", mi ? "64x64" : "32x32",
-                       widths[wi], (unsigned long long)t->cycles, stats_frame(t, r->st.instructions, 500, NULL).fps,
+                       widths[wi], (unsigned long long)t->cycles, stats_frame(t, f->instructions, 500, NULL).fps,
                        t->cycles ? (double)c16 / (double)t->cycles : 0.0, prel,
                        t->cycles ? 1000.0 * (double)nrays / (double)t->cycles : 0.0, prk,
                        pct(t->cycles - t->busy, t->cycles), pst);
@@ -377,7 +384,7 @@ static void timing_tables(void)
                        mi && widths[wi] == 16 ? t5_paper[pc] : "");
             }
             for (int wi = 0; wi < 6; wi++)
-                func_stats_free(&runs[wi].st);
+                run_frame_free(&runs[wi].fr);
             fflush(stdout);
         }
         printf("\n");
@@ -402,20 +409,20 @@ static void kd_tables(void)
            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
            w, h);
     for (int si = 0; si < 3; si++) {
-        Loaded l = {names[si], paths[si], {0}, {0}};
+        Loaded l = {.name = names[si], .path = paths[si]};
         load(&l, w, h, 1, -1);
         KdParams kp;
         kd_default_params(&kp);
         KdTree t;
         char err[1024];
-        if (accel_kd_build(&l.p, &kp, &t, err, sizeof err) != 0) {
+        if (accel_kd_build(&l.sc.p, &kp, &t, err, sizeof err) != 0) {
             fprintf(stderr, "%s: %s\n", l.name, err);
             exit(1);
         }
         static const int depths[5] = {1, 2, 3, 4, 8};
         RefKdStats st[8];
         memset(st, 0, sizeof st);
-        const PackedScene *p = &l.p;
+        const PackedScene *p = &l.sc.p;
         for (int y = 0; y < h; y++)
             for (int x = 0; x < w; x++) {
                 RefRay r;
@@ -438,7 +445,7 @@ static void kd_tables(void)
                     ref_kd_closest_hit(p, &t, REF_KD_SHORTSTACK, depths[di], &r, &hh, &st[3 + di]);
             }
         double base = (double)st[0].nodes_visited;
-        printf("| %s | %u | %u | %u | %.1f |", l.name, l.p.nprims, t.nnodes, t.depth, base / ((double)w * h));
+        printf("| %s | %u | %u | %u | %.1f |", l.name, p->nprims, t.nnodes, t.depth, base / ((double)w * h));
         for (int i = 1; i < 8; i++)
             printf(" %.3f |", (double)st[i].nodes_visited / base);
         printf(" %.1f %% fewer | %.1f %% fewer |\n",
@@ -446,8 +453,7 @@ static void kd_tables(void)
                100.0 * (1.0 - (double)st[5].nodes_visited / (double)st[2].nodes_visited));
         fflush(stdout);
         kd_free(&t);
-        pack_free(&l.p);
-        scene_free(&l.s);
+        unload(&l);
     }
     printf("\n");
 }
@@ -467,35 +473,74 @@ static const KdRow kd_rows[] = {
         {"kd packet 3", "packet", 3},    {"kd packet 8", "packet", 8},      {"kd stream filter", "stream", 3},
 };
 
+/* One row of a kd-kernel table: st, the frame of row (its image compared with ref's: NULL for the
+ * BVH row itself), cycles relative to the BVH row's. */
+static void kd_kernel_row(const KdRow *row, int workload, const RunFrame *fr, const RunFrame *ref, int lanes,
+                          uint64_t bvh_cycles, size_t n)
+{
+    const FuncStats *st = &fr->f;
+    const TimingStats *t = &st->timing;
+    double tu = 100.0 * stats_utilization_cycles(st, lanes, ISA_STAGE_TRAVERSAL);
+    const char *same = !ref ? "-" : memcmp(ref->rgb, fr->rgb, n * sizeof(float)) == 0 ? "same" : "DIFFERS";
+    double rel = bvh_cycles ? (double)t->cycles / (double)bvh_cycles : 0.0;
+    double fps = stats_frame(t, st->instructions, 500, NULL).fps;
+    if (workload == CFG_WORKLOAD_PHONG) {
+        printf("| %s | %llu | %.2f | %.2f | %s | %.1f |", row->label, (unsigned long long)t->cycles, fps, rel,
+               same, tu);
+        char bounce[32] = "-";
+        if (st->rays_indirect)
+            snprintf(bounce, sizeof bounce, "%.1f", stats_kd_per_ray(st, FUNC_KD_INDIRECT, FUNC_KD_NODES));
+        if (st->kd)
+            printf(" %.1f | %.1f | %s | %.3f |\n", stats_kd_per_ray(st, FUNC_KD_CAMERA, FUNC_KD_NODES),
+                   stats_kd_per_ray(st, FUNC_KD_SHADOW, FUNC_KD_NODES), bounce,
+                   stats_kd_per_ray(st, FUNC_KD_KINDS, FUNC_KD_RESTARTS));
+        else
+            printf(" | | | |\n");
+    } else {
+        printf("| %s | %llu | %llu | %.2f | %.2f | %s | %.1f |", row->label, (unsigned long long)st->instructions,
+               (unsigned long long)t->cycles, fps, rel, same, tu);
+        if (st->kd)
+            printf(" %.1f | %.1f | %.1f | %.3f | %.3f |\n", stats_kd_per_ray(st, FUNC_KD_CAMERA, FUNC_KD_NODES),
+                   stats_kd_per_ray(st, FUNC_KD_KINDS, FUNC_KD_NODES),
+                   stats_kd_per_ray(st, FUNC_KD_KINDS, FUNC_KD_PRIMS),
+                   stats_kd_per_ray(st, FUNC_KD_KINDS, FUNC_KD_RESTARTS),
+                   stats_kd_per_ray(st, FUNC_KD_KINDS, FUNC_KD_OVERFLOWS));
+        else
+            printf(" | | | | |\n");
+    }
+    fflush(stdout);
+}
+
 /* One scene: the kernels of rows[] (rows[0] the BVH), on the workload given; prints a table. */
 static void kd_kernel_scene(const char *name, const char *path, int w, int h, int workload, int bounces,
                             const int *rows, int nrows)
 {
-    Loaded l = {name, path, {0}, {0}};
-    load(&l, w, h, 1, 3);
     CfgMachine cfg;
     cfg_defaults(&cfg);
     cfg.workload_kind = workload;
     cfg.workload_bounces = bounces;
-    static char err[65536];
     CfgErrors ce = {0};
-    AccelKdInfo info;
-    if (cfg_set(&cfg, "accel.structure=kd", &ce) != 0 || accel_add_kd(&l.p, &cfg, &info, err, sizeof err) != 0) {
-        fprintf(stderr, "%s: %s%s\n", l.name, ce.text ? ce.text : "", err);
+    if (cfg_set(&cfg, "accel.structure=kd", &ce) != 0) {
+        fprintf(stderr, "%s: %s\n", name, ce.text ? ce.text : "");
         exit(1);
     }
+    /* One scene memory for every row: the BVH and the kd-tree of the kd.* keys (the BVH row
+     * ignores the tree). */
+    Loaded l = {.name = name, .path = path};
+    load_cfg(&l, w, h, 1, 3, &cfg);
+    const AccelKdInfo *info = &l.sc.accel.kd;
     if (workload == CFG_WORKLOAD_PHONG)
         printf("### %s, Phong, %d bounce%s (%u triangles; kd-tree %u nodes, depth %u)\n\n"
                "| kernel | cycles | fps | rel | image | trav util | nodes/camera ray | nodes/shadow ray | "
                "nodes/bounce ray | restarts/ray |\n|---|---|---|---|---|---|---|---|---|---|\n",
-               l.name, bounces, bounces == 1 ? "" : "s", l.s.ntris, info.nodes, info.depth);
+               l.name, bounces, bounces == 1 ? "" : "s", l.sc.s.ntris, info->nodes, info->depth);
     else
         printf("### %s (%u triangles; kd-tree %u nodes, depth %u)\n\n"
                "| kernel | instructions | cycles | fps | rel | image | trav util | camera nodes/ray | nodes/ray | "
                "prims/ray | restarts/ray | overflows/ray |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
-               l.name, l.s.ntris, info.nodes, info.depth);
+               l.name, l.sc.s.ntris, info->nodes, info->depth);
     size_t n = 3 * (size_t)w * h;
-    float *ref = calloc(n, sizeof(float)), *rgb = calloc(n, sizeof(float));
+    RunFrame ref;
     uint64_t bvh_cycles = 0;
     for (int i = 0; i < nrows; i++) {
         const KdRow *row = &kd_rows[rows[i]];
@@ -509,53 +554,21 @@ static void kd_kernel_scene(const char *name, const char *path, int w, int h, in
             snprintf(a, sizeof a, "kd.stack_depth=%d", row->depth);
             cfg_set(&c, a, &ce);
         }
-        FuncParams fp = {.cfg = &c, .kernel_path = "kernels/pathtrace.s", .needs = l.s.needs, .seed = 1,
-                         .threads = 2, .timed = 1};
-        FuncStats st;
-        memset(rgb, 0, n * sizeof(float));
-        if (!ref || !rgb || func_render(&l.p, &fp, i ? rgb : ref, &st, err, sizeof err) != 0) {
-            fprintf(stderr, "%s %s: %s\n", l.name, row->label, err);
-            exit(1);
-        }
-        const TimingStats *t = &st.timing;
+        RunFrame fr;
+        run_cfg(&l, &c, 1, &fr);
         if (i == 0)
-            bvh_cycles = t->cycles;
-        double tu = 100.0 * stats_utilization_cycles(&st, c.core_simd_width, ISA_STAGE_TRAVERSAL);
-        const char *same = i == 0 ? "-" : memcmp(ref, rgb, n * sizeof(float)) == 0 ? "same" : "DIFFERS";
-        double rel = bvh_cycles ? (double)t->cycles / (double)bvh_cycles : 0.0;
-        double fps = stats_frame(t, st.instructions, 500, NULL).fps;
-        if (workload == CFG_WORKLOAD_PHONG) {
-            printf("| %s | %llu | %.2f | %.2f | %s | %.1f |", row->label, (unsigned long long)t->cycles, fps, rel,
-                   same, tu);
-            char bounce[32] = "-";
-            if (st.rays_indirect)
-                snprintf(bounce, sizeof bounce, "%.1f", stats_kd_per_ray(&st, FUNC_KD_INDIRECT, FUNC_KD_NODES));
-            if (st.kd)
-                printf(" %.1f | %.1f | %s | %.3f |\n", stats_kd_per_ray(&st, FUNC_KD_CAMERA, FUNC_KD_NODES),
-                       stats_kd_per_ray(&st, FUNC_KD_SHADOW, FUNC_KD_NODES), bounce,
-                       stats_kd_per_ray(&st, FUNC_KD_KINDS, FUNC_KD_RESTARTS));
-            else
-                printf(" | | | |\n");
-        } else {
-            printf("| %s | %llu | %llu | %.2f | %.2f | %s | %.1f |", row->label, (unsigned long long)st.instructions,
-                   (unsigned long long)t->cycles, fps, rel, same, tu);
-            if (st.kd)
-                printf(" %.1f | %.1f | %.1f | %.3f | %.3f |\n", stats_kd_per_ray(&st, FUNC_KD_CAMERA, FUNC_KD_NODES),
-                       stats_kd_per_ray(&st, FUNC_KD_KINDS, FUNC_KD_NODES),
-                       stats_kd_per_ray(&st, FUNC_KD_KINDS, FUNC_KD_PRIMS),
-                       stats_kd_per_ray(&st, FUNC_KD_KINDS, FUNC_KD_RESTARTS),
-                       stats_kd_per_ray(&st, FUNC_KD_KINDS, FUNC_KD_OVERFLOWS));
-            else
-                printf(" | | | | |\n");
-        }
-        fflush(stdout);
-        func_stats_free(&st);
+            bvh_cycles = fr.f.timing.cycles;
+        kd_kernel_row(row, workload, &fr, i ? &ref : NULL, c.core_simd_width, bvh_cycles, n);
+        if (i == 0)
+            ref = fr; /* the BVH kernel's image, kept for the kd rows */
+        else
+            run_frame_free(&fr);
     }
-    free(ref);
-    free(rgb);
+    if (nrows > 0)
+        run_frame_free(&ref);
+    cfg_errors_free(&ce);
     printf("\n");
-    pack_free(&l.p);
-    scene_free(&l.s);
+    unload(&l);
 }
 
 static void kd_kernel_tables(void)
@@ -617,9 +630,7 @@ int main(int argc, char **argv)
     kd_tables();
     kd_kernel_tables();
     fprintf(stderr, "validation: %.0f s\n", util_now() - t0);
-    for (int i = 0; i < NSCENES; i++) {
-        pack_free(&scenes[i].p);
-        scene_free(&scenes[i].s);
-    }
+    for (int i = 0; i < NSCENES; i++)
+        unload(&scenes[i]);
     return 0;
 }
