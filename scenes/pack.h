@@ -61,7 +61,8 @@ void pack_free(PackedScene *p);
 int pack_add_kd(PackedScene *p, const KdTree *t, char *err, size_t errlen);
 
 /* Load a scene file, override its render size and samples (values > 0), and pack it with the
- * default BVH: the set-up of benchmarks and tools. 0, or -1 with a message (nothing to free). */
+ * default BVH: a short set-up for unit tests (the commands, tools and benchmarks open scenes through
+ * sim/run/run.h). 0, or -1 with a message (nothing to free). */
 int pack_load_file(const char *path, int width, int height, int spp, Scene *s, PackedScene *p, char *err,
                    size_t errlen);
 
