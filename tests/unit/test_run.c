@@ -1,7 +1,9 @@
 /* tests/unit/test_run.c -- the entry point's scene set-up (sim/run/run.h): run_scene_open packs
  * the same scene-memory bytes as the by-hand set-up it replaced in tools/validation.c and bench/
  * (scene_load, the size imposed, pack_scene with bvh_default_params, and for the kd-tree kernels
- * accel_add_kd), so their tables and figures did not move when they switched to it.
+ * accel_add_kd), so their tables and figures did not move when they switched to it; and the
+ * entry point's own rules: mode names, the render settings it checks, and the settings run_frame
+ * refuses before any work.
  */
 #include <criterion/criterion.h>
 #include <string.h>
@@ -96,4 +98,107 @@ Test(run_scene, kd_config_packs_as_pack_scene_then_accel_add_kd)
     run_scene_close(&sc);
     pack_free(&p);
     scene_free(&s);
+}
+
+Test(run_mode, names_round_trip_and_unknown_names_are_refused)
+{
+    for (int m = 0; m < RUN_MODE_COUNT; m++) {
+        RunMode got = RUN_MODE_COUNT;
+        cr_expect_eq(run_mode_parse(run_mode_names[m], &got), 0, "%s", run_mode_names[m]);
+        cr_expect_eq(got, (RunMode)m);
+    }
+    RunMode got = RUN_FUNCTIONAL;
+    cr_expect_eq(run_mode_parse("Detailed", &got), -1);
+    cr_expect_eq(run_mode_parse("", &got), -1);
+    cr_expect_eq(run_mode_parse(NULL, &got), -1);
+    cr_expect_eq(got, RUN_FUNCTIONAL, "a refused name leaves the mode as it was");
+    cr_expect(!run_mode_kernel(RUN_REFERENCE) && run_mode_kernel(RUN_FUNCTIONAL) && run_mode_kernel(RUN_SAMPLED));
+    cr_expect(!run_mode_timed(RUN_FUNCTIONAL) && run_mode_timed(RUN_DETAILED) && run_mode_timed(RUN_SAMPLED));
+}
+
+/* A render setting out of range is refused with its name; without a size (ray batches) the scene
+ * is taken as it is. */
+Test(run_scene, a_size_out_of_range_is_refused_by_name)
+{
+    static const struct {
+        RunSize size;
+        const char *want;
+    } cases[] = {
+        {{16385, 8, 1, 1}, "render size 16385 x 8 out of range (1..16384)"},
+        {{8, 8, 2000000, 1}, "render.spp 2000000 out of range (1..1048576)"},
+        {{8, 8, 1, 10000}, "render.max_depth 10000 out of range"},
+    };
+    char err[4096];
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        RunScene sc;
+        err[0] = 0;
+        cr_expect_eq(run_scene_open(&sc, "scenes/cornell/scene.ini", &cases[i].size, NULL, RUN_FUNCTIONAL, NULL, err,
+                                    sizeof err), -1);
+        cr_expect(strstr(err, cases[i].want) != NULL, "case %zu: %s", i, err);
+        run_scene_close(&sc);
+    }
+    RunScene sc;
+    cr_assert_eq(run_scene_open(&sc, "scenes/cornell/scene.ini", NULL, NULL, RUN_REFERENCE, NULL, err, sizeof err), 0,
+                 "%s", err);
+    cr_expect_gt(sc.p.size, 0u);
+    run_scene_close(&sc);
+}
+
+/* Settings run_frame refuses before it renders anything: no image is left to free. */
+Test(run_frame, bad_settings_are_refused_before_any_work)
+{
+    char err[4096];
+    RunScene sc;
+    RunSize size = {8, 8, 1, 1};
+    cr_assert_eq(run_scene_open(&sc, "scenes/cornell/scene.ini", &size, NULL, RUN_FUNCTIONAL, NULL, err, sizeof err), 0,
+                 "%s", err);
+    CfgMachine spec_cfg;
+    cfg_defaults(&spec_cfg);
+    spec_cfg.workload_kind = CFG_WORKLOAD_SPECULAR;
+    static const struct {
+        RunMode mode;
+        double sample;
+        int cfg_specular;
+        const char *want;
+    } cases[] = {
+        {RUN_SAMPLED, 0.0, 0, "--sample 0: expected a fraction of the tiles in (0, 1]"},
+        {RUN_SAMPLED, 1.5, 0, "--sample 1.5: expected a fraction"},
+        {RUN_REFERENCE, 0.0, 1, "workload.kind = specular has no golden model"},
+        {RUN_MODE_COUNT, 0.0, 0, "no such mode"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        RunSpec spec = {.mode = cases[i].mode, .cfg = cases[i].cfg_specular ? &spec_cfg : NULL, .seed = 1,
+                        .threads = 1, .sample = cases[i].sample};
+        RunFrame fr;
+        err[0] = 0;
+        cr_expect_eq(run_frame(&sc, &spec, &fr, err, sizeof err), -1, "case %zu", i);
+        cr_expect(strstr(err, cases[i].want) != NULL, "case %zu: %s", i, err);
+        run_frame_free(&fr);
+    }
+    run_scene_close(&sc);
+}
+
+/* The golden model's frame through the entry point: an image and its rays, the tile of the
+ * machine's stream, and the same bits on 1 and 2 host threads. */
+Test(run_frame, golden_frame_is_the_same_on_any_thread_count)
+{
+    char err[4096];
+    RunScene sc;
+    RunSize size = {130, 70, 2, 2}; /* 3 x 2 tiles of 64 x 64, the last column and row partial */
+    cr_assert_eq(run_scene_open(&sc, "scenes/cornell/scene.ini", &size, NULL, RUN_REFERENCE, NULL, err, sizeof err), 0,
+                 "%s", err);
+    RunFrame a, b;
+    RunSpec spec = {.mode = RUN_REFERENCE, .seed = 7, .threads = 1};
+    cr_assert_eq(run_frame(&sc, &spec, &a, err, sizeof err), 0, "%s", err);
+    spec.threads = 2;
+    cr_assert_eq(run_frame(&sc, &spec, &b, err, sizeof err), 0, "%s", err);
+    cr_expect_eq(a.tile, 64, "stream.rays = 4096 by default: 64 x 64 tiles");
+    cr_expect_eq(a.threads, 1);
+    cr_expect_eq(b.threads, 2);
+    cr_expect_eq(a.run.primary, 130u * 70u * 2u, "one camera ray per pixel and sample");
+    cr_expect_eq(memcmp(a.rgb, b.rgb, 3 * 130 * 70 * sizeof(float)), 0);
+    cr_expect_eq(a.has_est, 0);
+    run_frame_free(&a);
+    run_frame_free(&b);
+    run_scene_close(&sc);
 }
