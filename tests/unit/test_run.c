@@ -14,6 +14,7 @@
 #include "../../sim/config.h"
 #include "../../sim/run/accel.h"
 #include "../../sim/run/run.h"
+#include "../support/shared.h"
 
 /* The old set-up: load path, impose w x h x spp (> 0) and max_depth (>= 0), pack with the
  * default BVH. */
@@ -45,32 +46,45 @@ static void assert_same_pack(const PackedScene *a, const PackedScene *b)
     cr_assert(memcmp(a->mem, b->mem, a->size) == 0, "the packed bytes differ");
 }
 
+/* path packs the same through run_scene_open, in every mode, as by hand. */
+static void expect_packs_as_by_hand(const char *path)
+{
+    static const RunMode modes[] = {RUN_REFERENCE, RUN_FUNCTIONAL, RUN_DETAILED};
+    for (size_t m = 0; m < sizeof modes / sizeof modes[0]; m++) {
+        Scene s;
+        PackedScene p;
+        pack_by_hand(path, 32, 24, 2, 3, &s, &p);
+        RunScene sc;
+        char err[4096];
+        RunSize z = {32, 24, 2, 3};
+        cr_assert_eq(run_scene_open(&sc, path, &z, NULL, modes[m], NULL, err, sizeof err), 0, "%s", err);
+        cr_assert_eq(sc.s.render.width, 32);
+        cr_assert_eq(sc.s.render.height, 24);
+        cr_assert_eq(sc.s.render.spp, 2);
+        cr_assert_eq(sc.s.render.max_depth, 3);
+        assert_same_pack(&sc.p, &p);
+        run_scene_close(&sc);
+        pack_free(&p);
+        scene_free(&s);
+    }
+}
+
+#define MCGUIRE_GLB "../shared/scenes/cornell-box/CornellBox-Original.glb" /* scenes/cornell/mcguire.ini's */
+
 Test(run_scene, default_config_packs_as_pack_scene_with_the_default_bvh)
 {
-    static const char *const paths[] = {"scenes/cornell/scene.ini", "scenes/cornell/mcguire.ini"};
-    static const RunMode modes[] = {RUN_REFERENCE, RUN_FUNCTIONAL, RUN_DETAILED};
-    for (size_t i = 0; i < sizeof paths / sizeof paths[0]; i++)
-        for (size_t m = 0; m < sizeof modes / sizeof modes[0]; m++) {
-            Scene s;
-            PackedScene p;
-            pack_by_hand(paths[i], 32, 24, 2, 3, &s, &p);
-            RunScene sc;
-            char err[4096];
-            RunSize z = {32, 24, 2, 3};
-            cr_assert_eq(run_scene_open(&sc, paths[i], &z, NULL, modes[m], NULL, err, sizeof err), 0, "%s", err);
-            cr_assert_eq(sc.s.render.width, 32);
-            cr_assert_eq(sc.s.render.height, 24);
-            cr_assert_eq(sc.s.render.spp, 2);
-            cr_assert_eq(sc.s.render.max_depth, 3);
-            assert_same_pack(&sc.p, &p);
-            run_scene_close(&sc);
-            pack_free(&p);
-            scene_free(&s);
-        }
+    expect_packs_as_by_hand("scenes/cornell/scene.ini");
+}
+
+Test(run_scene, default_config_packs_a_gltf_scene_as_pack_scene)
+{
+    NEEDS_SHARED(MCGUIRE_GLB);
+    expect_packs_as_by_hand("scenes/cornell/mcguire.ini");
 }
 
 Test(run_scene, kd_config_packs_as_pack_scene_then_accel_add_kd)
 {
+    NEEDS_SHARED(MCGUIRE_GLB);
     CfgMachine cfg;
     cfg_defaults(&cfg);
     CfgErrors ce = {0};
