@@ -60,15 +60,15 @@ WORKLOAD = WL_PATH
 ; r21 next stream base            r22 next stream append pointer
 ; r23 next ray slot counter       r24 traversal stack pointer (scratchpad)
 ; r25 N                           r26, r27: scene header values (below)
-; r28 spp   r29 max depth         r30, r31 link registers
+; r28 end of the passes   r29 max depth         r30, r31 link registers
 
         .text
 start:  vli     vz, 0
         vli     vm2, -2
         rdn     r25
-        ld      r28, r0, SM_HDR_SPP
+        spld    r28, r0, L_PASS1        ; this run's passes: [L_PASS0, L_PASS1)
         ld      r29, r0, SM_HDR_MAX_DEPTH
-        li      r17, 0
+        spld    r17, r0, L_PASS0
 .ifdef TRACE_ONLY
 ; ==== `sfsim trace`: the host put L_W rays (origin, direction, tmax, kind) in the current ray
 ; buffer; the stream is their IDs 0..L_W-1. Set-up filter and traversal only; the host reads

@@ -108,10 +108,10 @@ static int timing_close(Worker *w, const TimingStats *before, FuncTile *ft)
     timing_end(w->tc.tm);
     const TimingStats *s = timing_stats(w->tc.tm);
     if (ft) {
-        ft->cycles = s->cycles - before->cycles;
-        ft->busy = s->busy - before->busy;
+        ft->cycles += s->cycles - before->cycles;
+        ft->busy += s->busy - before->busy;
         for (int c = 0; c < TM_CAUSE_COUNT; c++)
-            ft->stalls[c] = s->stalls[c] - before->stalls[c];
+            ft->stalls[c] += s->stalls[c] - before->stalls[c];
     }
     if (timing_error(w->tc.tm)) {
         fail(w->job, timing_error(w->tc.tm), 0);
@@ -233,26 +233,35 @@ static int run_tile(Worker *w, Core *c, uint32_t t, FuncStats *st)
     uint64_t before = core_instructions(c), lanes_before[ISA_STAGE_COUNT];
     for (int k = 0; k < ISA_STAGE_COUNT; k++)
         lanes_before[k] = core_stats(c)->active_lanes[k];
-    TimingStats tbefore;
-    timing_begin(w, c, t, &tbefore);
-    CoreExit ex = core_run(c, (uint64_t)j->fp->cfg->sim_max_instructions);
-    if (timing_close(w, &tbefore, ft))
-        return -1;
-    char msg[1400];
-    if (ex != CORE_EXIT_HALT) {
-        snprintf(msg, sizeof msg, "kernel, tile at (%u, %u): %s%s", ft->x0, ft->y0, core_trap_message(c),
-                 ex == CORE_EXIT_LIMIT ? " (sim.max_instructions)" : "");
-        fail(j, msg, 1);
-        return -1;
-    }
-    uint32_t kerr = spad_u32(c, a->l_error);
-    if (kerr) {
-        snprintf(msg, sizeof msg, "kernel, tile at (%u, %u): %s", ft->x0, ft->y0,
-                 kerr == a->err_stack ? "traversal stack overflow (raise spad.size_kb)"
-                 : kerr == a->err_generations ? "more generations than the kernel counts (64)"
-                                             : "error code set");
-        fail(j, msg, 1);
-        return -1;
+    /* One kernel run per pass (sample per pixel), each on a cold machine when timed; the
+     * framebuffer and the counters in the scratchpad carry over from pass to pass. */
+    uint32_t spp = sm_u32(j->p, sm_hdr(j->p, SM_HDR_SPP));
+    for (uint32_t pass = 0; pass < spp; pass++) {
+        if (pass)
+            core_restart(c);
+        spad_set(c, a->l_pass0, pass);
+        spad_set(c, a->l_pass1, pass + 1);
+        TimingStats tbefore;
+        timing_begin(w, c, t, &tbefore);
+        CoreExit ex = core_run(c, (uint64_t)j->fp->cfg->sim_max_instructions);
+        if (timing_close(w, &tbefore, ft))
+            return -1;
+        char msg[1400];
+        if (ex != CORE_EXIT_HALT) {
+            snprintf(msg, sizeof msg, "kernel, tile at (%u, %u), pass %u: %s%s", ft->x0, ft->y0, pass,
+                     core_trap_message(c), ex == CORE_EXIT_LIMIT ? " (sim.max_instructions)" : "");
+            fail(j, msg, 1);
+            return -1;
+        }
+        uint32_t kerr = spad_u32(c, a->l_error);
+        if (kerr) {
+            snprintf(msg, sizeof msg, "kernel, tile at (%u, %u), pass %u: %s", ft->x0, ft->y0, pass,
+                     kerr == a->err_stack ? "traversal stack overflow (raise spad.size_kb)"
+                     : kerr == a->err_generations ? "more generations than the kernel counts (64)"
+                                                 : "error code set");
+            fail(j, msg, 1);
+            return -1;
+        }
     }
     for (uint32_t y = 0; y < ft->h; y++)
         memcpy(&j->rgb[3 * ((size_t)(ft->y0 + y) * j->width + ft->x0)], fb + (size_t)12 * y * ft->w,

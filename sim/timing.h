@@ -78,7 +78,7 @@ typedef struct TimingStats {
     uint64_t stage_stalls[ISA_STAGE_COUNT][TM_CAUSE_COUNT];
     uint64_t gen_cycles[CORE_GENERATIONS], gen_busy[CORE_GENERATIONS];
     uint64_t gen_stalls[CORE_GENERATIONS][TM_CAUSE_COUNT];
-    uint64_t runs;                                          /* programs timed (tiles) */
+    uint64_t runs;                                          /* programs timed (passes of tiles; trace batches) */
     /* units */
     uint64_t rb_accesses, rb_lines, rb_conflicted;          /* gathers/scatters, lines, those with a conflict */
     uint64_t agu_fetches, agu_ahead;                        /* ID vectors fetched; of them fetched ahead */

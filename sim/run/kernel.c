@@ -44,7 +44,7 @@ static int abi_lookup(const AsmObject *obj, KernelAbi *abi, char *err, size_t er
     static const struct { const char *name; size_t off; } names[] = {
 #define A(field, name) {name, offsetof(KernelAbi, field)}
         A(l_x0, "L_X0"), A(l_y0, "L_Y0"), A(l_w, "L_W"), A(l_h, "L_H"), A(l_seed, "L_SEED"),
-        A(l_error, "L_ERROR"), A(st_dropped, "ST_DROPPED"), A(st_camera, "ST_CAMERA"),
+        A(l_error, "L_ERROR"), A(l_pass0, "L_PASS0"), A(l_pass1, "L_PASS1"), A(st_dropped, "ST_DROPPED"), A(st_camera, "ST_CAMERA"),
         A(st_indirect, "ST_INDIRECT"), A(st_shadow, "ST_SHADOW"), A(st_generations, "ST_GENERATIONS"),
         A(st_per_gen, "ST_PER_GEN"), A(st_max_gen, "ST_MAX_GEN"), A(st_gen_base, "ST_GEN_BASE"),
         A(st_gen_bytes, "ST_GEN_BYTES"), A(st_g_trav, "ST_G_TRAV"), A(st_g_isect, "ST_G_ISECT"),

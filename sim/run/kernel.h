@@ -22,7 +22,7 @@
 
 /* The ABI constants the host needs, looked up by name. */
 typedef struct KernelAbi {
-    uint32_t l_x0, l_y0, l_w, l_h, l_seed, l_error;
+    uint32_t l_x0, l_y0, l_w, l_h, l_seed, l_error, l_pass0, l_pass1;
     uint32_t st_dropped, st_camera, st_indirect, st_shadow, st_generations, st_per_gen, st_max_gen;
     uint32_t st_gen_base, st_gen_bytes, st_g_trav, st_g_isect, st_g_shade;
     uint32_t stack_base, ray_fields, err_stack, err_generations;
