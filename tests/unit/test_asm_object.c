@@ -45,6 +45,14 @@ static void assert_same_object(const AsmObject *a, const AsmObject *b)
     }
 }
 
+/* The sample object, and its encoding in *buf (malloc'ed). */
+static void encode_sample(AsmObject *obj, uint8_t **buf, size_t *len)
+{
+    char err[256];
+    sample_object(obj);
+    cr_assert_eq(asm_object_encode(obj, buf, len, err, sizeof err), 0, "%s", err);
+}
+
 Test(asm_object, write_read_round_trip)
 {
     AsmObject obj, back;
@@ -70,8 +78,7 @@ static void expect_reject(void (*patch)(uint8_t *buf, size_t *len), const char *
     uint8_t *buf;
     size_t len;
     char err[256];
-    sample_object(&obj);
-    cr_assert_eq(asm_object_encode(&obj, &buf, &len, err, sizeof err), 0);
+    encode_sample(&obj, &buf, &len);
     patch(buf, &len);
     cr_assert_eq(asm_object_decode(buf, len, "t.sfo", &back, err, sizeof err), -1, "accepted; want %s", msg);
     cr_assert_not_null(strstr(err, msg), "error '%s' lacks '%s'", err, msg);
@@ -151,8 +158,7 @@ Test(asm_object, every_prefix_is_rejected_or_exact)
     uint8_t *buf;
     size_t len;
     char err[256];
-    sample_object(&obj);
-    cr_assert_eq(asm_object_encode(&obj, &buf, &len, err, sizeof err), 0);
+    encode_sample(&obj, &buf, &len);
     for (size_t n = 0; n < len; n++) {
         uint8_t *copy = malloc(n ? n : 1);
         memcpy(copy, buf, n);
