@@ -708,13 +708,29 @@ static void shade_hit(Worker *w, const Ray *r, uint32_t *n)
         spawn(w, r, &s, d, thr, 0, n);
 }
 
+/* A unit's counts: what the worker's counters gained over its pass. */
+static void unit_counts(RefUnitStats *u, const RefStats *before, const RefStats *after, uint64_t hits)
+{
+    for (int k = 0; k < REF_RAY_KINDS; k++)
+        u->rays[k] = after->rays[k] - before->rays[k];
+    u->nodes_visited = after->nodes_visited - before->nodes_visited;
+    u->prims_tested = after->prims_tested - before->prims_tested;
+    u->hits = hits;
+    for (uint32_t g = 0; g < REF_MAX_GENERATIONS; g++)
+        if (after->rays_per_generation[g] != before->rays_per_generation[g])
+            u->generations = g + 1;
+}
+
 static void render_tile(Worker *w, uint32_t tile)
 {
     Ctx *c = w->c;
     uint32_t T = (uint32_t)c->rp->tile;
     uint32_t tiles_x = (c->width + T - 1) / T;
     uint32_t x0 = (tile % tiles_x) * T, y0 = (tile / tiles_x) * T;
-    for (uint32_t sample = 0; sample < c->spp; sample++) {
+    uint32_t pass1 = c->rp->pass1 ? c->rp->pass1 : c->spp;
+    for (uint32_t sample = c->rp->pass0; sample < pass1 && sample < c->spp; sample++) {
+        RefStats before = w->st;
+        uint64_t hits = 0;
         uint32_t n = 0;
         for (uint32_t ly = 0; ly < T; ly++)
             for (uint32_t lx = 0; lx < T; lx++)
@@ -755,6 +771,7 @@ static void render_tile(Worker *w, uint32_t tile)
                                   r->thr[2] * c->background[2]};
                     add_radiance(c, r->pixel, v);
                 } else {
+                    hits++;
                     shade_hit(w, r, &m);
                 }
             }
@@ -764,6 +781,8 @@ static void render_tile(Worker *w, uint32_t tile)
             n = m;
         }
         w->st.passes++;
+        if (c->rp->units)
+            unit_counts(&c->rp->units[(size_t)tile * c->spp + sample], &before, &w->st, hits);
     }
     w->st.tiles++;
 }
@@ -823,6 +842,10 @@ int ref_render(const PackedScene *p, const RefParams *rp, float *rgb, RefStats *
     c.ambient_mode = c.ambient[0] + c.ambient[1] + c.ambient[2] > 0.0f;
     if (c.width == 0 || c.height == 0 || c.spp == 0) {
         snprintf(err, errlen, "reference: empty image (%u x %u, %u spp)", c.width, c.height, c.spp);
+        return -1;
+    }
+    if (rp->pass1 && (rp->pass0 >= rp->pass1 || rp->pass1 > c.spp)) {
+        snprintf(err, errlen, "reference: passes [%u, %u) outside the frame's %u", rp->pass0, rp->pass1, c.spp);
         return -1;
     }
     uint32_t T = (uint32_t)rp->tile;

@@ -31,7 +31,21 @@ typedef struct RefParams {
     void *progress_ctx;
     RefWorkload workload;  /* 0 (the default of a zeroed struct): the path tracer */
     int bounces;       /* phong: mirror bounces after the camera hit (workload.bounces, >= 0) */
+    /* The passes (samples per pixel) to render, [pass0, pass1); pass1 = 0: every pass. The image
+     * then holds the sum of those passes over the frame's spp (a pilot's image is not the frame). */
+    uint32_t pass0, pass1;
+    /* When not NULL: the counts of each (tile, pass) unit, units[tile * spp + pass], ntiles * spp
+     * entries zeroed by the caller (sampled mode's auxiliary variables, docs/sampling.md). */
+    struct RefUnitStats *units;
 } RefParams;
+
+/* One (tile, pass) unit's work in the golden model. */
+typedef struct RefUnitStats {
+    uint64_t rays[REF_RAY_KINDS]; /* traced, by kind */
+    uint64_t nodes_visited, prims_tested;
+    uint64_t hits;             /* camera and indirect rays that hit a surface: shading events */
+    uint64_t generations;      /* generations the pass reached */
+} RefUnitStats;
 
 typedef struct RefStats {
     uint64_t rays[REF_RAY_KINDS];                 /* traced, by kind */

@@ -7,6 +7,8 @@
 #include <string.h>
 
 #include "../../sim/img.h"
+#include "../../scenes/pack.h"
+#include "../../scenes/scene.h"
 #include "../../sim/reference.h"
 
 typedef struct Builder {
@@ -258,4 +260,69 @@ Test(reference, rmse_falls_as_one_over_sqrt_spp, .timeout = 60)
     cr_log_info("convergence slope %.3f (ideal -0.5)", slope);
     cr_expect(slope < -0.4 && slope > -0.6, "slope %.3f", slope);
     free(ref);
+}
+
+/* Sampled mode's auxiliary variables: every (tile, pass) unit's counts add up to the frame's, and
+ * a unit rendered alone (a pass range) counts exactly what it counted in the whole frame. */
+Test(reference, unit_counts_add_up_and_a_pass_alone_counts_the_same)
+{
+    Scene s;
+    PackedScene p;
+    char err[4096];
+    enum { W = 80, H = 48, SPP = 3, T = 32, TILES = 6, UNITS = TILES * SPP }; /* 3 x 2 tiles, partial */
+    cr_assert_eq(pack_load_file("scenes/cornell/scene.ini", W, H, SPP, &s, &p, err, sizeof err), 0, "%s", err);
+    RefUnitStats *u = calloc(UNITS, sizeof *u), *v = calloc(UNITS, sizeof *v);
+    float *rgb = calloc(3 * W * H, sizeof *rgb), *rgb1 = calloc(3 * W * H, sizeof *rgb1);
+    cr_assert(u && v && rgb && rgb1);
+    RefParams rp = {.tile = T, .seed = 5, .threads = 2, .units = u};
+    RefStats st;
+    cr_assert_eq(ref_render(&p, &rp, rgb, &st, err, sizeof err), 0, "%s", err);
+    RefUnitStats sum = {{0}, 0, 0, 0, 0};
+    for (int i = 0; i < UNITS; i++) {
+        for (int k = 0; k < REF_RAY_KINDS; k++)
+            sum.rays[k] += u[i].rays[k];
+        sum.nodes_visited += u[i].nodes_visited;
+        sum.prims_tested += u[i].prims_tested;
+        sum.hits += u[i].hits;
+        int t = i / SPP, tw = t % 3 == 2 ? W - 2 * T : T, th = t / 3 == 1 ? H - T : T;
+        cr_expect_eq(u[i].rays[REF_RAY_CAMERA], (uint64_t)(tw * th), "unit %d: one camera ray per pixel", i);
+        cr_expect_geq(u[i].generations, 1u, "unit %d", i);
+    }
+    for (int k = 0; k < REF_RAY_KINDS; k++)
+        cr_expect_eq(sum.rays[k], st.rays[k], "ray kind %d", k);
+    cr_expect_eq(sum.nodes_visited, st.nodes_visited);
+    cr_expect_eq(sum.prims_tested, st.prims_tested);
+    cr_expect_gt(sum.hits, 0u);
+    cr_expect_leq(sum.hits, st.rays[REF_RAY_CAMERA] + st.rays[REF_RAY_INDIRECT]);
+    /* pass 1 alone, on one thread */
+    RefParams one = rp;
+    one.pass0 = 1;
+    one.pass1 = 2;
+    one.threads = 1;
+    one.units = v;
+    cr_assert_eq(ref_render(&p, &one, rgb1, NULL, err, sizeof err), 0, "%s", err);
+    for (int t = 0; t < TILES; t++)
+        for (int q = 0; q < SPP; q++) {
+            RefUnitStats zero;
+            memset(&zero, 0, sizeof zero);
+            const RefUnitStats *want = q == 1 ? &u[t * SPP + q] : &zero;
+            cr_expect_eq(memcmp(&v[t * SPP + q], want, sizeof zero), 0, "tile %d pass %d", t, q);
+        }
+    /* passes outside the frame */
+    static const uint32_t bad[][2] = {{2, 2}, {0, 4}, {3, 1}};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        RefParams r = rp;
+        r.pass0 = bad[i][0];
+        r.pass1 = bad[i][1];
+        r.units = NULL;
+        err[0] = 0;
+        cr_expect_eq(ref_render(&p, &r, rgb1, NULL, err, sizeof err), -1, "[%u, %u)", bad[i][0], bad[i][1]);
+        cr_expect(strstr(err, "outside the frame's 3") != NULL, "%s", err);
+    }
+    free(u);
+    free(v);
+    free(rgb);
+    free(rgb1);
+    pack_free(&p);
+    scene_free(&s);
 }
