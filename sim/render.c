@@ -278,10 +278,8 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         snprintf(err, errlen, "--mode %s: expected detailed, sampled, functional or reference", o->mode);
         return -1;
     }
-    if (spec.mode == RUN_SAMPLED && !(o->sample > 0.0 && o->sample <= 1.0)) {
-        snprintf(err, errlen, "--sample %g: expected a fraction of the tiles in (0, 1]", o->sample);
+    if (run_spec_check(&spec, err, errlen) != 0)
         return -1;
-    }
     /* Before any work: an output folder that cannot be made would fail the run only at its end. */
     if (outfile_check_dir(o->out_dir, err, errlen) != 0)
         return -3;

@@ -137,6 +137,23 @@ static int kernel_frame(const RunScene *sc, const RunSpec *spec, const CfgMachin
     return 0;
 }
 
+int run_spec_check(const RunSpec *spec, char *err, size_t errlen)
+{
+    if ((unsigned)spec->mode >= RUN_MODE_COUNT) {
+        snprintf(err, errlen, "run mode %d: no such mode", (int)spec->mode);
+        return -1;
+    }
+    if (spec->mode == RUN_SAMPLED && !(spec->sample > 0.0 && spec->sample <= 1.0)) {
+        snprintf(err, errlen, "--sample %g: expected a fraction of the tiles in (0, 1]", spec->sample);
+        return -1;
+    }
+    if (spec->cfg && spec->cfg->stream_rays != 1024 && spec->cfg->stream_rays != 4096) {
+        snprintf(err, errlen, "stream.rays %d: must be 1024 or 4096", spec->cfg->stream_rays);
+        return -1;
+    }
+    return 0;
+}
+
 int run_frame(const RunScene *sc, const RunSpec *spec, RunFrame *fr, char *err, size_t errlen)
 {
     memset(fr, 0, sizeof *fr);
@@ -146,18 +163,8 @@ int run_frame(const RunScene *sc, const RunSpec *spec, RunFrame *fr, char *err, 
         cfg_defaults(&defcfg);
         cfg = &defcfg;
     }
-    if ((unsigned)spec->mode >= RUN_MODE_COUNT) {
-        snprintf(err, errlen, "run mode %d: no such mode", (int)spec->mode);
+    if (run_spec_check(spec, err, errlen) != 0)
         return -1;
-    }
-    if (spec->mode == RUN_SAMPLED && !(spec->sample > 0.0 && spec->sample <= 1.0)) {
-        snprintf(err, errlen, "--sample %g: expected a fraction of the tiles in (0, 1]", spec->sample);
-        return -1;
-    }
-    if (cfg->stream_rays != 1024 && cfg->stream_rays != 4096) {
-        snprintf(err, errlen, "stream.rays %d: must be 1024 or 4096", cfg->stream_rays);
-        return -1;
-    }
     size_t npx = (size_t)sc->s.render.width * (size_t)sc->s.render.height;
     fr->rgb = calloc(3 * npx, sizeof(float));
     if (!fr->rgb) {

@@ -89,6 +89,11 @@ typedef struct RunFrame {
     double seconds;            /* host time rendering */
 } RunFrame;
 
+/* The settings run_frame refuses, checked before any work (a mode out of range, a sample fraction
+ * outside (0, 1] in RUN_SAMPLED, a stream size the kernel has no tile for): 0, or -1 with a
+ * message naming the setting. */
+int run_spec_check(const RunSpec *spec, char *err, size_t errlen);
+
 /* Render sc's frame as spec says. 0; -1 with a message (bad settings, a kernel that does not
  * assemble, memories too small, too few tiles to estimate from); -2 when the simulated program
  * failed in a tile: then fr->rgb holds the tiles that finished (fr->f.tiles_done of fr->f.ntiles)
