@@ -1,4 +1,6 @@
-/* sim/sampling.c -- tile sampling and the ratio estimator (see sampling.h, docs/sampling.md). */
+/* sim/sampling.c -- seeded samples, the ratio and regression estimators and the sequential stopping
+ * rule (formulas and the rule: sampling.h; design: docs/sampling.md). Pure functions: no I/O, no
+ * threads; only sample_select allocates (its shuffle). Must not run or time anything. */
 #include "sampling.h"
 
 #include <math.h>
@@ -22,6 +24,27 @@ static uint64_t splitmix64(uint64_t *s)
     return z ^ (z >> 31);
 }
 
+static uint64_t sample_seed_state(uint32_t seed)
+{
+    return 0x5f3759dfull ^ ((uint64_t)seed << 17) ^ seed;
+}
+
+void sample_order(uint32_t N, uint32_t seed, uint32_t *order)
+{
+    /* Fisher-Yates from the front, as sample_select: order[i] is drawn uniformly from the units
+     * not yet placed, so every prefix is a simple random sample without replacement (the modulo
+     * bias of a 64-bit draw reduced below 2^32 is under 2^-32). */
+    uint64_t s = sample_seed_state(seed);
+    for (uint32_t i = 0; i < N; i++)
+        order[i] = i;
+    for (uint32_t i = 0; i + 1 < N; i++) {
+        uint32_t j = i + (uint32_t)(splitmix64(&s) % (uint64_t)(N - i));
+        uint32_t t = order[i];
+        order[i] = order[j];
+        order[j] = t;
+    }
+}
+
 void sample_select(uint32_t ntiles, double fraction, uint32_t seed, uint8_t *selected)
 {
     memset(selected, 0, ntiles);
@@ -32,7 +55,7 @@ void sample_select(uint32_t ntiles, double fraction, uint32_t seed, uint8_t *sel
     }
     /* Partial Fisher-Yates over the tile indices: the first n places are the sample. */
     uint32_t *idx = malloc((size_t)ntiles * sizeof *idx);
-    uint64_t s = 0x5f3759dfull ^ ((uint64_t)seed << 17) ^ seed;
+    uint64_t s = sample_seed_state(seed);
     if (!idx) { /* no memory for the shuffle: a systematic sample with a seeded start instead */
         uint32_t step = ntiles / n, start = (uint32_t)(splitmix64(&s) % step);
         for (uint32_t k = 0; k < n; k++)
@@ -109,3 +132,166 @@ int sample_ratio_estimate(const double *y, const double *x, const uint8_t *selec
         out->lo = sy;
     return 0;
 }
+
+/* ---- the regression (GREG) estimator ---------------------------------------------------------- */
+
+#define FIT_CONST_TOL 1e-20 /* centred / raw sum of squares below this: a constant column */
+#define FIT_PIVOT_TOL 1e-9  /* Cholesky pivot (1 - R^2 on earlier kept columns) below this: collinear */
+
+typedef struct Fit {
+    uint32_t k;                      /* columns given */
+    uint32_t nkeep, keep[SAMPLE_MAX_AUX]; /* columns used, in order */
+    double ybar, xbar[SAMPLE_MAX_AUX];    /* sample means */
+    double s[SAMPLE_MAX_AUX][SAMPLE_MAX_AUX], sy[SAMPLE_MAX_AUX], syy; /* centred cross-products */
+    double raw[SAMPLE_MAX_AUX];      /* uncentred sums of squares */
+    double b[SAMPLE_MAX_AUX];        /* slopes per original column (0 for dropped ones) */
+    double sse;                      /* sum of squared residuals, from the data */
+} Fit;
+
+/* Sample means, then centred cross-products in a second pass (the two-pass form does not lose
+ * the small variance of a large count to cancellation). -1 on a unit index >= N. */
+static int fit_moments(Fit *f, const double *ys, const double *x, const uint32_t *sample, uint32_t n, uint32_t N)
+{
+    const uint32_t k = f->k;
+    for (uint32_t s = 0; s < n; s++) {
+        if (sample[s] >= N)
+            return -1;
+        f->ybar += ys[s];
+        for (uint32_t j = 0; j < k; j++)
+            f->xbar[j] += x[(size_t)sample[s] * k + j];
+    }
+    f->ybar /= n;
+    for (uint32_t j = 0; j < k; j++)
+        f->xbar[j] /= n;
+    for (uint32_t s = 0; s < n; s++) {
+        const double *xi = x ? x + (size_t)sample[s] * k : NULL;
+        double dy = ys[s] - f->ybar, d[SAMPLE_MAX_AUX];
+        f->syy += dy * dy;
+        for (uint32_t j = 0; j < k; j++) {
+            d[j] = xi[j] - f->xbar[j];
+            f->raw[j] += xi[j] * xi[j];
+            f->sy[j] += d[j] * dy;
+            for (uint32_t l = 0; l <= j; l++)
+                f->s[j][l] += d[j] * d[l];
+        }
+    }
+    return 0;
+}
+
+/* Chooses the columns (constant and collinear ones dropped, then the last kept ones until
+ * n - k - 1 >= 1) and solves the normal equations of the kept ones, scaled to unit sums of
+ * squares, by Cholesky: L L' beta = c, b_j = beta_j / sqrt(S_jj). */
+static void fit_solve(Fit *f, uint32_t n)
+{
+    double L[SAMPLE_MAX_AUX][SAMPLE_MAX_AUX], c[SAMPLE_MAX_AUX], sc[SAMPLE_MAX_AUX];
+    for (uint32_t j = 0; j < f->k; j++) {
+        double sjj = f->s[j][j];
+        if (!(sjj > FIT_CONST_TOL * f->raw[j]) || !(sjj > 0.0))
+            continue;
+        uint32_t m = f->nkeep;
+        sc[m] = sqrt(sjj);
+        double d = 1.0;
+        for (uint32_t p = 0; p < m; p++) { /* row m of L: the scaled column j against kept column p */
+            uint32_t q = f->keep[p];
+            double v = (j > q ? f->s[j][q] : f->s[q][j]) / (sc[m] * sc[p]);
+            for (uint32_t r = 0; r < p; r++)
+                v -= L[m][r] * L[p][r];
+            L[m][p] = v / L[p][p];
+            d -= L[m][p] * L[m][p];
+        }
+        if (!(d > FIT_PIVOT_TOL))
+            continue;
+        L[m][m] = sqrt(d);
+        f->keep[m] = j;
+        f->nkeep++;
+    }
+    if (f->nkeep + 1 >= n) /* df = n - k - 1 must stay >= 1 (n >= 2 here) */
+        f->nkeep = n - 2;
+    const uint32_t m = f->nkeep;
+    for (uint32_t p = 0; p < m; p++) { /* forward: L c = S_jy scaled */
+        double v = f->sy[f->keep[p]] / sc[p];
+        for (uint32_t r = 0; r < p; r++)
+            v -= L[p][r] * c[r];
+        c[p] = v / L[p][p];
+    }
+    for (uint32_t p = m; p-- > 0;) { /* backward: L' beta = c */
+        double v = c[p];
+        for (uint32_t r = p + 1; r < m; r++)
+            v -= L[r][p] * c[r];
+        c[p] = v / L[p][p];
+    }
+    for (uint32_t p = 0; p < m; p++)
+        f->b[f->keep[p]] = c[p] / sc[p];
+}
+
+/* The residual sum of squares from the data themselves, so a perfect fit gives ~0. */
+static void fit_residuals(Fit *f, const double *ys, const double *x, const uint32_t *sample, uint32_t n)
+{
+    for (uint32_t s = 0; s < n; s++) {
+        double e = ys[s] - f->ybar;
+        for (uint32_t p = 0; p < f->nkeep; p++) {
+            uint32_t j = f->keep[p];
+            e -= f->b[j] * (x[(size_t)sample[s] * f->k + j] - f->xbar[j]);
+        }
+        f->sse += e * e;
+    }
+}
+
+int sample_regression_estimate(const double *ys, const double *x, uint32_t k, const uint32_t *sample,
+                               uint32_t n, uint32_t N, SampleEstimate *out)
+{
+    memset(out, 0, sizeof *out);
+    out->n = n;
+    out->N = N;
+    if (N == 0 || n > N || k > SAMPLE_MAX_AUX || (k > 0 && !x) || (n < 2 && n < N))
+        return -1;
+    double sy = 0.0;
+    int nonneg = 1;
+    for (uint32_t s = 0; s < n; s++) {
+        sy += ys[s];
+        nonneg &= ys[s] >= 0.0;
+    }
+    if (n < 2) { /* a census of one unit */
+        out->total = out->lo = out->hi = sy;
+        return sample[0] < N ? 0 : -1;
+    }
+    Fit f;
+    memset(&f, 0, sizeof f);
+    f.k = k;
+    if (fit_moments(&f, ys, x, sample, n, N) != 0)
+        return -1;
+    fit_solve(&f, n);
+    fit_residuals(&f, ys, x, sample, n);
+    out->k = f.nkeep;
+    out->df = n - f.nkeep - 1;
+    out->coef[0] = f.ybar;
+    for (uint32_t j = 0; j < k; j++) {
+        out->coef[1 + j] = f.b[j];
+        out->coef[0] -= f.b[j] * f.xbar[j];
+    }
+    out->r2 = f.syy > 0.0 ? 1.0 - f.sse / f.syy : 1.0;
+    out->r2 = out->r2 < 0.0 ? 0.0 : out->r2 > 1.0 ? 1.0 : out->r2;
+    if (n == N) { /* a census: exact */
+        out->total = out->lo = out->hi = sy;
+        return 0;
+    }
+    double adj = 0.0; /* b'(Xbar - xbar), Xbar over all N units */
+    for (uint32_t p = 0; p < f.nkeep; p++) {
+        uint32_t j = f.keep[p];
+        double X = 0.0;
+        for (uint32_t i = 0; i < N; i++)
+            X += x[(size_t)i * k + j];
+        adj += f.b[j] * (X / N - f.xbar[j]);
+    }
+    const double Nd = (double)N;
+    double var = Nd * Nd * (1.0 - (double)n / Nd) / (double)n * f.sse / (double)out->df;
+    out->total = Nd * (f.ybar + adj);
+    out->std_error = sqrt(var);
+    out->t = sample_t975(out->df);
+    out->lo = out->total - out->t * out->std_error;
+    out->hi = out->total + out->t * out->std_error;
+    if (nonneg && out->lo < sy) /* the frame takes at least the cycles measured */
+        out->lo = sy;
+    return 0;
+}
+

@@ -1,17 +1,35 @@
-/* sim/sampling.h -- sampled simulation: which tiles get detailed timing, and the estimate of a
- * frame's cycles with a confidence interval from those tiles (SMARTS-style sampling, Wunderlich
- * et al., ISCA 2003; the estimator and its assumptions: docs/sampling.md).
+/* sim/sampling.h -- sampled simulation: which units get detailed timing, and the estimate of a
+ * frame's cycles with a confidence interval from those units (SMARTS-style sampling, Wunderlich
+ * et al., ISCA 2003; the design and its assumptions: docs/sampling.md).
  *
- * Owns: the seeded simple random sample of tiles (without replacement) and the ratio estimator.
- * Must not: run anything (sim/functional.c runs the tiles; sim/render.c reports).
+ * Owns: seeded simple random samples without replacement (a fixed-size selection and a
+ * permutation whose every prefix is a sample), the ratio estimator, the multiple-regression
+ * (GREG) estimator.
+ * Must not: run anything, print, allocate per unit beyond sample_select's shuffle, or use threads
+ * (sim/functional.c and the run layer run the units; sim/render.c reports).
  *
- * Every tile runs on the functional core, so its instruction count x_i is known exactly for all
- * N tiles; the sampled tiles also get their cycles y_i from the timing model. The frame's cycles
- * Y = sum y_i are estimated by the ratio estimator
+ * 1. The ratio estimator (tiles, one auxiliary: instructions x_i known for all N tiles):
  *     Y^ = X * R^,  R^ = sum_s y_i / sum_s x_i  (cycles per instruction of the sample),
- * with variance  V^ = N^2 (1 - n/N) / n * s_d^2,  s_d^2 = sum_s (y_i - R^ x_i)^2 / (n - 1),
- * and the interval Y^ +- t_{0.975, n-1} sqrt(V^) (Cochran, Sampling Techniques, 1977, 6.3-6.4).
- * With every tile sampled the interval has zero width and Y^ = Y exactly.
+ *     V^ = N^2 (1 - n/N) / n * s_d^2,  s_d^2 = sum_s (y_i - R^ x_i)^2 / (n - 1),
+ *     interval Y^ +- t_{0.975, n-1} sqrt(V^) (Cochran, Sampling Techniques, 1977, 6.3-6.4).
+ *
+ * 2. The regression (GREG with intercept) estimator (units, k <= SAMPLE_MAX_AUX auxiliaries x_ij
+ *    known exactly for all N units; Cochran 1977 Sec. 7.1-7.2, 7.10; Sarndal, Swensson & Wretman
+ *    1992, Ch. 6). With b the OLS fit of y on (1, x) over the sample s of size n:
+ *     Y^  = sum_{i<N} (b0 + b'x_i) = N (ybar + b'(Xbar - xbar)),
+ *     e_s = y_s - b0 - b'x_s,   df = n - k - 1,
+ *     V^  = N^2 (1 - n/N) / n * sum_s e_s^2 / df,
+ *     interval Y^ +- t_{0.975, df} sqrt(V^), its lower end raised to sum_s y_s when every sampled
+ *     y_s >= 0 (the frame takes at least the cycles measured).
+ *    The fit centres the columns on their sample means, scales them to unit sum of squares and
+ *    solves the normal equations by Cholesky; a column is dropped (coef 0, not counted in k) when
+ *    its centred sum of squares is below 1e-20 of its raw sum of squares (constant), or when its
+ *    Cholesky pivot falls below 1e-9 (R^2 > 1 - 1e-9 on the earlier kept columns: collinear).
+ *    When n <= k + 1 the LAST kept columns are dropped until df >= 1, so list auxiliaries most
+ *    useful first; k = 0 is the expansion estimator N ybar with V^ = N^2 (1 - n/N) s_y^2 / n.
+ *    The residuals are recomputed from the data (not from the normal equations), so a perfect fit
+ *    gives V^ ~ 0. A census (n == N) is exact: Y^ = sum y, lo = hi = Y^, t = std_error = 0 (the
+ *    fit's coef, k, df and r2 are still reported when n >= 2).
  */
 #ifndef SFSIM_SAMPLING_H
 #define SFSIM_SAMPLING_H
@@ -26,13 +44,25 @@ uint32_t sample_count(uint32_t ntiles, double fraction);
  * fixed by seed: selected[i] = 1 for the chosen tiles (selected has ntiles entries). */
 void sample_select(uint32_t ntiles, double fraction, uint32_t seed, uint8_t *selected);
 
+/* A permutation of 0..N-1 fixed by seed (a full Fisher-Yates shuffle on the same generator and
+ * seeding as sample_select, so order[0, sample_count(N, f)) is the set sample_select chooses).
+ * Every prefix order[0, n) is a simple random sample without replacement of size n. */
+void sample_order(uint32_t N, uint32_t seed, uint32_t *order);
+
+#define SAMPLE_MAX_AUX 8 /* auxiliary variables the regression estimator takes at most */
+
 typedef struct SampleEstimate {
-    uint32_t n, N;          /* tiles sampled, tiles in the frame */
+    uint32_t n, N;          /* units sampled, units in the frame */
     double total;           /* estimated frame total of y */
-    double lo, hi;          /* its 95 % confidence interval (lo >= the sampled tiles' own sum) */
-    double ratio;           /* R^: y per unit of x in the sample */
+    double lo, hi;          /* its 95 % confidence interval (lo >= the sampled units' own sum) */
+    double ratio;           /* ratio estimator: R^, y per unit of x in the sample (0 otherwise) */
     double std_error;       /* sqrt(V^) */
-    double t;               /* the t quantile used (0 when every tile is sampled) */
+    double t;               /* the t quantile used (0 when every unit is sampled) */
+    /* Regression estimator only (zero from the ratio estimator): */
+    uint32_t k;             /* auxiliaries used, after dropping constant or collinear ones */
+    uint32_t df;            /* n - k - 1: degrees of freedom of the residual variance */
+    double coef[SAMPLE_MAX_AUX + 1]; /* b0, then b_j per ORIGINAL column j (0 for dropped ones) */
+    double r2;              /* the fit's R^2 on the sample (1 when the sampled y do not vary) */
 } SampleEstimate;
 
 /* The ratio estimate of sum y over all N tiles from the sampled ones (y read only where
@@ -40,6 +70,13 @@ typedef struct SampleEstimate {
  * sampled (unless all are) or the sampled x sum to 0. */
 int sample_ratio_estimate(const double *y, const double *x, const uint8_t *selected, uint32_t ntiles,
                           SampleEstimate *out);
+
+/* The regression estimate of Y = sum of y over all N units (formulas above). ys[s] is y of unit
+ * sample[s] (s < n); x[i * k + j] is auxiliary j of unit i for EVERY unit i < N (x may be NULL
+ * when k == 0). O(N k + n k^2) time, no allocation. 0, or -1 when n < 2 (and n < N), n > N,
+ * N == 0, k > SAMPLE_MAX_AUX or a sample index is >= N. */
+int sample_regression_estimate(const double *ys, const double *x, uint32_t k, const uint32_t *sample,
+                               uint32_t n, uint32_t N, SampleEstimate *out);
 
 /* The 0.975 quantile of Student's t distribution with df degrees of freedom (df >= 1). */
 double sample_t975(uint32_t df);
