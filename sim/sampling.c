@@ -295,3 +295,52 @@ int sample_regression_estimate(const double *ys, const double *x, uint32_t k, co
     return 0;
 }
 
+/* ---- the sequential rule of --target-error --------------------------------------------------- */
+
+/* t se / |Y^|: the interval's relative half-width (0 for a census, infinite around a zero total). */
+static double sample_rel_half_width(const SampleEstimate *e)
+{
+    double h = e->t * e->std_error;
+    if (h == 0.0)
+        return 0.0;
+    return e->total != 0.0 ? h / fabs(e->total) : INFINITY;
+}
+
+/* The next sample size of the rule in sampling.h, for half-width h > target E > 0 at size n < N. */
+static uint32_t sample_next_size(uint32_t n, uint32_t N, double h, double E)
+{
+    double q = E / h; /* in [0, 1): the half-width must shrink by this factor */
+    double nstar = 1.0 / (1.0 / N + q * q * (1.0 / n - 1.0 / N));
+    double want = ceil(1.1 * nstar);
+    double step = n / 8 > 1 ? (double)(n / 8) : 1.0;
+    if (!(want >= (double)n + step)) /* also catches a NaN from a NaN half-width */
+        want = (double)n + step;
+    if (want > 4.0 * n)
+        want = 4.0 * n;
+    return want > (double)N ? N : (uint32_t)want;
+}
+
+int sample_sequential(const double *x, uint32_t k, const uint32_t *order, uint32_t N, uint32_t n0, double target,
+                      SampleMeasure measure, void *ctx, double *ys, SampleEstimate *out, uint32_t *rounds)
+{
+    memset(out, 0, sizeof *out);
+    if (rounds)
+        *rounds = 0;
+    if (N == 0 || k > SAMPLE_MAX_AUX || (k > 0 && !x) || !order || !measure || !ys)
+        return -1;
+    const uint32_t least = k + 3 < N ? k + 3 : N; /* df >= 2 with every auxiliary kept */
+    uint32_t n = n0 < least ? least : n0 > N ? N : n0, have = 0;
+    for (;;) {
+        if (measure(ctx, order + have, n - have, ys + have) != 0)
+            return -1;
+        have = n;
+        if (rounds)
+            (*rounds)++;
+        if (sample_regression_estimate(ys, x, k, order, n, N, out) != 0)
+            return -1;
+        double h = sample_rel_half_width(out);
+        if (target <= 0.0 || n == N || h <= target)
+            return 0;
+        n = sample_next_size(n, N, h, target);
+    }
+}

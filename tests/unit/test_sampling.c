@@ -1,7 +1,7 @@
 /* tests/unit/test_sampling.c -- sampled mode (sim/sampling.h): the tile sample, the ratio
  * estimator, and the coverage of its 95 % interval on a real frame; the seeded unit order, the
  * regression estimator (exact cases, a hand-computed one, dropped columns, coverage on a fixed
- * synthetic population).
+ * synthetic population) and the sequential stopping rule of --target-error.
  *
  * Coverage: a full detailed run of a small scene gives every tile's cycles; a sampled run is
  * checked to time exactly the tiles the sample selects and to measure each of them with the same
@@ -92,7 +92,7 @@ Test(sampling, ratio_estimator_by_hand)
     cr_expect_eq(sample_ratio_estimate(y, x, one, 4, &e), -1);
 }
 
-/* ---- units in a seeded order and the regression estimator ------------------------------------ */
+/* ---- units in a seeded order, the regression estimator and the sequential rule ---------------- */
 
 /* The tests' own generator (not the library's), so populations stay fixed whatever the library does. */
 static uint64_t test_rng(uint64_t *s)
@@ -404,6 +404,156 @@ Test(sampling, regression_interval_covers_the_true_total)
         cr_expect_geq(c1000, (int)ceil(1000.0 * (0.95 - 3.0 * sqrt(0.95 * 0.05 / 1000.0))),
                       "k = %u: %d of 1000 seeds covered", k, c1000);
     }
+}
+
+/* A measurement that records how the rule grows the sample, and can fail on a given call. */
+typedef struct Meter {
+    const double *y;
+    const uint32_t *order;
+    uint32_t calls, measured, fail_at, sizes[64];
+    int in_order; /* every call asked for the next slice of the order */
+} Meter;
+
+static int meter(void *ctx, const uint32_t *units, uint32_t count, double *ys)
+{
+    Meter *m = ctx;
+    m->calls++;
+    if (m->fail_at == m->calls)
+        return -1;
+    m->in_order &= units == m->order + m->measured && count > 0;
+    gather(m->y, units, count, ys);
+    m->measured += count;
+    if (m->calls <= 64)
+        m->sizes[m->calls - 1] = m->measured;
+    return 0;
+}
+
+static double rel_half(const SampleEstimate *e)
+{
+    return e->t * e->std_error / fabs(e->total);
+}
+
+/* The rule on one run, recomputed here from sampling.h's statement: sizes strictly grow, by at
+ * least max(1, n/8) and at most 4x, and each next size is min(N, 4n, max(n + max(1, n/8),
+ * ceil(1.1 n*))) with 1/n* - 1/N = (E/h)^2 (1/n - 1/N) from the estimate at the previous size. */
+static void expect_growth(const Meter *m, uint32_t n0, const double *x, uint32_t k, uint32_t N, const double *ys,
+                          double E)
+{
+    cr_expect_eq(m->sizes[0], n0);
+    cr_expect(m->in_order, "measure was asked for the next slice of the order each time");
+    for (uint32_t r = 1; r < m->calls && r < 64; r++) {
+        uint32_t a = m->sizes[r - 1], b = m->sizes[r], step = a / 8 > 1 ? a / 8 : 1;
+        cr_expect(b >= a + step && b <= 4 * a, "round %u: %u -> %u", r + 1, a, b);
+        SampleEstimate e;
+        cr_assert_eq(sample_regression_estimate(ys, x, k, m->order, a, N, &e), 0);
+        double q = E / rel_half(&e), nstar = 1.0 / (1.0 / N + q * q * (1.0 / a - 1.0 / N));
+        double want = fmin(fmin((double)N, 4.0 * a), fmax((double)(a + step), ceil(1.1 * nstar)));
+        cr_expect_eq(b, (uint32_t)want, "round %u: %u -> %u, the rule says %.0f (n* = %.1f)", r + 1, a, b, want,
+                     nstar);
+    }
+}
+
+Test(sampling, sequential_rule_stops_at_the_target)
+{
+    enum { N = 4000 };
+    static double x3[N * 3], y[N], xk[N * 2], ys[N];
+    static uint32_t order[N];
+    double truth = population(N, 2026, x3, y);
+    columns(x3, N, 2, xk);
+    sample_order(N, 1, order);
+    Meter m = {.y = y, .order = order, .in_order = 1};
+    SampleEstimate e, again;
+    uint32_t rounds = 0;
+    cr_assert_eq(sample_sequential(xk, 2, order, N, 30, 0.005, meter, &m, ys, &e, &rounds), 0);
+    printf("sampling: --target-error 0.5 %% on N = 4000 took n = %u units in %u rounds (sizes", e.n, rounds);
+    for (uint32_t r = 0; r < rounds && r < 64; r++)
+        printf(" %u", m.sizes[r]);
+    printf("); half-width %.3f %%, error %.3f %%\n", 100.0 * rel_half(&e), 100.0 * (e.total - truth) / truth);
+    cr_expect_leq(rel_half(&e), 0.005);
+    cr_expect_lt(e.n, N, "a reachable target needs no census");
+    cr_expect_gt(rounds, 1);
+    cr_expect_eq(rounds, m.calls);
+    cr_expect_eq(e.n, m.measured);
+    expect_growth(&m, 30, xk, 2, N, ys, 0.005);
+    /* The estimate is the regression estimate of the measured prefix. */
+    cr_assert_eq(sample_regression_estimate(ys, xk, 2, order, e.n, N, &again), 0);
+    cr_expect(again.total == e.total && again.hi == e.hi && again.lo == e.lo);
+    /* The coverage of the interval the rule stops with, over seeds 1..100 at E = 1 %. */
+    int covered = 0;
+    double mean_n = 0.0;
+    for (uint32_t seed = 1; seed <= 100; seed++) {
+        sample_order(N, seed, order);
+        Meter mm = {.y = y, .order = order, .in_order = 1};
+        cr_assert_eq(sample_sequential(xk, 2, order, N, 20, 0.01, meter, &mm, ys, &e, &rounds), 0);
+        covered += e.lo <= truth && truth <= e.hi;
+        mean_n += e.n / 100.0;
+    }
+    printf("sampling: --target-error 1 %% from n0 = 20: the final interval covers the total in %d of 100 seeds; "
+           "mean n %.0f\n", covered, mean_n);
+    cr_expect_geq(covered, 90, "the rule's final interval covered the total in %d of 100 seeds", covered);
+    /* Growth invariants and the stopping condition over many seeds and targets. */
+    const double targets[4] = {0.02, 0.01, 0.005, 0.002};
+    for (uint32_t seed = 1; seed <= 20; seed++)
+        for (int t = 0; t < 4; t++) {
+            sample_order(N, seed, order);
+            Meter mm = {.y = y, .order = order, .in_order = 1};
+            cr_assert_eq(sample_sequential(xk, 2, order, N, 20, targets[t], meter, &mm, ys, &e, &rounds), 0);
+            cr_expect(rel_half(&e) <= targets[t] || e.n == N, "seed %u, target %g: %g at n = %u", seed, targets[t],
+                      rel_half(&e), e.n);
+            expect_growth(&mm, 20, xk, 2, N, ys, targets[t]);
+        }
+}
+
+Test(sampling, sequential_rule_census_failure_and_fixed_size)
+{
+    enum { N = 300 };
+    static double x3[N * 3], y[N], ys[N];
+    static uint32_t order[N];
+    double truth = population(N, 7, x3, y);
+    sample_order(N, 9, order);
+    SampleEstimate e;
+    uint32_t rounds = 0;
+
+    /* An unreachable target ends in a census with the exact total. */
+    Meter m = {.y = y, .order = order, .in_order = 1};
+    cr_assert_eq(sample_sequential(x3, 3, order, N, 10, 1e-12, meter, &m, ys, &e, &rounds), 0);
+    cr_expect_eq(e.n, N);
+    cr_expect_float_eq(e.total, truth, 1e-9 * truth);
+    cr_expect(e.lo == e.total && e.hi == e.total && e.std_error == 0.0);
+    cr_expect_gt(rounds, 1);
+    cr_expect_eq(m.sizes[rounds - 1], N);
+    expect_growth(&m, 10, x3, 3, N, ys, 1e-12);
+
+    /* measure() failing stops the rule with -1, on the first call or a later one. */
+    for (uint32_t fail = 1; fail <= 2; fail++) {
+        Meter f = {.y = y, .order = order, .in_order = 1, .fail_at = fail};
+        cr_expect_eq(sample_sequential(x3, 3, order, N, 10, 1e-12, meter, &f, ys, &e, &rounds), -1);
+        cr_expect_eq(f.calls, fail, "no call after the failure");
+    }
+
+    /* target <= 0: exactly one round of n0 (the fixed-size design). */
+    for (int neg = 0; neg <= 1; neg++) {
+        Meter f = {.y = y, .order = order, .in_order = 1};
+        cr_assert_eq(sample_sequential(x3, 3, order, N, 50, neg ? -1.0 : 0.0, meter, &f, ys, &e, &rounds), 0);
+        cr_expect_eq(rounds, 1);
+        cr_expect_eq(f.calls, 1);
+        cr_expect_eq(e.n, 50);
+        cr_expect_eq(f.sizes[0], 50);
+        cr_expect_gt(e.hi, e.lo);
+    }
+
+    /* n0 is clamped to [min(N, k + 3), N]. */
+    Meter f = {.y = y, .order = order, .in_order = 1};
+    cr_assert_eq(sample_sequential(x3, 3, order, N, 0, 0.0, meter, &f, ys, &e, NULL), 0);
+    cr_expect_eq(f.sizes[0], 6);
+    Meter g = {.y = y, .order = order, .in_order = 1};
+    cr_assert_eq(sample_sequential(x3, 3, order, N, N + 5, 0.01, meter, &g, ys, &e, &rounds), 0);
+    cr_expect(g.calls == 1 && e.n == N && rounds == 1, "a census in one round");
+    const uint32_t two[2] = {1, 0};
+    Meter h = {.y = y, .order = two, .in_order = 1};
+    cr_assert_eq(sample_sequential(x3, 3, two, 2, 0, 0.01, meter, &h, ys, &e, &rounds), 0);
+    cr_expect(h.sizes[0] == 2 && e.n == 2 && e.lo == e.hi, "N = 2 < k + 3: a census");
+    cr_expect_eq(sample_sequential(x3, 3, order, 0, 5, 0.01, meter, &h, ys, &e, &rounds), -1, "no units");
 }
 
 static Scene scene;
