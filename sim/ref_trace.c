@@ -1,5 +1,5 @@
 /* sim/ref_trace.c -- the golden model's ray/box, ray/triangle and ray/sphere tests and its BVH
- * traversal over a packed scene.
+ * traversal over a packed scene, with the optional per-set counts of rays per node.
  *
  * Owns: the reference arithmetic for ray queries. Every expression is binary32 and evaluated in
  * the order written (the build uses ISO C mode, so no contraction into fused multiply-adds),
@@ -12,6 +12,7 @@
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 /* Conservative far bound for the slab test: 1 + 2 gamma(3) with gamma(n) = n eps / (1 - n eps)
  * (Ize, "Robust BVH Ray Traversal", JCGT 2013), so rounding in the slab distances cannot make a
@@ -148,6 +149,51 @@ int ref_hit_sphere(const float *center, float radius, const RefRay *r, float *t)
     return 0;
 }
 
+int ref_count_init(RefSetCount *c, const PackedScene *p)
+{
+    uint32_t nnodes = sm_u32(p, sm_hdr(p, SM_HDR_NNODES));
+    size_t nn = nnodes ? nnodes : 1;
+    memset(c, 0, sizeof *c);
+    c->p = p;
+    c->node_rays = calloc(nn, sizeof *c->node_rays);
+    c->leaf_rays = calloc(nn, sizeof *c->leaf_rays);
+    c->touched = malloc(nn * sizeof *c->touched);
+    if (c->node_rays && c->leaf_rays && c->touched)
+        return 0;
+    ref_count_free(c);
+    return -1;
+}
+
+void ref_count_free(RefSetCount *c)
+{
+    free(c->node_rays);
+    free(c->leaf_rays);
+    free(c->touched);
+    memset(c, 0, sizeof *c);
+}
+
+void ref_count_close(RefSetCount *c, uint32_t simd, uint64_t *node_steps, uint64_t *leaf_steps)
+{
+    uint32_t nodes = sm_u32(c->p, sm_hdr(c->p, SM_HDR_NODES));
+    for (uint32_t i = 0; i < c->ntouched; i++) {
+        uint32_t n = c->touched[i];
+        *node_steps += (c->node_rays[n] + (uint64_t)simd - 1) / simd;
+        if (c->leaf_rays[n]) {
+            /* a leaf entered: its primitives, one after another, on each group of N rays */
+            uint32_t prims = sm_u32(c->p, sm_rec(nodes, SM_NODE_WORDS, n, SM_NODE_INFO));
+            *leaf_steps += (c->leaf_rays[n] + (uint64_t)simd - 1) / simd * prims;
+        }
+        c->node_rays[n] = c->leaf_rays[n] = 0;
+    }
+    c->ntouched = 0;
+}
+
+static void count_node(RefSetCount *c, uint32_t n)
+{
+    if (c->node_rays[n]++ == 0)
+        c->touched[c->ntouched++] = n;
+}
+
 typedef struct Walk {
     uint32_t small[256];
     uint32_t *stack;
@@ -179,8 +225,11 @@ static int hit_prim(const PackedScene *p, uint32_t prims, uint32_t i, const RefR
     return ref_hit_triangle(g, g + 3, g + 6, r, t, u, v);
 }
 
-/* Depth-first walk; closest != 0 keeps searching for the nearest hit, else stops at the first. */
-static int walk(const PackedScene *p, const RefRay *r, RefHit *hit, int closest, RefTraceStats *st)
+/* Depth-first walk; closest != 0 keeps searching for the nearest hit, else stops at the first.
+ * count: where box tests and leaf entries are also counted (st->count), or NULL. Inlined into
+ * both walks below, so the one without counts has no test for them on its per-node path. */
+static inline __attribute__((always_inline)) int walk_body(const PackedScene *p, const RefRay *r, RefHit *hit,
+                                                            int closest, RefTraceStats *st, RefSetCount *count)
 {
     hit->prim = REF_NO_HIT;
     hit->t = r->tmax;
@@ -210,6 +259,8 @@ static int walk(const PackedScene *p, const RefRay *r, RefHit *hit, int closest,
             st->nodes_visited++;
             st->boxes_tested++;
         }
+        if (count)
+            count_node(count, n);
         if (!ref_hit_box(bmin, bmax, q.org, inv, q.tmax))
             continue;
         uint32_t info = sm_u32(p, sm_rec(nodes, SM_NODE_WORDS, n, SM_NODE_INFO));
@@ -222,6 +273,8 @@ static int walk(const PackedScene *p, const RefRay *r, RefHit *hit, int closest,
             stack[sp++] = neg ? first + 1 : first;
             continue;
         }
+        if (count)
+            count->leaf_rays[n]++; /* n was touched by its box test */
         for (uint32_t i = first; i < first + info; i++) {
             float t, u, v;
             if (st)
@@ -248,6 +301,21 @@ static int walk(const PackedScene *p, const RefRay *r, RefHit *hit, int closest,
     }
     walk_done(&w);
     return hit->prim != REF_NO_HIT;
+}
+
+static int walk_plain(const PackedScene *p, const RefRay *r, RefHit *hit, int closest, RefTraceStats *st)
+{
+    return walk_body(p, r, hit, closest, st, NULL);
+}
+
+static int walk_counted(const PackedScene *p, const RefRay *r, RefHit *hit, int closest, RefTraceStats *st)
+{
+    return walk_body(p, r, hit, closest, st, st->count);
+}
+
+static int walk(const PackedScene *p, const RefRay *r, RefHit *hit, int closest, RefTraceStats *st)
+{
+    return st && st->count ? walk_counted(p, r, hit, closest, st) : walk_plain(p, r, hit, closest, st);
 }
 
 void ref_closest_hit(const PackedScene *p, const RefRay *r, RefHit *hit, RefTraceStats *stats)

@@ -25,8 +25,30 @@ typedef struct RefHit {
     uint32_t prim;        /* packed primitive index, or REF_NO_HIT */
 } RefHit;
 
+/* Rays per BVH node over a set of rays traced together -- a generation of the golden model --
+ * from which the SIMD-step counts of docs/golden-model.md follow: a stream filter spends
+ * ceil(rays / N) steps on a node's box test, and as many on each primitive of a leaf the rays
+ * enter. One per thread; a query counts into it only when RefTraceStats.count points to it, and
+ * closing a set costs O(nodes touched), never O(nodes). */
+typedef struct RefSetCount {
+    const PackedScene *p;
+    uint32_t *node_rays;       /* nnodes entries: rays of the set that box-tested node n */
+    uint32_t *leaf_rays;       /* nnodes entries: rays of the set that entered leaf n (box hit) */
+    uint32_t *touched;         /* the nodes with a non-zero node_rays, ntouched of them */
+    uint32_t ntouched;
+} RefSetCount;
+
+/* 0, or -1 when out of memory (the caller says so); counts zeroed. */
+int ref_count_init(RefSetCount *c, const PackedScene *p);
+void ref_count_free(RefSetCount *c);
+/* Close the set: add sum over touched nodes of ceil(node_rays / simd) to *node_steps and sum over
+ * entered leaves of ceil(leaf_rays / simd) x (primitives in the leaf) to *leaf_steps, and zero
+ * the counts for the next set. simd >= 1. */
+void ref_count_close(RefSetCount *c, uint32_t simd, uint64_t *node_steps, uint64_t *leaf_steps);
+
 typedef struct RefTraceStats {
     uint64_t nodes_visited, boxes_tested, prims_tested;
+    RefSetCount *count;        /* NULL, or where each box test and leaf entry is also counted */
 } RefTraceStats;
 
 /* Closest hit; ties in t go to the lower primitive index, so the answer does not depend on

@@ -3,7 +3,8 @@
  * Owns: the algorithm and arithmetic of docs/golden-model.md. Every float expression is binary32,
  * evaluated left to right as written (ISO C mode: no fused multiply-add contraction), and uses
  * only operations the ISA has (+ - * /, sqrtf, 1/sqrtf, sinf, cosf, exp2f, log2f, floorf,
- * min/max with the ISA's NaN rule), so kernels/pathtrace.s can compute the same bits.
+ * min/max with the ISA's NaN rule), so kernels/pathtrace.s can compute the same bits; and the
+ * per-(tile, pass) unit counts, SIMD steps included (counts of work grouped N rays at a time).
  * Must not: model hardware timing, or depend on thread count or traversal order.
  */
 #include "reference.h"
@@ -150,6 +151,8 @@ typedef struct Worker {
     Ctx *c;
     Ray *cur, *next;
     RefStats st;
+    RefSetCount set;
+    RefSetCount *count;       /* &set when units are asked for, else NULL: nothing is counted */
 } Worker;
 
 static int finite3(const float *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
@@ -523,7 +526,7 @@ static void trace_shadow(Worker *w, const Ray *q)
         return;
     }
     RefRay rr = {{q->org[0], q->org[1], q->org[2]}, {q->dir[0], q->dir[1], q->dir[2]}, q->tmax};
-    RefTraceStats ts = {0, 0, 0};
+    RefTraceStats ts = {0, 0, 0, w->count};
     w->st.rays[REF_RAY_SHADOW]++;
     int occluded = ref_any_hit(c->p, &rr, &ts);
     w->st.nodes_visited += ts.nodes_visited;
@@ -708,8 +711,9 @@ static void shade_hit(Worker *w, const Ray *r, uint32_t *n)
         spawn(w, r, &s, d, thr, 0, n);
 }
 
-/* A unit's counts: what the worker's counters gained over its pass. */
-static void unit_counts(RefUnitStats *u, const RefStats *before, const RefStats *after, uint64_t hits)
+/* A unit's counts: what the worker's counters gained over its pass, and its SIMD steps. */
+static void unit_counts(RefUnitStats *u, const RefStats *before, const RefStats *after, uint64_t hits,
+                        const RefUnitStats *steps)
 {
     for (int k = 0; k < REF_RAY_KINDS; k++)
         u->rays[k] = after->rays[k] - before->rays[k];
@@ -719,6 +723,71 @@ static void unit_counts(RefUnitStats *u, const RefStats *before, const RefStats 
     for (uint32_t g = 0; g < REF_MAX_GENERATIONS; g++)
         if (after->rays_per_generation[g] != before->rays_per_generation[g])
             u->generations = g + 1;
+    u->node_steps = steps->node_steps;
+    u->leaf_steps = steps->leaf_steps;
+    u->ray_steps = steps->ray_steps;
+}
+
+static uint64_t rays_traced(const RefStats *st)
+{
+    return st->rays[REF_RAY_CAMERA] + st->rays[REF_RAY_INDIRECT] + st->rays[REF_RAY_SHADOW];
+}
+
+/* Trace the generation's rays w->cur[0, n), dropping those with non-finite data. */
+static void trace_generation(Worker *w, uint32_t n)
+{
+    const Ctx *c = w->c;
+    RefTraceStats ts = {0, 0, 0, w->count};
+    for (uint32_t i = 0; i < n; i++) {
+        Ray *r = &w->cur[i];
+        if (!finite3(r->org) || !finite3(r->dir) || !finite3(r->thr)) {
+            r->kind = 255; /* dropped: never traced, counted */
+            w->st.dropped++;
+            continue;
+        }
+        RefRay q = {{r->org[0], r->org[1], r->org[2]}, {r->dir[0], r->dir[1], r->dir[2]}, r->tmax};
+        w->st.rays[r->kind]++;
+        if (r->kind == REF_RAY_SHADOW)
+            r->occluded = ref_any_hit(c->p, &q, &ts);
+        else
+            ref_closest_hit(c->p, &q, &r->hit, &ts);
+    }
+    w->st.nodes_visited += ts.nodes_visited;
+    w->st.prims_tested += ts.prims_tested;
+}
+
+/* Shade the generation's traced rays, appending the next generation's to w->next; returns how
+ * many and adds the rays that hit a surface to *hits. */
+static uint32_t shade_generation(Worker *w, uint32_t n, uint64_t *hits)
+{
+    const Ctx *c = w->c;
+    uint32_t m = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        const Ray *r = &w->cur[i];
+        if (r->kind == 255)
+            continue;
+        if (r->kind == REF_RAY_SHADOW) {
+            if (!r->occluded)
+                add_radiance(c, r->pixel, r->thr);
+        } else if (r->hit.prim == REF_NO_HIT) {
+            float v[3] = {r->thr[0] * c->background[0], r->thr[1] * c->background[1],
+                          r->thr[2] * c->background[2]};
+            add_radiance(c, r->pixel, v);
+        } else {
+            (*hits)++;
+            shade_hit(w, r, &m);
+        }
+    }
+    return m;
+}
+
+/* The end of a generation when units are counted: its SIMD steps (docs/golden-model.md) from the
+ * rays it traced -- the Phong workload's shadow rays, traced while shading it, included. */
+static void close_generation(Worker *w, uint64_t traced_before, RefUnitStats *steps)
+{
+    uint32_t simd = w->c->rp->simd_width ? (uint32_t)w->c->rp->simd_width : 16u;
+    ref_count_close(w->count, simd, &steps->node_steps, &steps->leaf_steps);
+    steps->ray_steps += (rays_traced(&w->st) - traced_before + simd - 1) / simd;
 }
 
 static void render_tile(Worker *w, uint32_t tile)
@@ -730,6 +799,8 @@ static void render_tile(Worker *w, uint32_t tile)
     uint32_t pass1 = c->rp->pass1 ? c->rp->pass1 : c->spp;
     for (uint32_t sample = c->rp->pass0; sample < pass1 && sample < c->spp; sample++) {
         RefStats before = w->st;
+        RefUnitStats steps;
+        memset(&steps, 0, sizeof steps);
         uint64_t hits = 0;
         uint32_t n = 0;
         for (uint32_t ly = 0; ly < T; ly++)
@@ -741,40 +812,11 @@ static void render_tile(Worker *w, uint32_t tile)
                 w->st.rays_per_generation[gen] += n;
             if (gen + 1 > w->st.generations)
                 w->st.generations = gen + 1;
-            RefTraceStats ts = {0, 0, 0};
-            for (uint32_t i = 0; i < n; i++) {
-                Ray *r = &w->cur[i];
-                if (!finite3(r->org) || !finite3(r->dir) || !finite3(r->thr)) {
-                    r->kind = 255; /* dropped: never traced, counted */
-                    w->st.dropped++;
-                    continue;
-                }
-                RefRay q = {{r->org[0], r->org[1], r->org[2]}, {r->dir[0], r->dir[1], r->dir[2]}, r->tmax};
-                w->st.rays[r->kind]++;
-                if (r->kind == REF_RAY_SHADOW)
-                    r->occluded = ref_any_hit(c->p, &q, &ts);
-                else
-                    ref_closest_hit(c->p, &q, &r->hit, &ts);
-            }
-            w->st.nodes_visited += ts.nodes_visited;
-            w->st.prims_tested += ts.prims_tested;
-            uint32_t m = 0;
-            for (uint32_t i = 0; i < n; i++) {
-                const Ray *r = &w->cur[i];
-                if (r->kind == 255)
-                    continue;
-                if (r->kind == REF_RAY_SHADOW) {
-                    if (!r->occluded)
-                        add_radiance(c, r->pixel, r->thr);
-                } else if (r->hit.prim == REF_NO_HIT) {
-                    float v[3] = {r->thr[0] * c->background[0], r->thr[1] * c->background[1],
-                                  r->thr[2] * c->background[2]};
-                    add_radiance(c, r->pixel, v);
-                } else {
-                    hits++;
-                    shade_hit(w, r, &m);
-                }
-            }
+            uint64_t traced_before = rays_traced(&w->st);
+            trace_generation(w, n);
+            uint32_t m = shade_generation(w, n, &hits);
+            if (w->count)
+                close_generation(w, traced_before, &steps);
             Ray *t = w->cur;
             w->cur = w->next;
             w->next = t;
@@ -782,7 +824,7 @@ static void render_tile(Worker *w, uint32_t tile)
         }
         w->st.passes++;
         if (c->rp->units)
-            unit_counts(&c->rp->units[(size_t)tile * c->spp + sample], &before, &w->st, hits);
+            unit_counts(&c->rp->units[(size_t)tile * c->spp + sample], &before, &w->st, hits, &steps);
     }
     w->st.tiles++;
 }
@@ -797,6 +839,42 @@ static int launch_tile(void *ctx, int index, uint32_t tile)
     Launch *l = ctx;
     render_tile(&l->ws[index], tile);
     return 0;
+}
+
+/* A worker's ray buffers (a generation holds at most one ray per path: T*T rays each) and, when
+ * units are counted, its node counters. 0, or -1 with a message (ref_render frees what it got). */
+static int worker_init(Worker *w, Ctx *c, uint32_t T, char *err, size_t errlen)
+{
+    w->c = c;
+    w->cur = malloc(sizeof(Ray) * T * T);
+    w->next = malloc(sizeof(Ray) * T * T);
+    if (!w->cur || !w->next) {
+        snprintf(err, errlen, "reference: out of memory for ray buffers");
+        return -1;
+    }
+    if (c->rp->units) {
+        if (ref_count_init(&w->set, c->p) != 0) {
+            snprintf(err, errlen, "reference: out of memory for the unit counts' node counters");
+            return -1;
+        }
+        w->count = &w->set;
+    }
+    return 0;
+}
+
+static void sum_stats(RefStats *sum, const RefStats *s)
+{
+    for (int k = 0; k < REF_RAY_KINDS; k++)
+        sum->rays[k] += s->rays[k];
+    for (int g = 0; g < REF_MAX_GENERATIONS; g++)
+        sum->rays_per_generation[g] += s->rays_per_generation[g];
+    if (s->generations > sum->generations)
+        sum->generations = s->generations;
+    sum->nodes_visited += s->nodes_visited;
+    sum->prims_tested += s->prims_tested;
+    sum->dropped += s->dropped;
+    sum->tiles += s->tiles;
+    sum->passes += s->passes;
 }
 
 int ref_render(const PackedScene *p, const RefParams *rp, float *rgb, RefStats *stats, char *err,
@@ -844,6 +922,10 @@ int ref_render(const PackedScene *p, const RefParams *rp, float *rgb, RefStats *
         snprintf(err, errlen, "reference: empty image (%u x %u, %u spp)", c.width, c.height, c.spp);
         return -1;
     }
+    if (rp->units && rp->simd_width < 0) {
+        snprintf(err, errlen, "reference: SIMD width %d for the unit counts is negative", rp->simd_width);
+        return -1;
+    }
     if (rp->pass1 && (rp->pass0 >= rp->pass1 || rp->pass1 > c.spp)) {
         snprintf(err, errlen, "reference: passes [%u, %u) outside the frame's %u", rp->pass0, rp->pass1, c.spp);
         return -1;
@@ -858,17 +940,11 @@ int ref_render(const PackedScene *p, const RefParams *rp, float *rgb, RefStats *
         rc = -1;
         goto out;
     }
-    /* A generation holds at most one ray per path: T*T rays per buffer. */
-    for (int i = 0; i < nthreads; i++) {
-        ws[i].c = &c;
-        ws[i].cur = malloc(sizeof(Ray) * T * T);
-        ws[i].next = malloc(sizeof(Ray) * T * T);
-        if (!ws[i].cur || !ws[i].next) {
-            snprintf(err, errlen, "reference: out of memory for ray buffers");
+    for (int i = 0; i < nthreads; i++)
+        if (worker_init(&ws[i], &c, T, err, errlen) != 0) {
             rc = -1;
             goto out;
         }
-    }
     Launch launch = {ws};
     TileLaunch tl = {ntiles, rp->threads, NULL, launch_tile, NULL, &launch, rp->progress, rp->progress_ctx};
     tiles_run(&tl);
@@ -878,25 +954,14 @@ int ref_render(const PackedScene *p, const RefParams *rp, float *rgb, RefStats *
         rgb[i] = rgb[i] * inv;
     if (stats) {
         memset(stats, 0, sizeof *stats);
-        for (int i = 0; i < nthreads; i++) {
-            const RefStats *s = &ws[i].st;
-            for (int k = 0; k < REF_RAY_KINDS; k++)
-                stats->rays[k] += s->rays[k];
-            for (int g = 0; g < REF_MAX_GENERATIONS; g++)
-                stats->rays_per_generation[g] += s->rays_per_generation[g];
-            if (s->generations > stats->generations)
-                stats->generations = s->generations;
-            stats->nodes_visited += s->nodes_visited;
-            stats->prims_tested += s->prims_tested;
-            stats->dropped += s->dropped;
-            stats->tiles += s->tiles;
-            stats->passes += s->passes;
-        }
+        for (int i = 0; i < nthreads; i++)
+            sum_stats(stats, &ws[i].st);
     }
 out:
     for (int i = 0; ws && i < nthreads; i++) {
         free(ws[i].cur);
         free(ws[i].next);
+        ref_count_free(&ws[i].set);
     }
     free(ws);
     return rc;

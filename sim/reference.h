@@ -37,14 +37,23 @@ typedef struct RefParams {
     /* When not NULL: the counts of each (tile, pass) unit, units[tile * spp + pass], ntiles * spp
      * entries zeroed by the caller (sampled mode's auxiliary variables, docs/sampling.md). */
     struct RefUnitStats *units;
+    int simd_width;    /* N of the units' SIMD-step counts (core.simd_width); 0: 16. Only with units */
 } RefParams;
 
-/* One (tile, pass) unit's work in the golden model. */
+/* One (tile, pass) unit's work in the golden model. The SIMD-step counts model a stream filter of
+ * N = simd_width lanes (docs/golden-model.md): each generation's rays -- the Phong workload's
+ * shadow rays, traced while shading it, included -- form one set; a BVH node's box test, each
+ * primitive of an entered leaf and the generation itself cost ceil(rays of the set there / N)
+ * steps. They describe the BVH walk the golden model does whatever the machine's
+ * accel.structure (there is no kd-tree version). */
 typedef struct RefUnitStats {
     uint64_t rays[REF_RAY_KINDS]; /* traced, by kind */
     uint64_t nodes_visited, prims_tested;
     uint64_t hits;             /* camera and indirect rays that hit a surface: shading events */
     uint64_t generations;      /* generations the pass reached */
+    uint64_t node_steps;       /* per generation and node box-tested: ceil(rays that tested it / N) */
+    uint64_t leaf_steps;       /* per generation and leaf entered: ceil(rays that entered it / N) x its prims */
+    uint64_t ray_steps;        /* per generation: ceil(rays traced / N) */
 } RefUnitStats;
 
 typedef struct RefStats {

@@ -1,6 +1,7 @@
 /* tests/unit/test_reference.c -- the golden model on scenes built in the test: an analytic
  * direct-lighting value (path tracer and Phong workload), determinism across host threads and
- * reruns, no NaN/Inf, and Monte Carlo convergence at the 1/sqrt(spp) rate. */
+ * reruns, no NaN/Inf, and Monte Carlo convergence at the 1/sqrt(spp) rate; on the in-repo Cornell
+ * box, the per-(tile, pass) unit counts and their SIMD-step counts. */
 #include <criterion/criterion.h>
 #include <math.h>
 #include <stdlib.h>
@@ -277,7 +278,8 @@ Test(reference, unit_counts_add_up_and_a_pass_alone_counts_the_same)
     RefParams rp = {.tile = T, .seed = 5, .threads = 2, .units = u};
     RefStats st;
     cr_assert_eq(ref_render(&p, &rp, rgb, &st, err, sizeof err), 0, "%s", err);
-    RefUnitStats sum = {{0}, 0, 0, 0, 0};
+    RefUnitStats sum;
+    memset(&sum, 0, sizeof sum);
     for (int i = 0; i < UNITS; i++) {
         for (int k = 0; k < REF_RAY_KINDS; k++)
             sum.rays[k] += u[i].rays[k];
@@ -325,4 +327,142 @@ Test(reference, unit_counts_add_up_and_a_pass_alone_counts_the_same)
     free(rgb1);
     pack_free(&p);
     scene_free(&s);
+}
+
+/* The units' SIMD-step counts (docs/golden-model.md) on the Cornell box, path tracer and Phong
+ * workload: with N = 1 they are the plain counts they group (a step per box test, per ray; per
+ * primitive of every leaf entered, which is every primitive tested except those a shadow ray left
+ * after its hit); with N = 16 each lies between its N = 1 value / 16 and that value, and rays share
+ * steps; they do not depend on the thread count; counting changes neither the image nor the totals. */
+enum { SW = 80, SH = 48, SSPP = 2, ST = 32, SUNITS = 6 * SSPP }; /* 3 x 2 tiles, partial ones */
+
+static void steps_render(const PackedScene *p, RefWorkload wl, int threads, int simd, RefUnitStats *u, float *rgb,
+                         RefStats *st)
+{
+    char err[256];
+    uint32_t w = sm_u32(p, sm_hdr(p, SM_HDR_WIDTH)), h = sm_u32(p, sm_hdr(p, SM_HDR_HEIGHT));
+    memset(rgb, 0, sizeof(float) * 3 * w * h);
+    if (u)
+        memset(u, 0, sizeof *u * SUNITS);
+    RefParams rp = {.tile = ST, .seed = 3, .threads = threads, .workload = wl, .bounces = 1, .units = u,
+                    .simd_width = simd};
+    cr_assert_eq(ref_render(p, &rp, rgb, st, err, sizeof err), 0, "%s", err);
+}
+
+static uint64_t unit_rays(const RefUnitStats *u)
+{
+    return u->rays[REF_RAY_CAMERA] + u->rays[REF_RAY_INDIRECT] + u->rays[REF_RAY_SHADOW];
+}
+
+/* N = 16 groups each N = 1 count of unit i by at most 16 */
+static void expect_grouped(uint64_t by16, uint64_t by1, const char *what, int i)
+{
+    cr_expect_leq(by16, by1, "unit %d: %s %llu with N = 16, %llu with N = 1", i, what, (unsigned long long)by16,
+                  (unsigned long long)by1);
+    cr_expect_geq(16 * by16, by1, "unit %d: %s %llu with N = 16, %llu with N = 1", i, what, (unsigned long long)by16,
+                  (unsigned long long)by1);
+}
+
+static void check_simd_steps(const PackedScene *p, RefWorkload wl)
+{
+    size_t bytes = sizeof(float) * 3 * SW * SH;
+    RefUnitStats *u1 = calloc(SUNITS, sizeof *u1), *u16 = calloc(SUNITS, sizeof *u16), *v16 = calloc(SUNITS, sizeof *v16);
+    float *plain = malloc(bytes), *rgb = malloc(bytes);
+    cr_assert(u1 && u16 && v16 && plain && rgb);
+    RefStats st0, st;
+    steps_render(p, wl, 2, 0, NULL, plain, &st0);
+    cr_assert_eq(st0.dropped, 0u);
+    steps_render(p, wl, 2, 1, u1, rgb, &st);
+    cr_expect_eq(memcmp(rgb, plain, bytes), 0, "workload %d: the image with units counted (N = 1)", (int)wl);
+    cr_expect_eq(memcmp(&st, &st0, sizeof st), 0, "workload %d: the totals with units counted", (int)wl);
+    uint64_t pt = 0, ls1 = 0;
+    for (int i = 0; i < SUNITS; i++) {
+        cr_expect_eq(u1[i].node_steps, u1[i].nodes_visited, "unit %d: N = 1, a step per box test", i);
+        cr_expect_geq(u1[i].leaf_steps, u1[i].prims_tested, "unit %d: N = 1, at least a step per primitive test", i);
+        cr_expect_eq(u1[i].ray_steps, unit_rays(&u1[i]), "unit %d: N = 1, a step per ray", i);
+        pt += u1[i].prims_tested;
+        ls1 += u1[i].leaf_steps;
+    }
+    /* occluded shadow rays skip the rest of their last leaf; leaf steps count it */
+    cr_expect_gt(ls1, pt, "workload %d: N = 1, leaf steps %llu, primitive tests %llu", (int)wl,
+                 (unsigned long long)ls1, (unsigned long long)pt);
+    steps_render(p, wl, 2, 16, u16, rgb, &st);
+    cr_expect_eq(memcmp(rgb, plain, bytes), 0, "workload %d: the image with units counted (N = 16)", (int)wl);
+    cr_expect_eq(memcmp(&st, &st0, sizeof st), 0);
+    steps_render(p, wl, 1, 16, v16, rgb, NULL);
+    uint64_t nv = 0, ns = 0, ls = 0, rays = 0, rs = 0;
+    for (int i = 0; i < SUNITS; i++) {
+        const RefUnitStats *u = &u16[i];
+        cr_expect_eq(memcmp(u, &v16[i], sizeof *u), 0, "unit %d: 1 thread vs 2 threads", i);
+        cr_expect_eq(memcmp(u->rays, u1[i].rays, sizeof u->rays), 0, "unit %d: the same rays whatever N", i);
+        expect_grouped(u->node_steps, u1[i].node_steps, "node steps", i);
+        expect_grouped(u->leaf_steps, u1[i].leaf_steps, "leaf steps", i);
+        expect_grouped(u->ray_steps, u1[i].ray_steps, "ray steps", i);
+        cr_expect_geq(u->ray_steps, u->generations, "unit %d: each generation traced rays", i);
+        nv += u->nodes_visited;
+        ns += u->node_steps;
+        ls += u->leaf_steps;
+        rays += unit_rays(u);
+        rs += u->ray_steps;
+    }
+    cr_log_info("workload %d, N = 16: node steps %llu of %llu box tests, leaf steps %llu (N = 1: %llu, primitive "
+                "tests %llu), ray steps %llu of %llu rays", (int)wl, (unsigned long long)ns, (unsigned long long)nv,
+                (unsigned long long)ls, (unsigned long long)ls1, (unsigned long long)pt, (unsigned long long)rs,
+                (unsigned long long)rays);
+    /* Coherent camera rays share the root and the nodes near it: far fewer steps than tests. */
+    cr_expect_lt(4 * ns, nv, "node steps %llu, box tests %llu", (unsigned long long)ns, (unsigned long long)nv);
+    cr_expect_lt(2 * rs, rays, "ray steps %llu, rays %llu", (unsigned long long)rs, (unsigned long long)rays);
+    free(u1);
+    free(u16);
+    free(v16);
+    free(plain);
+    free(rgb);
+}
+
+Test(reference, simd_steps_group_the_unit_counts_by_n)
+{
+    Scene s;
+    PackedScene p;
+    char err[4096];
+    cr_assert_eq(pack_load_file("scenes/cornell/scene.ini", SW, SH, SSPP, &s, &p, err, sizeof err), 0, "%s", err);
+    check_simd_steps(&p, REF_WORKLOAD_PATH);
+    check_simd_steps(&p, REF_WORKLOAD_PHONG);
+    /* a negative N is refused (0 means 16) */
+    RefUnitStats u[SUNITS];
+    memset(u, 0, sizeof u);
+    float *rgb = calloc(3 * SW * SH, sizeof(float));
+    RefParams bad = {.tile = ST, .units = u, .simd_width = -1};
+    cr_expect_eq(ref_render(&p, &bad, rgb, NULL, err, sizeof err), -1);
+    cr_expect(strstr(err, "SIMD width -1") != NULL, "%s", err);
+    free(rgb);
+    pack_free(&p);
+    scene_free(&s);
+}
+
+/* Without lights there are no shadow rays, every ray tests every primitive of the leaves it
+ * enters, and with N = 1 the leaf steps are exactly the primitive tests. */
+Test(reference, simd_leaf_steps_are_the_primitive_tests_without_shadow_rays)
+{
+    Builder b;
+    Scene s;
+    box_scene(&b, &s, 2); /* 24 x 24: one tile of 32 */
+    s.nemissive = 0;
+    BvhParams bp;
+    bvh_default_params(&bp);
+    PackedScene p;
+    char err[256];
+    cr_assert_eq(pack_scene(&s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(p.nlights, 0u);
+    RefUnitStats u[SUNITS];
+    float *rgb = calloc(3 * SW * SH, sizeof(float));
+    RefStats st;
+    steps_render(&p, REF_WORKLOAD_PATH, 1, 1, u, rgb, &st);
+    cr_expect_eq(st.rays[REF_RAY_SHADOW], 0u);
+    cr_expect_gt(st.rays[REF_RAY_INDIRECT], 0u);
+    for (int i = 0; i < 2; i++) {
+        cr_expect_eq(u[i].leaf_steps, u[i].prims_tested, "pass %d", i);
+        cr_expect_gt(u[i].prims_tested, 0u, "pass %d", i);
+    }
+    free(rgb);
+    pack_free(&p);
 }
