@@ -7,7 +7,6 @@
  * tile's pixels come from its own run only).
  */
 #include "functional.h"
-#include "sampling.h"
 
 #include <limits.h>
 #include <math.h>
@@ -34,8 +33,11 @@ typedef struct Job {
     float *rgb;
     uint32_t width, height, tiles_x, ntiles;
     FuncTile *tiles;
-    uint8_t *sel;              /* sampled mode: the tiles to time */
+    uint32_t spp;
+    const uint32_t *units;     /* sampled mode: the round's (tile, pass) units, NULL for whole tiles */
+    FuncUnit *unit_out;        /* ... and their figures */
     struct Worker *workers;    /* one per host thread (sim/run/tiles.h) */
+    int nworkers;
     atomic_int failed;
     int trapped;               /* the failure was the kernel's (trap, limit, error code) */
     pthread_mutex_t lock;
@@ -46,7 +48,6 @@ typedef struct Worker {
     Job *job;
     TimedCore tc;              /* the core; its timing model in the timed modes */
     FuncStats st;
-    int tile_timed;            /* the current tile is timed (every tile, or the sample) */
 } Worker;
 
 
@@ -87,37 +88,42 @@ static void fail(Job *j, const char *msg, int trapped)
     pthread_mutex_unlock(&j->lock);
 }
 
-/* Detailed mode: start a cold machine for one tile or batch. */
-static void timing_begin(Worker *w, Core *c, uint32_t t, TimingStats *before)
+/* Detailed and sampled modes: start a cold machine for one run (a pass, or a trace batch). */
+static void timing_begin(Worker *w, Core *c, TimingStats *before)
 {
-    w->tile_timed = w->tc.tm && (!w->job->sel || w->job->sel[t]);
-    if (w->tc.tm)
-        core_set_hook(c, w->tile_timed ? timing_hook : NULL, w->tile_timed ? w->tc.tm : NULL);
-    if (w->tile_timed) {
-        timing_reset(w->tc.tm);
-        *before = *timing_stats(w->tc.tm);
-    }
+    if (!w->tc.tm)
+        return;
+    core_set_hook(c, timing_hook, w->tc.tm);
+    timing_reset(w->tc.tm);
+    *before = *timing_stats(w->tc.tm);
 }
 
-/* Detailed mode: close the run and give its figures to the tile; -1 if the model failed. */
-static int timing_close(Worker *w, const TimingStats *before, FuncTile *ft)
+/* Close the run and give its figures to fu (cycles, busy, stalls added); -1 if the model failed. */
+static int timing_close(Worker *w, const TimingStats *before, FuncUnit *fu)
 {
-    if (!w->tile_timed)
+    if (!w->tc.tm)
         return 0;
-    ft->sampled = 1;
     timing_end(w->tc.tm);
     const TimingStats *s = timing_stats(w->tc.tm);
-    if (ft) {
-        ft->cycles += s->cycles - before->cycles;
-        ft->busy += s->busy - before->busy;
-        for (int c = 0; c < TM_CAUSE_COUNT; c++)
-            ft->stalls[c] += s->stalls[c] - before->stalls[c];
-    }
+    fu->cycles += s->cycles - before->cycles;
+    fu->busy += s->busy - before->busy;
+    for (int c = 0; c < TM_CAUSE_COUNT; c++)
+        fu->stalls[c] += s->stalls[c] - before->stalls[c];
     if (timing_error(w->tc.tm)) {
         fail(w->job, timing_error(w->tc.tm), 0);
         return -1;
     }
     return 0;
+}
+
+/* A unit's (or a batch's) timed figures added to its tile's. */
+static void tile_add_timed(FuncTile *ft, const FuncUnit *fu)
+{
+    ft->sampled = 1;
+    ft->cycles += fu->cycles;
+    ft->busy += fu->busy;
+    for (int c = 0; c < TM_CAUSE_COUNT; c++)
+        ft->stalls[c] += fu->stalls[c];
 }
 
 static void rb_set(uint8_t *rb, uint32_t addr, uint32_t v) { memcpy(rb + addr, &v, 4); }
@@ -161,13 +167,17 @@ static int trace_batch(Worker *w, Core *c, uint32_t t, FuncStats *st)
         rb_set(rb, a->f_prim + 4 * i, UINT32_MAX);
     }
     TimingStats before;
-    timing_begin(w, c, t, &before);
+    timing_begin(w, c, &before);
     CoreExit ex = core_run(c, (uint64_t)j->fp->cfg->sim_max_instructions);
     FuncTile *ft = &j->tiles[t];
     ft->x0 = first;
     ft->w = n;
     ft->h = 1;
-    if (timing_close(w, &before, ft))
+    FuncUnit fu = {0};
+    int trc = timing_close(w, &before, &fu);
+    if (w->tc.tm)
+        tile_add_timed(ft, &fu);
+    if (trc)
         return -1;
     char msg[1400];
     if (ex != CORE_EXIT_HALT) {
@@ -207,18 +217,22 @@ static int trace_batch(Worker *w, Core *c, uint32_t t, FuncStats *st)
     return 0;
 }
 
-static int run_tile(Worker *w, Core *c, uint32_t t, FuncStats *st)
+/* Tile t's place in the frame. */
+static void tile_place(const Job *j, uint32_t t, FuncTile *ft)
 {
-    Job *j = w->job;
-    const KernelAbi *a = &j->k->abi;
-    if (j->fp->batch)
-        return trace_batch(w, c, t, st);
-    FuncTile *ft = &j->tiles[t];
     const uint32_t tw = j->k->tile_w, th = j->k->tile_h;
     ft->x0 = (t % j->tiles_x) * tw;
     ft->y0 = (t / j->tiles_x) * th;
     ft->w = j->width - ft->x0 < tw ? j->width - ft->x0 : tw;
     ft->h = j->height - ft->y0 < th ? j->height - ft->y0 : th;
+}
+
+/* A pass's launch block on a restarted core: the scratchpad's counters cleared (a pass starts
+ * from nothing an earlier pass left, so it runs alone exactly as inside its tile), and for a
+ * tile's first pass the framebuffer zeroed (the passes add to it). */
+static void pass_launch(Job *j, Core *c, const FuncTile *ft, int zero_fb)
+{
+    const KernelAbi *a = &j->k->abi;
     core_restart(c);
     uint32_t size;
     uint8_t *sp = core_mem(c, CORE_MEM_SPAD, &size);
@@ -229,51 +243,51 @@ static int run_tile(Worker *w, Core *c, uint32_t t, FuncStats *st)
     spad_set(c, a->l_h, ft->h);
     spad_set(c, a->l_seed, j->fp->seed);
     uint8_t *fb = core_mem(c, CORE_MEM_FB, &size);
-    memset(fb, 0, (size_t)ft->w * ft->h * 12);
-    uint64_t before = core_instructions(c), lanes_before[ISA_STAGE_COUNT];
-    for (int k = 0; k < ISA_STAGE_COUNT; k++)
-        lanes_before[k] = core_stats(c)->active_lanes[k];
-    /* One kernel run per pass (sample per pixel), each on a cold machine when timed; the
-     * framebuffer and the counters in the scratchpad carry over from pass to pass. */
-    uint32_t spp = sm_u32(j->p, sm_hdr(j->p, SM_HDR_SPP));
-    for (uint32_t pass = 0; pass < spp; pass++) {
-        if (pass)
-            core_restart(c);
-        spad_set(c, a->l_pass0, pass);
-        spad_set(c, a->l_pass1, pass + 1);
-        TimingStats tbefore;
-        timing_begin(w, c, t, &tbefore);
-        CoreExit ex = core_run(c, (uint64_t)j->fp->cfg->sim_max_instructions);
-        if (timing_close(w, &tbefore, ft))
-            return -1;
-        char msg[1400];
-        if (ex != CORE_EXIT_HALT) {
-            snprintf(msg, sizeof msg, "kernel, tile at (%u, %u), pass %u: %s%s", ft->x0, ft->y0, pass,
-                     core_trap_message(c), ex == CORE_EXIT_LIMIT ? " (sim.max_instructions)" : "");
-            fail(j, msg, 1);
-            return -1;
-        }
-        uint32_t kerr = spad_u32(c, a->l_error);
-        if (kerr) {
-            snprintf(msg, sizeof msg, "kernel, tile at (%u, %u), pass %u: %s", ft->x0, ft->y0, pass,
-                     kerr == a->err_stack ? "traversal stack overflow (raise spad.size_kb)"
-                     : kerr == a->err_generations ? "more generations than the kernel counts (64)"
-                                                 : "error code set");
-            fail(j, msg, 1);
-            return -1;
-        }
+    if (zero_fb)
+        memset(fb, 0, (size_t)ft->w * ft->h * 12);
+}
+
+/* One kernel run: pass `pass` of the launched tile, on a cold machine when timed (fu gets its
+ * timed figures). 0, or -1 after fail(). */
+static int run_pass(Worker *w, Core *c, const FuncTile *ft, uint32_t pass, FuncUnit *fu)
+{
+    Job *j = w->job;
+    const KernelAbi *a = &j->k->abi;
+    spad_set(c, a->l_pass0, pass);
+    spad_set(c, a->l_pass1, pass + 1);
+    TimingStats tbefore;
+    timing_begin(w, c, &tbefore);
+    CoreExit ex = core_run(c, (uint64_t)j->fp->cfg->sim_max_instructions);
+    if (timing_close(w, &tbefore, fu))
+        return -1;
+    char msg[1400];
+    if (ex != CORE_EXIT_HALT) {
+        snprintf(msg, sizeof msg, "kernel, tile at (%u, %u), pass %u: %s%s", ft->x0, ft->y0, pass,
+                 core_trap_message(c), ex == CORE_EXIT_LIMIT ? " (sim.max_instructions)" : "");
+        fail(j, msg, 1);
+        return -1;
     }
-    for (uint32_t y = 0; y < ft->h; y++)
-        memcpy(&j->rgb[3 * ((size_t)(ft->y0 + y) * j->width + ft->x0)], fb + (size_t)12 * y * ft->w,
-               (size_t)12 * ft->w);
-    ft->instructions = core_instructions(c) - before;
-    for (int k = 0; k < ISA_STAGE_COUNT; k++)
-        ft->active_lanes[k] = core_stats(c)->active_lanes[k] - lanes_before[k];
+    uint32_t kerr = spad_u32(c, a->l_error);
+    if (kerr) {
+        snprintf(msg, sizeof msg, "kernel, tile at (%u, %u), pass %u: %s", ft->x0, ft->y0, pass,
+                 kerr == a->err_stack         ? "traversal stack overflow (raise spad.size_kb)"
+                 : kerr == a->err_generations ? "more generations than the kernel counts (64)"
+                                             : "error code set");
+        fail(j, msg, 1);
+        return -1;
+    }
+    return 0;
+}
+
+/* The kernel's counters in the scratchpad, from the pass just run, added to st; the rays traced
+ * returned. */
+static uint64_t counters_add(Job *j, Core *c, FuncStats *st)
+{
+    const KernelAbi *a = &j->k->abi;
     st->dropped += spad_u32(c, a->st_dropped);
     st->rays_camera += spad_u32(c, a->st_camera);
     st->rays_indirect += spad_u32(c, a->st_indirect);
     st->rays_shadow += spad_u32(c, a->st_shadow);
-    ft->rays = (uint64_t)spad_u32(c, a->st_camera) + spad_u32(c, a->st_indirect) + spad_u32(c, a->st_shadow);
     uint32_t g = spad_u32(c, a->st_generations);
     if (g > st->generations)
         st->generations = g;
@@ -288,17 +302,78 @@ static int run_tile(Worker *w, Core *c, uint32_t t, FuncStats *st)
         }
     if (j->fp->cfg->accel_structure == CFG_ACCEL_KD)
         kd_counts_add(c, a, j->k->cp.lanes, st);
+    return (uint64_t)spad_u32(c, a->st_camera) + spad_u32(c, a->st_indirect) + spad_u32(c, a->st_shadow);
+}
+
+/* Every pass of tile t, one kernel run each; the framebuffer carries over from pass to pass (and
+ * nothing else), and the tile's pixels go to the image. */
+static int run_tile(Worker *w, Core *c, uint32_t t, FuncStats *st)
+{
+    Job *j = w->job;
+    if (j->fp->batch)
+        return trace_batch(w, c, t, st);
+    FuncTile *ft = &j->tiles[t];
+    tile_place(j, t, ft);
+    uint64_t before = core_instructions(c), lanes_before[ISA_STAGE_COUNT];
+    for (int k = 0; k < ISA_STAGE_COUNT; k++)
+        lanes_before[k] = core_stats(c)->active_lanes[k];
+    ft->rays = 0;
+    for (uint32_t pass = 0; pass < j->spp; pass++) {
+        pass_launch(j, c, ft, pass == 0);
+        FuncUnit fu = {0};
+        int rc = run_pass(w, c, ft, pass, &fu);
+        if (w->tc.tm)
+            tile_add_timed(ft, &fu);
+        if (rc)
+            return -1;
+        ft->rays += counters_add(j, c, st);
+    }
+    uint32_t size;
+    const uint8_t *fb = core_mem(c, CORE_MEM_FB, &size);
+    for (uint32_t y = 0; y < ft->h; y++)
+        memcpy(&j->rgb[3 * ((size_t)(ft->y0 + y) * j->width + ft->x0)], fb + (size_t)12 * y * ft->w,
+               (size_t)12 * ft->w);
+    ft->instructions = core_instructions(c) - before;
+    for (int k = 0; k < ISA_STAGE_COUNT; k++)
+        ft->active_lanes[k] = core_stats(c)->active_lanes[k] - lanes_before[k];
     return 0;
 }
 
-/* sim/run/tiles.h: a core (and in detailed mode a timing model) per host thread, with the scene
- * loaded once; each tile restarts the core. */
+/* Sampled mode: the i-th unit of the round alone, launched as every pass is (a pass reads nothing
+ * an earlier pass left but the framebuffer it adds to, so its instructions and cycles are those it
+ * has in the whole tile). */
+static int run_unit(Worker *w, Core *c, uint32_t i, FuncStats *st)
+{
+    Job *j = w->job;
+    FuncUnit *fu = &j->unit_out[i];
+    memset(fu, 0, sizeof *fu);
+    fu->unit = j->units[i];
+    FuncTile place;
+    tile_place(j, fu->unit / j->spp, &place);
+    pass_launch(j, c, &place, 1);
+    uint64_t before = core_instructions(c), lanes_before[ISA_STAGE_COUNT];
+    for (int k = 0; k < ISA_STAGE_COUNT; k++)
+        lanes_before[k] = core_stats(c)->active_lanes[k];
+    if (run_pass(w, c, &place, fu->unit % j->spp, fu))
+        return -1;
+    fu->instructions = core_instructions(c) - before;
+    for (int k = 0; k < ISA_STAGE_COUNT; k++)
+        fu->active_lanes[k] = core_stats(c)->active_lanes[k] - lanes_before[k];
+    fu->rays = counters_add(j, c, st);
+    return 0;
+}
+
+/* sim/run/tiles.h: a core (and in the timed modes a timing model) per host thread, with the scene
+ * loaded once and kept until workers_close (sampled mode runs several launches on the same cores);
+ * each tile or unit restarts the core. */
 static int worker_begin(void *ctx, int index)
 {
     Job *j = ctx;
     Worker *w = &j->workers[index];
     char err[512], msg[600];
     w->job = j;
+    if (w->tc.core)
+        return 0;
     int rc = timedcore_open(&w->tc, j->fp->cfg, &j->k->obj, j->fp->timed, err, sizeof err);
     if (rc != 0) {
         snprintf(msg, sizeof msg, "%s: %s", rc == -2 ? "timing model" : "kernel", err);
@@ -315,20 +390,22 @@ static int worker_tile(void *ctx, int index, uint32_t t)
 {
     Job *j = ctx;
     Worker *w = &j->workers[index];
-    return run_tile(w, w->tc.core, t, &w->st);
+    return j->units ? run_unit(w, w->tc.core, t, &w->st) : run_tile(w, w->tc.core, t, &w->st);
 }
 
-static void worker_end(void *ctx, int index)
+/* Each worker's core and timing counters into its stats, and its core closed. */
+static void workers_close(Job *j)
 {
-    Job *j = ctx;
-    Worker *w = &j->workers[index];
-    if (w->tc.core) {
-        w->st.core = *core_stats(w->tc.core);
-        w->st.instructions = core_instructions(w->tc.core);
+    for (int i = 0; i < j->nworkers; i++) {
+        Worker *w = &j->workers[i];
+        if (w->tc.core) {
+            w->st.core = *core_stats(w->tc.core);
+            w->st.instructions = core_instructions(w->tc.core);
+        }
+        if (w->tc.tm)
+            w->st.timing = *timing_stats(w->tc.tm);
+        timedcore_close(&w->tc);
     }
-    if (w->tc.tm)
-        w->st.timing = *timing_stats(w->tc.tm);
-    timedcore_close(&w->tc);
 }
 
 /* The workers' counters, summed in worker order (the totals do not depend on which thread ran
@@ -380,13 +457,14 @@ static void stats_sum(FuncStats *st, const Worker *ws, int nthreads)
     }
 }
 
-/* The tiles (or ray batches) of the run, and in sampled mode the ones to time. */
+/* The tiles (or ray batches) of the run. */
 static int job_tiles(Job *job, const FuncParams *fp, char *err, size_t errlen)
 {
     const PackedScene *p = job->p;
     const Kernel *k = job->k;
     job->width = sm_u32(p, sm_hdr(p, SM_HDR_WIDTH));
     job->height = sm_u32(p, sm_hdr(p, SM_HDR_HEIGHT));
+    job->spp = sm_u32(p, sm_hdr(p, SM_HDR_SPP));
     job->tiles_x = (job->width + k->tile_w - 1) / k->tile_w;
     job->ntiles = job->tiles_x * ((job->height + k->tile_h - 1) / k->tile_h);
     if (fp->batch)
@@ -396,94 +474,177 @@ static int job_tiles(Job *job, const FuncParams *fp, char *err, size_t errlen)
         snprintf(err, errlen, "out of memory");
         return -1;
     }
-    if (fp->timed && fp->sample > 0.0) {
-        if (fp->batch || !(fp->sample <= 1.0)) {
-            snprintf(err, errlen, fp->batch ? "sampled mode renders frames, not ray batches"
-                                            : "sample fraction %g outside (0, 1]", fp->sample);
+    for (uint32_t t = 0; !fp->batch && t < job->ntiles; t++)
+        tile_place(job, t, &job->tiles[t]);
+    return 0;
+}
+
+/* A session: the kernel built for the scene and the machine, the tiles, and one worker per host
+ * thread. func_render and the sampled-mode calls share it. */
+struct FuncSession {
+    Kernel k;
+    Job job;
+    FuncStats head;            /* the kernel's figures, known before any run */
+    int built;
+};
+
+static void session_free(FuncSession *s)
+{
+    if (!s)
+        return;
+    workers_close(&s->job);
+    free(s->job.tiles);
+    free(s->job.workers);
+    pthread_mutex_destroy(&s->job.lock);
+    if (s->built)
+        kernel_free(&s->k);
+    free(s);
+}
+
+int func_open(const PackedScene *p, const FuncParams *fp, FuncSession **out, char *err, size_t errlen)
+{
+    *out = NULL;
+    FuncSession *s = calloc(1, sizeof *s);
+    if (!s) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    Job *job = &s->job;
+    pthread_mutex_init(&job->lock, NULL);
+    atomic_init(&job->failed, 0);
+    if (kernel_build(p, fp->cfg, fp->kernel_path, fp->needs, fp->batch != NULL, &s->k, err, errlen) != 0) {
+        session_free(s);
+        return -1;
+    }
+    s->built = 1;
+    FuncStats *h = &s->head;
+    h->tile_w = s->k.tile_w;
+    h->tile_h = s->k.tile_h;
+    snprintf(h->defines, sizeof h->defines, "%s", s->k.defines);
+    h->kd = s->k.kd;
+    h->kd_stack_depth = s->k.kd_stack_depth;
+    h->kernel_instructions = s->k.obj.ntext;
+    job->p = p;
+    job->fp = fp;
+    job->k = &s->k;
+    if (job_tiles(job, fp, err, errlen) != 0) {
+        session_free(s);
+        return -1;
+    }
+    job->nworkers = tiles_threads(fp->threads, fp->batch ? job->ntiles : job->ntiles * job->spp);
+    job->workers = calloc((size_t)job->nworkers, sizeof *job->workers);
+    if (!job->workers) {
+        snprintf(err, errlen, "out of memory");
+        session_free(s);
+        return -1;
+    }
+    *out = s;
+    return 0;
+}
+
+uint32_t func_units_total(const FuncSession *s) { return s->job.ntiles * s->job.spp; }
+
+/* A failed launch's message and return (-2 when the kernel failed, -1 otherwise). */
+static int job_failure(Job *job, char *err, size_t errlen)
+{
+    snprintf(err, errlen, "%s", job->err);
+    return job->trapped ? -2 : -1;
+}
+
+int func_units(FuncSession *s, const uint32_t *units, uint32_t n, FuncUnit *out, char *err, size_t errlen)
+{
+    Job *job = &s->job;
+    uint32_t total = func_units_total(s);
+    for (uint32_t i = 0; i < n; i++)
+        if (units[i] >= total) {
+            snprintf(err, errlen, "unit %u: the frame has %u (tile, pass) units", units[i], total);
             return -1;
         }
-        job->sel = calloc(job->ntiles ? job->ntiles : 1, 1);
-        if (!job->sel) {
-            snprintf(err, errlen, "out of memory");
-            return -1;
-        }
-        sample_select(job->ntiles, fp->sample, fp->sample_seed, job->sel);
+    job->units = units;
+    job->unit_out = out;
+    TileLaunch launch = {n, job->nworkers, worker_begin, worker_tile, NULL, job, job->fp->progress,
+                         job->fp->progress_ctx};
+    tiles_run(&launch);
+    job->units = NULL;
+    job->unit_out = NULL;
+    if (atomic_load(&job->failed))
+        return job_failure(job, err, errlen);
+    /* The units' figures into their tiles, in list order (the same on any thread count). */
+    for (uint32_t i = 0; i < n; i++) {
+        FuncTile *ft = &job->tiles[out[i].unit / job->spp];
+        tile_add_timed(ft, &out[i]);
+        ft->units_timed++;
+        ft->instructions += out[i].instructions;
+        ft->rays += out[i].rays;
+        for (int k = 0; k < ISA_STAGE_COUNT; k++)
+            ft->active_lanes[k] += out[i].active_lanes[k];
     }
     return 0;
+}
+
+/* The session's figures into st (the workers' counters summed in worker order), the session
+ * freed. 0, or -1 when the timing model's totals do not add up. */
+static int session_finish(FuncSession *s, FuncStats *st, char *err, size_t errlen)
+{
+    Job *job = &s->job;
+    *st = s->head;
+    workers_close(job);
+    stats_sum(st, job->workers, job->nworkers);
+    int rc = 0;
+    if (job->fp->timed) {
+        st->timed = 1;
+        for (uint32_t i = 0; i < job->ntiles; i++) {
+            st->tiles_timed += job->tiles[i].sampled;
+            st->units_timed += job->tiles[i].units_timed;
+        }
+        rc = timing_check(&st->timing, err, errlen);
+    }
+    st->tiles = job->tiles;
+    st->ntiles = job->ntiles;
+    st->tiles_done = job->ntiles;
+    job->tiles = NULL;
+    session_free(s);
+    return rc;
+}
+
+int func_close(FuncSession *s, FuncStats *st, char *err, size_t errlen)
+{
+    memset(st, 0, sizeof *st);
+    if (!s)
+        return 0;
+    if (atomic_load(&s->job.failed)) {
+        int rc = job_failure(&s->job, err, errlen);
+        char ignored[256];
+        session_finish(s, st, ignored, sizeof ignored);
+        return rc;
+    }
+    return session_finish(s, st, err, errlen);
 }
 
 int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStats *st, char *err,
                 size_t errlen)
 {
     memset(st, 0, sizeof *st);
-    const CfgMachine *cfg = fp->cfg;
-    int rc = -1, nthreads = 0;
-    Kernel k;
-    Job *job = calloc(1, sizeof *job);
-    if (job)
-        pthread_mutex_init(&job->lock, NULL);
-    if (kernel_build(p, cfg, fp->kernel_path, fp->needs, fp->batch != NULL, &k, err, errlen) != 0)
-        goto out;
-    st->tile_w = k.tile_w;
-    st->tile_h = k.tile_h;
-    snprintf(st->defines, sizeof st->defines, "%s", k.defines);
-    st->kd = k.kd;
-    st->kd_stack_depth = k.kd_stack_depth;
-    st->kernel_instructions = k.obj.ntext;
-    if (!job) {
-        snprintf(err, errlen, "out of memory");
-        goto out;
-    }
-    job->p = p;
-    job->fp = fp;
-    job->k = &k;
+    FuncSession *s;
+    if (func_open(p, fp, &s, err, errlen) != 0)
+        return -1;
+    Job *job = &s->job;
     job->rgb = rgb;
-    atomic_init(&job->failed, 0);
-    if (job_tiles(job, fp, err, errlen) != 0)
-        goto out;
-    nthreads = tiles_threads(fp->threads, job->ntiles);
-    job->workers = calloc((size_t)nthreads, sizeof *job->workers);
-    if (!job->workers) {
-        snprintf(err, errlen, "out of memory");
-        goto out;
-    }
-    TileLaunch launch = {job->ntiles, fp->threads, worker_begin, worker_tile, worker_end, job,
-                         fp->progress, fp->progress_ctx};
+    TileLaunch launch = {job->ntiles, job->nworkers, worker_begin, worker_tile, NULL, job, fp->progress,
+                         fp->progress_ctx};
     uint32_t done = tiles_run(&launch);
-    float inv = 1.0f / (float)sm_u32(p, sm_hdr(p, SM_HDR_SPP));
+    float inv = 1.0f / (float)job->spp;
     for (size_t i = 0; rgb && i < 3 * (size_t)job->width * job->height; i++)
         rgb[i] = rgb[i] * inv;
     if (atomic_load(&job->failed)) {
-        snprintf(err, errlen, "%s", job->err);
-        rc = job->trapped ? -2 : -1;
+        int rc = job_failure(job, err, errlen);
         /* The tiles that finished are kept (the caller may write them as a partial image). */
         st->tiles_done = done;
         st->ntiles = job->ntiles;
-        goto out;
+        session_free(s);
+        return rc;
     }
-    stats_sum(st, job->workers, nthreads);
-    if (fp->timed) {
-        st->timed = 1;
-        for (uint32_t i = 0; i < job->ntiles; i++)
-            st->tiles_timed += job->tiles[i].sampled;
-        if (timing_check(&st->timing, err, errlen) != 0)
-            goto out;
-    }
-    st->tiles = job->tiles;
-    st->ntiles = job->ntiles;
-    st->tiles_done = job->ntiles;
-    job->tiles = NULL;
-    rc = 0;
-out:
-    if (job) {
-        free(job->tiles);
-        free(job->sel);
-        free(job->workers);
-        pthread_mutex_destroy(&job->lock);
-    }
-    free(job);
-    kernel_free(&k);
-    return rc;
+    return session_finish(s, st, err, errlen);
 }
 
 int func_trace(const PackedScene *p, const FuncParams *fp, FuncStats *st, char *err, size_t errlen)

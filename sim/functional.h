@@ -46,21 +46,29 @@ typedef struct FuncParams {
     /* Detailed mode: time every instruction on the machine of cfg (sim/timing.h). Each tile (or
      * trace batch) starts on a cold machine, so the cycles do not depend on the host threads. */
     int timed;
-    /* Sampled mode (with timed): only a seeded random sample of this fraction of the tiles is
-     * timed (sim/sampling.h); the others run on the functional core alone. 0 = every tile. */
-    double sample;
-    uint32_t sample_seed;
 } FuncParams;
 
 typedef struct FuncTile {
     uint32_t x0, y0, w, h;
     uint64_t instructions;
     uint64_t rays;             /* traced, all kinds */
-    uint64_t cycles, busy;     /* detailed mode (sampled mode: the sampled tiles) */
+    uint64_t cycles, busy;     /* detailed mode (sampled mode: the tile's sampled units) */
     uint64_t stalls[TM_CAUSE_COUNT];
-    uint8_t sampled;           /* timed: every tile in detailed mode, the sample in sampled mode */
+    uint8_t sampled;           /* timed: every tile in detailed mode; sampled mode: a unit of it was sampled */
+    uint32_t units_timed;      /* sampled mode: the tile's units timed */
     uint64_t active_lanes[ISA_STAGE_COUNT]; /* per stage (for sampled mode's utilization) */
 } FuncTile;
+
+/* Sampled mode's unit: one pass of one tile (unit = tile * spp + pass), run alone from a cleared
+ * launch block on a cold machine -- exactly as that pass runs inside detailed mode's frame. */
+typedef struct FuncUnit {
+    uint32_t unit;
+    uint64_t instructions;
+    uint64_t rays;             /* traced, all kinds */
+    uint64_t cycles, busy;     /* when timed */
+    uint64_t stalls[TM_CAUSE_COUNT];
+    uint64_t active_lanes[ISA_STAGE_COUNT];
+} FuncUnit;
 
 typedef struct FuncStats {
     CoreStats core;                                 /* summed over all tiles */
@@ -78,8 +86,9 @@ typedef struct FuncStats {
     uint32_t tile_w, tile_h;                        /* pixels (= rays) of a stream's tile */
     char defines[512];                              /* the -D symbols the kernel was built with */
     int timed;                                      /* detailed mode: timing holds the sums */
-    TimingStats timing;                             /* (sampled mode: of the sampled tiles) */
-    uint32_t tiles_timed;
+    TimingStats timing;                             /* (sampled mode: of the sampled units) */
+    uint32_t tiles_timed;                           /* detailed mode: every tile; sampled: tiles with a unit */
+    uint32_t units_timed;                           /* sampled mode: the units run */
     /* accel.structure = kd: the kernel's KD_STACK_DEPTH, and its counters summed over lanes,
      * tiles and threads */
     int kd;
@@ -94,6 +103,18 @@ typedef struct FuncStats {
 int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStats *st, char *err,
                 size_t errlen);
 void func_stats_free(FuncStats *st);
+
+/* Sampled mode's units: open a session (the kernel built once, one core per host thread kept
+ * across calls), run lists of (tile, pass) units in it (out[i] receives units[i]'s figures; the
+ * image is not made), and close it: st then holds the counters of every unit run (st->tiles: the
+ * frame's tiles, with the sums of their units). Returns as func_render; a session that failed
+ * must still be closed (its st is then partial). */
+typedef struct FuncSession FuncSession;
+int func_open(const PackedScene *p, const FuncParams *fp, FuncSession **out, char *err, size_t errlen);
+int func_units(FuncSession *s, const uint32_t *units, uint32_t n, FuncUnit *out, char *err, size_t errlen);
+/* The frame's units: tiles x spp. */
+uint32_t func_units_total(const FuncSession *s);
+int func_close(FuncSession *s, FuncStats *st, char *err, size_t errlen);
 
 /* `sfsim trace` through the kernel: fp->batch and fp->hits must be set. Same returns. */
 int func_trace(const PackedScene *p, const FuncParams *fp, FuncStats *st, char *err, size_t errlen);
