@@ -125,9 +125,10 @@ static void usage_run(FILE *out)
             "              with the cycle-accurate timing model of the machine in CONFIG: cycles, fps,\n"
             "              stalls by cause, per stage, generation and tile, the units' counters\n"
             "              (docs/model.md); the same image bits as functional mode\n"
-            "  sampled     detailed timing on a seeded random sample of the tiles (--sample F, default\n"
-            "              0.05), the functional core alone on the rest; cycles and fps estimated with a 95%%\n"
-            "              confidence interval (docs/sampling.md); the same image bits\n"
+            "  sampled     the golden model renders the image (the same bits) and counts every (tile, pass)\n"
+            "              unit's work; a seeded random sample of the units runs on the timed kernel and the\n"
+            "              rest are skipped; cycles, instructions and fps estimated with 95%% confidence\n"
+            "              intervals (docs/sampling.md): by default until the cycles are known to +-1%%\n"
             "  functional  the kernel executed instruction by instruction, no timing (fastest\n"
             "              simulation): operation mix, SIMD utilization and stream lengths per stage\n"
             "  reference   the golden model: a plain C path tracer over the packed scene memory\n"
@@ -144,8 +145,12 @@ static void usage_run(FILE *out)
             "  -j, --threads N          host threads (default: all cores; results do not change)\n"
             "  --exposure X             scale before tone mapping frame.png (default 1)\n"
             "  --no-progress            no progress bar (it is shown only on a terminal anyway)\n"
-            "  --sample F               sampled mode: the fraction of tiles timed, (0, 1] (default 0.05)\n"
-            "  --sample-seed S          sampled mode: which tiles (default 1)\n"
+            "  --target-error E         sampled mode: time units until the 95%% interval of the cycles is\n"
+            "                           within +-E (a fraction: 0.01 = 1%%, the default), or every unit\n"
+            "  --sample F               sampled mode: time a fixed fraction F of the units, (0, 1], instead\n"
+            "  --sample-seed S          sampled mode: which units (default 1)\n"
+            "  --no-image               sampled mode: no image; the golden model runs only a pilot pass per\n"
+            "                           tile for the units' counts (the estimate alone, fastest)\n"
             "  --kernel FILE            kernel modes: the kernel source (default:\n"
             "                           kernels/pathtrace.s in the data folder, or $SFSIM_KERNEL)\n");
 }
@@ -578,7 +583,7 @@ static int cmd_run(int argc, char **argv)
     o.out_dir = "out";
     o.progress = isatty(2);
     const char *mode = "detailed";
-    int sample_given = 0;
+    int sample_given = 0, target_given = 0;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         int has_next = i + 1 < argc;
@@ -609,11 +614,22 @@ static int cmd_run(int argc, char **argv)
             char *end;
             o.sample = strtod(argv[++i], &end);
             if (*end || !(o.sample > 0.0 && o.sample <= 1.0)) {
-                fprintf(stderr, "sfsim run: --sample %s: expected a fraction of the tiles in (0, 1], e.g. 0.05\n",
+                fprintf(stderr, "sfsim run: --sample %s: expected a fraction of the units in (0, 1], e.g. 0.05\n",
                         argv[i]);
                 return EXIT_INPUT;
             }
             sample_given = 1;
+        } else if (!strcmp(a, "--target-error") && has_next) {
+            char *end;
+            o.target_error = strtod(argv[++i], &end);
+            if (end == argv[i] || *end || !(o.target_error > 0.0 && o.target_error < 1.0)) {
+                fprintf(stderr, "sfsim run: --target-error %s: expected a fraction in (0, 1), e.g. 0.01 for +-1%%\n",
+                        argv[i]);
+                return EXIT_INPUT;
+            }
+            target_given = 1;
+        } else if (!strcmp(a, "--no-image")) {
+            o.no_image = 1;
         } else if (!strcmp(a, "--sample-seed") && has_next) {
             if (parse_int("run", a, argv[++i], 0, 4294967295L, &v))
                 return EXIT_INPUT;
@@ -653,10 +669,18 @@ static int cmd_run(int argc, char **argv)
                 mode);
         return EXIT_INPUT;
     }
-    if (sample_given && strcmp(mode, "sampled") != 0) {
-        fprintf(stderr, "sfsim run: --sample applies to --mode sampled only (sfsim help run)\n");
+    if ((sample_given || target_given || o.no_image) && strcmp(mode, "sampled") != 0) {
+        fprintf(stderr, "sfsim run: --sample, --target-error and --no-image apply to --mode sampled only "
+                        "(sfsim help run)\n");
         return EXIT_USAGE;
     }
+    if (sample_given && target_given) {
+        fprintf(stderr, "sfsim run: --sample F (a fixed fraction) and --target-error E (as many units as E needs) "
+                        "exclude each other (sfsim help run)\n");
+        return EXIT_USAGE;
+    }
+    if (sample_given)
+        o.target_error = 0.0; /* the fixed-size design */
     o.mode = mode;
     static char default_scene[4096];
     if (!o.scene_path) {
@@ -679,7 +703,7 @@ static int cmd_run(int argc, char **argv)
         /* -3: an output could not be written (trace_run's convention, for render_run's writers) */
         return rrc == -2 ? EXIT_PROGRAM : rrc == -3 ? EXIT_IO : EXIT_INPUT;
     }
-    printf("sfsim run: wrote %s/frame.png, frame.exr, report.txt, report.json%s\n", o.out_dir,
+    printf("sfsim run: wrote %s/%sreport.txt, report.json%s\n", o.out_dir, o.no_image ? "" : "frame.png, frame.exr, ",
            !strcmp(mode, "detailed") || !strcmp(mode, "sampled") ? ", cost.png" : "");
     return EXIT_OK;
 }

@@ -46,7 +46,8 @@ void render_default_options(RenderOptions *o)
     o->width = o->height = o->spp = o->max_depth = -1;
     o->exposure = 1.0f;
     o->mode = "detailed";
-    o->sample = 0.05;
+    o->sample = 0.05;        /* used only when target_error is 0 (sfsim run --sample) */
+    o->target_error = 0.01;
     o->sample_seed = 1;
 }
 
@@ -69,6 +70,18 @@ static void progress_cb(void *ctx, uint32_t done, uint32_t total)
             "########################################", width - fill, "", done, total, el, left);
     if (done == total)
         fputc('\n', stderr);
+    fflush(stderr);
+    pthread_mutex_unlock(&pr->lock);
+}
+
+/* Sampled mode's rounds (RunSpec.note), on the progress line's terminal. */
+static void note_cb(void *ctx, const char *line)
+{
+    Progress *pr = ctx;
+    if (!pr->enabled)
+        return;
+    pthread_mutex_lock(&pr->lock);
+    fprintf(stderr, "sampled: %s\n", line);
     fflush(stderr);
     pthread_mutex_unlock(&pr->lock);
 }
@@ -96,8 +109,9 @@ static int remove_stale(const char *dir, const char *const *keep, char *err, siz
 }
 
 /* Detailed and sampled modes: cost.png, simulated cycles per pixel of each tile (sampled mode:
- * tiles not sampled get the sample's cycles per instruction times their instructions). */
-static int write_cost_map(OutSet *set, const char *dir, const FuncStats *f, const SampleEstimate *est, int width,
+ * est holds each tile's estimate, its measured units plus the regression's prediction for the
+ * others). */
+static int write_cost_map(OutSet *set, const char *dir, const FuncStats *f, const double *est, int width,
                           int height, char *err, size_t errlen)
 {
     /* One value per pixel; an image wider or taller than the heat map takes (8192) is drawn one
@@ -115,7 +129,7 @@ static int write_cost_map(OutSet *set, const char *dir, const FuncStats *f, cons
     }
     for (uint32_t i = 0; i < f->ntiles; i++) {
         const FuncTile *t = &f->tiles[i];
-        double cyc = stats_tile_cycles(f, est, i);
+        double cyc = est ? est[i] : (double)t->cycles;
         double per = t->w && t->h ? cyc / ((double)t->w * t->h) : 0.0;
         for (uint32_t y = t->y0; y < t->y0 + t->h && y < (uint32_t)height; y += (uint32_t)scale_y)
             for (uint32_t x = t->x0; x < t->x0 + t->w && x < (uint32_t)width; x += (uint32_t)scale_x)
@@ -126,7 +140,7 @@ static int write_cost_map(OutSet *set, const char *dir, const FuncStats *f, cons
     char path[4200], title[128];
     snprintf(path, sizeof path, "%s/cost.png", dir);
     snprintf(title, sizeof title, "simulated cycles per pixel (tiles of %u x %u%s)", f->tile_w, f->tile_h,
-             est ? "; unsampled tiles estimated" : "");
+             est ? "; estimated from the sampled units" : "");
     int rc = heatmap_write(set, path, v, width, height, title, "cycles", err, errlen);
     free(v);
     return rc;
@@ -200,10 +214,11 @@ static int stage_outputs(OutSet *set, const Report *r, char *err, size_t errlen)
     const Scene *s = &r->sc->s;
     char path[4200];
     snprintf(path, sizeof path, "%s/frame.exr", o->out_dir);
-    if (img_write_linear(set, path, r->fr->rgb, s->render.width, s->render.height, err, errlen) != 0)
+    if (!o->no_image && img_write_linear(set, path, r->fr->rgb, s->render.width, s->render.height, err, errlen) != 0)
         return -1;
     snprintf(path, sizeof path, "%s/frame.png", o->out_dir);
-    if (img_write_display(set, path, r->fr->rgb, s->render.width, s->render.height, o->exposure, err, errlen) != 0)
+    if (!o->no_image &&
+        img_write_display(set, path, r->fr->rgb, s->render.width, s->render.height, o->exposure, err, errlen) != 0)
         return -1;
     cJSON *root = report_json(r);
     char *json_text = root ? cJSON_Print(root) : NULL;
@@ -222,7 +237,7 @@ static int stage_outputs(OutSet *set, const Report *r, char *err, size_t errlen)
     snprintf(path, sizeof path, "%s/report.txt", o->out_dir);
     if (outfile_write_file(set, path, txt, strlen(txt), err, errlen) != 0)
         return -1;
-    if (run_mode_timed(r->mode) && write_cost_map(set, o->out_dir, &r->fr->f, r->fr->has_est ? &r->fr->est : NULL,
+    if (run_mode_timed(r->mode) && write_cost_map(set, o->out_dir, &r->fr->f, r->fr->has_est ? r->fr->tile_cycles : NULL,
                                                   s->render.width, s->render.height, err, errlen) != 0)
         return -1;
     return 0;
@@ -235,14 +250,16 @@ static int write_outputs(const Report *r, char *err, size_t errlen)
 {
     static const char *const keep_timed[] = {"frame.exr", "frame.png", "report.txt", "report.json", "cost.png", NULL};
     static const char *const keep_untimed[] = {"frame.exr", "frame.png", "report.txt", "report.json", NULL};
+    static const char *const keep_no_image[] = {"report.txt", "report.json", "cost.png", NULL};
     const char *dir = r->o->out_dir;
+    const char *const *keep = r->o->no_image ? keep_no_image : run_mode_timed(r->mode) ? keep_timed : keep_untimed;
     OutDirs dirs = {0};
     OutSet *set = outset_new();
     int rc = -1;
     if (!set)
         snprintf(err, errlen, "%s: out of memory", dir);
     else if (outfile_make_dirs(dir, &dirs, err, errlen) == 0 && stage_outputs(set, r, err, errlen) == 0 &&
-             remove_stale(dir, run_mode_timed(r->mode) ? keep_timed : keep_untimed, err, errlen) == 0 &&
+             remove_stale(dir, keep, err, errlen) == 0 &&
              outset_commit(set, err, errlen) == 0) {
         outfile_keep_dirs(&dirs);
         rc = 0;
@@ -273,10 +290,15 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     const CfgMachine *cfg = o->cfg ? o->cfg : &defcfg;
     Progress pr = {PTHREAD_MUTEX_INITIALIZER, 0.0, o->progress};
     RunSpec spec = {.cfg = cfg, .kernel_path = o->kernel_path, .seed = o->seed, .threads = o->threads,
-                    .sample = o->sample, .sample_seed = o->sample_seed, .progress = progress_cb, .progress_ctx = &pr};
+                    .sample = o->sample, .sample_seed = o->sample_seed, .progress = progress_cb, .note = note_cb,
+                    .progress_ctx = &pr};
     if (run_mode_parse(o->mode, &spec.mode) != 0) {
         snprintf(err, errlen, "--mode %s: expected detailed, sampled, functional or reference", o->mode);
         return -1;
+    }
+    if (spec.mode == RUN_SAMPLED) {
+        spec.target_error = o->target_error;
+        spec.no_image = o->no_image;
     }
     if (run_spec_check(&spec, err, errlen) != 0)
         return -1;
@@ -291,7 +313,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     if (rc == 0) {
         pr.start = util_now();
         rc = run_frame(&sc, &spec, &fr, err, errlen);
-        if (rc == -2)
+        if (rc == -2 && spec.mode != RUN_SAMPLED) /* sampled mode's image is the golden model's, never partial */
             keep_partial(o, &sc, &fr, err, errlen);
     }
     if (rc == 0) {

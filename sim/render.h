@@ -22,8 +22,10 @@ typedef struct RenderOptions {
     const struct CfgMachine *cfg; /* the machine (functional mode; NULL: defaults) */
     const char *config_path;   /* the -c file as given, for the report; NULL: the built-in defaults */
     const char *kernel_path;   /* kernel modes: the kernel source (NULL: next to the binary) */
-    double sample;             /* sampled mode: the fraction of tiles timed, (0, 1] */
-    uint32_t sample_seed;      /* sampled mode: which tiles */
+    double sample;             /* sampled mode: a fixed fraction of the units timed, (0, 1], when */
+    double target_error;       /* ... target_error is 0; else the 95 % half-width wanted (0.01 = 1 %) */
+    uint32_t sample_seed;      /* sampled mode: which units */
+    int no_image;              /* sampled mode: no image, a pilot of the golden model for the counts */
 } RenderOptions;
 
 /* The render keys `--set` takes beside the machine keys (sfsim run, sfsim sweep), with their

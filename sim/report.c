@@ -91,13 +91,20 @@ static void add_kernel_json(cJSON *root, const FuncStats *f, const CfgMachine *c
 }
 
 /* Sampled mode: how the sample was drawn and estimated (its figures: sim/stats.def). */
-static void add_sample_json(cJSON *root, double fraction, uint32_t seed)
+static void add_sample_json(cJSON *root, const RenderOptions *o, const RunFrame *fr)
 {
     cJSON *sm = object_of(root, "sample");
-    cJSON_AddNumberToObject(sm, "fraction", fraction);
-    cJSON_AddNumberToObject(sm, "seed", seed);
-    cJSON_AddStringToObject(sm, "estimator", "ratio of cycles to instructions (docs/sampling.md)");
+    if (o->target_error > 0.0)
+        cJSON_AddNumberToObject(sm, "target_error", o->target_error);
+    else
+        cJSON_AddNumberToObject(sm, "fraction", o->sample);
+    cJSON_AddNumberToObject(sm, "seed", o->sample_seed);
+    cJSON_AddStringToObject(sm, "unit", "one pass of one tile");
+    cJSON_AddStringToObject(sm, "estimator", "regression on the golden model's SIMD-step counts (docs/sampling.md)");
+    cJSON_AddNumberToObject(sm, "auxiliaries", fr->est.k);
     cJSON_AddNumberToObject(sm, "confidence", 0.95);
+    cJSON_AddBoolToObject(sm, "image", !o->no_image);
+    cJSON_AddNumberToObject(sm, "golden_seconds", fr->golden_seconds);
 }
 
 /* The statistics walk's view of the run (sim/stats.h). */
@@ -110,7 +117,8 @@ static StatsCtx stats_ctx(const Report *r)
     StatsCtx c = {.mode = mode_bit[r->mode] | (kernel && r->fr->f.kd ? STATS_M_KD : 0),
                   .cfg = r->cfg, .run = &r->fr->run, .f = kernel ? &r->fr->f : NULL,
                   .t = run_mode_timed(r->mode) ? &r->fr->f.timing : NULL,
-                  .est = r->fr->has_est ? &r->fr->est : NULL};
+                  .est = r->fr->has_est ? &r->fr->est : NULL,
+                  .est_instructions = r->fr->has_est ? &r->fr->est_instructions : NULL, .rounds = r->fr->rounds};
     return c;
 }
 
@@ -138,7 +146,7 @@ cJSON *report_json(const Report *r)
     if (functional)
         add_kernel_json(root, &rsp->f, cfg);
     if (sampled)
-        add_sample_json(root, o->sample, o->sample_seed);
+        add_sample_json(root, o, rsp);
     if (functional && rsp->f.kd)
         add_kd_json(root, r);
     cJSON *sc = cJSON_AddObjectToObject(root, "scene");
@@ -234,7 +242,7 @@ void report_txt(const Report *r, char *txt, size_t cap)
              "             mean %.5f, non-finite values %ld\n",
              o->mode,
              detailed     ? "the kernel on the timing model of the machine"
-             : sampled    ? "the kernel; sampled tiles on the timing model, the frame's cycles estimated"
+             : sampled    ? "the golden model's image; sampled (tile, pass) units on the timed kernel, the frame's cycles estimated"
              : functional ? "the kernel on the functional core: no timing"
                           : "golden model: no timing",
              o->scene_path, sp->ntris, sp->nspheres, pp->nlights, needs[0] ? needs : "-", pp->bvh.nnodes,

@@ -1,6 +1,6 @@
-/* sim/sampling.c -- seeded samples, the ratio and regression estimators and the sequential stopping
- * rule (formulas and the rule: sampling.h; design: docs/sampling.md). Pure functions: no I/O, no
- * threads; only sample_select allocates (its shuffle). Must not run or time anything. */
+/* sim/sampling.c -- seeded samples, the regression estimator and the sequential stopping rule
+ * (formulas and the rule: sampling.h; design: docs/sampling.md). Pure functions: no I/O, no
+ * threads, no allocation. Must not run or time anything. */
 #include "sampling.h"
 
 #include <math.h>
@@ -31,7 +31,7 @@ static uint64_t sample_seed_state(uint32_t seed)
 
 void sample_order(uint32_t N, uint32_t seed, uint32_t *order)
 {
-    /* Fisher-Yates from the front, as sample_select: order[i] is drawn uniformly from the units
+    /* Fisher-Yates from the front: order[i] is drawn uniformly from the units
      * not yet placed, so every prefix is a simple random sample without replacement (the modulo
      * bias of a 64-bit draw reduced below 2^32 is under 2^-32). */
     uint64_t s = sample_seed_state(seed);
@@ -43,35 +43,6 @@ void sample_order(uint32_t N, uint32_t seed, uint32_t *order)
         order[i] = order[j];
         order[j] = t;
     }
-}
-
-void sample_select(uint32_t ntiles, double fraction, uint32_t seed, uint8_t *selected)
-{
-    memset(selected, 0, ntiles);
-    uint32_t n = sample_count(ntiles, fraction);
-    if (n == ntiles) {
-        memset(selected, 1, ntiles);
-        return;
-    }
-    /* Partial Fisher-Yates over the tile indices: the first n places are the sample. */
-    uint32_t *idx = malloc((size_t)ntiles * sizeof *idx);
-    uint64_t s = sample_seed_state(seed);
-    if (!idx) { /* no memory for the shuffle: a systematic sample with a seeded start instead */
-        uint32_t step = ntiles / n, start = (uint32_t)(splitmix64(&s) % step);
-        for (uint32_t k = 0; k < n; k++)
-            selected[start + k * step] = 1;
-        return;
-    }
-    for (uint32_t i = 0; i < ntiles; i++)
-        idx[i] = i;
-    for (uint32_t i = 0; i < n; i++) {
-        uint32_t j = i + (uint32_t)(splitmix64(&s) % (uint64_t)(ntiles - i));
-        uint32_t t = idx[i];
-        idx[i] = idx[j];
-        idx[j] = t;
-        selected[idx[i]] = 1;
-    }
-    free(idx);
 }
 
 double sample_t975(uint32_t df)
@@ -89,48 +60,6 @@ double sample_t975(uint32_t df)
     double g1 = (z3 + z) / 4.0, g2 = (5 * z5 + 16 * z3 + 3 * z) / 96.0,
            g3 = (3 * z7 + 19 * z5 + 17 * z3 - 15 * z) / 384.0;
     return z + g1 / d + g2 / (d * d) + g3 / (d * d * d);
-}
-
-int sample_ratio_estimate(const double *y, const double *x, const uint8_t *selected, uint32_t ntiles,
-                          SampleEstimate *out)
-{
-    memset(out, 0, sizeof *out);
-    out->N = ntiles;
-    double sy = 0.0, sx = 0.0, X = 0.0;
-    uint32_t n = 0;
-    for (uint32_t i = 0; i < ntiles; i++) {
-        X += x[i];
-        if (selected[i]) {
-            sy += y[i];
-            sx += x[i];
-            n++;
-        }
-    }
-    out->n = n;
-    if (n == ntiles) { /* a census: exact */
-        out->total = out->lo = out->hi = sy;
-        out->ratio = sx > 0 ? sy / sx : 0.0;
-        return 0;
-    }
-    if (n < 2 || !(sx > 0.0))
-        return -1;
-    double r = sy / sx, ss = 0.0;
-    for (uint32_t i = 0; i < ntiles; i++)
-        if (selected[i]) {
-            double d = y[i] - r * x[i];
-            ss += d * d;
-        }
-    double sd2 = ss / (double)(n - 1), N = (double)ntiles;
-    double var = N * N * (1.0 - (double)n / N) / (double)n * sd2;
-    out->ratio = r;
-    out->total = r * X;
-    out->std_error = sqrt(var);
-    out->t = sample_t975(n - 1);
-    out->lo = out->total - out->t * out->std_error;
-    out->hi = out->total + out->t * out->std_error;
-    if (out->lo < sy) /* the frame takes at least the cycles measured */
-        out->lo = sy;
-    return 0;
 }
 
 /* ---- the regression (GREG) estimator ---------------------------------------------------------- */

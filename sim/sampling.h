@@ -2,18 +2,13 @@
  * frame's cycles with a confidence interval from those units (SMARTS-style sampling, Wunderlich
  * et al., ISCA 2003; the design and its assumptions: docs/sampling.md).
  *
- * Owns: seeded simple random samples without replacement (a fixed-size selection and a
- * permutation whose every prefix is a sample), the ratio estimator, the multiple-regression
- * (GREG) estimator, and the sequential stopping rule of --target-error.
- * Must not: run anything, print, allocate per unit beyond sample_select's shuffle, or use threads
- * (sim/functional.c and the run layer run the units; sim/render.c reports).
+ * Owns: seeded simple random samples without replacement (a permutation whose every prefix is a
+ * sample), the multiple-regression (GREG) estimator, and the sequential stopping rule of
+ * --target-error.
+ * Must not: run anything, print, allocate, or use threads (sim/run/sampled.c runs the units through
+ * sim/functional.c; sim/report.c reports).
  *
- * 1. The ratio estimator (tiles, one auxiliary: instructions x_i known for all N tiles):
- *     Y^ = X * R^,  R^ = sum_s y_i / sum_s x_i  (cycles per instruction of the sample),
- *     V^ = N^2 (1 - n/N) / n * s_d^2,  s_d^2 = sum_s (y_i - R^ x_i)^2 / (n - 1),
- *     interval Y^ +- t_{0.975, n-1} sqrt(V^) (Cochran, Sampling Techniques, 1977, 6.3-6.4).
- *
- * 2. The regression (GREG with intercept) estimator (units, k <= SAMPLE_MAX_AUX auxiliaries x_ij
+ * 1. The regression (GREG with intercept) estimator (units, k <= SAMPLE_MAX_AUX auxiliaries x_ij
  *    known exactly for all N units; Cochran 1977 Sec. 7.1-7.2, 7.10; Sarndal, Swensson & Wretman
  *    1992, Ch. 6). With b the OLS fit of y on (1, x) over the sample s of size n:
  *     Y^  = sum_{i<N} (b0 + b'x_i) = N (ybar + b'(Xbar - xbar)),
@@ -31,7 +26,7 @@
  *    gives V^ ~ 0. A census (n == N) is exact: Y^ = sum y, lo = hi = Y^, t = std_error = 0 (the
  *    fit's coef, k, df and r2 are still reported when n >= 2).
  *
- * 3. The sequential rule of --target-error E (sample_sequential): with units taken in the order
+ * 2. The sequential rule of --target-error E (sample_sequential): with units taken in the order
  *    of a seeded permutation (sample_order), so that every prefix is a simple random sample,
  *     n_1 = n0 clamped to [min(N, k + 3), N]; measure units order[0, n_1);
  *     round r: estimate from the n_r measured units (regression estimator); h_r = t se / |Y^|;
@@ -51,16 +46,12 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* Tiles a fraction f of N selects: ceil(f N), at least 2 (a variance needs two), at most N. */
+/* Units a fraction f of N selects (--sample F): ceil(f N), at least 2 (a variance needs two), at
+ * most N. */
 uint32_t sample_count(uint32_t ntiles, double fraction);
 
-/* A simple random sample without replacement of sample_count(ntiles, fraction) of the tiles,
- * fixed by seed: selected[i] = 1 for the chosen tiles (selected has ntiles entries). */
-void sample_select(uint32_t ntiles, double fraction, uint32_t seed, uint8_t *selected);
-
-/* A permutation of 0..N-1 fixed by seed (a full Fisher-Yates shuffle on the same generator and
- * seeding as sample_select, so order[0, sample_count(N, f)) is the set sample_select chooses).
- * Every prefix order[0, n) is a simple random sample without replacement of size n. */
+/* A permutation of 0..N-1 fixed by seed (a Fisher-Yates shuffle driven by splitmix64). Every
+ * prefix order[0, n) is a simple random sample without replacement of size n. */
 void sample_order(uint32_t N, uint32_t seed, uint32_t *order);
 
 #define SAMPLE_MAX_AUX 8 /* auxiliary variables the regression estimator takes at most */
@@ -69,21 +60,13 @@ typedef struct SampleEstimate {
     uint32_t n, N;          /* units sampled, units in the frame */
     double total;           /* estimated frame total of y */
     double lo, hi;          /* its 95 % confidence interval (lo >= the sampled units' own sum) */
-    double ratio;           /* ratio estimator: R^, y per unit of x in the sample (0 otherwise) */
     double std_error;       /* sqrt(V^) */
     double t;               /* the t quantile used (0 when every unit is sampled) */
-    /* Regression estimator only (zero from the ratio estimator): */
     uint32_t k;             /* auxiliaries used, after dropping constant or collinear ones */
     uint32_t df;            /* n - k - 1: degrees of freedom of the residual variance */
     double coef[SAMPLE_MAX_AUX + 1]; /* b0, then b_j per ORIGINAL column j (0 for dropped ones) */
     double r2;              /* the fit's R^2 on the sample (1 when the sampled y do not vary) */
 } SampleEstimate;
-
-/* The ratio estimate of sum y over all N tiles from the sampled ones (y read only where
- * selected). x must be > 0 for the sampled tiles' sum. 0, or -1 if fewer than 2 tiles are
- * sampled (unless all are) or the sampled x sum to 0. */
-int sample_ratio_estimate(const double *y, const double *x, const uint8_t *selected, uint32_t ntiles,
-                          SampleEstimate *out);
 
 /* The regression estimate of Y = sum of y over all N units (formulas above). ys[s] is y of unit
  * sample[s] (s < n); x[i * k + j] is auxiliary j of unit i for EVERY unit i < N (x may be NULL

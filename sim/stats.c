@@ -207,12 +207,12 @@ double stats_kd_per_ray(const FuncStats *f, int kind, int counter)
     return stats_ratio(counts[counter], rays);
 }
 
-StatsFrame stats_frame(const TimingStats *t, uint64_t instructions, double clock_mhz, const SampleEstimate *est)
+StatsFrame stats_frame(const TimingStats *t, double instructions, double clock_mhz, const SampleEstimate *est)
 {
     StatsFrame s;
     double hz = clock_mhz * 1e6;
     s.cycles = est ? est->total : (double)t->cycles;
-    s.busy = est ? (double)instructions : (double)t->busy;   /* one issue cycle per instruction */
+    s.busy = est ? instructions : (double)t->busy;   /* one issue cycle per instruction */
     s.cycles_lo = est ? est->lo : s.cycles;
     s.cycles_hi = est ? est->hi : s.cycles;
     s.fps = s.cycles > 0 ? hz / s.cycles : 0.0;
@@ -222,32 +222,6 @@ StatsFrame stats_frame(const TimingStats *t, uint64_t instructions, double clock
     return s;
 }
 
-int stats_sample_estimate(const FuncStats *f, SampleEstimate *est)
-{
-    uint32_t nt = f->ntiles;
-    double *y = calloc(nt ? nt : 1, sizeof *y), *x = calloc(nt ? nt : 1, sizeof *x);
-    uint8_t *sel = calloc(nt ? nt : 1, 1);
-    int rc = -1;
-    if (y && x && sel) {
-        for (uint32_t i = 0; i < nt; i++) {
-            y[i] = (double)f->tiles[i].cycles;
-            x[i] = (double)f->tiles[i].instructions;
-            sel[i] = f->tiles[i].sampled;
-        }
-        rc = sample_ratio_estimate(y, x, sel, nt, est);
-    }
-    free(y);
-    free(x);
-    free(sel);
-    return rc;
-}
-
-double stats_tile_cycles(const FuncStats *f, const SampleEstimate *est, uint32_t tile)
-{
-    const FuncTile *t = &f->tiles[tile];
-    return t->sampled || !est ? (double)t->cycles : est->ratio * (double)t->instructions;
-}
-
 /* ---- the rows' figures (FN in stats.def): fig_<name>(ctx, element, na) ----------------------- */
 
 #define FIG(name) static double fig_##name(const StatsCtx *c, const int *idx, int *na)
@@ -255,7 +229,8 @@ double stats_tile_cycles(const FuncStats *f, const SampleEstimate *est, uint32_t
 
 StatsFrame stats_frame_of(const StatsCtx *c)
 {
-    return stats_frame(c->t, c->f ? c->f->instructions : 0, c->cfg ? c->cfg->core_clock_mhz : 0.0, c->est);
+    double instructions = c->est_instructions ? c->est_instructions->total : c->f ? (double)c->f->instructions : 0.0;
+    return stats_frame(c->t, instructions, c->cfg ? c->cfg->core_clock_mhz : 0.0, c->est);
 }
 /* A ratio, and whether it has a meaning (its denominator is not 0). */
 static double defined_if(double v, int ok, int *na)
@@ -272,11 +247,13 @@ FIG(fps_no_stall) { UNUSED_FIG_ARGS; return stats_frame_of(c).fps_no_stall; }
 FIG(clock_mhz) { UNUSED_FIG_ARGS; return c->cfg->core_clock_mhz; }
 FIG(cycles_ci95) { UNUSED_FIG_ARGS; return idx[0] ? stats_frame_of(c).cycles_hi : stats_frame_of(c).cycles_lo; }
 FIG(fps_ci95) { UNUSED_FIG_ARGS; return idx[0] ? stats_frame_of(c).fps_hi : stats_frame_of(c).fps_lo; }
-FIG(sample_tiles) { UNUSED_FIG_ARGS; return c->est->N; }
-FIG(sample_tiles_sampled) { UNUSED_FIG_ARGS; return c->est->n; }
+FIG(sample_units) { UNUSED_FIG_ARGS; return c->est->N; }
+FIG(sample_units_sampled) { UNUSED_FIG_ARGS; return c->est->n; }
+FIG(sample_rounds) { UNUSED_FIG_ARGS; return c->rounds; }
 FIG(sample_t) { UNUSED_FIG_ARGS; return c->est->t; }
 FIG(sample_std_error) { UNUSED_FIG_ARGS; return c->est->std_error; }
-FIG(sample_cpi) { UNUSED_FIG_ARGS; return c->est->ratio; }
+FIG(sample_r2) { UNUSED_FIG_ARGS; return c->est->r2; }
+FIG(sample_instr) { UNUSED_FIG_ARGS; return c->est_instructions ? c->est_instructions->total : 0.0; }
 FIG(rays_total) { UNUSED_FIG_ARGS; return (double)(c->run->primary + c->run->shadow + c->run->indirect); }
 FIG(instructions) { UNUSED_FIG_ARGS; return (double)c->f->instructions; }
 FIG(ops) { UNUSED_FIG_ARGS; return (double)stats_ops(&c->f->core, idx[0]); }

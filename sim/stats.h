@@ -105,6 +105,7 @@ typedef enum StatsDim {
     X(NUMBER,       "number") \
     X(EVENTS,       "count") \
     X(TILES,        "tiles") \
+    X(UNITS,        "(tile, pass) units") \
     X(PIXELS,       "pixels") \
     X(ACCESSES,     "accesses") \
     X(LINES,        "lines") \
@@ -185,7 +186,9 @@ struct StatsCtx {
     const StatsRun *run;         /* every mode but exec */
     const FuncStats *f;          /* kernel modes */
     const TimingStats *t;        /* timed modes (&f->timing) and exec */
-    const SampleEstimate *est;   /* sampled mode */
+    const SampleEstimate *est;   /* sampled mode: the cycles */
+    const SampleEstimate *est_instructions; /* ... the instructions */
+    uint32_t rounds;             /* ... rounds of the sequential rule */
 };
 
 /* The statistics of report.json, added to root (objects the walk creates may be shared with the
@@ -215,17 +218,13 @@ double stats_stall_share(const TimingStats *t, int cause);
 /* A kd counter per ray of a kind (FUNC_KD_KINDS: all kinds). */
 double stats_kd_per_ray(const FuncStats *f, int kind, int counter);
 
-/* The frame's timing: measured (detailed), or estimated from the sampled tiles (est != NULL). */
+/* The frame's timing: measured (detailed), or estimated from the sampled units (est != NULL:
+ * the cycles; busy is then the instructions given, the estimated ones). */
 typedef struct StatsFrame {
     double cycles, busy, fps, fps_no_stall;
     double cycles_lo, cycles_hi, fps_lo, fps_hi;   /* sampled mode: the 95 % intervals */
 } StatsFrame;
-StatsFrame stats_frame(const TimingStats *t, uint64_t instructions, double clock_mhz, const SampleEstimate *est);
-/* Sampled mode: the ratio estimate of the frame's cycles from f's sampled tiles. 0, or -1. */
-int stats_sample_estimate(const FuncStats *f, SampleEstimate *est);
-/* A tile's cycles: measured, or (a tile sampled mode did not time) the sample's cycles per
- * instruction times its instructions. */
-double stats_tile_cycles(const FuncStats *f, const SampleEstimate *est, uint32_t tile);
+StatsFrame stats_frame(const TimingStats *t, double instructions, double clock_mhz, const SampleEstimate *est);
 
 /* The table's rules for one row (path names the dimensions, sources and text styles fit, fields
  * inside their struct): 0, or -1 with the row and the rule in err. */

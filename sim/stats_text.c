@@ -90,9 +90,9 @@ static void headline(TextW *w, const StatsRow *r)
     StatsFrame s = stats_frame_of(c);
     double mhz = c->cfg->core_clock_mhz;
     if (c->est)
-        out(w, "%-12s ~%.0f (95%%: %.0f .. %.0f) = %.0f busy + ~%.0f stalled; estimated from %u of %u tiles\n"
+        out(w, "%-12s ~%.0f (95%%: %.0f .. %.0f) = ~%.0f busy + ~%.0f stalled; estimated from %u of %u units\n"
             "fps          ~%.2f (95%%: %.2f .. %.2f) at %g MHz (%.2f fps with no stalls)\n"
-            "sample       the shares and unit lines below are those of the %u sampled tiles (docs/sampling.md)\n",
+            "sample       the shares and unit lines below are those of the %u sampled units (docs/sampling.md)\n",
             r->label, s.cycles, s.cycles_lo, s.cycles_hi, s.busy, s.cycles - s.busy, c->est->n, c->est->N, s.fps,
             s.fps_lo, s.fps_hi, mhz, s.fps_no_stall, c->est->n);
     else

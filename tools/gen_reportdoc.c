@@ -52,7 +52,7 @@ static const char *const sec_titles[SEC_COUNT] = {
     "Every mode (the timing figures are `null` unless detailed or sampled)",
     "Reference mode (the golden model)",
     "Kernel modes (`functional`, `detailed`, `sampled`)",
-    "Detailed and sampled modes (sampled: the frame figures are estimates, the breakdowns the sampled tiles', docs/sampling.md)",
+    "Detailed and sampled modes (sampled: the frame figures are estimates, the breakdowns the sampled units', docs/sampling.md)",
     "Kernel modes with `accel.structure = kd` (the `kd` object)",
     "report.txt only (no report.json key)",
 };

@@ -17,6 +17,7 @@
 #include "../ref_trace.h"
 #include "../util.h"
 #include "kernel.h"
+#include "sampled.h"
 #include "tiles.h"
 
 const char *const run_mode_names[RUN_MODE_COUNT] = {"reference", "functional", "detailed", "sampled"};
@@ -118,21 +119,12 @@ static int kernel_frame(const RunScene *sc, const RunSpec *spec, const CfgMachin
                      .threads = fr->threads,
                      .progress = spec->progress,
                      .progress_ctx = spec->progress_ctx,
-                     .timed = run_mode_timed(spec->mode),
-                     .sample = spec->mode == RUN_SAMPLED ? spec->sample : 0.0,
-                     .sample_seed = spec->sample_seed};
+                     .timed = run_mode_timed(spec->mode)};
+    if (spec->mode == RUN_SAMPLED)
+        return sampled_frame(sc, spec, cfg, &fp, fr, err, errlen);
     int rc = func_render(&sc->p, &fp, fr->rgb, &fr->f, err, errlen);
     if (rc != 0)
         return rc;
-    if (spec->mode == RUN_SAMPLED) {
-        /* The frame's cycles from the sampled tiles (sim/sampling.h). */
-        if (stats_sample_estimate(&fr->f, &fr->est) != 0) {
-            snprintf(err, errlen, "sampled mode: cannot estimate from %u sampled of %u tiles (the frame needs at "
-                     "least 2 tiles; render more pixels or use --mode detailed)", fr->f.tiles_timed, fr->f.ntiles);
-            return -1;
-        }
-        fr->has_est = 1;
-    }
     stats_run_from_func(&fr->run, &fr->f);
     return 0;
 }
@@ -143,8 +135,24 @@ int run_spec_check(const RunSpec *spec, char *err, size_t errlen)
         snprintf(err, errlen, "run mode %d: no such mode", (int)spec->mode);
         return -1;
     }
-    if (spec->mode == RUN_SAMPLED && !(spec->sample > 0.0 && spec->sample <= 1.0)) {
-        snprintf(err, errlen, "--sample %g: expected a fraction of the tiles in (0, 1]", spec->sample);
+    if (spec->mode == RUN_SAMPLED && !(spec->target_error >= 0.0 && spec->target_error < 1.0)) {
+        snprintf(err, errlen, "--target-error %g: expected a fraction in (0, 1), e.g. 0.01 for +-1 %%",
+                 spec->target_error);
+        return -1;
+    }
+    if (spec->mode == RUN_SAMPLED && spec->target_error <= 0.0 && !(spec->sample > 0.0 && spec->sample <= 1.0)) {
+        snprintf(err, errlen, "--sample %g: expected a fraction of the units in (0, 1]", spec->sample);
+        return -1;
+    }
+    if (spec->mode == RUN_SAMPLED && spec->cfg && spec->cfg->workload_kind != CFG_WORKLOAD_PATH &&
+        spec->cfg->workload_kind != CFG_WORKLOAD_PHONG) {
+        snprintf(err, errlen, "--mode sampled: workload.kind = %s has no golden model to draw the units' auxiliary "
+                 "counts from (path and phong do); use --mode detailed",
+                 cfg_enum_name("workload", "kind", spec->cfg->workload_kind));
+        return -1;
+    }
+    if (spec->mode != RUN_SAMPLED && (spec->target_error != 0.0 || spec->no_image)) {
+        snprintf(err, errlen, "--target-error and --no-image belong to --mode sampled");
         return -1;
     }
     if (spec->cfg && spec->cfg->stream_rays != 1024 && spec->cfg->stream_rays != 4096) {
@@ -183,6 +191,7 @@ int run_frame(const RunScene *sc, const RunSpec *spec, RunFrame *fr, char *err, 
 void run_frame_free(RunFrame *fr)
 {
     free(fr->rgb);
+    free(fr->tile_cycles);
     func_stats_free(&fr->f);
     memset(fr, 0, sizeof *fr);
 }

@@ -28,8 +28,8 @@
 #include "../timing.h"
 #include "accel.h"
 
-/* The modes (docs/modes.md): the golden model, the kernel on the functional core, the kernel
- * timed on the machine, and the kernel with a sample of its tiles timed. */
+/* The modes: the golden model, the kernel on the functional core, the kernel timed on the
+ * machine, and a sample of the kernel's (tile, pass) units timed (docs/sampling.md). */
 typedef enum RunMode { RUN_REFERENCE, RUN_FUNCTIONAL, RUN_DETAILED, RUN_SAMPLED, RUN_MODE_COUNT } RunMode;
 extern const char *const run_mode_names[RUN_MODE_COUNT]; /* "reference", "functional", ... */
 
@@ -37,7 +37,7 @@ extern const char *const run_mode_names[RUN_MODE_COUNT]; /* "reference", "functi
 int run_mode_parse(const char *name, RunMode *mode);
 /* The kernel runs (every mode but the golden model's). */
 static inline int run_mode_kernel(RunMode m) { return m != RUN_REFERENCE; }
-/* The timing model runs (on every tile, or on the sample). */
+/* The timing model runs (on every unit, or on the sample). */
 static inline int run_mode_timed(RunMode m) { return m == RUN_DETAILED || m == RUN_SAMPLED; }
 
 /* The render size a caller imposes over the scene file's [render]; -1 (or 0 for the sizes) keeps
@@ -71,9 +71,17 @@ typedef struct RunSpec {
     const char *kernel_path;   /* NULL: kernels/pathtrace.s beside the binary (sim/run/kernel.h) */
     uint32_t seed;             /* the path tracer's random stream */
     int threads;               /* host threads; 0: every core */
-    double sample;             /* RUN_SAMPLED: the fraction of tiles timed, (0, 1] */
-    uint32_t sample_seed;      /* RUN_SAMPLED: which tiles */
+    /* RUN_SAMPLED (docs/sampling.md): the fraction of the (tile, pass) units timed, (0, 1], or
+     * when target_error > 0 as many as the sequential rule needs for a 95 % interval of the cycles
+     * within +-target_error (a fraction, 0.01 = 1 %); sample_seed fixes which units. no_image: the
+     * golden model runs only a pilot (fr->rgb stays black). */
+    double sample;
+    double target_error;
+    uint32_t sample_seed;
+    int no_image;
     void (*progress)(void *ctx, uint32_t tiles_done, uint32_t tiles_total);
+    /* A line on what a long run is doing (sampled mode's rounds); may be NULL. */
+    void (*note)(void *ctx, const char *line);
     void *progress_ctx;
 } RunSpec;
 
@@ -83,15 +91,21 @@ typedef struct RunFrame {
     StatsRun run;              /* rays and generations, from either engine */
     FuncStats f;               /* the kernel modes' counters (zero for the golden model) */
     SampleEstimate est;        /* RUN_SAMPLED: the frame's cycles estimated from the sample */
+    SampleEstimate est_instructions; /* ... and its instructions */
     int has_est;
+    uint32_t units_sampled;    /* RUN_SAMPLED: units timed */
+    uint32_t rounds;           /* RUN_SAMPLED: rounds of the sequential rule */
+    double golden_seconds;     /* RUN_SAMPLED: host time of the golden model (image and counts) */
+    double *tile_cycles;       /* RUN_SAMPLED: each tile's estimated cycles (f.ntiles entries) */
     int tile;                  /* the stream's tile side for the golden model: sqrt(stream.rays) */
     int threads;               /* host threads used */
     double seconds;            /* host time rendering */
 } RunFrame;
 
-/* The settings run_frame refuses, checked before any work (a mode out of range, a sample fraction
- * outside (0, 1] in RUN_SAMPLED, a stream size the kernel has no tile for): 0, or -1 with a
- * message naming the setting. */
+/* The settings run_frame refuses, checked before any work (a mode out of range; in RUN_SAMPLED a
+ * target error outside [0, 1), a sample fraction outside (0, 1] when there is no target, or a
+ * workload without a golden model; target_error or no_image in another mode; a stream size the
+ * kernel has no tile for): 0, or -1 with a message naming the setting. */
 int run_spec_check(const RunSpec *spec, char *err, size_t errlen);
 
 /* Render sc's frame as spec says. 0; -1 with a message (bad settings, a kernel that does not

@@ -359,34 +359,56 @@ end
 
 begin "sfsim run --mode sampled: same image, an interval; --sample 1 gives detailed mode's cycles"
 run "$SFSIM" run -s scenes/cornell/scene.ini -o "$T/det4" --set render.width=96 --set render.height=64 \
-    --set render.spp=1 --set stream.rays=1024 -j 2 --no-progress
+    --set render.spp=2 --set stream.rays=1024 -j 2 --no-progress
 want_rc 0
 run "$SFSIM" run --mode sampled --sample 0.5 -s scenes/cornell/scene.ini -o "$T/samp1" --set render.width=96 \
-    --set render.height=64 --set render.spp=1 --set stream.rays=1024 -j 2 --no-progress
+    --set render.height=64 --set render.spp=2 --set stream.rays=1024 -j 2 --no-progress
 want_rc 0; want_out "cost.png"
 grep -qE '"mode":[[:space:]]+"sampled"' "$T/samp1/report.json" 2>/dev/null || no "report.json: mode is not sampled"
-for k in fps_ci95 cycles_ci95 sample tiles_sampled cycles_per_instruction; do
+for k in fps_ci95 cycles_ci95 sample units_sampled rounds r2 instructions; do
     grep -q "\"$k\"" "$T/samp1/report.json" 2>/dev/null || no "report.json lacks $k"
 done
-grep -qE '^cycles +~[0-9]+ \(95%: [0-9]+ \.\. [0-9]+\).*estimated from 3 of 6 tiles' "$T/samp1/report.txt" 2>/dev/null \
+grep -qE '^cycles +~[0-9]+ \(95%: [0-9]+ \.\. [0-9]+\).*estimated from 6 of 12 units' "$T/samp1/report.txt" 2>/dev/null \
     || no "report.txt has no estimated cycles line"
 run "$SFSIM" compare "$T/det4/frame.exr" "$T/samp1/frame.exr"
 want_rc 0; want_out "max diff +0$"
 run "$SFSIM" run --mode sampled --sample 1 -s scenes/cornell/scene.ini -o "$T/samp2" --set render.width=96 \
-    --set render.height=64 --set render.spp=1 --set stream.rays=1024 -j 2 --no-progress
+    --set render.height=64 --set render.spp=2 --set stream.rays=1024 -j 2 --no-progress
 want_rc 0
 cd4=$(grep -E '^cycles +[0-9]' "$T/det4/report.txt" 2>/dev/null | sed -E 's/^cycles +([0-9]+).*/\1/')
 cs2=$(grep -E '^cycles +~' "$T/samp2/report.txt" 2>/dev/null | sed -E 's/^cycles +~([0-9]+) \(95%: ([0-9]+) \.\. ([0-9]+)\).*/\1 \2 \3/')
-[ -n "$cd4" ] && [ "$cs2" = "$cd4 $cd4 $cd4" ] || no "sampling every tile: '$cs2', detailed: '$cd4'"
+[ -n "$cd4" ] && [ "$cs2" = "$cd4 $cd4 $cd4" ] || no "sampling every unit: '$cs2', detailed: '$cd4'"
 end
 
-begin "sfsim run: bad --sample values are bad input (exit 1); --sample without sampled mode is a usage error (exit 2)"
+begin "sfsim run --mode sampled: --target-error (the default) reports its units; --no-image writes no image"
+run "$SFSIM" run --mode sampled --target-error 0.02 -s scenes/cornell/scene.ini -o "$T/samp4" --set render.width=128 \
+    --set render.height=128 --set render.spp=4 --set stream.rays=1024 -j 2 --no-progress
+want_rc 0; want_out "frame.png"
+grep -qE '"target_error":[[:space:]]+0.02' "$T/samp4/report.json" 2>/dev/null || no "report.json lacks the target error"
+grep -qE '"units":[[:space:]]+64' "$T/samp4/report.json" 2>/dev/null || no "report.json: not 64 units (16 tiles x 4 passes)"
+cp "$T/samp4/frame.png" "$T/samp4-frame.png"
+run "$SFSIM" run --mode sampled --no-image -s scenes/cornell/scene.ini -o "$T/samp4" --set render.width=128 \
+    --set render.height=128 --set render.spp=4 --set stream.rays=1024 -j 2 --no-progress
+want_rc 0; want_out "wrote $T/samp4/report.txt"
+[ ! -e "$T/samp4/frame.png" ] && [ ! -e "$T/samp4/frame.exr" ] || no "--no-image left (or kept an earlier run's) frame files"
+grep -qE '"image":[[:space:]]+false' "$T/samp4/report.json" 2>/dev/null || no "report.json does not say there is no image"
+end
+
+begin "sfsim run: bad --sample / --target-error values are bad input (exit 1); sampled options without sampled mode, or both sizes, are usage errors (exit 2)"
 run "$SFSIM" run --mode sampled --sample 0 -o "$T/samp3"
 want_rc 1; want_err "--sample 0"
 run "$SFSIM" run --mode sampled --sample 1.5 -o "$T/samp3"
 want_rc 1; want_err "\(0, 1\]"
 run "$SFSIM" run --sample 0.1 -o "$T/samp3"
 want_rc 2; want_err "--mode sampled only"
+run "$SFSIM" run --no-image -o "$T/samp3"
+want_rc 2; want_err "--mode sampled only"
+run "$SFSIM" run --mode sampled --target-error 0 -o "$T/samp3"
+want_rc 1; want_err "--target-error 0: expected a fraction in \(0, 1\)"
+run "$SFSIM" run --mode sampled --target-error 1% -o "$T/samp3"
+want_rc 1; want_err "--target-error 1%"
+run "$SFSIM" run --mode sampled --sample 0.1 --target-error 0.01 -o "$T/samp3"
+want_rc 2; want_err "exclude each other"
 end
 
 begin "sfsim run: a render key out of range names the key and its range (exit 1, as for machine keys)"

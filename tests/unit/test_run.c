@@ -171,18 +171,24 @@ Test(run_frame, bad_settings_are_refused_before_any_work)
     spec_cfg.workload_kind = CFG_WORKLOAD_SPECULAR;
     static const struct {
         RunMode mode;
-        double sample;
-        int cfg_specular;
+        double sample, target;
+        int cfg_specular, no_image;
         const char *want;
     } cases[] = {
-        {RUN_SAMPLED, 0.0, 0, "--sample 0: expected a fraction of the tiles in (0, 1]"},
-        {RUN_SAMPLED, 1.5, 0, "--sample 1.5: expected a fraction"},
-        {RUN_REFERENCE, 0.0, 1, "workload.kind = specular has no golden model"},
-        {RUN_MODE_COUNT, 0.0, 0, "no such mode"},
+        {RUN_SAMPLED, 0.0, 0.0, 0, 0, "--sample 0: expected a fraction of the units in (0, 1]"},
+        {RUN_SAMPLED, 1.5, 0.0, 0, 0, "--sample 1.5: expected a fraction"},
+        {RUN_SAMPLED, 0.0, 1.0, 0, 0, "--target-error 1: expected a fraction in (0, 1)"},
+        {RUN_SAMPLED, 0.0, -0.5, 0, 0, "--target-error -0.5: expected a fraction in (0, 1)"},
+        {RUN_DETAILED, 0.0, 0.01, 0, 0, "belong to --mode sampled"},
+        {RUN_FUNCTIONAL, 0.0, 0.0, 0, 1, "belong to --mode sampled"},
+        {RUN_SAMPLED, 0.0, 0.01, 1, 0, "workload.kind = specular has no golden model"},
+        {RUN_REFERENCE, 0.0, 0.0, 1, 0, "workload.kind = specular has no golden model"},
+        {RUN_MODE_COUNT, 0.0, 0.0, 0, 0, "no such mode"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         RunSpec spec = {.mode = cases[i].mode, .cfg = cases[i].cfg_specular ? &spec_cfg : NULL, .seed = 1,
-                        .threads = 1, .sample = cases[i].sample};
+                        .threads = 1, .sample = cases[i].sample, .target_error = cases[i].target,
+                        .no_image = cases[i].no_image};
         RunFrame fr;
         err[0] = 0;
         cr_expect_eq(run_frame(&sc, &spec, &fr, err, sizeof err), -1, "case %zu", i);
