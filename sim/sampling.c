@@ -75,6 +75,7 @@ typedef struct Fit {
     double raw[SAMPLE_MAX_AUX];      /* uncentred sums of squares */
     double b[SAMPLE_MAX_AUX];        /* slopes per original column (0 for dropped ones) */
     double sse;                      /* sum of squared residuals, from the data */
+    double L[SAMPLE_MAX_AUX][SAMPLE_MAX_AUX], sc[SAMPLE_MAX_AUX]; /* the kept columns' scaled Cholesky factor */
 } Fit;
 
 /* Sample means, then centred cross-products in a second pass (the two-pass form does not lose
@@ -112,7 +113,7 @@ static int fit_moments(Fit *f, const double *ys, const double *x, const uint32_t
  * squares, by Cholesky: L L' beta = c, b_j = beta_j / sqrt(S_jj). */
 static void fit_solve(Fit *f, uint32_t n)
 {
-    double L[SAMPLE_MAX_AUX][SAMPLE_MAX_AUX], c[SAMPLE_MAX_AUX], sc[SAMPLE_MAX_AUX];
+    double(*L)[SAMPLE_MAX_AUX] = f->L, *sc = f->sc, c[SAMPLE_MAX_AUX];
     for (uint32_t j = 0; j < f->k; j++) {
         double sjj = f->s[j][j];
         if (!(sjj > FIT_CONST_TOL * f->raw[j]) || !(sjj > 0.0))
@@ -151,6 +152,62 @@ static void fit_solve(Fit *f, uint32_t n)
     }
     for (uint32_t p = 0; p < m; p++)
         f->b[f->keep[p]] = c[p] / sc[p];
+}
+
+/* u = C^-1 v over the kept columns (C: their centred cross-products, = D L L' D with D the
+ * scales), v and u indexed by kept position. */
+static void fit_cinv(const Fit *f, const double *v, double *u)
+{
+    const uint32_t m = f->nkeep;
+    double c[SAMPLE_MAX_AUX];
+    for (uint32_t p = 0; p < m; p++) {
+        double a = v[p] / f->sc[p];
+        for (uint32_t r = 0; r < p; r++)
+            a -= f->L[p][r] * c[r];
+        c[p] = a / f->L[p][p];
+    }
+    for (uint32_t p = m; p-- > 0;) {
+        double a = c[p];
+        for (uint32_t r = p + 1; r < m; r++)
+            a -= f->L[r][p] * c[r];
+        c[p] = a / f->L[p][p];
+    }
+    for (uint32_t p = 0; p < m; p++)
+        u[p] = c[p] / f->sc[p];
+}
+
+/* The delete-one jackknife variance of the regression estimate (sampling.h), or -1 when a unit
+ * has leverage 1 (its deletion leaves the fit undetermined). Xbar: the population means of the
+ * kept columns. Deleting unit s moves the estimate by -w_s e_s / (1 - h_s), where
+ * w_s = N (1/n + (Xbar - xbar)' C^-1 (x_s - xbar)) is its regression weight and
+ * h_s = 1/n + (x_s - xbar)' C^-1 (x_s - xbar) its leverage. */
+static double fit_jackknife(const Fit *f, const double *ys, const double *x, const uint32_t *sample, uint32_t n,
+                            uint32_t N, const double *Xbar)
+{
+    const uint32_t m = f->nkeep;
+    double dX[SAMPLE_MAX_AUX] = {0}, g[SAMPLE_MAX_AUX] = {0}, sum = 0.0, sum2 = 0.0;
+    for (uint32_t p = 0; p < m; p++)
+        dX[p] = Xbar[p] - f->xbar[f->keep[p]];
+    fit_cinv(f, dX, g);
+    for (uint32_t s = 0; s < n; s++) {
+        double dx[SAMPLE_MAX_AUX], q[SAMPLE_MAX_AUX], e = ys[s] - f->ybar, w = 1.0 / n, h = 1.0 / n;
+        for (uint32_t p = 0; p < m; p++) {
+            uint32_t j = f->keep[p];
+            dx[p] = x[(size_t)sample[s] * f->k + j] - f->xbar[j];
+            e -= f->b[j] * dx[p];
+            w += g[p] * dx[p];
+        }
+        fit_cinv(f, dx, q);
+        for (uint32_t p = 0; p < m; p++)
+            h += dx[p] * q[p];
+        if (!(1.0 - h > 1e-9))
+            return -1.0;
+        double d = (double)N * w * e / (1.0 - h);
+        sum += d;
+        sum2 += d * d;
+    }
+    double mean = sum / n, ss = sum2 - n * mean * mean;
+    return (1.0 - (double)n / N) * (n - 1.0) / n * (ss > 0.0 ? ss : 0.0);
 }
 
 /* The residual sum of squares from the data themselves, so a perfect fit gives ~0. */
@@ -204,16 +261,19 @@ int sample_regression_estimate(const double *ys, const double *x, uint32_t k, co
         out->total = out->lo = out->hi = sy;
         return 0;
     }
-    double adj = 0.0; /* b'(Xbar - xbar), Xbar over all N units */
+    double adj = 0.0, Xbar[SAMPLE_MAX_AUX]; /* b'(Xbar - xbar), Xbar over all N units */
     for (uint32_t p = 0; p < f.nkeep; p++) {
         uint32_t j = f.keep[p];
         double X = 0.0;
         for (uint32_t i = 0; i < N; i++)
             X += x[(size_t)i * k + j];
-        adj += f.b[j] * (X / N - f.xbar[j]);
+        Xbar[p] = X / N;
+        adj += f.b[j] * (Xbar[p] - f.xbar[j]);
     }
     const double Nd = (double)N;
-    double var = Nd * Nd * (1.0 - (double)n / Nd) / (double)n * f.sse / (double)out->df;
+    double var = fit_jackknife(&f, ys, x, sample, n, N, Xbar);
+    if (var < 0.0) /* a unit of leverage 1: the linearization variance instead */
+        var = Nd * Nd * (1.0 - (double)n / Nd) / (double)n * f.sse / (double)out->df;
     out->total = Nd * (f.ybar + adj);
     out->std_error = sqrt(var);
     out->t = sample_t975(out->df);

@@ -13,7 +13,15 @@
  *    1992, Ch. 6). With b the OLS fit of y on (1, x) over the sample s of size n:
  *     Y^  = sum_{i<N} (b0 + b'x_i) = N (ybar + b'(Xbar - xbar)),
  *     e_s = y_s - b0 - b'x_s,   df = n - k - 1,
- *     V^  = N^2 (1 - n/N) / n * sum_s e_s^2 / df,
+ *     V^  = the delete-one jackknife variance (Wolter, Introduction to Variance Estimation, 2nd
+ *           ed., 2007, Ch. 4): with Y^_(s) the estimate refitted without unit s,
+ *           V^ = (1 - n/N) (n - 1)/n sum_s (Y^_(s) - mean_s Y^_(s))^2, computed in closed form:
+ *           Y^_(s) = Y^ - w_s e_s / (1 - h_s), w_s = N (1/n + (Xbar - xbar)' C^-1 (x_s - xbar))
+ *           the unit's regression weight, h_s = 1/n + (x_s - xbar)' C^-1 (x_s - xbar) its
+ *           leverage, C the sample's centred cross-products. (The linearization variance
+ *           N^2 (1 - n/N) / n * sum_s e_s^2 / df, used only if a unit has leverage 1, is too small
+ *           in samples of a few tens: its 95 % interval covered 91.8 % against the jackknife's
+ *           95.0 % with 30 of the 256 units of a conference frame, docs/sampling.md.)
  *     interval Y^ +- t_{0.975, df} sqrt(V^), its lower end raised to sum_s y_s when every sampled
  *     y_s >= 0 (the frame takes at least the cycles measured).
  *    The fit centres the columns on their sample means, scales them to unit sum of squares and

@@ -27,9 +27,6 @@
 enum { AUX_K = 0 SAMPLED_AUX(AUX_COUNT) };
 _Static_assert(AUX_K == SAMPLED_AUX_K, "sampled.h's SAMPLED_AUX_K counts the columns of SAMPLED_AUX");
 
-/* The units a --target-error run measures first: enough for the residual variance to mean
- * something with AUX_K auxiliaries (the rule then grows the sample, sim/sampling.h). */
-#define SAMPLED_FIRST_UNITS 30u
 
 /* The sampled units' figures, kept in the order they were drawn. */
 typedef struct Measured {

@@ -192,21 +192,47 @@ Test(sampling, regression_by_hand)
     double b = sxy / sxx, a = yb - b * xb, Y = 10 * a + b * X, sse = 0;
     for (int i = 0; i < 5; i++)
         sse += (ys[i] - a - b * x[smp[i]]) * (ys[i] - a - b * x[smp[i]]);
-    double V = 100.0 * (1.0 - 0.5) / 5 * sse / 3;
-    /* ... and in exact fractions: b = 325/86, a = -375/43, Y = 10375/86, sse = 719/86, V = 3595/129. */
+    /* The variance is the delete-one jackknife's (sampling.h): each unit left out in turn, the
+     * simple regression refitted on the other four, its estimate 10 a_(j) + b_(j) X, and
+     * V = (1 - n/N) (n - 1)/n sum (Y_(j) - their mean)^2 -- brute force here, the library's is
+     * the closed form. */
+    double Yj[5], Ym = 0.0;
+    for (int d = 0; d < 5; d++) {
+        double xm = 0, ym = 0, cxx = 0, cxy = 0;
+        for (int i = 0; i < 5; i++)
+            if (i != d) {
+                xm += x[smp[i]] / 4;
+                ym += ys[i] / 4;
+            }
+        for (int i = 0; i < 5; i++)
+            if (i != d) {
+                cxx += (x[smp[i]] - xm) * (x[smp[i]] - xm);
+                cxy += (x[smp[i]] - xm) * (ys[i] - ym);
+            }
+        double bj = cxy / cxx;
+        Yj[d] = 10 * (ym - bj * xm) + bj * X;
+        Ym += Yj[d] / 5;
+    }
+    double V = 0.0;
+    for (int d = 0; d < 5; d++)
+        V += (1.0 - 0.5) * 4.0 / 5.0 * (Yj[d] - Ym) * (Yj[d] - Ym);
+    /* ... and the estimate in exact fractions: b = 325/86, a = -375/43, Y = 10375/86, sse = 719/86
+     * (the linearization variance would be 100 (1 - 1/2) / 5 sse / 3 = 3595/129). */
     cr_expect_float_eq(Y, 10375.0 / 86, 1e-9);
-    cr_expect_float_eq(V, 3595.0 / 129, 1e-9);
+    cr_expect_float_eq(sse, 719.0 / 86, 1e-9);
+    cr_expect_gt(V, 3595.0 / 129, "the jackknife is wider than the linearization here (high-leverage units)");
     SampleEstimate e;
     cr_assert_eq(sample_regression_estimate(ys, x, 1, smp, 5, 10, &e), 0);
     cr_expect_float_eq(e.total, 10375.0 / 86, 1e-9);
-    cr_expect_float_eq(e.std_error, sqrt(3595.0 / 129), 1e-9);
+    cr_expect_float_eq(e.std_error, sqrt(V), 1e-9, "library %.12g, brute force %.12g", e.std_error, sqrt(V));
     cr_expect_float_eq(e.coef[0], -375.0 / 43, 1e-9);
     cr_expect_float_eq(e.coef[1], 325.0 / 86, 1e-9);
     cr_expect_eq(e.k, 1);
     cr_expect_eq(e.df, 3);
     cr_expect_float_eq(e.t, 3.182, 1e-9);
-    cr_expect_float_eq(e.lo, 10375.0 / 86 - 3.182 * sqrt(3595.0 / 129), 1e-9);
-    cr_expect_float_eq(e.hi, 10375.0 / 86 + 3.182 * sqrt(3595.0 / 129), 1e-9);
+    /* the lower end, raised to the sampled units' own sum (100) where it falls below it */
+    cr_expect_float_eq(e.lo, fmax(10375.0 / 86 - 3.182 * sqrt(V), 100.0), 1e-9);
+    cr_expect_float_eq(e.hi, 10375.0 / 86 + 3.182 * sqrt(V), 1e-9);
     cr_expect_float_eq(e.r2, 1.0 - (719.0 / 86) / 254.0, 1e-12); /* S_yy = 254 */
 
     /* The lower end is raised to the sampled units' own sum when every y >= 0 ... */
@@ -656,7 +682,8 @@ Test(sampled_frame, interval_covers_the_detailed_run, .init = frame_setup, .fini
         worst = rel > worst ? rel : worst;
         sample_order(pop.N, seed, order);
         Meter m = {.y = pop.cycles, .order = order, .in_order = 1};
-        cr_assert_eq(sample_sequential(pop.x, SAMPLED_AUX_K, order, pop.N, 30, 0.01, meter, &m, ys, &e, NULL), 0);
+        cr_assert_eq(sample_sequential(pop.x, SAMPLED_AUX_K, order, pop.N, SAMPLED_FIRST_UNITS, 0.01, meter, &m, ys, &e,
+                                       NULL), 0);
         seq += e.lo <= pop.total_cycles && pop.total_cycles <= e.hi;
         units += e.n / 100.0;
     }
