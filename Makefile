@@ -47,7 +47,7 @@ ASMLIB_OBJ = $(patsubst %.c,$(BUILD)/obj/%.o,$(ISA_SRC) $(ASM_SRC))
 LIB_OBJ  = $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/obj/%.o,$(CXX_SRC))
 ASAN_OBJ = $(patsubst %.c,$(BUILD)/asan/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/asan/%.o,$(CXX_SRC))
 
-.PHONY: all deps install run test test-standalone test-asan test-unit test-hard test-slurm fuzz fuzz-run bench validation docs check-docs clean run-built test-built check-outputs help
+.PHONY: all deps install run test test-standalone test-asan test-unit test-hard test-slurm fuzz fuzz-run bench validation paper docs check-docs clean run-built test-built check-outputs help
 
 all: bin/sfasm bin/sfsim
 
@@ -59,7 +59,11 @@ help:
 	@echo "make test-slurm the sweep's Slurm path on a real one-node Slurm started on localhost"
 	@echo "make fuzz       build the libFuzzer targets, assembler and scene loader (clang);"
 	@echo "                make fuzz-run FUZZ_SECONDS=600 runs each for that long"
-	@echo "make bench      build and run the benchmarks in bench/ (core, functional and detailed speed, Embree)"
+	@echo "make bench      build and run the benchmarks in bench/ (core, functional and detailed speed, Embree,"
+	@echo "                sampled mode's speed against error at 512 x 512 x 16)"
+	@echo "make validation the papers' experiments at reduced size into docs/validation-data.md (needs ../shared)"
+	@echo "make paper      seed 001 Table 6 at the paper's scale in sampled mode, checked by one full detailed run"
+	@echo "                (about 90 min; PAPER_ARGS= skips the detailed run) into docs/validation-data.md"
 	@echo "make docs       regenerate docs/isa.md, docs/exit-codes.md, docs/report.md's statistics, the layout include and docs, the kernel constants, the shipped Cornell box"
 	@echo "make check-outputs  the same-outputs table alone (tests/outputs/check.sh; part of make test)"
 	@echo "make install    install into PREFIX (default /usr/local; DESTDIR honoured): docs/install.md"
@@ -280,9 +284,27 @@ $(BUILD)/validation: tools/validation.c $(BUILD)/libsfsim.a
 	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
 
 # The utilization experiments of docs/validation.md (several minutes on 2 cores).
+$(BUILD)/paper: tools/paper.c $(BUILD)/libsfsim.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
+
+# The utilization experiments of docs/validation.md (several minutes on 2 cores). The section
+# `make paper` wrote is kept.
 validation: deps
 	@$(MAKE) --no-print-directory $(BUILD)/validation
-	$(BUILD)/validation > docs/validation-data.md
+	sed -n '/<!-- make paper: begin -->/,/<!-- make paper: end -->/p' docs/validation-data.md > $(BUILD)/paper-section.md
+	$(BUILD)/validation > $(BUILD)/validation-data.md
+	cat $(BUILD)/validation-data.md $(BUILD)/paper-section.md > docs/validation-data.md
+
+# Seed 001 Table 6 at the paper's scale in sampled mode, with one full detailed run to check it
+# (tools/paper.c: about 90 minutes on 2 cores, most of it the detailed run); its section of
+# docs/validation-data.md is replaced. PAPER_ARGS= (empty) skips the detailed run.
+PAPER_ARGS ?= --check
+paper: deps
+	@$(MAKE) --no-print-directory all $(BUILD)/paper
+	$(BUILD)/paper $(PAPER_ARGS) > $(BUILD)/paper-section.md
+	sed '/<!-- make paper: begin -->/,/<!-- make paper: end -->/d' docs/validation-data.md > $(BUILD)/validation-data.md
+	cat $(BUILD)/validation-data.md $(BUILD)/paper-section.md > docs/validation-data.md
 
 bench: deps
 	@$(MAKE) --no-print-directory $(BUILD)/bench/core_speed $(BUILD)/bench/embree_xcheck $(BUILD)/bench/functional_speed \
