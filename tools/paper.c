@@ -101,7 +101,7 @@ static void print_head(const RunSize *size, int threads)
 
 static void print_point(const Point *p, double fps16, int mi, int ni)
 {
-    printf("| %s | %d | %.4f | %.4f .. %.4f | %.2f %% | %u of %u | %u | %.1f | %.1f | %.2f | %.2f | %.2f |\n",
+    printf("| %s | %d | %.5f | %.5f .. %.5f | %.2f %% | %u of %u | %u | %.1f | %.1f | %.2f | %.2f | %.2f |\n",
            p->m == 1024 ? "32x32" : "64x64", p->n, p->fps, p->lo, p->hi, 100.0 * p->half, p->units_sampled, p->units,
            p->rounds, p->seconds, p->scene_seconds, paper_fps[mi][ni], p->fps / fps16,
            paper_fps[mi][ni] / paper_fps[mi][2]);
@@ -138,7 +138,7 @@ int main(int argc, char **argv)
     if (point(&size, 16, 4096, 1, 0, &img) != 0)
         return 1;
     printf("\nAll six points: %.1f s of host time, loading included. With the image (the golden model renders\n"
-           "the whole frame), N = 16, M = 64x64: %.4f fps (95 %%: %.4f .. %.4f), %u of %u units, %.1f s + %.1f s.\n",
+           "the whole frame), N = 16, M = 64x64: %.5f fps (95 %%: %.5f .. %.5f), %u of %u units, %.1f s + %.1f s.\n",
            six, img.fps, img.lo, img.hi, img.units_sampled, img.units, img.seconds, img.scene_seconds);
     int rc = 0;
     if (check) {
@@ -146,7 +146,7 @@ int main(int argc, char **argv)
             return 1;
         const Point *e = &pts[1][2];
         int inside = e->cycles_lo <= det.cycles && det.cycles <= e->cycles_hi;
-        printf("\nThe full detailed run of N = 16, M = 64x64: %.0f cycles, %.4f fps, %.1f s of host time (+ %.1f s).\n"
+        printf("\nThe full detailed run of N = 16, M = 64x64: %.0f cycles, %.5f fps, %.1f s of host time (+ %.1f s).\n"
                "The sampled estimate without the image: %.0f cycles (95 %%: %.0f .. %.0f), error %+.2f %%, %s; host\n"
                "time %.1f s: %.0fx faster. With the image: %.1f s, %.0fx faster.\n",
                det.cycles, det.fps, det.seconds, det.scene_seconds, e->cycles, e->cycles_lo, e->cycles_hi,
