@@ -27,7 +27,6 @@
 enum { AUX_K = 0 SAMPLED_AUX(AUX_COUNT) };
 _Static_assert(AUX_K == SAMPLED_AUX_K, "sampled.h's SAMPLED_AUX_K counts the columns of SAMPLED_AUX");
 
-
 /* The sampled units' figures, kept in the order they were drawn. */
 typedef struct Measured {
     FuncSession *fs;
