@@ -351,7 +351,7 @@ install: all
 	install -m 644 configs/sweeps/*.ini $(DATADIR)/configs/sweeps/
 	install -m 644 $(SHIPPED_SCENES) $(DATADIR)/scenes/cornell/
 	install -m 644 README.md $(DOCDIR)/
-	install -m 644 docs/*.md docs/*.png $(DOCDIR)/docs/
+	install -m 644 docs/*.md $(wildcard docs/*.png) $(DOCDIR)/docs/
 	@echo "installed sfsim into $(DESTDIR)$(PREFIX) (data: $(PREFIX)/share/sfsim)"
 
 clean:

@@ -107,13 +107,26 @@ static int golden_frame(const RunScene *sc, const RunSpec *spec, const CfgMachin
     return 0;
 }
 
+const CfgMachine *run_spec_machine(const RunSpec *spec, CfgMachine *defcfg)
+{
+    if (spec->cfg)
+        return spec->cfg;
+    cfg_defaults(defcfg);
+    return defcfg;
+}
+
+const char *run_spec_kernel(const RunSpec *spec, char *kpath, size_t len)
+{
+    return spec->kernel_path ? spec->kernel_path : kernel_default_path(kpath, len);
+}
+
 /* The kernel's frame, timed as the mode says. */
 static int kernel_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg, RunFrame *fr, char *err,
                         size_t errlen)
 {
     char kpath[4200];
     FuncParams fp = {.cfg = cfg,
-                     .kernel_path = spec->kernel_path ? spec->kernel_path : kernel_default_path(kpath, sizeof kpath),
+                     .kernel_path = run_spec_kernel(spec, kpath, sizeof kpath),
                      .needs = sc->s.needs,
                      .seed = spec->seed,
                      .threads = fr->threads,
@@ -166,11 +179,7 @@ int run_frame(const RunScene *sc, const RunSpec *spec, RunFrame *fr, char *err, 
 {
     memset(fr, 0, sizeof *fr);
     CfgMachine defcfg;
-    const CfgMachine *cfg = spec->cfg;
-    if (!cfg) {
-        cfg_defaults(&defcfg);
-        cfg = &defcfg;
-    }
+    const CfgMachine *cfg = run_spec_machine(spec, &defcfg);
     if (run_spec_check(spec, err, errlen) != 0)
         return -1;
     size_t npx = (size_t)sc->s.render.width * (size_t)sc->s.render.height;
@@ -243,14 +252,10 @@ int run_trace(const PackedScene *p, uint32_t needs, const RunSpec *spec, const R
         return -1;
     }
     CfgMachine defcfg;
-    const CfgMachine *cfg = spec->cfg;
-    if (!cfg) {
-        cfg_defaults(&defcfg);
-        cfg = &defcfg;
-    }
+    const CfgMachine *cfg = run_spec_machine(spec, &defcfg);
     char kpath[4200];
     FuncParams fp = {.cfg = cfg,
-                     .kernel_path = spec->kernel_path ? spec->kernel_path : kernel_default_path(kpath, sizeof kpath),
+                     .kernel_path = run_spec_kernel(spec, kpath, sizeof kpath),
                      .needs = needs,
                      .seed = spec->seed ? spec->seed : 1,
                      .threads = spec->threads,

@@ -85,6 +85,11 @@ typedef struct RunSpec {
     void *progress_ctx;
 } RunSpec;
 
+/* spec's machine: spec->cfg, or the defaults written into *defcfg. */
+const CfgMachine *run_spec_machine(const RunSpec *spec, CfgMachine *defcfg);
+/* spec's kernel source: spec->kernel_path, or kernels/pathtrace.s beside the binary (kpath holds it). */
+const char *run_spec_kernel(const RunSpec *spec, char *kpath, size_t len);
+
 /* A rendered frame and its figures. */
 typedef struct RunFrame {
     float *rgb;                /* 3 x width x height, linear radiance */

@@ -244,14 +244,10 @@ int sampled_population(const RunScene *sc, const RunSpec *spec, SampledPopulatio
 {
     memset(pop, 0, sizeof *pop);
     CfgMachine defcfg;
-    const CfgMachine *cfg = spec->cfg;
-    if (!cfg) {
-        cfg_defaults(&defcfg);
-        cfg = &defcfg;
-    }
+    const CfgMachine *cfg = run_spec_machine(spec, &defcfg);
     char kpath[4200];
     FuncParams fp = {.cfg = cfg,
-                     .kernel_path = spec->kernel_path ? spec->kernel_path : kernel_default_path(kpath, sizeof kpath),
+                     .kernel_path = run_spec_kernel(spec, kpath, sizeof kpath),
                      .needs = sc->s.needs, .seed = spec->seed, .threads = spec->threads, .timed = 1};
     FuncSession *fs;
     if (func_open(&sc->p, &fp, &fs, err, errlen) != 0)
