@@ -115,6 +115,11 @@ const CfgMachine *run_spec_machine(const RunSpec *spec, CfgMachine *defcfg)
     return defcfg;
 }
 
+int run_spec_threads(const RunSpec *spec)
+{
+    return spec->threads > 0 ? spec->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
+}
+
 const char *run_spec_kernel(const RunSpec *spec, char *kpath, size_t len)
 {
     return spec->kernel_path ? spec->kernel_path : kernel_default_path(kpath, len);
@@ -188,7 +193,7 @@ int run_frame(const RunScene *sc, const RunSpec *spec, RunFrame *fr, char *err, 
         snprintf(err, errlen, "out of memory for a %d x %d image", sc->s.render.width, sc->s.render.height);
         return -1;
     }
-    fr->threads = spec->threads > 0 ? spec->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
+    fr->threads = run_spec_threads(spec);
     fr->tile = (int)lrint(sqrt((double)cfg->stream_rays));
     double t0 = util_now();
     int rc = run_mode_kernel(spec->mode) ? kernel_frame(sc, spec, cfg, fr, err, errlen)

@@ -87,6 +87,8 @@ typedef struct RunSpec {
 
 /* spec's machine: spec->cfg, or the defaults written into *defcfg. */
 const CfgMachine *run_spec_machine(const RunSpec *spec, CfgMachine *defcfg);
+/* spec's host threads: spec->threads, or every core. */
+int run_spec_threads(const RunSpec *spec);
 /* spec's kernel source: spec->kernel_path, or kernels/pathtrace.s beside the binary (kpath holds it). */
 const char *run_spec_kernel(const RunSpec *spec, char *kpath, size_t len);
 

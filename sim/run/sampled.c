@@ -13,7 +13,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "../reference.h"
 #include "../util.h"
@@ -224,7 +223,7 @@ static int population_aux(const RunScene *sc, const RunSpec *spec, const CfgMach
                           uint32_t pilot, double *x, char *err, size_t errlen)
 {
     uint32_t spp = (uint32_t)sc->s.render.spp;
-    RunFrame fr = {.threads = spec->threads > 0 ? spec->threads : (int)sysconf(_SC_NPROCESSORS_ONLN), .tile = (int)lrint(sqrt(cfg->stream_rays))};
+    RunFrame fr = {.threads = run_spec_threads(spec), .tile = (int)lrint(sqrt(cfg->stream_rays))};
     fr.rgb = calloc(3 * (size_t)sc->s.render.width * (size_t)sc->s.render.height, sizeof(float));
     RefUnitStats *units = calloc((size_t)ntiles * spp, sizeof *units);
     RunSpec gs = *spec;
@@ -279,10 +278,13 @@ int sampled_population(const RunScene *sc, const RunSpec *spec, SampledPopulatio
         pop->total_cycles += pop->cycles[u];
         pop->total_instructions += pop->instructions[u];
     }
+    /* With one pass per tile the pilot is the whole frame: its auxiliaries are the same. */
     uint32_t pilot = pop->spp > SAMPLED_PILOT_PASSES ? SAMPLED_PILOT_PASSES : 0;
-    if ((rc = population_aux(sc, spec, cfg, pop->ntiles, 0, pop->x, err, errlen)) == 0 &&
-        (rc = population_aux(sc, spec, cfg, pop->ntiles, pilot, pop->x_pilot, err, errlen)) == 0)
-        rc = 0;
+    rc = population_aux(sc, spec, cfg, pop->ntiles, 0, pop->x, err, errlen);
+    if (rc == 0 && pilot)
+        rc = population_aux(sc, spec, cfg, pop->ntiles, pilot, pop->x_pilot, err, errlen);
+    else if (rc == 0)
+        memcpy(pop->x_pilot, pop->x, N * SAMPLED_AUX_K * sizeof(double));
 out:;
     FuncStats st;
     char cerr[1024];
