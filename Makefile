@@ -60,7 +60,7 @@ help:
 	@echo "make fuzz       build the libFuzzer targets, assembler and scene loader (clang);"
 	@echo "                make fuzz-run FUZZ_SECONDS=600 runs each for that long"
 	@echo "make bench      build and run the benchmarks in bench/ (core, functional and detailed speed, Embree,"
-	@echo "                sampled mode's speed against error at 512 x 512 x 16)"
+	@echo "                sampled mode's speed against error at 512 x 512 x 16, per-ray time against Embree)"
 	@echo "make validation the papers' experiments at reduced size into docs/validation-data.md (needs ../shared)"
 	@echo "make paper      seed 001 Table 6 at the paper's scale in sampled mode, checked by one full detailed run"
 	@echo "                (about 90 min; PAPER_ARGS= skips the detailed run) into docs/validation-data.md"
@@ -192,7 +192,7 @@ TEST_ENV = SFSIM_BUILD=$(BUILD) SFSIM_GEN_ISADOC=$(BUILD)/gen_isadoc
 
 # The tools the test suite does not run are still built (-Werror), so they cannot rot.
 test-built: all $(BUILD)/tests/unit $(BUILD)/tests/io $(BUILD)/gen_cornell $(BUILD)/outputs_digest \
-		$(BUILD)/validation $(BUILD)/paper $(BUILD)/bench/speed_vs_error
+		$(BUILD)/validation $(BUILD)/paper $(BUILD)/bench/speed_vs_error $(BUILD)/bench/per_ray
 	@bash tests/outputs/check.sh
 	@bash tests/cli/run.sh
 	@bash tests/cli/sweep.sh
@@ -269,6 +269,10 @@ $(BUILD)/bench/embree_xcheck: bench/embree_xcheck.c tests/support/xcheck.c tests
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $^ -o $@ $(EMBREE) $(INIH) $(LDLIBS)
 
+$(BUILD)/bench/per_ray: bench/per_ray.c tests/support/xcheck.c tests/support/shared.c $(BUILD)/libsfsim.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $^ -o $@ $(EMBREE) $(INIH) $(LDLIBS)
+
 $(BUILD)/bench/functional_speed: bench/functional_speed.c tests/support/shared.c $(BUILD)/libsfsim.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
@@ -310,12 +314,13 @@ paper: deps
 
 bench: deps
 	@$(MAKE) --no-print-directory $(BUILD)/bench/core_speed $(BUILD)/bench/embree_xcheck $(BUILD)/bench/functional_speed \
-		$(BUILD)/bench/detailed_speed $(BUILD)/bench/speed_vs_error
+		$(BUILD)/bench/detailed_speed $(BUILD)/bench/speed_vs_error $(BUILD)/bench/per_ray
 	$(BUILD)/bench/core_speed
 	$(BUILD)/bench/embree_xcheck
 	$(BUILD)/bench/functional_speed
 	$(BUILD)/bench/detailed_speed
 	$(BUILD)/bench/speed_vs_error out/bench
+	$(BUILD)/bench/per_ray
 
 # ---- the example `make run` executes --------------------------------------------------------
 # The default scene on the default machine in detailed mode, sized to take one to two minutes

@@ -1,7 +1,6 @@
 /* tests/support/xcheck.c -- golden-model closest hits against Embree 3 (robust mode). */
 #include "xcheck.h"
 
-#include <embree3/rtcore.h>
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -80,21 +79,19 @@ static float t_tolerance(const Scene *s, const RefRay *r, uint32_t tri, float t)
     return 32.0f * FLT_EPSILON * mag * (1.0f + sliver) / fmaxf(c, 1e-3f);
 }
 
-int xcheck_run(const Scene *scene, const PackedScene *p, const XcheckTracer *tr, uint32_t camera_rays,
-               uint32_t random_rays, uint32_t seed, XcheckResult *out, char *err, size_t errlen)
+int xcheck_embree_open(const Scene *scene, XcheckEmbree *e, char *err, size_t errlen)
 {
-    memset(out, 0, sizeof *out);
-    out->first_bad = UINT64_MAX;
-    RTCDevice dev = rtcNewDevice("threads=1");
-    if (!dev) {
+    memset(e, 0, sizeof *e);
+    e->dev = rtcNewDevice("threads=1");
+    if (!e->dev) {
         snprintf(err, errlen, "embree: cannot create a device (error %d)", (int)rtcGetDeviceError(NULL));
         return -1;
     }
-    RTCScene es = rtcNewScene(dev);
-    rtcSetSceneFlags(es, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(es, RTC_BUILD_QUALITY_HIGH);
+    e->scene = rtcNewScene(e->dev);
+    rtcSetSceneFlags(e->scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(e->scene, RTC_BUILD_QUALITY_HIGH);
     if (scene->ntris > 0) {
-        RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+        RTCGeometry g = rtcNewGeometry(e->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
         float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                             3 * sizeof(float), 3 * (size_t)scene->ntris);
         unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
@@ -102,27 +99,65 @@ int xcheck_run(const Scene *scene, const PackedScene *p, const XcheckTracer *tr,
         if (!vb || !ib) {
             snprintf(err, errlen, "embree: cannot allocate buffers for %u triangles", scene->ntris);
             rtcReleaseGeometry(g);
-            rtcReleaseScene(es);
-            rtcReleaseDevice(dev);
+            xcheck_embree_close(e);
             return -1;
         }
         memcpy(vb, scene->pos, sizeof(float) * 9 * (size_t)scene->ntris);
         for (uint32_t i = 0; i < 3 * scene->ntris; i++)
             ib[i] = i;
         rtcCommitGeometry(g);
-        rtcAttachGeometry(es, g);
+        rtcAttachGeometry(e->scene, g);
         rtcReleaseGeometry(g);
     }
-    rtcCommitScene(es);
+    double t0 = util_now();
+    rtcCommitScene(e->scene);
+    e->build_seconds = util_now() - t0;
+    if (rtcGetDeviceError(e->dev) != RTC_ERROR_NONE) {
+        snprintf(err, errlen, "embree: the scene's build failed (error %d)", (int)rtcGetDeviceError(e->dev));
+        xcheck_embree_close(e);
+        return -1;
+    }
+    return 0;
+}
 
+void xcheck_embree_close(XcheckEmbree *e)
+{
+    if (e->scene)
+        rtcReleaseScene(e->scene);
+    if (e->dev)
+        rtcReleaseDevice(e->dev);
+    memset(e, 0, sizeof *e);
+}
+
+XcheckVerdict xcheck_compare(const Scene *scene, const PackedScene *p, const RefRay *r, const RefHit *ours,
+                             int ehit, uint32_t eprim, float et)
+{
+    int ohit = ours->prim != REF_NO_HIT;
+    if (!ehit || !ohit)
+        return ehit == ohit ? XCHECK_AGREE : XCHECK_DISAGREE;
+    uint32_t prims = sm_u32(p, sm_hdr(p, SM_HDR_PRIMS));
+    uint32_t osrc = sm_u32(p, sm_rec(prims, SM_PRIM_WORDS, ours->prim, SM_PRIM_SRC));
+    int close = fabsf(ours->t - et) <= t_tolerance(scene, r, osrc, ours->t);
+    if (osrc == eprim)
+        return close ? XCHECK_AGREE : XCHECK_DISAGREE;
+    return close ? XCHECK_TIE : XCHECK_DISAGREE;
+}
+
+int xcheck_run(const Scene *scene, const PackedScene *p, const XcheckTracer *tr, uint32_t camera_rays,
+               uint32_t random_rays, uint32_t seed, XcheckResult *out, char *err, size_t errlen)
+{
+    memset(out, 0, sizeof *out);
+    out->first_bad = UINT64_MAX;
+    XcheckEmbree e;
+    if (xcheck_embree_open(scene, &e, err, errlen) != 0)
+        return -1;
     uint32_t n = camera_rays + random_rays;
     RefHit *ours = malloc(sizeof(RefHit) * n);
     RefRay *rays = malloc(sizeof(RefRay) * n);
     if (!ours || !rays) {
         free(ours);
         free(rays);
-        rtcReleaseScene(es);
-        rtcReleaseDevice(dev);
+        xcheck_embree_close(&e);
         snprintf(err, errlen, "xcheck: out of memory for %u rays", n);
         return -1;
     }
@@ -140,47 +175,24 @@ int xcheck_run(const Scene *scene, const PackedScene *p, const XcheckTracer *tr,
         ref_closest_hit(p, &rays[i], &b, NULL);
         out->unlike_bvh += b.prim != ours[i].prim || (b.prim != REF_NO_HIT && memcmp(&b, &ours[i], sizeof b) != 0);
     }
-    uint32_t prims = sm_u32(p, sm_hdr(p, SM_HDR_PRIMS));
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     double te = 0.0;
     for (uint32_t i = 0; i < n; i++) {
         struct RTCRayHit rh;
         memset(&rh, 0, sizeof rh);
-        rh.ray.org_x = rays[i].org[0];
-        rh.ray.org_y = rays[i].org[1];
-        rh.ray.org_z = rays[i].org[2];
-        rh.ray.dir_x = rays[i].dir[0];
-        rh.ray.dir_y = rays[i].dir[1];
-        rh.ray.dir_z = rays[i].dir[2];
-        rh.ray.tnear = 0.0f;
-        rh.ray.tfar = INFINITY;
-        rh.ray.mask = 0xFFFFFFFFu;
+        xcheck_embree_ray(&rays[i], &rh.ray);
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         double a = util_now();
-        rtcIntersect1(es, &ctx, &rh);
+        rtcIntersect1(e.scene, &ctx, &rh);
         te += util_now() - a;
-        int ehit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-        int ohit = ours[i].prim != REF_NO_HIT;
-        uint32_t osrc = ohit ? sm_u32(p, sm_rec(prims, SM_PRIM_WORDS, ours[i].prim, SM_PRIM_SRC)) : 0;
-        out->hits += (uint64_t)ohit;
-        int ok;
-        if (!ehit || !ohit) {
-            ok = ehit == ohit;
-        } else {
-            float tol = t_tolerance(scene, &rays[i], osrc, ours[i].t);
-            int close = fabsf(ours[i].t - rh.ray.tfar) <= tol;
-            if (osrc == rh.hit.primID) {
-                ok = close;
-            } else if (close) {
-                out->ties++;
-                continue;
-            } else {
-                ok = 0;
-            }
-        }
-        if (ok) {
+        out->hits += (uint64_t)(ours[i].prim != REF_NO_HIT);
+        XcheckVerdict v = xcheck_compare(scene, p, &rays[i], &ours[i], rh.hit.geomID != RTC_INVALID_GEOMETRY_ID,
+                                         rh.hit.primID, rh.ray.tfar);
+        if (v == XCHECK_AGREE) {
             out->agree++;
+        } else if (v == XCHECK_TIE) {
+            out->ties++;
         } else {
             out->disagree++;
             if (out->first_bad == UINT64_MAX)
@@ -192,7 +204,20 @@ int xcheck_run(const Scene *scene, const PackedScene *p, const XcheckTracer *tr,
     out->embree_seconds = te;
     free(ours);
     free(rays);
-    rtcReleaseScene(es);
-    rtcReleaseDevice(dev);
+    xcheck_embree_close(&e);
     return 0;
+}
+
+void xcheck_embree_ray(const RefRay *r, struct RTCRay *er)
+{
+    memset(er, 0, sizeof *er);
+    er->org_x = r->org[0];
+    er->org_y = r->org[1];
+    er->org_z = r->org[2];
+    er->dir_x = r->dir[0];
+    er->dir_y = r->dir[1];
+    er->dir_z = r->dir[2];
+    er->tnear = 0.0f;
+    er->tfar = r->tmax;
+    er->mask = 0xFFFFFFFFu;
 }

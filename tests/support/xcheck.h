@@ -7,10 +7,12 @@
 #ifndef SFSIM_XCHECK_H
 #define SFSIM_XCHECK_H
 
+#include <embree3/rtcore.h>
 #include <stdint.h>
 
 #include "../../scenes/kdtree.h"
 #include "../../scenes/pack.h"
+#include "../../sim/ref_trace.h"
 
 typedef struct XcheckResult {
     uint64_t rays;
@@ -35,5 +37,24 @@ typedef struct XcheckTracer {
  * 0, or -1 with a message (Embree device or build failure). */
 int xcheck_run(const Scene *scene, const PackedScene *p, const XcheckTracer *tr, uint32_t camera_rays,
                uint32_t random_rays, uint32_t seed, XcheckResult *out, char *err, size_t errlen);
+
+/* Embree 3 over a scene's triangles (primID = source triangle): one thread, robust, the
+ * high-quality build (SAH with spatial splits); build_seconds times rtcCommitScene alone. */
+typedef struct XcheckEmbree {
+    RTCDevice dev;
+    RTCScene scene;
+    double build_seconds;
+} XcheckEmbree;
+
+/* 0, or -1 with a message (the device, a buffer or the build failed; nothing is left open). */
+int xcheck_embree_open(const Scene *scene, XcheckEmbree *e, char *err, size_t errlen);
+void xcheck_embree_close(XcheckEmbree *e);
+/* r as Embree's ray: tnear 0, tfar r->tmax, every mask bit. */
+void xcheck_embree_ray(const RefRay *r, struct RTCRay *er);
+
+/* The agreement rule: our closest hit against Embree's (ehit: it hit; eprim its primID, et its t). */
+typedef enum XcheckVerdict { XCHECK_AGREE = 0, XCHECK_TIE = 1, XCHECK_DISAGREE = 2 } XcheckVerdict;
+XcheckVerdict xcheck_compare(const Scene *scene, const PackedScene *p, const RefRay *r, const RefHit *ours,
+                             int ehit, uint32_t eprim, float et);
 
 #endif
