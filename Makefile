@@ -6,9 +6,16 @@ CXX     ?= c++
 CLANG   ?= clang
 OPT     ?= -O2
 WARN    := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wmissing-prototypes
-CFLAGS  := -std=c11 $(OPT) -g $(WARN) -D_GNU_SOURCE $(EXTRA_CFLAGS)
+# Built for this host's instruction set (-march=native); `make PORTABLE=1` builds for the
+# compiler's baseline target instead, for binaries that must run on other machines. Results are
+# identical either way (docs/performance.md): ISO C/C++ mode and -ffp-contract=off forbid fusing
+# a multiply and an add, nothing uses -ffast-math, so only the choice of host instructions
+# changes; make test-portable checks a portable build against the same-outputs table.
+PORTABLE ?=
+ARCH    := $(if $(PORTABLE),,-march=native) -ffp-contract=off
+CFLAGS  := -std=c11 $(OPT) $(ARCH) -g $(WARN) -D_GNU_SOURCE $(EXTRA_CFLAGS)
 CXXWARN := -Wall -Wextra -Werror
-CXXFLAGS := -std=c++17 $(OPT) -g $(CXXWARN) $(EXTRA_CXXFLAGS)
+CXXFLAGS := -std=c++17 $(OPT) $(ARCH) -g $(CXXWARN) $(EXTRA_CXXFLAGS)
 # C++ appears only inside the shims that wrap C++ libraries (ARCHITECTURE.md Sec. 2).
 GLTF    := $(shell pkg-config --libs tinygltf 2>/dev/null || echo -ltinygltf)
 OIIO    := $(shell pkg-config --libs OpenImageIO 2>/dev/null || echo -lOpenImageIO -lOpenImageIO_Util)
@@ -19,6 +26,11 @@ CRIT    := $(shell pkg-config --libs criterion 2>/dev/null || echo -lcriterion)
 EMBREE  := -lembree3
 
 BUILD   ?= build
+BIN     ?= bin
+# Objects depend on the flags they were compiled with: switching PORTABLE (or OPT) rebuilds.
+FLAGS_STAMP := $(BUILD)/.flags
+$(shell mkdir -p $(BUILD) && (echo '$(CC) $(CFLAGS) | $(CXX) $(CXXFLAGS)' | cmp -s - $(FLAGS_STAMP) || \
+        echo '$(CC) $(CFLAGS) | $(CXX) $(CXXFLAGS)' > $(FLAGS_STAMP)))
 SAN     := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 
 # Library sources: everything but the programs' main files.
@@ -47,9 +59,9 @@ ASMLIB_OBJ = $(patsubst %.c,$(BUILD)/obj/%.o,$(ISA_SRC) $(ASM_SRC))
 LIB_OBJ  = $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/obj/%.o,$(CXX_SRC))
 ASAN_OBJ = $(patsubst %.c,$(BUILD)/asan/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/asan/%.o,$(CXX_SRC))
 
-.PHONY: all deps install run test test-standalone test-asan test-unit test-hard test-slurm fuzz fuzz-run bench validation paper docs check-docs clean run-built test-built check-outputs help
+.PHONY: all deps install run test test-standalone test-asan test-unit test-hard test-slurm test-portable fuzz fuzz-run bench validation paper docs check-docs clean run-built test-built check-outputs help
 
-all: bin/sfasm bin/sfsim
+all: $(BIN)/sfasm $(BIN)/sfsim
 
 help:
 	@echo "make run        install deps, build, run the example program"
@@ -66,11 +78,21 @@ help:
 	@echo "                (about 90 min; PAPER_ARGS= skips the detailed run) into docs/validation-data.md"
 	@echo "make docs       regenerate docs/isa.md, docs/exit-codes.md, docs/report.md's statistics, the layout include and docs, the kernel constants, the shipped Cornell box"
 	@echo "make check-outputs  the same-outputs table alone (tests/outputs/check.sh; part of make test)"
+	@echo "make test-portable  the same table from a PORTABLE=1 build (the default builds for this host's CPU)"
 	@echo "make install    install into PREFIX (default /usr/local; DESTDIR honoured): docs/install.md"
 
 # The same-outputs table (tests/outputs/outputs.tsv): cycles, instructions, image and report hashes.
 check-outputs: all $(BUILD)/outputs_digest
 	@bash tests/outputs/check.sh
+
+# The same table from a build for the compiler's baseline target (PORTABLE=1) in $(BUILD)/portable:
+# with make test's run of it on the default build for this host, the two builds give the same
+# results (CI runs both).
+test-portable: deps
+	@$(MAKE) --no-print-directory PORTABLE=1 BUILD=$(BUILD)/portable BIN=$(BUILD)/portable/bin \
+		$(BUILD)/portable/bin/sfsim $(BUILD)/portable/bin/sfasm $(BUILD)/portable/outputs_digest
+	SFSIM_DATA_DIR=$(CURDIR) SFSIM=$(BUILD)/portable/bin/sfsim SFASM=$(BUILD)/portable/bin/sfasm \
+		OUTPUTS_DIGEST=$(BUILD)/portable/outputs_digest bash tests/outputs/check.sh
 
 deps:
 	@bash scripts/deps.sh
@@ -81,19 +103,19 @@ run: deps
 test: deps
 	@$(MAKE) --no-print-directory test-built
 
-$(BUILD)/obj/%.o: %.c
+$(BUILD)/obj/%.o: %.c $(FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -MMD -MP -c $< -o $@
 
-$(BUILD)/asan/%.o: %.c
+$(BUILD)/asan/%.o: %.c $(FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(SAN) -MMD -MP -c $< -o $@
 
-$(BUILD)/obj/%.o: %.cpp
+$(BUILD)/obj/%.o: %.cpp $(FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS) -MMD -MP -c $< -o $@
 
-$(BUILD)/asan/%.o: %.cpp
+$(BUILD)/asan/%.o: %.cpp $(FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS) $(SAN) -MMD -MP -c $< -o $@
 
@@ -112,12 +134,12 @@ $(BUILD)/libsfsim-asan.a: $(ASAN_OBJ)
 	@rm -f $@
 	$(AR) rcs $@ $^
 
-bin/sfasm: $(BUILD)/obj/asm/main_sfasm.o $(BUILD)/libsfasm.a
-	@mkdir -p bin
+$(BIN)/sfasm: $(BUILD)/obj/asm/main_sfasm.o $(BUILD)/libsfasm.a
+	@mkdir -p $(BIN)
 	$(CC) $(CFLAGS) $^ -o $@ -lm
 
-bin/sfsim: $(BUILD)/obj/sim/main.o $(BUILD)/libsfsim.a
-	@mkdir -p bin
+$(BIN)/sfsim: $(BUILD)/obj/sim/main.o $(BUILD)/libsfsim.a
+	@mkdir -p $(BIN)
 	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
 
 # ---- tools and docs -------------------------------------------------------------------------

@@ -429,6 +429,7 @@ static void startup_time(void)
     double best = INFINITY;
     int status = 0;
     for (int rep = 0; rep < 5; rep++) {
+        fflush(stdout); /* or the child's freopen writes the parent's buffered lines again */
         double t0 = util_now();
         pid_t pid = fork();
         if (pid == 0) {
