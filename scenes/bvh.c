@@ -25,16 +25,17 @@ void bvh_default_params(BvhParams *p)
  * is never read back. */
 typedef struct Box { _Alignas(16) float lo[4]; float hi[4]; } Box;
 
-/* The minimum and maximum of glibc's x86-64 fminf / fmaxf (minss / maxss), which the trees were
- * first built with: on a tie they return the second argument, so when -0.0 and +0.0 meet, the one
- * seen last is kept. Inlined, and the stored zeros stay the same bytes. No NaN reaches them:
- * bvh_build rejects NaN boxes, and centroids of finite boxes are finite or infinite. */
-static inline float min_last(float cur, float x) { return cur < x ? cur : x; }
-static inline float max_last(float cur, float x) { return cur > x ? cur : x; }
-/* The same result as min_last / max_last over a sequence visited backwards: keep the value
- * already held on a tie (it is the later one in the forward order). */
-static inline float min_first(float cur, float x) { return x < cur ? x : cur; }
-static inline float max_first(float cur, float x) { return x > cur ? x : cur; }
+/* The minimum and maximum the trees were first built with, bit for bit. That build called libm's
+ * fminf(new, held) / fmaxf(new, held) (GCC orders the operands of these commutative calls so) and
+ * glibc's x86-64 fminf / fmaxf (minss / maxss) return their second operand on a tie: so the value
+ * already held stays, which decides between -0.0 and +0.0 and so the bytes stored. No NaN reaches
+ * them: bvh_build rejects NaN boxes, and centroids of finite boxes are finite or infinite. */
+static inline float min_keep(float held, float x) { return x < held ? x : held; }
+static inline float max_keep(float held, float x) { return x > held ? x : held; }
+/* The same result over a sequence visited backwards: on a tie take the new value (it comes
+ * earlier in the forward order). */
+static inline float min_take(float held, float x) { return held < x ? held : x; }
+static inline float max_take(float held, float x) { return held > x ? held : x; }
 
 static const Box box_none = {{INFINITY, INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY, -INFINITY}};
 
@@ -44,8 +45,8 @@ static void box_empty(Box *b) { *b = box_none; }
 static inline void box_grow(Box *restrict b, const float *restrict lo, const float *restrict hi)
 {
     for (int k = 0; k < 4; k++) {
-        b->lo[k] = min_last(b->lo[k], lo[k]);
-        b->hi[k] = max_last(b->hi[k], hi[k]);
+        b->lo[k] = min_keep(b->lo[k], lo[k]);
+        b->hi[k] = max_keep(b->hi[k], hi[k]);
     }
 }
 
@@ -54,8 +55,8 @@ static inline void box_grow(Box *restrict b, const float *restrict lo, const flo
 static inline void box_grow_backwards(Box *restrict b, const float *restrict lo, const float *restrict hi)
 {
     for (int k = 0; k < 4; k++) {
-        b->lo[k] = min_first(b->lo[k], lo[k]);
-        b->hi[k] = max_first(b->hi[k], hi[k]);
+        b->lo[k] = min_take(b->lo[k], lo[k]);
+        b->hi[k] = max_take(b->hi[k], hi[k]);
     }
 }
 
