@@ -56,6 +56,28 @@ static uint8_t srgb_encode8(float lin)
     return (uint8_t)lrintf(e * 255.0f);
 }
 
+/* srgb_encode8 once per distinct value: three powf per texel were most of a textured scene's
+ * packing (sponza), and textures decoded from 8-bit files hold at most 256 values per channel.
+ * Direct-mapped on the float's bits; a miss computes srgb_encode8, so every byte is the same. */
+enum { SRGB_CACHE_SLOTS = 4096 };
+typedef struct SrgbCache {
+    uint64_t slot[SRGB_CACHE_SLOTS]; /* bits << 32 | 0x100 | code; 0: empty */
+} SrgbCache;
+
+static uint8_t srgb_encode8_cached(SrgbCache *c, float lin)
+{
+    if (!c)
+        return srgb_encode8(lin);
+    uint32_t bits;
+    memcpy(&bits, &lin, 4);
+    uint64_t *e = &c->slot[(bits * 2654435761u) >> 20];
+    if ((*e & 0x100u) && (uint32_t)(*e >> 32) == bits)
+        return (uint8_t)*e;
+    uint8_t code = srgb_encode8(lin);
+    *e = (uint64_t)bits << 32 | 0x100u | code;
+    return code;
+}
+
 static float srgb_decode8(int code)
 {
     float c = (float)code / 255.0f;
@@ -311,6 +333,7 @@ static void pack_materials(Writer *w, const Scene *s, const Layout *l)
 static void pack_textures(Writer *w, const Scene *s, const Layout *l)
 {
     uint32_t texs = l->texs;
+    SrgbCache *cache = s->ntextures ? calloc(1, sizeof *cache) : NULL; /* NULL: uncached, same bytes */
     for (uint32_t t = 0; t < s->ntextures; t++) {
         const SceneTexture *tx = &s->textures[t];
         put_u32(w, sm_rec(texs, SM_TEX_WORDS, t, SM_TEX_WIDTH), (uint32_t)tx->width);
@@ -320,11 +343,13 @@ static void pack_textures(Writer *w, const Scene *s, const Layout *l)
         for (size_t i = 0; i < n; i++) {
             const float *c = &tx->rgba[4 * i];
             float a = c[3] <= 0.0f ? 0.0f : (c[3] >= 1.0f ? 1.0f : c[3]);
-            uint32_t word = (uint32_t)srgb_encode8(c[0]) | (uint32_t)srgb_encode8(c[1]) << 8 |
-                            (uint32_t)srgb_encode8(c[2]) << 16 | (uint32_t)lrintf(a * 255.0f) << 24;
+            uint32_t word = (uint32_t)srgb_encode8_cached(cache, c[0]) |
+                            (uint32_t)srgb_encode8_cached(cache, c[1]) << 8 |
+                            (uint32_t)srgb_encode8_cached(cache, c[2]) << 16 | (uint32_t)lrintf(a * 255.0f) << 24;
             put_u32(w, l->texels[t] + 4u * (uint32_t)i, word);
         }
     }
+    free(cache);
 }
 
 /* The file's lights: records 0 .. nlights-1 of the light table. */
