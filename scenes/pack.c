@@ -56,6 +56,28 @@ static uint8_t srgb_encode8(float lin)
     return (uint8_t)lrintf(e * 255.0f);
 }
 
+/* srgb_encode8 once per distinct value: three powf per texel were most of a textured scene's
+ * packing (sponza), and textures decoded from 8-bit files hold at most 256 values per channel.
+ * Direct-mapped on the float's bits; a miss computes srgb_encode8, so every byte is the same. */
+enum { SRGB_CACHE_SLOTS = 4096 };
+typedef struct SrgbCache {
+    uint64_t slot[SRGB_CACHE_SLOTS]; /* bits << 32 | 0x100 | code; 0: empty */
+} SrgbCache;
+
+static uint8_t srgb_encode8_cached(SrgbCache *c, float lin)
+{
+    if (!c)
+        return srgb_encode8(lin);
+    uint32_t bits;
+    memcpy(&bits, &lin, 4);
+    uint64_t *e = &c->slot[(bits * 2654435761u) >> 20];
+    if ((*e & 0x100u) && (uint32_t)(*e >> 32) == bits)
+        return (uint8_t)*e;
+    uint8_t code = srgb_encode8(lin);
+    *e = (uint64_t)bits << 32 | 0x100u | code;
+    return code;
+}
+
 static float srgb_decode8(int code)
 {
     float c = (float)code / 255.0f;
@@ -116,6 +138,23 @@ static int32_t emissive_texture(const Scene *s, const SceneMaterial *m)
                                                                                               : -1;
 }
 
+/* A triangle's extent on one axis from its vertices' coordinates a, b, c, as the first packer
+ * computed it with libm: the object code called fminf(fminf(c, b), a) (GCC orders the operands of
+ * these commutative calls so) and glibc's x86-64 fminf returns its second operand on a tie. So the
+ * value is the minimum, and between -0.0 and +0.0 the earlier vertex's: the bytes of the node
+ * boxes stay the same. Inlined: they were two million libm calls on the conference room. */
+static inline float tri_min(float a, float b, float c)
+{
+    float m = b < a ? b : a;
+    return c < m ? c : m;
+}
+
+static inline float tri_max(float a, float b, float c)
+{
+    float m = b > a ? b : a;
+    return c > m ? c : m;
+}
+
 /* The BVH over the triangles' and spheres' bounding boxes, its invariants checked. */
 static int pack_build_bvh(const Scene *s, const BvhParams *bp, uint32_t nprims, Bvh *bvh, char *err,
                           size_t errlen)
@@ -131,8 +170,8 @@ static int pack_build_bvh(const Scene *s, const BvhParams *bp, uint32_t nprims, 
     for (uint32_t i = 0; i < s->ntris; i++) {
         const float *p = &s->pos[9 * i];
         for (int k = 0; k < 3; k++) {
-            lo[3 * i + k] = fminf(p[k], fminf(p[3 + k], p[6 + k]));
-            hi[3 * i + k] = fmaxf(p[k], fmaxf(p[3 + k], p[6 + k]));
+            lo[3 * i + k] = tri_min(p[k], p[3 + k], p[6 + k]);
+            hi[3 * i + k] = tri_max(p[k], p[3 + k], p[6 + k]);
         }
     }
     for (uint32_t j = 0; j < s->nspheres; j++) {
@@ -190,6 +229,26 @@ static int pack_lay_out(Writer *w, const Scene *s, Layout *l, char *err, size_t 
         return -1;
     }
     return 0;
+}
+
+/* pack_lay_out into one zeroed block of the image's size: a first pass with no memory learns the
+ * size (w_alloc never grows a writer whose capacity is unbounded), the second reserves the same
+ * addresses. Growing the block by doubling zeroed up to twice the image and copied it: a tenth of
+ * the conference room's packing time, most of it in page faults. 0, or -1 with a message. */
+static int pack_reserve(Writer *w, const Scene *s, Layout *l, char *err, size_t errlen)
+{
+    Writer probe = {NULL, 0, SIZE_MAX, w->base, 0};
+    Layout sized = *l;
+    if (pack_lay_out(&probe, s, &sized, err, errlen) != 0)
+        return -1;
+    free(sized.texels);
+    w->mem = calloc(probe.size ? probe.size : 1, 1);
+    if (!w->mem) {
+        snprintf(err, errlen, "pack: scene does not fit in memory (%zu bytes)", probe.size);
+        return -1;
+    }
+    w->cap = probe.size;
+    return pack_lay_out(w, s, l, err, errlen);
 }
 
 /* The header: counts, table addresses, render settings, camera, bounds. */
@@ -294,6 +353,7 @@ static void pack_materials(Writer *w, const Scene *s, const Layout *l)
 static void pack_textures(Writer *w, const Scene *s, const Layout *l)
 {
     uint32_t texs = l->texs;
+    SrgbCache *cache = s->ntextures ? calloc(1, sizeof *cache) : NULL; /* NULL: uncached, same bytes */
     for (uint32_t t = 0; t < s->ntextures; t++) {
         const SceneTexture *tx = &s->textures[t];
         put_u32(w, sm_rec(texs, SM_TEX_WORDS, t, SM_TEX_WIDTH), (uint32_t)tx->width);
@@ -303,11 +363,13 @@ static void pack_textures(Writer *w, const Scene *s, const Layout *l)
         for (size_t i = 0; i < n; i++) {
             const float *c = &tx->rgba[4 * i];
             float a = c[3] <= 0.0f ? 0.0f : (c[3] >= 1.0f ? 1.0f : c[3]);
-            uint32_t word = (uint32_t)srgb_encode8(c[0]) | (uint32_t)srgb_encode8(c[1]) << 8 |
-                            (uint32_t)srgb_encode8(c[2]) << 16 | (uint32_t)lrintf(a * 255.0f) << 24;
+            uint32_t word = (uint32_t)srgb_encode8_cached(cache, c[0]) |
+                            (uint32_t)srgb_encode8_cached(cache, c[1]) << 8 |
+                            (uint32_t)srgb_encode8_cached(cache, c[2]) << 16 | (uint32_t)lrintf(a * 255.0f) << 24;
             put_u32(w, l->texels[t] + 4u * (uint32_t)i, word);
         }
     }
+    free(cache);
 }
 
 /* The file's lights: records 0 .. nlights-1 of the light table. */
@@ -399,7 +461,7 @@ int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *
     /* Emissive triangles and file lights become light records. */
     Layout l = {.nprims = nprims, .nnodes = out->bvh.nnodes, .nlights = s->nlights + s->nemissive};
     Writer w = {NULL, 0, 0, base, 0};
-    if (pack_lay_out(&w, s, &l, err, errlen) != 0) {
+    if (pack_reserve(&w, s, &l, err, errlen) != 0) {
         free(w.mem);
         bvh_free(&out->bvh);
         return -1;

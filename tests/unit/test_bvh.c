@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "../../scenes/bvh.h"
+#include "../support/bvh_ref.h"
 
 static uint32_t rng_state = 12345u;
 static float frand(void)
@@ -231,4 +232,92 @@ Test(bvh_errors, checker_catches_broken_trees)
     bvh_free(&b);
     free(lo);
     free(hi);
+}
+
+/* Boxes for the reference comparison, family f: 0 unit-cube boxes; 1 a coarse lattice where
+ * coordinates tie and zeros come with either sign; 2 all the same box (the halving path); 3
+ * boxes near FLT_MAX (infinite centroids and extents); 4 denormal extents. */
+static void family_boxes(int f, uint32_t n, float *lo, float *hi)
+{
+    for (uint32_t i = 0; i < n; i++) {
+        for (int k = 0; k < 3; k++) {
+            float a, b;
+            if (f == 0) {
+                float c = frand(), e = 0.01f * frand();
+                a = c - e;
+                b = c + e;
+            } else if (f == 1) {
+                a = (float)((int)(frand() * 9.0f) - 4) * 0.5f;
+                b = a + (float)(int)(frand() * 3.0f) * 0.5f;
+                if (a == 0.0f && frand() < 0.5f)
+                    a = -0.0f;
+                if (b == 0.0f && frand() < 0.5f)
+                    b = -0.0f;
+            } else if (f == 2) {
+                a = -1.0f;
+                b = 1.0f;
+            } else if (f == 3) {
+                a = (frand() < 0.5f ? -3.0e38f : 1.0e38f) * frand();
+                b = a + 2.0e38f * frand();
+            } else {
+                a = 1.0e-40f * (float)(int)(frand() * 4.0f);
+                b = a + 1.0e-40f * (float)(int)(frand() * 2.0f);
+            }
+            lo[3 * i + k] = a;
+            hi[3 * i + k] = b;
+        }
+    }
+}
+
+/* The fast builder's trees are the plain builder's, bit for bit: every node's box (zeros' signs
+ * included), the primitive order, depth and cost, over degenerate inputs and several parameter
+ * sets. */
+Test(bvh_build, matches_the_plain_reference_bit_for_bit)
+{
+    static const BvhParams params[] = {{4, 16, 1.0f, 1.0f}, {1, 2, 1.0f, 1.0f}, {8, 256, 0.5f, 1.0f},
+                                       {2, 7, 1.0f, 2.0f}, {16, 3, 0.0f, 1.0f}};
+    uint32_t n = 3000;
+    float *lo = malloc(sizeof(float) * 3 * n), *hi = malloc(sizeof(float) * 3 * n);
+    char err[256];
+    for (int f = 0; f < 5; f++) {
+        family_boxes(f, n, lo, hi);
+        for (size_t q = 0; q < sizeof params / sizeof params[0]; q++) {
+            Bvh fast, ref;
+            cr_assert_eq(bvh_build(&params[q], lo, hi, n, &fast, err, sizeof err), 0, "%s", err);
+            cr_assert_eq(bvh_ref_build(&params[q], lo, hi, n, &ref), 0);
+            cr_expect_eq(bvh_check(&fast, lo, hi, err, sizeof err), 0, "family %d: %s", f, err);
+            cr_assert_eq(fast.nnodes, ref.nnodes, "family %d, parameters %zu", f, q);
+            cr_expect_eq(memcmp(fast.nodes, ref.nodes, sizeof(BvhNode) * ref.nnodes), 0,
+                         "family %d, parameters %zu: nodes differ", f, q);
+            cr_expect_eq(memcmp(fast.prim_index, ref.prim_index, sizeof(uint32_t) * n), 0,
+                         "family %d, parameters %zu: primitive order differs", f, q);
+            cr_expect_eq(fast.depth, ref.depth);
+            cr_expect_eq(fast.nleaves, ref.nleaves);
+            cr_expect(fast.sah_cost == ref.sah_cost, "family %d, parameters %zu: %.17g != %.17g", f, q,
+                      fast.sah_cost, ref.sah_cost);
+            bvh_free(&fast);
+            bvh_free(&ref);
+        }
+    }
+    free(lo);
+    free(hi);
+}
+
+/* The tie rule the trees were first built with: a box keeps the zero it holds when the other
+ * sign comes later (the first build's fminf(new, held) returned held on a tie). The root box of
+ * +0 then -0 keeps +0; of -0 then +0 keeps -0. */
+Test(bvh_build, a_box_keeps_the_first_zero_on_a_tie)
+{
+    BvhParams p;
+    bvh_default_params(&p);
+    for (int first_negative = 0; first_negative < 2; first_negative++) {
+        float z0 = first_negative ? -0.0f : 0.0f, z1 = first_negative ? 0.0f : -0.0f;
+        float lo[6] = {z0, 0, 0, z1, 1, 0}, hi[6] = {z0, 1, 1, z1, 2, 1};
+        Bvh b;
+        char err[256];
+        cr_assert_eq(bvh_build(&p, lo, hi, 2, &b, err, sizeof err), 0, "%s", err);
+        cr_expect_eq(signbit(b.nodes[0].bmin[0]) != 0, first_negative, "root bmin.x %g", (double)b.nodes[0].bmin[0]);
+        cr_expect_eq(signbit(b.nodes[0].bmax[0]) != 0, first_negative, "root bmax.x %g", (double)b.nodes[0].bmax[0]);
+        bvh_free(&b);
+    }
 }

@@ -156,6 +156,77 @@ Test(pack, rejects_unaligned_base)
     cr_expect_str_eq(err, "pack: base address 0x64 is not a multiple of 64");
 }
 
+/* The sRGB encoding of texels, computed once per distinct value by the packer, gives every texel
+ * the byte the formula gives: 3 x 64 x 64 values, a third of them repeats, in slots that collide. */
+static uint8_t encode_srgb(float lin)
+{
+    float x = lin <= 0.0f ? 0.0f : (lin >= 1.0f ? 1.0f : lin);
+    float e = x <= 0.0031308f ? 12.92f * x : 1.055f * powf(x, 1.0f / 2.4f) - 0.055f;
+    return (uint8_t)lrintf(e * 255.0f);
+}
+
+Test(pack, every_texel_is_encoded_by_the_formula)
+{
+    enum { SIDE = 64 };
+    static float texels[SIDE * SIDE * 4];
+    uint32_t st = 99u;
+    for (int i = 0; i < SIDE * SIDE * 4; i++) {
+        st = st * 1664525u + 1013904223u;
+        float v = (float)(st >> 8) / 16777216.0f * 1.2f - 0.1f;
+        texels[i] = i % 3 == 2 && i > 0 ? texels[i / 2] : v;
+    }
+    Scene s;
+    tiny_scene(&s);
+    SceneTexture tex = {"big", SIDE, SIDE, texels};
+    s.textures = &tex;
+    BvhParams bp;
+    bvh_default_params(&bp);
+    PackedScene p;
+    char err[256];
+    cr_assert_eq(pack_scene(&s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
+    uint32_t texs = sm_u32(&p, sm_hdr(&p, SM_HDR_TEXS));
+    uint32_t at = sm_u32(&p, sm_rec(texs, SM_TEX_WORDS, 0, SM_TEX_TEXELS));
+    for (int i = 0; i < SIDE * SIDE; i++) {
+        uint32_t word = sm_u32(&p, at + 4u * (uint32_t)i);
+        for (int k = 0; k < 3; k++)
+            cr_assert_eq(word >> (8 * k) & 0xffu, encode_srgb(texels[4 * i + k]), "texel %d channel %d (%g)", i, k,
+                         (double)texels[4 * i + k]);
+    }
+    pack_free(&p);
+}
+
+/* A triangle's box on an axis where two vertices hold zeros of opposite signs keeps the earlier
+ * vertex's zero, as the first packer's libm calls did (the node box bytes depend on it): x ties at
+ * the minimum (the third vertex at 1), y at the maximum (the third at -1). */
+Test(pack, triangle_box_keeps_the_earlier_vertex_zero)
+{
+    static const int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+    for (int pr = 0; pr < 3; pr++)
+        for (int neg_first = 0; neg_first < 2; neg_first++) {
+            Scene s;
+            tiny_scene(&s);
+            float pos[9] = {1, -1, -1, 1, -1, -1, 1, -1, -1};
+            int i = pairs[pr][0], j = pairs[pr][1];
+            pos[3 * i] = pos[3 * i + 1] = neg_first ? -0.0f : 0.0f;
+            pos[3 * j] = pos[3 * j + 1] = neg_first ? 0.0f : -0.0f;
+            s.pos = pos;
+            s.ntris = 1;
+            s.nemissive = 0;
+            s.nspheres = 0;
+            BvhParams bp;
+            bvh_default_params(&bp);
+            PackedScene p;
+            char err[256];
+            cr_assert_eq(pack_scene(&s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
+            uint32_t node = sm_u32(&p, sm_hdr(&p, SM_HDR_NODES));
+            float lo_x = sm_f32(&p, sm_rec(node, SM_NODE_WORDS, 0, SM_NODE_BMIN));
+            float hi_y = sm_f32(&p, sm_rec(node, SM_NODE_WORDS, 0, SM_NODE_BMAX + 1));
+            cr_expect_eq(signbit(lo_x) != 0, neg_first, "vertices %d, %d: bmin.x %g", i, j, (double)lo_x);
+            cr_expect_eq(signbit(hi_y) != 0, neg_first, "vertices %d, %d: bmax.y %g", i, j, (double)hi_y);
+            pack_free(&p);
+        }
+}
+
 /* pack_add_kd: the Cornell box's kd-tree read back word by word through the layout constants. */
 Test(pack, kd_tree_round_trip)
 {
