@@ -32,8 +32,8 @@ void ref_inv_dir(const float *dir, float *inv)
         inv[k] = 1.0f / dir[k];
 }
 
-int ref_hit_box(const float *bmin, const float *bmax, const float *org, const float *inv_dir,
-                float tmax)
+static inline int box_hit(const float *bmin, const float *bmax, const float *org, const float *inv_dir,
+                          float tmax)
 {
     /* tmax (the closest hit so far) is widened by REF_HIT_SCALE: a hit distance from the triangle
      * test and a box's entry distance from the slab test round differently, so a box whose
@@ -51,18 +51,32 @@ int ref_hit_box(const float *bmin, const float *bmax, const float *org, const fl
     return tn <= tf;
 }
 
-/* Watertight ray/triangle test after Woop, Benthin and Wald, "Watertight Ray/Triangle
- * Intersection", JCGT 2(1), 2013: shear and scale so the ray runs along +z from the origin,
- * then 2D edge functions whose signs are computed identically for the two triangles sharing an
- * edge, so a ray through an edge or vertex hits at least one of them. Edge functions that are
- * exactly zero count as inside (the conservative choice; the paper's double-precision re-test
- * is left out because the simulated machine has no doubles: it cannot create leaks, only
- * report a hit on both triangles of an edge, and the closest-hit tie rule picks one). */
-int ref_hit_triangle(const float *v0, const float *v1, const float *v2, const RefRay *r,
-                     float *t, float *u, float *v)
+int ref_hit_box(const float *bmin, const float *bmax, const float *org, const float *inv_dir,
+                float tmax)
 {
-    float d[3] = {r->dir[0], r->dir[1], r->dir[2]};
-    ref_sanitize_dir(d);
+    return box_hit(bmin, bmax, org, inv_dir, tmax);
+}
+
+/* What the tests of one ray depend on that no primitive or box changes: the sanitized direction,
+ * its inverse for the slab test and the shear of the watertight triangle test. A traversal computes
+ * it once instead of once per triangle; every test below reads the same values the per-call
+ * expressions gave, so the answers are the same bits. */
+typedef struct RayPre {
+    float org[3], dir[3];      /* dir sanitized (ref_sanitize_dir) */
+    float inv[3];              /* ref_inv_dir(dir) */
+    int kx, ky, kz;            /* kz: the dominant axis; kx, ky in winding order */
+    float sx, sy, sz;          /* the shear and scale taking the ray to +z */
+} RayPre;
+
+static void ray_prepare(RayPre *R, const float *org, const float *dir)
+{
+    for (int k = 0; k < 3; k++) {
+        R->org[k] = org[k];
+        R->dir[k] = dir[k];
+    }
+    ref_sanitize_dir(R->dir);
+    ref_inv_dir(R->dir, R->inv);
+    const float *d = R->dir;
     float ax = fabsf(d[0]), ay = fabsf(d[1]), az = fabsf(d[2]);
     int kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
     int kx = kz == 2 ? 0 : kz + 1;
@@ -72,17 +86,34 @@ int ref_hit_triangle(const float *v0, const float *v1, const float *v2, const Re
         kx = ky;
         ky = tmp;
     }
-    float sx = d[kx] / d[kz], sy = d[ky] / d[kz], sz = 1.0f / d[kz];
+    R->kx = kx;
+    R->ky = ky;
+    R->kz = kz;
+    R->sx = d[kx] / d[kz];
+    R->sy = d[ky] / d[kz];
+    R->sz = 1.0f / d[kz];
+}
 
-    float A[3], B[3], C[3];
-    for (int k = 0; k < 3; k++) {
-        A[k] = v0[k] - r->org[k];
-        B[k] = v1[k] - r->org[k];
-        C[k] = v2[k] - r->org[k];
-    }
-    float Ax = A[kx] - sx * A[kz], Ay = A[ky] - sy * A[kz];
-    float Bx = B[kx] - sx * B[kz], By = B[ky] - sy * B[kz];
-    float Cx = C[kx] - sx * C[kz], Cy = C[ky] - sy * C[kz];
+/* Watertight ray/triangle test after Woop, Benthin and Wald, "Watertight Ray/Triangle
+ * Intersection", JCGT 2(1), 2013: shear and scale so the ray runs along +z from the origin,
+ * then 2D edge functions whose signs are computed identically for the two triangles sharing an
+ * edge, so a ray through an edge or vertex hits at least one of them. Edge functions that are
+ * exactly zero count as inside (the conservative choice; the paper's double-precision re-test
+ * is left out because the simulated machine has no doubles: it cannot create leaks, only
+ * report a hit on both triangles of an edge, and the closest-hit tie rule picks one).
+ * Hits must satisfy 0 < t < tmax; t, u, v are written whenever det != 0 and T is in range. */
+static inline int tri_hit(const RayPre *R, const float *v0, const float *v1, const float *v2, float tmax,
+                          float *t, float *u, float *v)
+{
+    int kx = R->kx, ky = R->ky, kz = R->kz;
+    float sx = R->sx, sy = R->sy, sz = R->sz;
+    /* Only the components the test reads; each is the same difference as in the whole vector. */
+    float Akx = v0[kx] - R->org[kx], Aky = v0[ky] - R->org[ky], Akz = v0[kz] - R->org[kz];
+    float Bkx = v1[kx] - R->org[kx], Bky = v1[ky] - R->org[ky], Bkz = v1[kz] - R->org[kz];
+    float Ckx = v2[kx] - R->org[kx], Cky = v2[ky] - R->org[ky], Ckz = v2[kz] - R->org[kz];
+    float Ax = Akx - sx * Akz, Ay = Aky - sy * Akz;
+    float Bx = Bkx - sx * Bkz, By = Bky - sy * Bkz;
+    float Cx = Ckx - sx * Ckz, Cy = Cky - sy * Ckz;
     float U = Cx * By - Cy * Bx;
     float V = Ax * Cy - Ay * Cx;
     float W = Bx * Ay - By * Ax;
@@ -91,7 +122,7 @@ int ref_hit_triangle(const float *v0, const float *v1, const float *v2, const Re
     float det = U + V + W;
     if (det == 0.0f)
         return 0;
-    float Az = sz * A[kz], Bz = sz * B[kz], Cz = sz * C[kz];
+    float Az = sz * Akz, Bz = sz * Bkz, Cz = sz * Ckz;
     float T = U * Az + V * Bz + W * Cz;
     if (det < 0.0f) { /* seen from behind: flip signs so the range test below holds for both */
         T = -T;
@@ -105,23 +136,30 @@ int ref_hit_triangle(const float *v0, const float *v1, const float *v2, const Re
      * it would otherwise "hit" it at a tiny t of either sign (docs/numerics.md). */
     float zmax = ref_fmax(ref_fmax(fabsf(Az), fabsf(Bz)), fabsf(Cz));
     float tlo = zmax * REF_T_ROUND * det;
-    if (!(T > tlo) || !(T < r->tmax * det))
+    if (!(T > tlo) || !(T < tmax * det))
         return 0;
     float rcp = 1.0f / det;
     *t = T * rcp;
     *u = V * rcp;
     *v = W * rcp;
-    return *t > 0.0f && *t < r->tmax;
+    return *t > 0.0f && *t < tmax;
+}
+
+int ref_hit_triangle(const float *v0, const float *v1, const float *v2, const RefRay *r,
+                     float *t, float *u, float *v)
+{
+    RayPre R;
+    ray_prepare(&R, r->org, r->dir);
+    return tri_hit(&R, v0, v1, v2, r->tmax, t, u, v);
 }
 
 /* Ray/sphere with the discriminant computed from the closest-approach vector (Haines,
  * Guenther and Akenine-Moeller, "Precision Improvements for Ray/Sphere Intersection", Ray
  * Tracing Gems, 2019), which keeps small spheres far away from losing all precision. */
-int ref_hit_sphere(const float *center, float radius, const RefRay *r, float *t)
+static int sph_hit(const RayPre *R, const float *center, float radius, float tmax, float *t)
 {
-    float d[3] = {r->dir[0], r->dir[1], r->dir[2]};
-    ref_sanitize_dir(d);
-    float oc[3] = {r->org[0] - center[0], r->org[1] - center[1], r->org[2] - center[2]};
+    const float *d = R->dir;
+    float oc[3] = {R->org[0] - center[0], R->org[1] - center[1], R->org[2] - center[2]};
     float a = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
     if (!(a > 0.0f))
         return 0;
@@ -138,15 +176,22 @@ int ref_hit_sphere(const float *center, float radius, const RefRay *r, float *t)
         return 0;
     float t0 = c / q, t1 = q / a;
     float lo = ref_fmin(t0, t1), hi = ref_fmax(t0, t1);
-    if (lo > 0.0f && lo < r->tmax) {
+    if (lo > 0.0f && lo < tmax) {
         *t = lo;
         return 1;
     }
-    if (hi > 0.0f && hi < r->tmax) {
+    if (hi > 0.0f && hi < tmax) {
         *t = hi;
         return 1;
     }
     return 0;
+}
+
+int ref_hit_sphere(const float *center, float radius, const RefRay *r, float *t)
+{
+    RayPre R;
+    ray_prepare(&R, r->org, r->dir);
+    return sph_hit(&R, center, radius, r->tmax, t);
 }
 
 int ref_count_init(RefSetCount *c, const PackedScene *p)
@@ -211,18 +256,37 @@ static void walk_done(Walk *w)
         free(w->stack);
 }
 
-static int hit_prim(const PackedScene *p, uint32_t prims, uint32_t i, const RefRay *r, float *t,
-                    float *u, float *v)
-{
+/* A packed primitive's words, read straight from the image (scene memory's layout,
+ * scenes/layout.def): vertices (sphere: centre and radius) and kind. */
+typedef struct PrimRec {
     float g[9];
-    uint32_t a = sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_V0);
-    for (int k = 0; k < 9; k++)
-        g[k] = sm_f32(p, a + 4u * (uint32_t)k);
-    if (sm_u32(p, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_KIND)) == 1) {
+    uint32_t kind;
+} PrimRec;
+
+static inline void prim_read(const uint8_t *prims, uint32_t i, PrimRec *pr)
+{
+    const uint8_t *rec = prims + (size_t)4 * SM_PRIM_WORDS * i;
+    memcpy(pr->g, rec + 4 * SM_PRIM_V0, sizeof pr->g);
+    memcpy(&pr->kind, rec + 4 * SM_PRIM_KIND, sizeof pr->kind);
+}
+
+/* prims: the primitive array's first byte in p->mem. */
+static inline int hit_prim(const uint8_t *prims, uint32_t i, const RayPre *R, float tmax, float *t, float *u,
+                           float *v)
+{
+    PrimRec pr;
+    prim_read(prims, i, &pr);
+    if (pr.kind == 1) {
         *u = *v = 0.0f;
-        return ref_hit_sphere(g, g[3], r, t);
+        return sph_hit(R, pr.g, pr.g[3], tmax, t);
     }
-    return ref_hit_triangle(g, g + 3, g + 6, r, t, u, v);
+    return tri_hit(R, pr.g, pr.g + 3, pr.g + 6, tmax, t, u, v);
+}
+
+/* Where array `addr` (a scene-memory address) sits in the image. */
+static inline const uint8_t *image_at(const PackedScene *p, uint32_t addr)
+{
+    return p->mem + (addr - p->base);
 }
 
 /* Depth-first walk; closest != 0 keeps searching for the nearest hit, else stops at the first.
@@ -237,11 +301,12 @@ static inline __attribute__((always_inline)) int walk_body(const PackedScene *p,
     uint32_t nnodes = sm_u32(p, sm_hdr(p, SM_HDR_NNODES));
     if (nnodes == 0)
         return 0;
-    uint32_t nodes = sm_u32(p, sm_hdr(p, SM_HDR_NODES)), prims = sm_u32(p, sm_hdr(p, SM_HDR_PRIMS));
-    RefRay q = *r;
-    ref_sanitize_dir(q.dir);
-    float inv[3];
-    ref_inv_dir(q.dir, inv);
+    const uint8_t *nodes = image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_NODES)));
+    const uint8_t *prims = image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_PRIMS)));
+    RayPre R;
+    ray_prepare(&R, r->org, r->dir);
+    float tmax = r->tmax;      /* boxes: the closest hit so far (widened in box_hit) */
+    float ptmax = tmax;        /* primitives: tmax, then the tie probe past the closest hit */
     Walk w;
     uint32_t *stack = walk_stack(&w, p);
     if (!stack)
@@ -250,25 +315,27 @@ static inline __attribute__((always_inline)) int walk_body(const PackedScene *p,
     stack[sp++] = 0;
     while (sp > 0) {
         uint32_t n = stack[--sp];
-        float bmin[3], bmax[3];
-        for (int k = 0; k < 3; k++) {
-            bmin[k] = sm_f32(p, sm_rec(nodes, SM_NODE_WORDS, n, SM_NODE_BMIN + k));
-            bmax[k] = sm_f32(p, sm_rec(nodes, SM_NODE_WORDS, n, SM_NODE_BMAX + k));
-        }
+        struct {
+            float bmin[3], bmax[3];
+            uint32_t first, info;
+        } node;
+        _Static_assert(sizeof node == 4 * SM_NODE_WORDS && SM_NODE_BMIN == 0 && SM_NODE_BMAX == 3 &&
+                           SM_NODE_FIRST == 6 && SM_NODE_INFO == 7,
+                       "node record as scenes/layout.def lays it out");
+        memcpy(&node, nodes + sizeof node * (size_t)n, sizeof node);
         if (st) {
             st->nodes_visited++;
             st->boxes_tested++;
         }
         if (count)
             count_node(count, n);
-        if (!ref_hit_box(bmin, bmax, q.org, inv, q.tmax))
+        if (!box_hit(node.bmin, node.bmax, R.org, R.inv, tmax))
             continue;
-        uint32_t info = sm_u32(p, sm_rec(nodes, SM_NODE_WORDS, n, SM_NODE_INFO));
-        uint32_t first = sm_u32(p, sm_rec(nodes, SM_NODE_WORDS, n, SM_NODE_FIRST));
+        uint32_t info = node.info, first = node.first;
         if (info & SM_NODE_INNER) {
             /* Front to back: the right child holds the larger centroids on the split axis. */
             uint32_t axis = info & 3u;
-            int neg = q.dir[axis] < 0.0f;
+            int neg = R.dir[axis] < 0.0f;
             stack[sp++] = neg ? first : first + 1;
             stack[sp++] = neg ? first + 1 : first;
             continue;
@@ -279,19 +346,18 @@ static inline __attribute__((always_inline)) int walk_body(const PackedScene *p,
             float t, u, v;
             if (st)
                 st->prims_tested++;
-            /* Hits at exactly the best distance are still tested so that the lower primitive
-             * index wins a tie whatever the visiting order. */
-            RefRay probe = q;
-            if (closest && hit->prim != REF_NO_HIT)
-                probe.tmax = ref_tie_probe(q.tmax);
-            if (!hit_prim(p, prims, i, &probe, &t, &u, &v))
+            /* Hits at exactly the best distance are still tested (ptmax) so that the lower
+             * primitive index wins a tie whatever the visiting order. */
+            if (!hit_prim(prims, i, &R, ptmax, &t, &u, &v))
                 continue;
             if (hit->prim == REF_NO_HIT || t < hit->t || (t == hit->t && i < hit->prim)) {
                 hit->t = t;
                 hit->u = u;
                 hit->v = v;
                 hit->prim = i;
-                q.tmax = t;
+                tmax = t;
+                if (closest)
+                    ptmax = ref_tie_probe(t);
             }
             if (!closest) {
                 walk_done(&w);
@@ -331,5 +397,7 @@ int ref_any_hit(const PackedScene *p, const RefRay *r, RefTraceStats *stats)
 
 int ref_hit_prim(const PackedScene *p, uint32_t i, const RefRay *r, float *t, float *u, float *v)
 {
-    return hit_prim(p, sm_u32(p, sm_hdr(p, SM_HDR_PRIMS)), i, r, t, u, v);
+    RayPre R;
+    ray_prepare(&R, r->org, r->dir);
+    return hit_prim(image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_PRIMS))), i, &R, r->tmax, t, u, v);
 }
