@@ -32,6 +32,78 @@ void ref_inv_dir(const float *dir, float *inv)
         inv[k] = 1.0f / dir[k];
 }
 
+#if defined(__SSE2__)
+/* The slab test with its three axes in the lanes of one SSE register (x86-64 always has SSE2).
+ * Each lane computes the scalar expressions: _mm_min_ps(c, b) is c < b ? c : b, ref_fmin(b, c)
+ * exactly, NaN rule included. Lane 3 holds a NaN origin, so its slab distances are NaN and
+ * neutral: ref_fmax(tn, NaN) keeps tn and ref_fmin(tf, NaN) keeps tf, as the scalar chain skips
+ * a NaN axis. The chains over the axes become lane reductions: tn never is NaN (it starts at 0
+ * and only takes a larger number) and tf is NaN in every lane or in none (only when tmax is), so
+ * max and min reach the same values in any order, and the answer tn <= tf is the same; the only
+ * values an order could change are the signs of zeros, which <= does not see. */
+#include <xmmintrin.h>
+
+typedef struct BoxRay {
+    __m128 org, inv;           /* origin x, y, z, NaN; inverse direction x, y, z, 0 */
+} BoxRay;
+
+static inline void box_ray(BoxRay *b, const float *org, const float *inv_dir)
+{
+    b->org = _mm_setr_ps(org[0], org[1], org[2], NAN);
+    b->inv = _mm_setr_ps(inv_dir[0], inv_dir[1], inv_dir[2], 0.0f);
+}
+
+/* bmin, bmax: x, y, z in lanes 0-2; lane 3 any number that is not a denormal (a denormal
+ * operand is slow on some hosts, whatever its lane). */
+static inline int box_hit_v(__m128 bmin, __m128 bmax, const BoxRay *b, float tmax)
+{
+    /* tmax (the closest hit so far) is widened by REF_HIT_SCALE: see box_hit below. */
+    __m128 tf = _mm_set1_ps(tmax * REF_HIT_SCALE);
+    __m128 t0 = _mm_mul_ps(_mm_sub_ps(bmin, b->org), b->inv);
+    __m128 t1 = _mm_mul_ps(_mm_sub_ps(bmax, b->org), b->inv);
+    __m128 lo = _mm_min_ps(t1, t0);                                         /* ref_fmin(t0, t1) */
+    __m128 hi = _mm_mul_ps(_mm_max_ps(t1, t0), _mm_set1_ps(REF_SLAB_FAR_SCALE));
+    __m128 tn = _mm_max_ps(lo, _mm_setzero_ps());                           /* ref_fmax(0, lo) */
+    tf = _mm_min_ps(hi, tf);                                                /* ref_fmin(tf, hi) */
+    tn = _mm_max_ps(tn, _mm_movehl_ps(tn, tn));
+    tn = _mm_max_ss(tn, _mm_shuffle_ps(tn, tn, 1));
+    tf = _mm_min_ps(tf, _mm_movehl_ps(tf, tf));
+    tf = _mm_min_ss(tf, _mm_shuffle_ps(tf, tf, 1));
+    return _mm_cvtss_f32(tn) <= _mm_cvtss_f32(tf);
+}
+
+/* A packed BVH node's box (scenes/layout.def: BMIN at word 0, BMAX at word 3). */
+_Static_assert(SM_NODE_BMIN == 0 && SM_NODE_BMAX == 3 && SM_NODE_WORDS == 8,
+               "box_hit_node reads BMIN and BMAX with two 4-word loads inside the 8-word node");
+static inline int box_hit_node(const uint8_t *node, const BoxRay *b, float tmax)
+{
+    const __m128 xyz = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
+    __m128 bmin = _mm_loadu_ps((const float *)node);               /* lane 3: BMAX x */
+    __m128 bmax = _mm_and_ps(_mm_loadu_ps((const float *)node + 3), xyz); /* lane 3: FIRST -> 0 */
+    return box_hit_v(bmin, bmax, b, tmax);
+}
+
+int ref_hit_box(const float *bmin, const float *bmax, const float *org, const float *inv_dir,
+                float tmax)
+{
+    BoxRay b;
+    box_ray(&b, org, inv_dir);
+    return box_hit_v(_mm_setr_ps(bmin[0], bmin[1], bmin[2], 0.0f), _mm_setr_ps(bmax[0], bmax[1], bmax[2], 0.0f),
+                     &b, tmax);
+}
+#else
+typedef struct BoxRay {
+    float org[3], inv[3];
+} BoxRay;
+
+static inline void box_ray(BoxRay *b, const float *org, const float *inv_dir)
+{
+    for (int k = 0; k < 3; k++) {
+        b->org[k] = org[k];
+        b->inv[k] = inv_dir[k];
+    }
+}
+
 static inline int box_hit(const float *bmin, const float *bmax, const float *org, const float *inv_dir,
                           float tmax)
 {
@@ -51,11 +123,19 @@ static inline int box_hit(const float *bmin, const float *bmax, const float *org
     return tn <= tf;
 }
 
+static inline int box_hit_node(const uint8_t *node, const BoxRay *b, float tmax)
+{
+    float box[6];
+    memcpy(box, node + 4 * SM_NODE_BMIN, sizeof box);
+    return box_hit(box, box + 3, b->org, b->inv, tmax);
+}
+
 int ref_hit_box(const float *bmin, const float *bmax, const float *org, const float *inv_dir,
                 float tmax)
 {
     return box_hit(bmin, bmax, org, inv_dir, tmax);
 }
+#endif
 
 /* What the tests of one ray depend on that no primitive or box changes: the sanitized direction,
  * its inverse for the slab test and the shear of the watertight triangle test. A traversal computes
@@ -305,7 +385,9 @@ static inline __attribute__((always_inline)) int walk_body(const PackedScene *p,
     const uint8_t *prims = image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_PRIMS)));
     RayPre R;
     ray_prepare(&R, r->org, r->dir);
-    float tmax = r->tmax;      /* boxes: the closest hit so far (widened in box_hit) */
+    BoxRay B;
+    box_ray(&B, R.org, R.inv);
+    float tmax = r->tmax;      /* boxes: the closest hit so far (widened in the box test) */
     float ptmax = tmax;        /* primitives: tmax, then the tie probe past the closest hit */
     Walk w;
     uint32_t *stack = walk_stack(&w, p);
@@ -315,23 +397,18 @@ static inline __attribute__((always_inline)) int walk_body(const PackedScene *p,
     stack[sp++] = 0;
     while (sp > 0) {
         uint32_t n = stack[--sp];
-        struct {
-            float bmin[3], bmax[3];
-            uint32_t first, info;
-        } node;
-        _Static_assert(sizeof node == 4 * SM_NODE_WORDS && SM_NODE_BMIN == 0 && SM_NODE_BMAX == 3 &&
-                           SM_NODE_FIRST == 6 && SM_NODE_INFO == 7,
-                       "node record as scenes/layout.def lays it out");
-        memcpy(&node, nodes + sizeof node * (size_t)n, sizeof node);
+        const uint8_t *nd = nodes + 4 * SM_NODE_WORDS * (size_t)n;
         if (st) {
             st->nodes_visited++;
             st->boxes_tested++;
         }
         if (count)
             count_node(count, n);
-        if (!box_hit(node.bmin, node.bmax, R.org, R.inv, tmax))
+        if (!box_hit_node(nd, &B, tmax))
             continue;
-        uint32_t info = node.info, first = node.first;
+        uint32_t info, first;
+        memcpy(&info, nd + 4 * SM_NODE_INFO, sizeof info);
+        memcpy(&first, nd + 4 * SM_NODE_FIRST, sizeof first);
         if (info & SM_NODE_INNER) {
             /* Front to back: the right child holds the larger centroids on the split axis. */
             uint32_t axis = info & 3u;
