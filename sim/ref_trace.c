@@ -55,10 +55,19 @@ static inline void box_ray(BoxRay *b, const float *org, const float *inv_dir)
 
 /* bmin, bmax: x, y, z in lanes 0-2; lane 3 any number that is not a denormal (a denormal
  * operand is slow on some hosts, whatever its lane). */
-static inline int box_hit_v(__m128 bmin, __m128 bmax, const BoxRay *b, float tmax)
+/* The far end of the ray for box tests, in every lane: tmax (the closest hit so far) widened by
+ * REF_HIT_SCALE, because a hit distance from the triangle test and a box's entry distance from
+ * the slab test round differently and a box whose entry rounds up past the hit could otherwise
+ * hide a closer or tied hit. A traversal makes it when tmax changes. */
+typedef __m128 BoxFar;
+
+static inline BoxFar box_far(float tmax)
 {
-    /* tmax (the closest hit so far) is widened by REF_HIT_SCALE: see box_hit below. */
-    __m128 tf = _mm_set1_ps(tmax * REF_HIT_SCALE);
+    return _mm_set1_ps(tmax * REF_HIT_SCALE);
+}
+
+static inline int box_hit_v(__m128 bmin, __m128 bmax, const BoxRay *b, BoxFar tf)
+{
     __m128 t0 = _mm_mul_ps(_mm_sub_ps(bmin, b->org), b->inv);
     __m128 t1 = _mm_mul_ps(_mm_sub_ps(bmax, b->org), b->inv);
     __m128 lo = _mm_min_ps(t1, t0);                                         /* ref_fmin(t0, t1) */
@@ -75,12 +84,12 @@ static inline int box_hit_v(__m128 bmin, __m128 bmax, const BoxRay *b, float tma
 /* A packed BVH node's box (scenes/layout.def: BMIN at word 0, BMAX at word 3). */
 _Static_assert(SM_NODE_BMIN == 0 && SM_NODE_BMAX == 3 && SM_NODE_WORDS == 8,
                "box_hit_node reads BMIN and BMAX with two 4-word loads inside the 8-word node");
-static inline int box_hit_node(const uint8_t *node, const BoxRay *b, float tmax)
+static inline int box_hit_node(const uint8_t *node, const BoxRay *b, BoxFar tf)
 {
     const __m128 xyz = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
     __m128 bmin = _mm_loadu_ps((const float *)node);               /* lane 3: BMAX x */
     __m128 bmax = _mm_and_ps(_mm_loadu_ps((const float *)node + 3), xyz); /* lane 3: FIRST -> 0 */
-    return box_hit_v(bmin, bmax, b, tmax);
+    return box_hit_v(bmin, bmax, b, tf);
 }
 
 int ref_hit_box(const float *bmin, const float *bmax, const float *org, const float *inv_dir,
@@ -89,7 +98,7 @@ int ref_hit_box(const float *bmin, const float *bmax, const float *org, const fl
     BoxRay b;
     box_ray(&b, org, inv_dir);
     return box_hit_v(_mm_setr_ps(bmin[0], bmin[1], bmin[2], 0.0f), _mm_setr_ps(bmax[0], bmax[1], bmax[2], 0.0f),
-                     &b, tmax);
+                     &b, box_far(tmax));
 }
 #else
 typedef struct BoxRay {
@@ -104,13 +113,17 @@ static inline void box_ray(BoxRay *b, const float *org, const float *inv_dir)
     }
 }
 
-static inline int box_hit(const float *bmin, const float *bmax, const float *org, const float *inv_dir,
-                          float tmax)
+typedef float BoxFar;      /* as above, one float */
+
+static inline BoxFar box_far(float tmax)
 {
-    /* tmax (the closest hit so far) is widened by REF_HIT_SCALE: a hit distance from the triangle
-     * test and a box's entry distance from the slab test round differently, so a box whose
-     * entry rounds up past the hit could otherwise hide a closer or tied hit. */
-    float tn = 0.0f, tf = tmax * REF_HIT_SCALE;
+    return tmax * REF_HIT_SCALE;
+}
+
+static inline int box_hit(const float *bmin, const float *bmax, const float *org, const float *inv_dir,
+                          BoxFar far)
+{
+    float tn = 0.0f, tf = far;
     for (int k = 0; k < 3; k++) {
         /* inv_dir is finite (sanitized directions), so no 0 x inf = NaN can arise here. */
         float t0 = (bmin[k] - org[k]) * inv_dir[k];
@@ -123,17 +136,17 @@ static inline int box_hit(const float *bmin, const float *bmax, const float *org
     return tn <= tf;
 }
 
-static inline int box_hit_node(const uint8_t *node, const BoxRay *b, float tmax)
+static inline int box_hit_node(const uint8_t *node, const BoxRay *b, BoxFar far)
 {
     float box[6];
     memcpy(box, node + 4 * SM_NODE_BMIN, sizeof box);
-    return box_hit(box, box + 3, b->org, b->inv, tmax);
+    return box_hit(box, box + 3, b->org, b->inv, far);
 }
 
 int ref_hit_box(const float *bmin, const float *bmax, const float *org, const float *inv_dir,
                 float tmax)
 {
-    return box_hit(bmin, bmax, org, inv_dir, tmax);
+    return box_hit(bmin, bmax, org, inv_dir, box_far(tmax));
 }
 #endif
 
@@ -387,8 +400,8 @@ static inline __attribute__((always_inline)) int walk_body(const PackedScene *p,
     ray_prepare(&R, r->org, r->dir);
     BoxRay B;
     box_ray(&B, R.org, R.inv);
-    float tmax = r->tmax;      /* boxes: the closest hit so far (widened in the box test) */
-    float ptmax = tmax;        /* primitives: tmax, then the tie probe past the closest hit */
+    BoxFar far = box_far(r->tmax); /* boxes: the closest hit so far, widened */
+    float ptmax = r->tmax;         /* primitives: tmax, then the tie probe past the closest hit */
     Walk w;
     uint32_t *stack = walk_stack(&w, p);
     if (!stack)
@@ -404,7 +417,7 @@ static inline __attribute__((always_inline)) int walk_body(const PackedScene *p,
         }
         if (count)
             count_node(count, n);
-        if (!box_hit_node(nd, &B, tmax))
+        if (!box_hit_node(nd, &B, far))
             continue;
         uint32_t info, first;
         memcpy(&info, nd + 4 * SM_NODE_INFO, sizeof info);
@@ -432,7 +445,7 @@ static inline __attribute__((always_inline)) int walk_body(const PackedScene *p,
                 hit->u = u;
                 hit->v = v;
                 hit->prim = i;
-                tmax = t;
+                far = box_far(t);
                 if (closest)
                     ptmax = ref_tie_probe(t);
             }
