@@ -406,10 +406,8 @@ static inline __attribute__((always_inline)) int walk_body(const PackedScene *p,
     uint32_t *stack = walk_stack(&w, p);
     if (!stack)
         abort(); /* out of memory for a traversal stack: nothing sensible to return */
-    uint32_t sp = 0;
-    stack[sp++] = 0;
-    while (sp > 0) {
-        uint32_t n = stack[--sp];
+    uint32_t sp = 0, n = 0;
+    for (;;) {
         const uint8_t *nd = nodes + 4 * SM_NODE_WORDS * (size_t)n;
         if (st) {
             st->nodes_visited++;
@@ -417,43 +415,49 @@ static inline __attribute__((always_inline)) int walk_body(const PackedScene *p,
         }
         if (count)
             count_node(count, n);
-        if (!box_hit_node(nd, &B, far))
-            continue;
-        uint32_t info, first;
-        memcpy(&info, nd + 4 * SM_NODE_INFO, sizeof info);
-        memcpy(&first, nd + 4 * SM_NODE_FIRST, sizeof first);
-        if (info & SM_NODE_INNER) {
-            /* Front to back: the right child holds the larger centroids on the split axis. */
-            uint32_t axis = info & 3u;
-            int neg = R.dir[axis] < 0.0f;
-            stack[sp++] = neg ? first : first + 1;
-            stack[sp++] = neg ? first + 1 : first;
-            continue;
-        }
-        if (count)
-            count->leaf_rays[n]++; /* n was touched by its box test */
-        for (uint32_t i = first; i < first + info; i++) {
-            float t, u, v;
-            if (st)
-                st->prims_tested++;
-            /* Hits at exactly the best distance are still tested (ptmax) so that the lower
-             * primitive index wins a tie whatever the visiting order. */
-            if (!hit_prim(prims, i, &R, ptmax, &t, &u, &v))
+        if (box_hit_node(nd, &B, far)) {
+            uint32_t info, first;
+            memcpy(&info, nd + 4 * SM_NODE_INFO, sizeof info);
+            memcpy(&first, nd + 4 * SM_NODE_FIRST, sizeof first);
+            if (info & SM_NODE_INNER) {
+                /* Front to back: the right child holds the larger centroids on the split axis.
+                 * The far child waits on the stack; the near one, which a stack would pop at
+                 * once, goes next straight from a register (the next box's load then does not
+                 * wait for a store to the stack and a load from it). */
+                uint32_t axis = info & 3u;
+                int neg = R.dir[axis] < 0.0f;
+                stack[sp++] = neg ? first : first + 1;
+                n = neg ? first + 1 : first;
                 continue;
-            if (hit->prim == REF_NO_HIT || t < hit->t || (t == hit->t && i < hit->prim)) {
-                hit->t = t;
-                hit->u = u;
-                hit->v = v;
-                hit->prim = i;
-                far = box_far(t);
-                if (closest)
-                    ptmax = ref_tie_probe(t);
             }
-            if (!closest) {
-                walk_done(&w);
-                return 1;
+            if (count)
+                count->leaf_rays[n]++; /* n was touched by its box test */
+            for (uint32_t i = first; i < first + info; i++) {
+                float t, u, v;
+                if (st)
+                    st->prims_tested++;
+                /* Hits at exactly the best distance are still tested (ptmax) so that the lower
+                 * primitive index wins a tie whatever the visiting order. */
+                if (!hit_prim(prims, i, &R, ptmax, &t, &u, &v))
+                    continue;
+                if (hit->prim == REF_NO_HIT || t < hit->t || (t == hit->t && i < hit->prim)) {
+                    hit->t = t;
+                    hit->u = u;
+                    hit->v = v;
+                    hit->prim = i;
+                    far = box_far(t);
+                    if (closest)
+                        ptmax = ref_tie_probe(t);
+                }
+                if (!closest) {
+                    walk_done(&w);
+                    return 1;
+                }
             }
         }
+        if (sp == 0)
+            break;
+        n = stack[--sp];
     }
     walk_done(&w);
     return hit->prim != REF_NO_HIT;
