@@ -150,13 +150,12 @@ int ref_hit_box(const float *bmin, const float *bmax, const float *org, const fl
 }
 #endif
 
-/* What the tests of one ray depend on that no primitive or box changes: the sanitized direction,
- * its inverse for the slab test and the shear of the watertight triangle test. A traversal computes
- * it once instead of once per triangle; every test below reads the same values the per-call
- * expressions gave, so the answers are the same bits. */
+/* What the primitive tests of one ray depend on that no primitive changes: the sanitized
+ * direction and the shear of the watertight triangle test (the walks add the inverse direction
+ * for their boxes). A traversal computes it once instead of once per triangle; the tests below
+ * read the same values the per-call expressions gave, so the answers are the same bits. */
 typedef struct RayPre {
     float org[3], dir[3];      /* dir sanitized (ref_sanitize_dir) */
-    float inv[3];              /* ref_inv_dir(dir) */
     int kx, ky, kz;            /* kz: the dominant axis; kx, ky in winding order */
     float sx, sy, sz;          /* the shear and scale taking the ray to +z */
 } RayPre;
@@ -168,7 +167,6 @@ static void ray_prepare(RayPre *R, const float *org, const float *dir)
         R->dir[k] = dir[k];
     }
     ref_sanitize_dir(R->dir);
-    ref_inv_dir(R->dir, R->inv);
     const float *d = R->dir;
     float ax = fabsf(d[0]), ay = fabsf(d[1]), az = fabsf(d[2]);
     int kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
@@ -399,7 +397,9 @@ static inline __attribute__((always_inline)) int walk_body(const PackedScene *p,
     RayPre R;
     ray_prepare(&R, r->org, r->dir);
     BoxRay B;
-    box_ray(&B, R.org, R.inv);
+    float inv[3];
+    ref_inv_dir(R.dir, inv);
+    box_ray(&B, R.org, inv);
     BoxFar far = box_far(r->tmax); /* boxes: the closest hit so far, widened */
     float ptmax = r->tmax;         /* primitives: tmax, then the tie probe past the closest hit */
     Walk w;
