@@ -150,21 +150,11 @@ int ref_hit_box(const float *bmin, const float *bmax, const float *org, const fl
 }
 #endif
 
-/* What the primitive tests of one ray depend on that no primitive changes: the sanitized
- * direction and the shear of the watertight triangle test (the walks add the inverse direction
- * for their boxes). A traversal computes it once instead of once per triangle; the tests below
- * read the same values the per-call expressions gave, so the answers are the same bits. */
-typedef struct RayPre {
-    float org[3], dir[3];      /* dir sanitized (ref_sanitize_dir) */
-    int kx, ky, kz;            /* kz: the dominant axis; kx, ky in winding order */
-    float sx, sy, sz;          /* the shear and scale taking the ray to +z */
-} RayPre;
-
-static void ray_prepare(RayPre *R, const float *org, const float *dir)
+void ref_ray_prepare(RefRayPre *R, const RefRay *r)
 {
     for (int k = 0; k < 3; k++) {
-        R->org[k] = org[k];
-        R->dir[k] = dir[k];
+        R->org[k] = r->org[k];
+        R->dir[k] = r->dir[k];
     }
     ref_sanitize_dir(R->dir);
     const float *d = R->dir;
@@ -193,7 +183,7 @@ static void ray_prepare(RayPre *R, const float *org, const float *dir)
  * is left out because the simulated machine has no doubles: it cannot create leaks, only
  * report a hit on both triangles of an edge, and the closest-hit tie rule picks one).
  * Hits must satisfy 0 < t < tmax; t, u, v are written whenever det != 0 and T is in range. */
-static inline int tri_hit(const RayPre *R, const float *v0, const float *v1, const float *v2, float tmax,
+static inline int tri_hit(const RefRayPre *R, const float *v0, const float *v1, const float *v2, float tmax,
                           float *t, float *u, float *v)
 {
     int kx = R->kx, ky = R->ky, kz = R->kz;
@@ -239,15 +229,15 @@ static inline int tri_hit(const RayPre *R, const float *v0, const float *v1, con
 int ref_hit_triangle(const float *v0, const float *v1, const float *v2, const RefRay *r,
                      float *t, float *u, float *v)
 {
-    RayPre R;
-    ray_prepare(&R, r->org, r->dir);
+    RefRayPre R;
+    ref_ray_prepare(&R, r);
     return tri_hit(&R, v0, v1, v2, r->tmax, t, u, v);
 }
 
 /* Ray/sphere with the discriminant computed from the closest-approach vector (Haines,
  * Guenther and Akenine-Moeller, "Precision Improvements for Ray/Sphere Intersection", Ray
  * Tracing Gems, 2019), which keeps small spheres far away from losing all precision. */
-static int sph_hit(const RayPre *R, const float *center, float radius, float tmax, float *t)
+static int sph_hit(const RefRayPre *R, const float *center, float radius, float tmax, float *t)
 {
     const float *d = R->dir;
     float oc[3] = {R->org[0] - center[0], R->org[1] - center[1], R->org[2] - center[2]};
@@ -280,8 +270,8 @@ static int sph_hit(const RayPre *R, const float *center, float radius, float tma
 
 int ref_hit_sphere(const float *center, float radius, const RefRay *r, float *t)
 {
-    RayPre R;
-    ray_prepare(&R, r->org, r->dir);
+    RefRayPre R;
+    ref_ray_prepare(&R, r);
     return sph_hit(&R, center, radius, r->tmax, t);
 }
 
@@ -362,7 +352,7 @@ static inline void prim_read(const uint8_t *prims, uint32_t i, PrimRec *pr)
 }
 
 /* prims: the primitive array's first byte in p->mem. */
-static inline int hit_prim(const uint8_t *prims, uint32_t i, const RayPre *R, float tmax, float *t, float *u,
+static inline int hit_prim(const uint8_t *prims, uint32_t i, const RefRayPre *R, float tmax, float *t, float *u,
                            float *v)
 {
     PrimRec pr;
@@ -394,8 +384,8 @@ static inline __attribute__((always_inline)) int walk_body(const PackedScene *p,
         return 0;
     const uint8_t *nodes = image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_NODES)));
     const uint8_t *prims = image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_PRIMS)));
-    RayPre R;
-    ray_prepare(&R, r->org, r->dir);
+    RefRayPre R;
+    ref_ray_prepare(&R, r);
     BoxRay B;
     float inv[3];
     ref_inv_dir(R.dir, inv);
@@ -489,9 +479,15 @@ int ref_any_hit(const PackedScene *p, const RefRay *r, RefTraceStats *stats)
     return walk(p, r, &h, 0, stats);
 }
 
+int ref_hit_prim_pre(const PackedScene *p, uint32_t i, const RefRayPre *R, float tmax, float *t, float *u,
+                     float *v)
+{
+    return hit_prim(image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_PRIMS))), i, R, tmax, t, u, v);
+}
+
 int ref_hit_prim(const PackedScene *p, uint32_t i, const RefRay *r, float *t, float *u, float *v)
 {
-    RayPre R;
-    ray_prepare(&R, r->org, r->dir);
-    return hit_prim(image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_PRIMS))), i, &R, r->tmax, t, u, v);
+    RefRayPre R;
+    ref_ray_prepare(&R, r);
+    return ref_hit_prim_pre(p, i, &R, r->tmax, t, u, v);
 }
