@@ -41,7 +41,7 @@ void ref_inv_dir(const float *dir, float *inv)
  * and only takes a larger number) and tf is NaN in every lane or in none (only when tmax is), so
  * max and min reach the same values in any order, and the answer tn <= tf is the same; the only
  * values an order could change are the signs of zeros, which <= does not see. */
-#include <xmmintrin.h>
+#include <emmintrin.h>
 
 typedef struct BoxRay {
     __m128 org, inv;           /* origin x, y, z, NaN; inverse direction x, y, z, 0 */
@@ -53,8 +53,6 @@ static inline void box_ray(BoxRay *b, const float *org, const float *inv_dir)
     b->inv = _mm_setr_ps(inv_dir[0], inv_dir[1], inv_dir[2], 0.0f);
 }
 
-/* bmin, bmax: x, y, z in lanes 0-2; lane 3 any number that is not a denormal (a denormal
- * operand is slow on some hosts, whatever its lane). */
 /* The far end of the ray for box tests, in every lane: tmax (the closest hit so far) widened by
  * REF_HIT_SCALE, because a hit distance from the triangle test and a box's entry distance from
  * the slab test round differently and a box whose entry rounds up past the hit could otherwise
@@ -66,6 +64,8 @@ static inline BoxFar box_far(float tmax)
     return _mm_set1_ps(tmax * REF_HIT_SCALE);
 }
 
+/* bmin, bmax: x, y, z in lanes 0-2; lane 3 any number (not a denormal, preferably: a denormal
+ * operand is slow on some hosts, whatever its lane). */
 static inline int box_hit_v(__m128 bmin, __m128 bmax, const BoxRay *b, BoxFar tf)
 {
     __m128 t0 = _mm_mul_ps(_mm_sub_ps(bmin, b->org), b->inv);
