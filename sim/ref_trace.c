@@ -453,6 +453,12 @@ static inline __attribute__((always_inline)) int walk_body(const PackedScene *p,
     return hit->prim != REF_NO_HIT;
 }
 
+/* Batches of rays (sfsim trace, run_trace, per_ray) ask without stats: no test for them per node. */
+static int walk_bare(const PackedScene *p, const RefRay *r, RefHit *hit, int closest)
+{
+    return walk_body(p, r, hit, closest, NULL, NULL);
+}
+
 static int walk_plain(const PackedScene *p, const RefRay *r, RefHit *hit, int closest, RefTraceStats *st)
 {
     return walk_body(p, r, hit, closest, st, NULL);
@@ -465,7 +471,9 @@ static int walk_counted(const PackedScene *p, const RefRay *r, RefHit *hit, int 
 
 static int walk(const PackedScene *p, const RefRay *r, RefHit *hit, int closest, RefTraceStats *st)
 {
-    return st && st->count ? walk_counted(p, r, hit, closest, st) : walk_plain(p, r, hit, closest, st);
+    if (!st)
+        return walk_bare(p, r, hit, closest);
+    return st->count ? walk_counted(p, r, hit, closest, st) : walk_plain(p, r, hit, closest, st);
 }
 
 void ref_closest_hit(const PackedScene *p, const RefRay *r, RefHit *hit, RefTraceStats *stats)
