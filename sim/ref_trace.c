@@ -198,7 +198,9 @@ static inline int tri_hit(const RefRayPre *R, const float *v0, const float *v1, 
     float U = Cx * By - Cy * Bx;
     float V = Ax * Cy - Ay * Cx;
     float W = Bx * Ay - By * Ax;
-    if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f))
+    /* One branch for the six comparisons (| and & instead of || and &&: the same answer, and a
+     * mispredicted branch per comparison is what a miss would otherwise cost). */
+    if (((U < 0.0f) | (V < 0.0f) | (W < 0.0f)) & ((U > 0.0f) | (V > 0.0f) | (W > 0.0f)))
         return 0;
     float det = U + V + W;
     if (det == 0.0f)
@@ -217,7 +219,7 @@ static inline int tri_hit(const RefRayPre *R, const float *v0, const float *v1, 
      * it would otherwise "hit" it at a tiny t of either sign (docs/numerics.md). */
     float zmax = ref_fmax(ref_fmax(fabsf(Az), fabsf(Bz)), fabsf(Cz));
     float tlo = zmax * REF_T_ROUND * det;
-    if (!(T > tlo) || !(T < tmax * det))
+    if (!(T > tlo) | !(T < tmax * det))
         return 0;
     float rcp = 1.0f / det;
     *t = T * rcp;
