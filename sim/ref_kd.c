@@ -67,6 +67,8 @@ static int trace(const PackedScene *p, const KdTree *t, RefKdVariant v, int dept
     ref_sanitize_dir(q.dir);
     float inv[3];
     ref_inv_dir(q.dir, inv);
+    RefRayPre pre;
+    ref_ray_prepare(&pre, &q);
     /* The ray's segment inside the scene box (the slab test of the BVH traversal). */
     float t0 = 0.0f, t1 = q.tmax * REF_HIT_SCALE; /* widened as in ref_hit_box */
     for (int k = 0; k < 3; k++) {
@@ -150,10 +152,10 @@ static int trace(const PackedScene *p, const KdTree *t, RefKdVariant v, int dept
             float th, u, w;
             if (st)
                 st->prims_tested++;
-            RefRay probe = q;
+            float ptmax = q.tmax;
             if (hit->prim != REF_NO_HIT)
-                probe.tmax = closest ? ref_tie_probe(hit->t) : hit->t;
-            if (!ref_hit_prim(p, pr, &probe, &th, &u, &w))
+                ptmax = closest ? ref_tie_probe(hit->t) : hit->t;
+            if (!ref_hit_prim_pre(p, pr, &pre, ptmax, &th, &u, &w))
                 continue;
             if (hit->prim == REF_NO_HIT || th < hit->t || (th == hit->t && pr < hit->prim)) {
                 hit->t = th;
@@ -208,6 +210,7 @@ typedef struct Packet {
     int n, cap, bottom, depth;
     PEntry *stack;
     RefRay q[KD_PACKET];          /* the rays, directions sanitized */
+    RefRayPre pre[KD_PACKET];     /* their primitive tests' constants */
     float inv[KD_PACKET][3], t1[KD_PACKET], prog[KD_PACKET];
     uint64_t done, all;           /* rays finished; every ray of the packet */
     uint32_t root;                /* the push-down root restarts begin at */
@@ -229,6 +232,7 @@ static void packet_start(Packet *k)
         k->q[i] = k->rays[i];
         ref_sanitize_dir(k->q[i].dir);
         ref_inv_dir(k->q[i].dir, k->inv[i]);
+        ref_ray_prepare(&k->pre[i], &k->q[i]);
         float a0 = 0.0f, a1 = k->q[i].tmax * REF_HIT_SCALE;
         for (int c = 0; c < 3; c++) {
             float a = (t->bmin[c] - k->q[i].org[c]) * k->inv[i][c], b = (t->bmax[c] - k->q[i].org[c]) * k->inv[i][c];
@@ -402,10 +406,10 @@ static void packet_leaf(Packet *k, const KdNode *nd, const PEntry *cur)
             float th, u, w;
             if (st)
                 st->prims_tested++;
-            RefRay probe = k->q[i];
+            float ptmax = k->q[i].tmax;
             if (h->prim != REF_NO_HIT)
-                probe.tmax = ref_tie_probe(h->t);
-            if (!ref_hit_prim(k->p, pr, &probe, &th, &u, &w))
+                ptmax = ref_tie_probe(h->t);
+            if (!ref_hit_prim_pre(k->p, pr, &k->pre[i], ptmax, &th, &u, &w))
                 continue;
             if (h->prim == REF_NO_HIT || th < h->t || (th == h->t && pr < h->prim)) {
                 h->t = th;

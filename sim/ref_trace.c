@@ -32,13 +32,98 @@ void ref_inv_dir(const float *dir, float *inv)
         inv[k] = 1.0f / dir[k];
 }
 
+#if defined(__SSE2__)
+/* The slab test with its three axes in the lanes of one SSE register (x86-64 always has SSE2).
+ * Each lane computes the scalar expressions: _mm_min_ps(c, b) is c < b ? c : b, ref_fmin(b, c)
+ * exactly, NaN rule included. Lane 3 holds a NaN origin, so its slab distances are NaN and
+ * neutral: ref_fmax(tn, NaN) keeps tn and ref_fmin(tf, NaN) keeps tf, as the scalar chain skips
+ * a NaN axis. The chains over the axes become lane reductions: tn never is NaN (it starts at 0
+ * and only takes a larger number) and tf is NaN in every lane or in none (only when tmax is), so
+ * max and min reach the same values in any order, and the answer tn <= tf is the same; the only
+ * values an order could change are the signs of zeros, which <= does not see. */
+#include <emmintrin.h>
+
+typedef struct BoxRay {
+    __m128 org, inv;           /* origin x, y, z, NaN; inverse direction x, y, z, 0 */
+} BoxRay;
+
+static inline void box_ray(BoxRay *b, const float *org, const float *inv_dir)
+{
+    b->org = _mm_setr_ps(org[0], org[1], org[2], NAN);
+    b->inv = _mm_setr_ps(inv_dir[0], inv_dir[1], inv_dir[2], 0.0f);
+}
+
+/* The far end of the ray for box tests, in every lane: tmax (the closest hit so far) widened by
+ * REF_HIT_SCALE, because a hit distance from the triangle test and a box's entry distance from
+ * the slab test round differently and a box whose entry rounds up past the hit could otherwise
+ * hide a closer or tied hit. A traversal makes it when tmax changes. */
+typedef __m128 BoxFar;
+
+static inline BoxFar box_far(float tmax)
+{
+    return _mm_set1_ps(tmax * REF_HIT_SCALE);
+}
+
+/* bmin, bmax: x, y, z in lanes 0-2; lane 3 any number (not a denormal, preferably: a denormal
+ * operand is slow on some hosts, whatever its lane). */
+static inline int box_hit_v(__m128 bmin, __m128 bmax, const BoxRay *b, BoxFar tf)
+{
+    __m128 t0 = _mm_mul_ps(_mm_sub_ps(bmin, b->org), b->inv);
+    __m128 t1 = _mm_mul_ps(_mm_sub_ps(bmax, b->org), b->inv);
+    __m128 lo = _mm_min_ps(t1, t0);                                         /* ref_fmin(t0, t1) */
+    __m128 hi = _mm_mul_ps(_mm_max_ps(t1, t0), _mm_set1_ps(REF_SLAB_FAR_SCALE));
+    __m128 tn = _mm_max_ps(lo, _mm_setzero_ps());                           /* ref_fmax(0, lo) */
+    tf = _mm_min_ps(hi, tf);                                                /* ref_fmin(tf, hi) */
+    tn = _mm_max_ps(tn, _mm_movehl_ps(tn, tn));
+    tn = _mm_max_ss(tn, _mm_shuffle_ps(tn, tn, 1));
+    tf = _mm_min_ps(tf, _mm_movehl_ps(tf, tf));
+    tf = _mm_min_ss(tf, _mm_shuffle_ps(tf, tf, 1));
+    return _mm_cvtss_f32(tn) <= _mm_cvtss_f32(tf);
+}
+
+/* A packed BVH node's box (scenes/layout.def: BMIN at word 0, BMAX at word 3). */
+_Static_assert(SM_NODE_BMIN == 0 && SM_NODE_BMAX == 3 && SM_NODE_WORDS == 8,
+               "box_hit_node reads BMIN and BMAX with two 4-word loads inside the 8-word node");
+static inline int box_hit_node(const uint8_t *node, const BoxRay *b, BoxFar tf)
+{
+    const __m128 xyz = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
+    __m128 bmin = _mm_loadu_ps((const float *)node);               /* lane 3: BMAX x */
+    __m128 bmax = _mm_and_ps(_mm_loadu_ps((const float *)node + 3), xyz); /* lane 3: FIRST -> 0 */
+    return box_hit_v(bmin, bmax, b, tf);
+}
+
 int ref_hit_box(const float *bmin, const float *bmax, const float *org, const float *inv_dir,
                 float tmax)
 {
-    /* tmax (the closest hit so far) is widened by REF_HIT_SCALE: a hit distance from the triangle
-     * test and a box's entry distance from the slab test round differently, so a box whose
-     * entry rounds up past the hit could otherwise hide a closer or tied hit. */
-    float tn = 0.0f, tf = tmax * REF_HIT_SCALE;
+    BoxRay b;
+    box_ray(&b, org, inv_dir);
+    return box_hit_v(_mm_setr_ps(bmin[0], bmin[1], bmin[2], 0.0f), _mm_setr_ps(bmax[0], bmax[1], bmax[2], 0.0f),
+                     &b, box_far(tmax));
+}
+#else
+typedef struct BoxRay {
+    float org[3], inv[3];
+} BoxRay;
+
+static inline void box_ray(BoxRay *b, const float *org, const float *inv_dir)
+{
+    for (int k = 0; k < 3; k++) {
+        b->org[k] = org[k];
+        b->inv[k] = inv_dir[k];
+    }
+}
+
+typedef float BoxFar;      /* as above, one float */
+
+static inline BoxFar box_far(float tmax)
+{
+    return tmax * REF_HIT_SCALE;
+}
+
+static inline int box_hit(const float *bmin, const float *bmax, const float *org, const float *inv_dir,
+                          BoxFar far)
+{
+    float tn = 0.0f, tf = far;
     for (int k = 0; k < 3; k++) {
         /* inv_dir is finite (sanitized directions), so no 0 x inf = NaN can arise here. */
         float t0 = (bmin[k] - org[k]) * inv_dir[k];
@@ -51,18 +136,28 @@ int ref_hit_box(const float *bmin, const float *bmax, const float *org, const fl
     return tn <= tf;
 }
 
-/* Watertight ray/triangle test after Woop, Benthin and Wald, "Watertight Ray/Triangle
- * Intersection", JCGT 2(1), 2013: shear and scale so the ray runs along +z from the origin,
- * then 2D edge functions whose signs are computed identically for the two triangles sharing an
- * edge, so a ray through an edge or vertex hits at least one of them. Edge functions that are
- * exactly zero count as inside (the conservative choice; the paper's double-precision re-test
- * is left out because the simulated machine has no doubles: it cannot create leaks, only
- * report a hit on both triangles of an edge, and the closest-hit tie rule picks one). */
-int ref_hit_triangle(const float *v0, const float *v1, const float *v2, const RefRay *r,
-                     float *t, float *u, float *v)
+static inline int box_hit_node(const uint8_t *node, const BoxRay *b, BoxFar far)
 {
-    float d[3] = {r->dir[0], r->dir[1], r->dir[2]};
-    ref_sanitize_dir(d);
+    float box[6];
+    memcpy(box, node + 4 * SM_NODE_BMIN, sizeof box);
+    return box_hit(box, box + 3, b->org, b->inv, far);
+}
+
+int ref_hit_box(const float *bmin, const float *bmax, const float *org, const float *inv_dir,
+                float tmax)
+{
+    return box_hit(bmin, bmax, org, inv_dir, box_far(tmax));
+}
+#endif
+
+void ref_ray_prepare(RefRayPre *R, const RefRay *r)
+{
+    for (int k = 0; k < 3; k++) {
+        R->org[k] = r->org[k];
+        R->dir[k] = r->dir[k];
+    }
+    ref_sanitize_dir(R->dir);
+    const float *d = R->dir;
     float ax = fabsf(d[0]), ay = fabsf(d[1]), az = fabsf(d[2]);
     int kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
     int kx = kz == 2 ? 0 : kz + 1;
@@ -72,26 +167,45 @@ int ref_hit_triangle(const float *v0, const float *v1, const float *v2, const Re
         kx = ky;
         ky = tmp;
     }
-    float sx = d[kx] / d[kz], sy = d[ky] / d[kz], sz = 1.0f / d[kz];
+    R->kx = kx;
+    R->ky = ky;
+    R->kz = kz;
+    R->sx = d[kx] / d[kz];
+    R->sy = d[ky] / d[kz];
+    R->sz = 1.0f / d[kz];
+}
 
-    float A[3], B[3], C[3];
-    for (int k = 0; k < 3; k++) {
-        A[k] = v0[k] - r->org[k];
-        B[k] = v1[k] - r->org[k];
-        C[k] = v2[k] - r->org[k];
-    }
-    float Ax = A[kx] - sx * A[kz], Ay = A[ky] - sy * A[kz];
-    float Bx = B[kx] - sx * B[kz], By = B[ky] - sy * B[kz];
-    float Cx = C[kx] - sx * C[kz], Cy = C[ky] - sy * C[kz];
+/* Watertight ray/triangle test after Woop, Benthin and Wald, "Watertight Ray/Triangle
+ * Intersection", JCGT 2(1), 2013: shear and scale so the ray runs along +z from the origin,
+ * then 2D edge functions whose signs are computed identically for the two triangles sharing an
+ * edge, so a ray through an edge or vertex hits at least one of them. Edge functions that are
+ * exactly zero count as inside (the conservative choice; the paper's double-precision re-test
+ * is left out because the simulated machine has no doubles: it cannot create leaks, only
+ * report a hit on both triangles of an edge, and the closest-hit tie rule picks one).
+ * Hits must satisfy 0 < t < tmax; t, u, v are written whenever det != 0 and T is in range. */
+static inline int tri_hit(const RefRayPre *R, const float *v0, const float *v1, const float *v2, float tmax,
+                          float *t, float *u, float *v)
+{
+    int kx = R->kx, ky = R->ky, kz = R->kz;
+    float sx = R->sx, sy = R->sy, sz = R->sz;
+    /* Only the components the test reads; each is the same difference as in the whole vector. */
+    float Akx = v0[kx] - R->org[kx], Aky = v0[ky] - R->org[ky], Akz = v0[kz] - R->org[kz];
+    float Bkx = v1[kx] - R->org[kx], Bky = v1[ky] - R->org[ky], Bkz = v1[kz] - R->org[kz];
+    float Ckx = v2[kx] - R->org[kx], Cky = v2[ky] - R->org[ky], Ckz = v2[kz] - R->org[kz];
+    float Ax = Akx - sx * Akz, Ay = Aky - sy * Akz;
+    float Bx = Bkx - sx * Bkz, By = Bky - sy * Bkz;
+    float Cx = Ckx - sx * Ckz, Cy = Cky - sy * Ckz;
     float U = Cx * By - Cy * Bx;
     float V = Ax * Cy - Ay * Cx;
     float W = Bx * Ay - By * Ax;
-    if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f))
+    /* One branch for the six comparisons (| and & instead of || and &&: the same answer, and a
+     * mispredicted branch per comparison is what a miss would otherwise cost). */
+    if (((U < 0.0f) | (V < 0.0f) | (W < 0.0f)) & ((U > 0.0f) | (V > 0.0f) | (W > 0.0f)))
         return 0;
     float det = U + V + W;
     if (det == 0.0f)
         return 0;
-    float Az = sz * A[kz], Bz = sz * B[kz], Cz = sz * C[kz];
+    float Az = sz * Akz, Bz = sz * Bkz, Cz = sz * Ckz;
     float T = U * Az + V * Bz + W * Cz;
     if (det < 0.0f) { /* seen from behind: flip signs so the range test below holds for both */
         T = -T;
@@ -105,23 +219,30 @@ int ref_hit_triangle(const float *v0, const float *v1, const float *v2, const Re
      * it would otherwise "hit" it at a tiny t of either sign (docs/numerics.md). */
     float zmax = ref_fmax(ref_fmax(fabsf(Az), fabsf(Bz)), fabsf(Cz));
     float tlo = zmax * REF_T_ROUND * det;
-    if (!(T > tlo) || !(T < r->tmax * det))
+    if (!(T > tlo) | !(T < tmax * det))
         return 0;
     float rcp = 1.0f / det;
     *t = T * rcp;
     *u = V * rcp;
     *v = W * rcp;
-    return *t > 0.0f && *t < r->tmax;
+    return *t > 0.0f && *t < tmax;
+}
+
+int ref_hit_triangle(const float *v0, const float *v1, const float *v2, const RefRay *r,
+                     float *t, float *u, float *v)
+{
+    RefRayPre R;
+    ref_ray_prepare(&R, r);
+    return tri_hit(&R, v0, v1, v2, r->tmax, t, u, v);
 }
 
 /* Ray/sphere with the discriminant computed from the closest-approach vector (Haines,
  * Guenther and Akenine-Moeller, "Precision Improvements for Ray/Sphere Intersection", Ray
  * Tracing Gems, 2019), which keeps small spheres far away from losing all precision. */
-int ref_hit_sphere(const float *center, float radius, const RefRay *r, float *t)
+static int sph_hit(const RefRayPre *R, const float *center, float radius, float tmax, float *t)
 {
-    float d[3] = {r->dir[0], r->dir[1], r->dir[2]};
-    ref_sanitize_dir(d);
-    float oc[3] = {r->org[0] - center[0], r->org[1] - center[1], r->org[2] - center[2]};
+    const float *d = R->dir;
+    float oc[3] = {R->org[0] - center[0], R->org[1] - center[1], R->org[2] - center[2]};
     float a = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
     if (!(a > 0.0f))
         return 0;
@@ -138,15 +259,22 @@ int ref_hit_sphere(const float *center, float radius, const RefRay *r, float *t)
         return 0;
     float t0 = c / q, t1 = q / a;
     float lo = ref_fmin(t0, t1), hi = ref_fmax(t0, t1);
-    if (lo > 0.0f && lo < r->tmax) {
+    if (lo > 0.0f && lo < tmax) {
         *t = lo;
         return 1;
     }
-    if (hi > 0.0f && hi < r->tmax) {
+    if (hi > 0.0f && hi < tmax) {
         *t = hi;
         return 1;
     }
     return 0;
+}
+
+int ref_hit_sphere(const float *center, float radius, const RefRay *r, float *t)
+{
+    RefRayPre R;
+    ref_ray_prepare(&R, r);
+    return sph_hit(&R, center, radius, r->tmax, t);
 }
 
 int ref_count_init(RefSetCount *c, const PackedScene *p)
@@ -211,18 +339,37 @@ static void walk_done(Walk *w)
         free(w->stack);
 }
 
-static int hit_prim(const PackedScene *p, uint32_t prims, uint32_t i, const RefRay *r, float *t,
-                    float *u, float *v)
-{
+/* A packed primitive's words, read straight from the image (scene memory's layout,
+ * scenes/layout.def): vertices (sphere: centre and radius) and kind. */
+typedef struct PrimRec {
     float g[9];
-    uint32_t a = sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_V0);
-    for (int k = 0; k < 9; k++)
-        g[k] = sm_f32(p, a + 4u * (uint32_t)k);
-    if (sm_u32(p, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_KIND)) == 1) {
+    uint32_t kind;
+} PrimRec;
+
+static inline void prim_read(const uint8_t *prims, uint32_t i, PrimRec *pr)
+{
+    const uint8_t *rec = prims + (size_t)4 * SM_PRIM_WORDS * i;
+    memcpy(pr->g, rec + 4 * SM_PRIM_V0, sizeof pr->g);
+    memcpy(&pr->kind, rec + 4 * SM_PRIM_KIND, sizeof pr->kind);
+}
+
+/* prims: the primitive array's first byte in p->mem. */
+static inline int hit_prim(const uint8_t *prims, uint32_t i, const RefRayPre *R, float tmax, float *t, float *u,
+                           float *v)
+{
+    PrimRec pr;
+    prim_read(prims, i, &pr);
+    if (pr.kind == 1) {
         *u = *v = 0.0f;
-        return ref_hit_sphere(g, g[3], r, t);
+        return sph_hit(R, pr.g, pr.g[3], tmax, t);
     }
-    return ref_hit_triangle(g, g + 3, g + 6, r, t, u, v);
+    return tri_hit(R, pr.g, pr.g + 3, pr.g + 6, tmax, t, u, v);
+}
+
+/* Where array `addr` (a scene-memory address) sits in the image. */
+static inline const uint8_t *image_at(const PackedScene *p, uint32_t addr)
+{
+    return p->mem + (addr - p->base);
 }
 
 /* Depth-first walk; closest != 0 keeps searching for the nearest hit, else stops at the first.
@@ -237,70 +384,81 @@ static inline __attribute__((always_inline)) int walk_body(const PackedScene *p,
     uint32_t nnodes = sm_u32(p, sm_hdr(p, SM_HDR_NNODES));
     if (nnodes == 0)
         return 0;
-    uint32_t nodes = sm_u32(p, sm_hdr(p, SM_HDR_NODES)), prims = sm_u32(p, sm_hdr(p, SM_HDR_PRIMS));
-    RefRay q = *r;
-    ref_sanitize_dir(q.dir);
+    const uint8_t *nodes = image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_NODES)));
+    const uint8_t *prims = image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_PRIMS)));
+    RefRayPre R;
+    ref_ray_prepare(&R, r);
+    BoxRay B;
     float inv[3];
-    ref_inv_dir(q.dir, inv);
+    ref_inv_dir(R.dir, inv);
+    box_ray(&B, R.org, inv);
+    BoxFar far = box_far(r->tmax); /* boxes: the closest hit so far, widened */
+    float ptmax = r->tmax;         /* primitives: tmax, then the tie probe past the closest hit */
     Walk w;
     uint32_t *stack = walk_stack(&w, p);
     if (!stack)
         abort(); /* out of memory for a traversal stack: nothing sensible to return */
-    uint32_t sp = 0;
-    stack[sp++] = 0;
-    while (sp > 0) {
-        uint32_t n = stack[--sp];
-        float bmin[3], bmax[3];
-        for (int k = 0; k < 3; k++) {
-            bmin[k] = sm_f32(p, sm_rec(nodes, SM_NODE_WORDS, n, SM_NODE_BMIN + k));
-            bmax[k] = sm_f32(p, sm_rec(nodes, SM_NODE_WORDS, n, SM_NODE_BMAX + k));
-        }
+    uint32_t sp = 0, n = 0;
+    for (;;) {
+        const uint8_t *nd = nodes + 4 * SM_NODE_WORDS * (size_t)n;
         if (st) {
             st->nodes_visited++;
             st->boxes_tested++;
         }
         if (count)
             count_node(count, n);
-        if (!ref_hit_box(bmin, bmax, q.org, inv, q.tmax))
-            continue;
-        uint32_t info = sm_u32(p, sm_rec(nodes, SM_NODE_WORDS, n, SM_NODE_INFO));
-        uint32_t first = sm_u32(p, sm_rec(nodes, SM_NODE_WORDS, n, SM_NODE_FIRST));
-        if (info & SM_NODE_INNER) {
-            /* Front to back: the right child holds the larger centroids on the split axis. */
-            uint32_t axis = info & 3u;
-            int neg = q.dir[axis] < 0.0f;
-            stack[sp++] = neg ? first : first + 1;
-            stack[sp++] = neg ? first + 1 : first;
-            continue;
-        }
-        if (count)
-            count->leaf_rays[n]++; /* n was touched by its box test */
-        for (uint32_t i = first; i < first + info; i++) {
-            float t, u, v;
-            if (st)
-                st->prims_tested++;
-            /* Hits at exactly the best distance are still tested so that the lower primitive
-             * index wins a tie whatever the visiting order. */
-            RefRay probe = q;
-            if (closest && hit->prim != REF_NO_HIT)
-                probe.tmax = ref_tie_probe(q.tmax);
-            if (!hit_prim(p, prims, i, &probe, &t, &u, &v))
+        if (box_hit_node(nd, &B, far)) {
+            uint32_t info, first;
+            memcpy(&info, nd + 4 * SM_NODE_INFO, sizeof info);
+            memcpy(&first, nd + 4 * SM_NODE_FIRST, sizeof first);
+            if (info & SM_NODE_INNER) {
+                /* Front to back: the right child holds the larger centroids on the split axis.
+                 * The far child waits on the stack; the near one, which a stack would pop at
+                 * once, goes next straight from a register (the next box's load then does not
+                 * wait for a store to the stack and a load from it). */
+                uint32_t axis = info & 3u;
+                int neg = R.dir[axis] < 0.0f;
+                stack[sp++] = neg ? first : first + 1;
+                n = neg ? first + 1 : first;
                 continue;
-            if (hit->prim == REF_NO_HIT || t < hit->t || (t == hit->t && i < hit->prim)) {
-                hit->t = t;
-                hit->u = u;
-                hit->v = v;
-                hit->prim = i;
-                q.tmax = t;
             }
-            if (!closest) {
-                walk_done(&w);
-                return 1;
+            if (count)
+                count->leaf_rays[n]++; /* n was touched by its box test */
+            for (uint32_t i = first; i < first + info; i++) {
+                float t, u, v;
+                if (st)
+                    st->prims_tested++;
+                /* Hits at exactly the best distance are still tested (ptmax) so that the lower
+                 * primitive index wins a tie whatever the visiting order. */
+                if (!hit_prim(prims, i, &R, ptmax, &t, &u, &v))
+                    continue;
+                if (hit->prim == REF_NO_HIT || t < hit->t || (t == hit->t && i < hit->prim)) {
+                    hit->t = t;
+                    hit->u = u;
+                    hit->v = v;
+                    hit->prim = i;
+                    far = box_far(t);
+                    if (closest)
+                        ptmax = ref_tie_probe(t);
+                }
+                if (!closest) {
+                    walk_done(&w);
+                    return 1;
+                }
             }
         }
+        if (sp == 0)
+            break;
+        n = stack[--sp];
     }
     walk_done(&w);
     return hit->prim != REF_NO_HIT;
+}
+
+/* Batches of rays (sfsim trace, run_trace, per_ray) ask without stats: no test for them per node. */
+static int walk_bare(const PackedScene *p, const RefRay *r, RefHit *hit, int closest)
+{
+    return walk_body(p, r, hit, closest, NULL, NULL);
 }
 
 static int walk_plain(const PackedScene *p, const RefRay *r, RefHit *hit, int closest, RefTraceStats *st)
@@ -315,7 +473,9 @@ static int walk_counted(const PackedScene *p, const RefRay *r, RefHit *hit, int 
 
 static int walk(const PackedScene *p, const RefRay *r, RefHit *hit, int closest, RefTraceStats *st)
 {
-    return st && st->count ? walk_counted(p, r, hit, closest, st) : walk_plain(p, r, hit, closest, st);
+    if (!st)
+        return walk_bare(p, r, hit, closest);
+    return st->count ? walk_counted(p, r, hit, closest, st) : walk_plain(p, r, hit, closest, st);
 }
 
 void ref_closest_hit(const PackedScene *p, const RefRay *r, RefHit *hit, RefTraceStats *stats)
@@ -329,7 +489,15 @@ int ref_any_hit(const PackedScene *p, const RefRay *r, RefTraceStats *stats)
     return walk(p, r, &h, 0, stats);
 }
 
+int ref_hit_prim_pre(const PackedScene *p, uint32_t i, const RefRayPre *R, float tmax, float *t, float *u,
+                     float *v)
+{
+    return hit_prim(image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_PRIMS))), i, R, tmax, t, u, v);
+}
+
 int ref_hit_prim(const PackedScene *p, uint32_t i, const RefRay *r, float *t, float *u, float *v)
 {
-    return hit_prim(p, sm_u32(p, sm_hdr(p, SM_HDR_PRIMS)), i, r, t, u, v);
+    RefRayPre R;
+    ref_ray_prepare(&R, r);
+    return ref_hit_prim_pre(p, i, &R, r->tmax, t, u, v);
 }

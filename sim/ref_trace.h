@@ -61,6 +61,21 @@ int ref_any_hit(const PackedScene *p, const RefRay *r, RefTraceStats *stats);
  * with 0 < t < r->tmax (the test every traversal uses). */
 int ref_hit_prim(const PackedScene *p, uint32_t i, const RefRay *r, float *t, float *u, float *v);
 
+/* What a ray's primitive tests depend on that no primitive changes: its sanitized direction
+ * and the shear of the watertight triangle test (dominant axis kz, kx and ky in winding order,
+ * sx = d[kx] / d[kz], sy = d[ky] / d[kz], sz = 1 / d[kz]). A traversal prepares it once per ray
+ * instead of once per primitive; the tests read the same values, so the answers are the same. */
+typedef struct RefRayPre {
+    float org[3], dir[3];      /* dir sanitized (ref_sanitize_dir) */
+    int kx, ky, kz;
+    float sx, sy, sz;
+} RefRayPre;
+
+void ref_ray_prepare(RefRayPre *R, const RefRay *r);
+/* ref_hit_prim of the ray R was prepared from with tmax in place of its own, bit for bit. */
+int ref_hit_prim_pre(const PackedScene *p, uint32_t i, const RefRayPre *R, float tmax, float *t, float *u,
+                     float *v);
+
 /* The smallest T / det a triangle hit may have, relative to the largest depth of its vertices
  * along the ray: 2^-19, 32 times the unit roundoff (kernels/lib/isect.inc: T_ROUND_F). */
 #define REF_T_ROUND 0x1p-19f
