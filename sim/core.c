@@ -232,22 +232,76 @@ static inline int32_t cvt_f2i(float x)
 static inline int popcount64(uint64_t x) { return __builtin_popcountll(x); }
 
 /* ---- lane loops ---------------------------------------------------------------------------- */
-/* Compute EXPR (which may use l, B, C, D: the operand registers) for every lane into a temporary,
- * then merge the exec-mask lanes into the destination. Computing idle lanes is harmless (pure
- * arithmetic, no traps) and lets the compiler vectorize the loop. FIELD selects u/i/f views. */
+/* Lanes are processed in blocks of CORE_BLOCK: each block's loop has a constant trip count, which
+ * is what GCC's default (-O2, "very cheap") vectorizer needs to turn it into a few SIMD
+ * instructions of the host; a loop to a run-time N stays scalar (measured with callgrind: the
+ * scalar lane loops were most of the core's host instructions). Lanes from N up to the block's
+ * end are computed too but never kept: pure arithmetic, no traps, and the merge below keeps
+ * only the exec-mask lanes, which are all below N. Vector registers hold ISA_MAX_LANES lanes, a
+ * whole number of blocks. Nothing here changes a lane's arithmetic: each lane's value is the
+ * same expression, evaluated once, as before. */
+#define CORE_BLOCK 16
+_Static_assert(ISA_MAX_LANES % CORE_BLOCK == 0, "vector registers must hold whole blocks");
+
+/* lane_sel[b] has, for each of 8 lanes, all ones where bit l of byte b is set: the merge of a
+ * block under a mask becomes an and/or the compiler vectorizes. A constant table (no start-up
+ * work, nothing shared written by threads). */
+#define LANE_SEL1(b, l) ((((b) >> (l)) & 1) ? 0xFFFFFFFFu : 0u)
+#define LANE_SEL_ROW(b)                                                                           \
+    {LANE_SEL1(b, 0), LANE_SEL1(b, 1), LANE_SEL1(b, 2), LANE_SEL1(b, 3),                          \
+     LANE_SEL1(b, 4), LANE_SEL1(b, 5), LANE_SEL1(b, 6), LANE_SEL1(b, 7)}
+#define LANE_SEL4(b) LANE_SEL_ROW(b), LANE_SEL_ROW((b) + 1), LANE_SEL_ROW((b) + 2), LANE_SEL_ROW((b) + 3)
+#define LANE_SEL16(b) LANE_SEL4(b), LANE_SEL4((b) + 4), LANE_SEL4((b) + 8), LANE_SEL4((b) + 12)
+#define LANE_SEL64(b) LANE_SEL16(b), LANE_SEL16((b) + 16), LANE_SEL16((b) + 32), LANE_SEL16((b) + 48)
+static const uint32_t lane_sel[256][8] = {LANE_SEL64(0), LANE_SEL64(64), LANE_SEL64(128), LANE_SEL64(192)};
+
+/* The 32-bit lane selects of lanes [l0, l0 + CORE_BLOCK) from mask bits. */
+static inline void block_sel(uint32_t *sel, uint64_t mask, int l0)
+{
+    for (int g = 0; g < CORE_BLOCK / 8; g++)
+        memcpy(sel + 8 * g, lane_sel[(mask >> (l0 + 8 * g)) & 0xFFu], sizeof lane_sel[0]);
+}
+
+/* Blocks covering lanes 0..n-1. */
+static inline int lane_blocks(int n) { return (n + CORE_BLOCK - 1) / CORE_BLOCK; }
+
+/* Lanes [l0, l0 + CORE_BLOCK) of dst become src's where mask bit l is set. */
+static inline void block_merge(uint32_t *restrict dst, const uint32_t *restrict src, uint64_t mask, int l0)
+{
+    uint32_t sel[CORE_BLOCK];
+    block_sel(sel, mask, l0);
+    for (int l = 0; l < CORE_BLOCK; l++)
+        dst[l0 + l] = (src[l] & sel[l]) | (dst[l0 + l] & ~sel[l]);
+}
+
+/* Pack 8 bytes that are each 0 or 1 into 8 bits (byte l to bit l): each byte's bit lands in the
+ * top byte of the product at a distinct position, so no two partial products collide. */
+static inline uint64_t bits_of_bytes8(const uint8_t *b)
+{
+    uint64_t x;
+    memcpy(&x, b, 8);
+    return (x * 0x0102040810204080ull) >> 56;
+}
+
+/* Compute EXPR (which may use l, B, C, D: the operand registers) for every lane of a block into a
+ * temporary, then merge the exec-mask lanes into the destination. FIELD selects u/i/f views. */
 #define VOP(OUT, EXPR)                                                                          \
     do {                                                                                        \
         VReg *A_ = &c->v[in->a];                                                                \
         const VReg *B = &c->v[in->b], *C = &c->v[in->c], *D = &c->v[in->d];                     \
-        VReg t_;                                                                                \
         (void)B; (void)C; (void)D;                                                              \
-        for (int l = 0; l < n; l++)                                                             \
-            t_.OUT[l] = (EXPR);                                                                 \
-        if (E == c->all) {                                                                      \
-            memcpy(A_->u, t_.u, sizeof(uint32_t) * (size_t)n);                                  \
-        } else {                                                                                \
-            for (int l = 0; l < n; l++)                                                         \
-                A_->u[l] = ((E >> l) & 1u) ? t_.u[l] : A_->u[l];                                \
+        for (int b_ = 0; b_ < lane_blocks(n); b_++) {                                           \
+            VReg t_;                                                                            \
+            for (int k_ = 0; k_ < CORE_BLOCK; k_++) {                                           \
+                const int l = b_ * CORE_BLOCK + k_;                                             \
+                (void)l;                                                                        \
+                t_.OUT[k_] = (EXPR);                                                            \
+            }                                                                                   \
+            if (E == c->all)                                                                    \
+                memcpy(A_->u + b_ * CORE_BLOCK, t_.u,                                           \
+                       sizeof(uint32_t) * (size_t)(n - b_ * CORE_BLOCK < CORE_BLOCK ? n - b_ * CORE_BLOCK : CORE_BLOCK)); \
+            else                                                                                \
+                block_merge(A_->u, t_.u, E, b_ * CORE_BLOCK);                                   \
         }                                                                                       \
     } while (0)
 
@@ -256,8 +310,16 @@ static inline int popcount64(uint64_t x) { return __builtin_popcountll(x); }
     do {                                                                                        \
         const VReg *B = &c->v[in->b], *C = &c->v[in->c];                                        \
         uint64_t res_ = 0;                                                                      \
-        for (int l = 0; l < n; l++)                                                             \
-            res_ |= (uint64_t)((TEST) ? 1u : 0u) << l;                                          \
+        for (int b_ = 0; b_ < lane_blocks(n); b_++) {                                           \
+            uint8_t t_[CORE_BLOCK];                                                             \
+            for (int k_ = 0; k_ < CORE_BLOCK; k_++) {                                           \
+                const int l = b_ * CORE_BLOCK + k_;                                             \
+                (void)l;                                                                        \
+                t_[k_] = (TEST) ? 1u : 0u;                                                      \
+            }                                                                                   \
+            for (int g_ = 0; g_ < CORE_BLOCK / 8; g_++)                                         \
+                res_ |= bits_of_bytes8(t_ + 8 * g_) << (b_ * CORE_BLOCK + 8 * g_);              \
+        }                                                                                       \
         c->m[in->a] = res_ & E;                                                                 \
     } while (0)
 
@@ -547,9 +609,12 @@ static ALWAYS_INLINE int exec_mask(Core *c, Exec *x, IsaOp op)
     case ISA_OP_VILT: VCMP(B->i[l] < C->i[l]); break;
     case ISA_OP_VILTU: VCMP(B->u[l] < C->u[l]); break;
     /* moves and select */
-    case ISA_OP_VSEL: {
-        uint64_t sel = c->m[in->d];
-        VOP(u, ((sel >> l) & 1u) ? B->u[l] : C->u[l]);
+    case ISA_OP_VSEL: { /* lane l: B where bit l of mask register d is set, else C */
+        uint64_t msel = c->m[in->d];
+        uint32_t sel[ISA_MAX_LANES];
+        for (int b = 0; b < lane_blocks(n); b++)
+            block_sel(sel + b * CORE_BLOCK, msel, b * CORE_BLOCK);
+        VOP(u, (B->u[l] & sel[l]) | (C->u[l] & ~sel[l]));
         break;
     }
     case ISA_OP_VMOV: VOP(u, B->u[l]); break;

@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-const int tc_widths[TC_N_WIDTHS] = {1, 4, 12, 16, 64};
+const int tc_widths[TC_N_WIDTHS] = {1, 4, 12, 16, 20, 33, 64}; /* 20, 33: partial 16-lane blocks of the core */
 
 uint32_t tc_fbits(float f)
 {

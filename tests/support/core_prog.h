@@ -41,7 +41,7 @@
 #define PROG(...) ((const IsaInstr[]){__VA_ARGS__}), (sizeof((const IsaInstr[]){__VA_ARGS__}) / sizeof(IsaInstr))
 
 /* The vector widths every width-dependent test runs at. */
-#define TC_N_WIDTHS 5
+#define TC_N_WIDTHS 7
 extern const int tc_widths[TC_N_WIDTHS];
 
 /* Memory sizes of the test machine (bytes): small, so that ranges are easy to hit. */

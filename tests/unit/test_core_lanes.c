@@ -418,3 +418,36 @@ Test(core_mask, fbadd_adds_in_lane_order)
                  tc_peek(t.c, CORE_MEM_FB, 16));
     tc_free(&t);
 }
+
+Test(core_mask, lanes_at_or_above_n_are_never_written)
+{
+    /* The core computes lanes in blocks of 16 (sim/core.c); lanes N.. of a block are computed but
+     * must never reach a register: every vector write, whole or under a mask, keeps them 0. */
+    static const IsaInstr prog[] = {
+        V_A(VIOTA, 0, 0),                   /* v0 = l */
+        V_AI(VLI, 1, 0x3FC00000, 0),        /* 1.5f */
+        V_ABC(VFADD, 2, 1, 1, 0),
+        V_ABC(VFMUL, 3, 1, 2, 0),
+        V_ABI(VANDI, 4, 0, 1, 0),
+        V_AI(VLI, 5, 0, 0),
+        V_ABC(VIEQ, 2, 4, 5, 0),            /* m2 = even lanes */
+        V_ABC(VFSUB, 6, 3, 1, 2),           /* under m2 */
+        V_ABCD(VSEL, 7, 1, 3, 2, 0),
+        V_AB(VFNEG, 8, 1, 2),
+        I_0(HALT),
+    };
+    for (int w = 0; w < TC_N_WIDTHS; w++) {
+        int n = tc_widths[w];
+        TcCore t;
+        tc_init(&t, prog, sizeof prog / sizeof prog[0], n);
+        tc_run_halt(&t);
+        for (int v = 0; v <= 8; v++)
+            for (int l = n; l < ISA_MAX_LANES; l++)
+                cr_expect_eq(core_vreg(t.c, v, l), 0u, "N=%d v%d lane %d written", n, v, l);
+        for (int l = 0; l < n; l++) {
+            cr_expect_eq(core_vreg(t.c, 6, l), (l % 2 == 0) ? tc_fbits(3.0f) : 0u, "N=%d vfsub under m2 lane %d", n, l);
+            cr_expect_eq(core_vreg(t.c, 7, l), (l % 2 == 0) ? tc_fbits(1.5f) : tc_fbits(4.5f), "N=%d vsel lane %d", n, l);
+        }
+        tc_free(&t);
+    }
+}
