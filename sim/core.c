@@ -34,6 +34,13 @@ typedef struct Dec {
     uint8_t masked;   /* format takes an exec mask */
 } Dec;
 
+/* The counters: step adds an execution to its opcode's column (and a vector instruction's
+ * active lanes to the last column) of the row of the current statistics stage and generation,
+ * which STAGE and SGEN select; CoreStats is folded from the rows when read (core_stats). Two
+ * additions per instruction instead of up to eight into CoreStats's arrays. */
+#define COUNT_COLS (ISA_OP_COUNT + 1)
+#define COUNT_ROWS (ISA_STAGE_COUNT * CORE_GENERATIONS)
+
 struct Core {
     int n;                        /* lanes */
     uint64_t all;                 /* mask of the N lanes */
@@ -46,19 +53,64 @@ struct Core {
     int cur_rb;                   /* physical buffer (0/1) that is RBc */
     uint8_t *mem[CORE_MEM_COUNT];
     uint32_t size[CORE_MEM_COUNT];
+    int64_t last[CORE_MEM_COUNT]; /* highest legal word address: size - 4 (negative: none) */
     Dec *code;
     uint32_t ncode;
     const AsmObject *obj;
     uint8_t *pq;                  /* partition unit's mask queue, one byte per bit */
     uint32_t pq_len, pq_cap;
     uint32_t *part_tmp;           /* scratch for the in-place partition */
-    CoreStats st;
+    CoreStats st;                 /* folded from counts (count_fold) when asked for */
+    uint64_t *counts;             /* COUNT_ROWS rows of COUNT_COLS: executions per opcode, then
+                                     active lanes, per (stage, generation) */
+    uint64_t *row;                /* the current (stage, gen)'s row */
+    uint64_t touched[(COUNT_ROWS + 63) / 64]; /* rows that may hold counts not yet folded */
     uint64_t total;
     CoreHook hook;
     void *hook_ctx;
     CoreRecord rec;
     char trap[1024];
 };
+
+/* ---- counters -------------------------------------------------------------------------------- */
+
+/* Point row at the current (stage, gen) and mark it as holding counts. */
+static void count_select_row(Core *c)
+{
+    uint32_t r = (uint32_t)c->stage * CORE_GENERATIONS + c->gen;
+    c->row = c->counts + (size_t)r * COUNT_COLS;
+    c->touched[r / 64] |= 1ull << (r % 64);
+}
+
+/* Add every touched row into st and clear it: the same sums step used to add one by one. */
+static void count_fold(Core *c)
+{
+    for (uint32_t r = 0; r < COUNT_ROWS; r++) {
+        if (!((c->touched[r / 64] >> (r % 64)) & 1u))
+            continue;
+        const uint32_t stage = r / CORE_GENERATIONS, gen = r % CORE_GENERATIONS;
+        uint64_t *row = c->counts + (size_t)r * COUNT_COLS;
+        for (int op = 0; op < ISA_OP_COUNT; op++) {
+            uint64_t k = row[op];
+            if (!k)
+                continue;
+            const IsaOpInfo *oi = &isa_ops[op];
+            c->st.instructions[stage] += k;
+            c->st.ops[stage][oi->category] += k;
+            c->st.by_op[op] += k;
+            c->st.gen_instructions[gen][stage] += k;
+            if (oi->flags & ISA_FL_VEC) {
+                c->st.vec_instructions[stage] += k;
+                c->st.gen_vec_instructions[gen][stage] += k;
+            }
+        }
+        c->st.active_lanes[stage] += row[ISA_OP_COUNT];
+        c->st.gen_active_lanes[gen][stage] += row[ISA_OP_COUNT];
+        memset(row, 0, sizeof(uint64_t) * COUNT_COLS);
+    }
+    memset(c->touched, 0, sizeof c->touched);
+    count_select_row(c);
+}
 
 /* ---- construction ---------------------------------------------------------------------------- */
 
@@ -93,13 +145,16 @@ Core *core_new(const CoreParams *p, const AsmObject *obj, char *err, size_t errl
     c->all = p->lanes == 64 ? ~0ull : (1ull << p->lanes) - 1;
     c->obj = obj;
     c->ncode = obj->ntext;
-    c->code = calloc(obj->ntext ? obj->ntext : 1, sizeof(Dec));
+    c->code = calloc((size_t)obj->ntext + 1, sizeof(Dec)); /* + the end sentinel */
     int ok = c->code != NULL;
     for (int m = 0; ok && m < CORE_MEM_COUNT; m++) {
         c->size[m] = p->mem_bytes[m];
+        c->last[m] = (int64_t)p->mem_bytes[m] - 4;
         c->mem[m] = calloc(p->mem_bytes[m] ? p->mem_bytes[m] : 4, 1);
         ok = c->mem[m] != NULL;
     }
+    c->counts = ok ? calloc((size_t)COUNT_ROWS * COUNT_COLS, sizeof(uint64_t)) : NULL;
+    ok = ok && c->counts;
     c->pq_cap = p->mem_bytes[CORE_MEM_IDM] / 4 + ISA_MAX_LANES;
     c->pq = ok ? malloc(c->pq_cap) : NULL;
     c->part_tmp = ok ? malloc(sizeof(uint32_t) * (p->mem_bytes[CORE_MEM_IDM] / 4 + 1)) : NULL;
@@ -122,11 +177,15 @@ Core *core_new(const CoreParams *p, const AsmObject *obj, char *err, size_t errl
         c->code[i].vec = (oi->flags & ISA_FL_VEC) != 0;
         c->code[i].masked = (uint8_t)isa_formats[oi->format].masked;
     }
+    /* The sentinel after the last instruction: reaching it (pc == ncode: a fall-through or a
+     * branch to the end) traps, so step needs no bounds test of pc. */
+    c->code[obj->ntext].in.op = ISA_OP_COUNT;
     if (obj->ndata)
         memcpy(c->mem[CORE_MEM_SCENE], obj->data, obj->ndata);
     if (obj->nspad)
         memcpy(c->mem[CORE_MEM_SPAD], obj->spad, obj->nspad);
     c->m[0] = c->all;
+    count_select_row(c);
     return c;
 }
 
@@ -142,6 +201,7 @@ void core_restart(Core *c)
     c->cur_rb = 0;
     c->pq_len = 0;
     c->trap[0] = 0;
+    count_select_row(c);
 }
 
 void core_free(Core *c)
@@ -153,6 +213,7 @@ void core_free(Core *c)
     free(c->code);
     free(c->pq);
     free(c->part_tmp);
+    free(c->counts);
     free(c);
 }
 
@@ -179,14 +240,20 @@ static int trap(Core *c, const char *fmt, ...)
 
 const char *core_trap_message(const Core *c) { return c->trap; }
 
-/* 0 if a 4-byte access at addr of memory m is legal, else traps and returns 1. */
-static int check(Core *c, CoreMem m, uint32_t addr, const char *what)
+/* The trap of check(): out of line, so the legal case stays a few instructions. Returns 1. */
+static __attribute__((noinline, cold)) int check_trap(Core *c, CoreMem m, uint32_t addr, const char *what)
 {
     if (addr & 3u)
         return trap(c, "%s %s misaligned: address 0x%08x", mem_long[m], what, addr);
-    if (c->size[m] < 4 || addr > c->size[m] - 4)
-        return trap(c, "%s %s out of range: address 0x%08x (size %u)", mem_long[m], what, addr, c->size[m]);
-    return 0;
+    return trap(c, "%s %s out of range: address 0x%08x (size %u)", mem_long[m], what, addr, c->size[m]);
+}
+
+/* 0 if a 4-byte access at addr of memory m is legal, else traps and returns 1. */
+static inline int check(Core *c, CoreMem m, uint32_t addr, const char *what)
+{
+    if (__builtin_expect((addr & 3u) == 0 && (int64_t)addr <= c->last[m], 1))
+        return 0;
+    return check_trap(c, m, addr, what);
 }
 
 static inline uint32_t rd32(const Core *c, CoreMem m, uint32_t a)
@@ -343,9 +410,9 @@ static void record_reset(CoreRecord *rec, uint32_t pc, const IsaInstr *in, uint8
     rec->exec = exec;
 }
 
-static inline void rec_addr(Core *c, CoreMem m, uint32_t a)
+static inline void rec_addr(Core *c, int hooked, CoreMem m, uint32_t a)
 {
-    if (c->hook) {
+    if (hooked) {
         c->rec.mem = (uint8_t)m;
         if (c->rec.naddr < ISA_MAX_LANES)
             c->rec.addr[c->rec.naddr++] = a;
@@ -354,7 +421,7 @@ static inline void rec_addr(Core *c, CoreMem m, uint32_t a)
 
 /* ---- the partition unit ---------------------------------------------------------------------- */
 
-static int do_part(Core *c, const IsaInstr *in)
+static int do_part(Core *c, const IsaInstr *in, int hooked)
 {
     uint32_t b = SR(in->b), e = SR(in->c);
     if (b > e)
@@ -377,7 +444,7 @@ static int do_part(Core *c, const IsaInstr *in)
     memcpy(c->mem[CORE_MEM_IDM] + b, c->part_tmp, 4 * (size_t)len);
     SR(in->a) = b + 4 * set;
     c->pq_len = 0;
-    if (c->hook) {
+    if (hooked) {
         c->rec.mem = CORE_MEM_IDM;
         c->rec.count = len;
         c->rec.base = b;
@@ -405,8 +472,10 @@ typedef struct Exec {
     uint64_t E;       /* exec mask as applied */
     int n;            /* lanes */
     uint32_t next;    /* pc after this instruction */
-    uint32_t active;  /* active lanes counted for a vector instruction */
+    uint64_t lanes;   /* the lanes counted active for a vector instruction (E; sfetch: the
+                         lanes that received an ID), popcounted only when counted */
     int halt;
+    int hooked;       /* a timing hook wants the CoreRecord: a constant in each copy of step */
 } Exec;
 
 #define ALWAYS_INLINE inline __attribute__((always_inline))
@@ -424,7 +493,7 @@ static int no_semantics(Core *c, IsaOp op, const char *family)
             if (IMM > c->ncode)                                                                 \
                 return -trap(c, "branch target %u outside the program (%u instructions)", IMM, c->ncode); \
             x->next = IMM;                                                                      \
-            if (c->hook)                                                                        \
+            if (x->hooked)                                                                      \
                 c->rec.taken = 1;                                                               \
         }                                                                                       \
     } while (0)
@@ -443,11 +512,13 @@ static ALWAYS_INLINE int exec_control(Core *c, Exec *x, IsaOp op)
     case ISA_OP_HALT: x->halt = 1; break;
     case ISA_OP_SGEN:
         c->gen = (uint8_t)(SR(in->a) < CORE_GENERATIONS ? SR(in->a) : CORE_GENERATIONS - 1);
+        count_select_row(c);
         break;
     case ISA_OP_STAGE:
         if (IMM >= ISA_STAGE_COUNT)
             return -trap(c, "bad stage %u (0..%d)", IMM, ISA_STAGE_COUNT - 1);
         c->stage = (uint8_t)IMM;
+        count_select_row(c);
         break;
     case ISA_OP_JMP: BRANCH_TO(1); break;
     case ISA_OP_JAL: {
@@ -460,7 +531,7 @@ static ALWAYS_INLINE int exec_control(Core *c, Exec *x, IsaOp op)
         if (SR(in->a) > c->ncode)
             return -trap(c, "jump target %u outside the program (%u instructions)", SR(in->a), c->ncode);
         x->next = SR(in->a);
-        if (c->hook)
+        if (x->hooked)
             c->rec.taken = 1;
         break;
     case ISA_OP_BEQ: BRANCH_TO(SR(in->a) == SR(in->b)); break;
@@ -674,7 +745,7 @@ static ALWAYS_INLINE int exec_stream(Core *c, Exec *x, IsaOp op)
         VReg *A = &c->v[in->a];
         for (uint32_t l = 0; l < k; l++) {
             A->u[l] = rd32(c, CORE_MEM_IDM, b + 4 * l);
-            rec_addr(c, CORE_MEM_IDM, b + 4 * l);
+            rec_addr(c, x->hooked, CORE_MEM_IDM, b + 4 * l);
         }
         if (k > 0)
             for (uint32_t l = k; l < (uint32_t)n; l++)
@@ -683,8 +754,8 @@ static ALWAYS_INLINE int exec_stream(Core *c, Exec *x, IsaOp op)
         SR(in->c) = b + 4 * k;
         /* Utilization counts the lanes that carry a ray: a stream's last, partial vector is the
          * paper's first source of under-utilization (Gribble & Ramani 2008, Sec. 4.1). */
-        x->active = k;
-        if (c->hook) {
+        x->lanes = c->m[in->b];
+        if (x->hooked) {
             c->rec.exec = c->m[in->b];
             c->rec.mem = CORE_MEM_IDM;
             c->rec.count = avail;
@@ -696,27 +767,26 @@ static ALWAYS_INLINE int exec_stream(Core *c, Exec *x, IsaOp op)
         uint32_t a = SR(in->b) + IMM;
         MEMCHK(CORE_MEM_IDM, a, "load");
         SR(in->a) = rd32(c, CORE_MEM_IDM, a);
-        rec_addr(c, CORE_MEM_IDM, a);
+        rec_addr(c, x->hooked, CORE_MEM_IDM, a);
         break;
     }
     case ISA_OP_SST: {
         uint32_t a = SR(in->b) + IMM;
         MEMCHK(CORE_MEM_IDM, a, "store");
         wr32(c, CORE_MEM_IDM, a, SR(in->a));
-        rec_addr(c, CORE_MEM_IDM, a);
+        rec_addr(c, x->hooked, CORE_MEM_IDM, a);
         break;
     }
     case ISA_OP_SAPP: {
         uint32_t p = SR(in->a);
-        if (c->hook)
+        if (x->hooked)
             c->rec.base = p;
         const VReg *B = &c->v[in->b];
-        for (int l = 0; l < n; l++) {
-            if (!((E >> l) & 1u))
-                continue;
+        for (uint64_t e_ = E; e_; e_ &= e_ - 1) { /* the exec-mask lanes, lowest first */
+            const int l = __builtin_ctzll(e_);
             MEMCHK(CORE_MEM_IDM, p, "append");
             wr32(c, CORE_MEM_IDM, p, B->u[l]);
-            rec_addr(c, CORE_MEM_IDM, p);
+            rec_addr(c, x->hooked, CORE_MEM_IDM, p);
             p += 4;
         }
         SR(in->a) = p;
@@ -753,9 +823,9 @@ static ALWAYS_INLINE int exec_rbuf(Core *c, Exec *x, IsaOp op)
         uint32_t base = SR(in->c) + IMM;
         VReg *A = &c->v[in->a];
         const VReg *B = &c->v[in->b];
-        for (int l = 0; l < n; l++) {
-            if (!((E >> l) & 1u))
-                continue;
+        (void)n;
+        for (uint64_t e = E; e; e &= e - 1) { /* the exec-mask lanes, lowest first */
+            const int l = __builtin_ctzll(e);
             /* In 64 bits, so a huge ray ID cannot wrap around onto a valid address. */
             uint64_t a64 = (uint64_t)base + 4u * (uint64_t)B->u[l];
             if (a64 > UINT32_MAX)
@@ -767,7 +837,7 @@ static ALWAYS_INLINE int exec_rbuf(Core *c, Exec *x, IsaOp op)
                 wr32(c, m, a, A->u[l]);
             else
                 A->u[l] = rd32(c, m, a);
-            rec_addr(c, m, a);
+            rec_addr(c, x->hooked, m, a);
         }
         break;
     }
@@ -778,12 +848,12 @@ static ALWAYS_INLINE int exec_rbuf(Core *c, Exec *x, IsaOp op)
         uint64_t mk = c->m[in->a];
         for (int l = 0; l < n; l++)
             c->pq[c->pq_len++] = (uint8_t)((mk >> l) & 1u);
-        if (c->hook)
+        if (x->hooked)
             c->rec.count = c->pq_len;
         break;
     }
     case ISA_OP_PART:
-        if (do_part(c, in))
+        if (do_part(c, in, x->hooked))
             return -1;
         break;
     case ISA_OP_PCLR: c->pq_len = 0; break;
@@ -803,14 +873,14 @@ static ALWAYS_INLINE int exec_memory(Core *c, Exec *x, IsaOp op)
         uint32_t a = SR(in->b) + IMM;
         MEMCHK(CORE_MEM_SPAD, a, "load");
         SR(in->a) = rd32(c, CORE_MEM_SPAD, a);
-        rec_addr(c, CORE_MEM_SPAD, a);
+        rec_addr(c, x->hooked, CORE_MEM_SPAD, a);
         break;
     }
     case ISA_OP_SPST: {
         uint32_t a = SR(in->b) + IMM;
         MEMCHK(CORE_MEM_SPAD, a, "store");
         wr32(c, CORE_MEM_SPAD, a, SR(in->a));
-        rec_addr(c, CORE_MEM_SPAD, a);
+        rec_addr(c, x->hooked, CORE_MEM_SPAD, a);
         break;
     }
     case ISA_OP_VSPLD:
@@ -818,16 +888,15 @@ static ALWAYS_INLINE int exec_memory(Core *c, Exec *x, IsaOp op)
         int store = op == ISA_OP_VSPST;
         uint32_t base = SR(in->b) + IMM;
         VReg *A = &c->v[in->a];
-        for (int l = 0; l < n; l++) {
-            if (!((E >> l) & 1u))
-                continue;
+        for (uint64_t e_ = E; e_; e_ &= e_ - 1) { /* the exec-mask lanes, lowest first */
+            const int l = __builtin_ctzll(e_);
             uint32_t a = base + 4u * (uint32_t)l;
             MEMCHK(CORE_MEM_SPAD, a, store ? "store" : "load");
             if (store)
                 wr32(c, CORE_MEM_SPAD, a, A->u[l]);
             else
                 A->u[l] = rd32(c, CORE_MEM_SPAD, a);
-            rec_addr(c, CORE_MEM_SPAD, a);
+            rec_addr(c, x->hooked, CORE_MEM_SPAD, a);
         }
         break;
     }
@@ -835,14 +904,14 @@ static ALWAYS_INLINE int exec_memory(Core *c, Exec *x, IsaOp op)
         uint32_t a = SR(in->b) + IMM;
         MEMCHK(CORE_MEM_SCENE, a, "load");
         SR(in->a) = rd32(c, CORE_MEM_SCENE, a);
-        rec_addr(c, CORE_MEM_SCENE, a);
+        rec_addr(c, x->hooked, CORE_MEM_SCENE, a);
         break;
     }
     case ISA_OP_ST: {
         uint32_t a = SR(in->b) + IMM;
         MEMCHK(CORE_MEM_SCENE, a, "store");
         wr32(c, CORE_MEM_SCENE, a, SR(in->a));
-        rec_addr(c, CORE_MEM_SCENE, a);
+        rec_addr(c, x->hooked, CORE_MEM_SCENE, a);
         break;
     }
     case ISA_OP_LDB: {
@@ -850,7 +919,7 @@ static ALWAYS_INLINE int exec_memory(Core *c, Exec *x, IsaOp op)
         if (E) { /* one access serves every lane; no lane, no access */
             MEMCHK(CORE_MEM_SCENE, a, "broadcast load");
             uint32_t v = rd32(c, CORE_MEM_SCENE, a);
-            rec_addr(c, CORE_MEM_SCENE, a);
+            rec_addr(c, x->hooked, CORE_MEM_SCENE, a);
             VOP(u, v);
         }
         break;
@@ -858,25 +927,23 @@ static ALWAYS_INLINE int exec_memory(Core *c, Exec *x, IsaOp op)
     case ISA_OP_LDG: {
         VReg *A = &c->v[in->a];
         const VReg *B = &c->v[in->b];
-        for (int l = 0; l < n; l++) {
-            if (!((E >> l) & 1u))
-                continue;
+        for (uint64_t e_ = E; e_; e_ &= e_ - 1) { /* the exec-mask lanes, lowest first */
+            const int l = __builtin_ctzll(e_);
             uint32_t a = B->u[l] + IMM;
             MEMCHK(CORE_MEM_SCENE, a, "gather");
             A->u[l] = rd32(c, CORE_MEM_SCENE, a);
-            rec_addr(c, CORE_MEM_SCENE, a);
+            rec_addr(c, x->hooked, CORE_MEM_SCENE, a);
         }
         break;
     }
     case ISA_OP_FBADD: {
         const VReg *A = &c->v[in->a], *B = &c->v[in->b];
-        for (int l = 0; l < n; l++) {
-            if (!((E >> l) & 1u))
-                continue;
+        for (uint64_t e_ = E; e_; e_ &= e_ - 1) { /* the exec-mask lanes, lowest first */
+            const int l = __builtin_ctzll(e_);
             uint32_t a = B->u[l] + IMM;
             MEMCHK(CORE_MEM_FB, a, "scatter-add");
             wr32(c, CORE_MEM_FB, a, u_of(f_of(rd32(c, CORE_MEM_FB, a)) + A->f[l]));
-            rec_addr(c, CORE_MEM_FB, a);
+            rec_addr(c, x->hooked, CORE_MEM_FB, a);
         }
         break;
     }
@@ -909,23 +976,21 @@ static ALWAYS_INLINE int exec_memory(Core *c, Exec *x, IsaOp op)
 
 /* ---- execution ----------------------------------------------------------------------------- */
 
-/* Execute the instruction at pc. Returns 0 to go on, 1 on halt, -1 on a trap. */
-static int step(Core *c)
+/* Execute the instruction at pc. Returns 0 to go on, 1 on halt, -1 on a trap. Inlined twice into
+ * core_run_slice, once with hooked = 0 (functional mode: no record is built, no hook test is
+ * left in the code) and once with hooked = 1 (the timed modes). */
+static ALWAYS_INLINE int step(Core *c, const int hooked)
 {
-    if (c->pc >= c->ncode) {
-        trap(c, "pc past the end of the program (%u instructions)", c->ncode);
-        return -1;
-    }
-    const Dec *dc = &c->code[c->pc];
+    const Dec *dc = &c->code[c->pc]; /* pc <= ncode always: code[ncode] is the end sentinel */
     const IsaInstr *in = &dc->in;
     const int n = c->n;
     if (n < 1 || n > ISA_MAX_LANES) /* core_new guarantees it; tells the compiler the lane bound */
         __builtin_unreachable();
     const uint64_t E = dc->masked ? c->m[in->mask] & c->all : c->all;
-    Exec x = {.in = in, .E = E, .n = n, .next = c->pc + 1, .active = dc->vec ? (uint32_t)popcount64(E) : 0};
-    if (c->hook)
+    Exec x = {.in = in, .E = E, .n = n, .next = c->pc + 1, .lanes = E, .hooked = hooked};
+    if (hooked)
         record_reset(&c->rec, c->pc, in, c->stage, c->gen, E);
-    const uint8_t stage = c->stage, gen = c->gen;
+    uint64_t *const row = c->row; /* counted in the stage and generation before the instruction */
 
     int r = 0;
     switch ((IsaOp)in->op) {
@@ -933,24 +998,17 @@ static int step(Core *c)
     case ISA_OP_##name: r = CORE_EXEC_##unit(c, &x, ISA_OP_##name); break;
 #include "../isa/opcodes.def"
 #undef ISA_OP
-    case ISA_OP_COUNT: /* not an opcode: isa_decode never produces it */
-        return -trap(c, "internal error: undecoded instruction");
+    case ISA_OP_COUNT: /* not an opcode: only the sentinel after the program carries it */
+        return -trap(c, "pc past the end of the program (%u instructions)", c->ncode);
     }
     if (r)
         return -1;
 
-    c->st.instructions[stage]++;
-    c->st.ops[stage][dc->cat]++;
-    c->st.by_op[in->op]++;
-    c->st.gen_instructions[gen][stage]++;
-    if (dc->vec) {
-        c->st.vec_instructions[stage]++;
-        c->st.active_lanes[stage] += x.active;
-        c->st.gen_vec_instructions[gen][stage]++;
-        c->st.gen_active_lanes[gen][stage] += x.active;
-    }
+    row[in->op]++;
+    if (dc->vec)
+        row[ISA_OP_COUNT] += (uint64_t)popcount64(x.lanes);
     c->total++;
-    if (c->hook) {
+    if (hooked) {
         c->rec.next_pc = x.halt ? c->pc : x.next;
         c->hook(c->hook_ctx, &c->rec);
     }
@@ -959,11 +1017,11 @@ static int step(Core *c)
     return x.halt;
 }
 
-CoreExit core_run_slice(Core *c, uint64_t max_instr, uint64_t limit)
+/* The run loop for one value of hooked (a constant after inlining). */
+static ALWAYS_INLINE CoreExit run_loop(Core *c, uint64_t max_instr, uint64_t limit, const int hooked)
 {
-    c->trap[0] = 0;
     for (uint64_t done = 0; max_instr == 0 || done < max_instr; done++) {
-        int r = step(c);
+        int r = step(c, hooked);
         if (r > 0)
             return CORE_EXIT_HALT;
         if (r < 0)
@@ -971,6 +1029,12 @@ CoreExit core_run_slice(Core *c, uint64_t max_instr, uint64_t limit)
     }
     trap(c, "instruction limit of %llu reached", (unsigned long long)limit);
     return CORE_EXIT_LIMIT;
+}
+
+CoreExit core_run_slice(Core *c, uint64_t max_instr, uint64_t limit)
+{
+    c->trap[0] = 0;
+    return c->hook ? run_loop(c, max_instr, limit, 1) : run_loop(c, max_instr, limit, 0);
 }
 
 CoreExit core_run(Core *c, uint64_t max_instr)
@@ -991,7 +1055,11 @@ void core_set_sreg(Core *c, int r, uint32_t v) { c->r[r] = v; }
 uint32_t core_vreg(const Core *c, int v, int lane) { return c->v[v].u[lane]; }
 uint64_t core_mreg(const Core *c, int m) { return c->m[m]; }
 int core_current_rb(const Core *c) { return c->cur_rb; }
-const CoreStats *core_stats(const Core *c) { return &c->st; }
+const CoreStats *core_stats(Core *c)
+{
+    count_fold(c);
+    return &c->st;
+}
 uint64_t core_instructions(const Core *c) { return c->total; }
 
 uint8_t *core_mem(Core *c, CoreMem m, uint32_t *bytes)

@@ -101,7 +101,7 @@ uint32_t core_vreg(const Core *c, int v, int lane);
 uint64_t core_mreg(const Core *c, int m);
 uint8_t *core_mem(Core *c, CoreMem m, uint32_t *bytes);
 int core_current_rb(const Core *c);              /* 0 or 1: which physical buffer is RBc */
-const CoreStats *core_stats(const Core *c);
+const CoreStats *core_stats(Core *c);           /* folds the counters: not for concurrent readers */
 uint64_t core_instructions(const Core *c);       /* total executed */
 
 extern const char *const core_mem_names[CORE_MEM_COUNT]; /* "rb0", "rb1", "idm", "spad", "scene", "fb" */
