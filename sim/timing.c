@@ -36,9 +36,23 @@ const char *const tm_cause_descs[TM_CAUSE_COUNT] = {
 #undef TM_DESC
 };
 
-/* Events: a result lands in a register, a unit class leaves its issue interval, fetch resumes
- * after a taken branch, the partition unit finishes. */
-enum { EV_REG, EV_UNIT, EV_FETCH, EV_PART };
+/* Events on the queue: a unit class leaves its issue interval, fetch resumes after a taken
+ * branch, the partition unit finishes. A result landing in a register is an event too, but the
+ * most frequent one by far: it is kept in the scoreboard's table of ready cycles (simd.h) rather
+ * than on the heap, and time jumps to the earliest of the queue's top and the landings the
+ * waiting instruction needs (wait_hazards). */
+enum { EV_UNIT, EV_FETCH, EV_PART };
+
+/* The scoreboard registers of one program instruction (simd_operands), worked out the first time
+ * the instruction runs and kept by its pc: they depend only on the instruction. */
+typedef struct TmOperands {
+    uint32_t run;                            /* the run (timing_reset) they were made in: a
+                                                run's program is fixed, so pc names its
+                                                instruction; a new run works them out again */
+    uint8_t nregs, ndst;
+    uint8_t regs[2 * ISA_MAX_OPERANDS + 1];  /* sources, exec mask, destinations */
+    uint8_t dsts[ISA_MAX_OPERANDS];
+} TmOperands;
 
 struct Timing {
     EvQueue q;
@@ -50,6 +64,10 @@ struct Timing {
     PartUnit part;
     Spad spad;
     SceneMem mem;
+    TmOperands *ops;               /* by pc (operands()); grown to the program's size once */
+    uint32_t ops_cap;
+    uint32_t run;                  /* runs since timing_new, from 1 (TmOperands.run) */
+    TmOperands spare;              /* operands() when the table cannot grow */
     int halted;
     char err[256];
     TimingStats st;
@@ -95,6 +113,7 @@ void timing_free(Timing *t)
     if (!t)
         return;
     evq_free(&t->q);
+    free(t->ops);
     mem_free(&t->mem);
     rb_free(&t->rb);
     free(t);
@@ -110,6 +129,11 @@ void timing_reset(Timing *t)
     xbar_reset(&t->xbar);
     mem_reset(&t->mem);
     t->halted = 0;
+    if (++t->run == 0) { /* wrapped: no entry may look current */
+        if (t->ops)
+            memset(t->ops, 0, sizeof *t->ops * t->ops_cap);
+        t->run = 1;
+    }
 }
 
 const TimingStats *timing_stats(const Timing *t)
@@ -170,7 +194,6 @@ static void drain(Timing *t, uint64_t at)
     const EvEvent *e;
     while ((e = evq_top(&t->q)) && e->time <= at) {
         switch (e->kind) {
-        case EV_REG: simd_result_landed(&t->simd, e->arg, e->tag); break;
         case EV_UNIT: simd_unit_free(&t->simd, e->arg); break;
         case EV_FETCH: simd_fetch_resumed(&t->simd); break;
         case EV_PART: part_done(&t->part); break;
@@ -181,46 +204,82 @@ static void drain(Timing *t, uint64_t at)
 
 /* ---- 1. hazards that an event clears ------------------------------------------------------ */
 
-/* The highest-priority hazard that an event will clear, or -1 (docs/model.md, "Stall causes"). */
-static int hazard(const Timing *t, const IsaOpInfo *oi, const CoreRecord *rec, const int *regs, int nregs,
-                  int is_halt)
+/* The highest-priority hazard at cycle at that an event will clear, or -1 (docs/model.md, "Stall
+ * causes"). */
+static int hazard(const Timing *t, const IsaOpInfo *oi, const CoreRecord *rec, const TmOperands *o, int is_halt,
+                  uint64_t at)
 {
     if (t->simd.fetch_pending)
         return TM_CONTROL;
-    int cause = simd_waiting_operand(&t->simd, regs, nregs);
+    int cause = simd_waiting_operand(&t->simd, o->regs, o->nregs, at);
     if (cause >= 0)
         return cause;
     if (t->simd.unit_pending[oi->unit])
         return TM_FU_BUSY;
-    if (part_blocks(&t->part, oi, rec))
+    if (t->part.busy && part_blocks(&t->part, oi, rec))
         return TM_PARTITION;
     if (is_halt) { /* the program ends when every result in flight has landed */
         if (t->part.busy)
             return TM_PARTITION;
-        return simd_any_waiting(&t->simd);
+        return simd_any_waiting(&t->simd, at);
     }
     return -1;
 }
 
-/* From t->now, jump from event to event while a hazard holds; returns the first cycle free of them. */
-static uint64_t wait_hazards(Timing *t, const IsaOpInfo *oi, const CoreRecord *rec, const int *regs, int nregs,
+/* From t->now, jump from event to event while a hazard holds; returns the first cycle free of them.
+ * The next event is the queue's top or a register landing the hazards read, whichever is first:
+ * between two such events no hazard changes, so each interval goes to one cause. */
+static uint64_t wait_hazards(Timing *t, const IsaOpInfo *oi, const CoreRecord *rec, const TmOperands *o,
                              int is_halt)
 {
     uint64_t at = t->now;
     for (;;) {
         drain(t, at);
-        int cause = hazard(t, oi, rec, regs, nregs, is_halt);
+        int cause = hazard(t, oi, rec, o, is_halt, at);
         if (cause < 0)
             break;
+        uint64_t next = simd_next_landing(&t->simd, o->regs, is_halt ? -1 : o->nregs, at);
         const EvEvent *e = evq_top(&t->q);
-        if (!e || e->time <= at) {
+        if (e && e->time < next)
+            next = e->time;
+        if (next == UINT64_MAX || next <= at) {
             internal_error(t, "a hazard with no event to clear it");
             break;
         }
-        charge(t, cause, e->time - at, rec->stage, rec->gen);
-        at = e->time;
+        charge(t, cause, next - at, rec->stage, rec->gen);
+        at = next;
     }
     return at;
+}
+
+/* The scoreboard registers of the instruction at rec->pc: from the table, filled on first use. A
+ * failed allocation works them out into *spare instead (slower, same answer). */
+static const TmOperands *operands(Timing *t, const CoreRecord *rec)
+{
+    TmOperands *o;
+    if (__builtin_expect(rec->pc < t->ops_cap, 1)) {
+        o = &t->ops[rec->pc];
+        if (o->run == t->run)
+            return o;
+    } else {
+        uint32_t cap = t->ops_cap ? t->ops_cap : 256;
+        while (cap <= rec->pc && cap < UINT32_MAX / 2)
+            cap *= 2;
+        TmOperands *g = cap > rec->pc ? realloc(t->ops, sizeof *g * cap) : NULL;
+        if (g) {
+            memset(g + t->ops_cap, 0, sizeof *g * (cap - t->ops_cap));
+            t->ops = g;
+            t->ops_cap = cap;
+            o = &t->ops[rec->pc];
+        } else {
+            o = &t->spare;
+        }
+    }
+    int ndst;
+    o->nregs = (uint8_t)simd_operands(&t->simd, rec->in, o->regs, o->dsts, &ndst);
+    o->ndst = (uint8_t)ndst;
+    o->run = o == &t->spare ? 0 : t->run;
+    return o;
 }
 
 /* ---- 2, 3. the units an instruction uses as it issues ------------------------------------- */
@@ -348,21 +407,17 @@ void timing_hook(void *ctx, const CoreRecord *rec)
         internal_error(t, "instruction after halt");
         return;
     }
-    int regs[2 * ISA_MAX_OPERANDS + 1], dsts[ISA_MAX_OPERANDS], ndst;
-    const int nregs = simd_operands(&t->simd, rec->in, regs, dsts, &ndst);
+    const TmOperands *o = operands(t, rec);
 
-    Issue is = {wait_hazards(t, oi, rec, regs, nregs, is_halt), 0, 0, TM_DATA_DEPENDENCY};
+    Issue is = {wait_hazards(t, oi, rec, o, is_halt), 0, 0, TM_DATA_DEPENDENCY};
     issue_units(t, oi, rec, &is);
     count_issue(t, oi, rec->stage, rec->gen);
     const uint64_t last = is.at + is.ext; /* the instruction's last issue cycle */
     const uint64_t end = last + 1;        /* the next instruction's earliest issue cycle */
 
     const uint64_t ready = result_time(t, oi, rec, &is, last, end);
-    for (int i = 0; i < ndst; i++) {
-        uint32_t tag;
-        if (simd_result(&t->simd, dsts[i], ready, end, is.res_cause, &tag))
-            push(t, ready, EV_REG, dsts[i], tag, is.res_cause);
-    }
+    for (int i = 0; i < o->ndst; i++)
+        simd_result(&t->simd, o->dsts[i], ready, is.res_cause);
     uint64_t until;
     if (simd_hold_unit(&t->simd, oi->unit, is.at, end, &until))
         push(t, until, EV_UNIT, oi->unit, 0, TM_FU_BUSY);

@@ -70,8 +70,7 @@ void simd_init(SimdUnit *u, const SimdParams *p)
 
 void simd_reset(SimdUnit *u)
 {
-    memset(u->pending, 0, sizeof u->pending);
-    u->tagseq = 0;
+    memset(u->ready, 0, sizeof u->ready);
     memset(u->unit_pending, 0, sizeof u->unit_pending);
     u->fetch_pending = 0;
 }

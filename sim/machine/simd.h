@@ -40,9 +40,9 @@ typedef struct SimdOpRegs {    /* registers an opcode reads and writes, from the
 typedef struct SimdUnit {
     SimdParams p;
     SimdOpRegs ops[ISA_OP_COUNT];
-    uint8_t pending[SIMD_NREGS];       /* a result is on its way */
+    uint64_t ready[SIMD_NREGS];        /* the cycle the register's latest write lands: an
+                                          instruction needing it waits while ready > its cycle */
     uint8_t rcause[SIMD_NREGS];        /* what a wait for it is charged to (its producer's cause) */
-    uint32_t rtag[SIMD_NREGS], tagseq; /* the latest write's tag: older results' events are ignored */
     uint8_t unit_pending[ISA_U_COUNT]; /* the class is inside its issue interval */
     uint8_t fetch_pending;             /* the bubble after a taken branch */
 } SimdUnit;
@@ -64,38 +64,56 @@ static inline int simd_field(const IsaInstr *in, int f)
 
 /* The registers an instruction must find ready: its sources, the exec mask, and its destinations
  * (no write after a pending write). Writes them to regs (returns how many) and the destinations
- * alone to dsts (*ndst). */
-static inline int simd_operands(const SimdUnit *u, const IsaInstr *in, int *regs, int *dsts, int *ndst)
+ * alone to dsts (*ndst). The timing core calls it once per program instruction and keeps the
+ * lists (sim/timing.c). */
+static inline int simd_operands(const SimdUnit *u, const IsaInstr *in, uint8_t *regs, uint8_t *dsts, int *ndst)
 {
     const SimdOpRegs *orr = &u->ops[in->op];
     int n = 0;
     for (int i = 0; i < orr->nsrc; i++)
-        regs[n++] = simd_reg(orr->src_kind[i], simd_field(in, orr->src_field[i]));
+        regs[n++] = (uint8_t)simd_reg(orr->src_kind[i], simd_field(in, orr->src_field[i]));
     if (orr->mask_src)
-        regs[n++] = simd_reg(ISA_K_M, in->mask);
+        regs[n++] = (uint8_t)simd_reg(ISA_K_M, in->mask);
     *ndst = 0;
     for (int i = 0; i < orr->ndst; i++)
-        regs[n++] = dsts[(*ndst)++] = simd_reg(orr->dst_kind[i], simd_field(in, orr->dst_field[i]));
+        regs[n++] = dsts[(*ndst)++] = (uint8_t)simd_reg(orr->dst_kind[i], simd_field(in, orr->dst_field[i]));
     return n;
 }
 
-/* The cause of the first of regs[0..n) still waiting for a result, or -1. */
-static inline int simd_waiting_operand(const SimdUnit *u, const int *regs, int n)
+/* The cause of the first of regs[0..n) still waiting for a result at cycle at, or -1. */
+static inline int simd_waiting_operand(const SimdUnit *u, const uint8_t *regs, int n, uint64_t at)
 {
     for (int i = 0; i < n; i++)
-        if (u->pending[regs[i]])
+        if (u->ready[regs[i]] > at)
             return u->rcause[regs[i]];
     return -1;
 }
 
-/* The cause of the first register still waiting for a result, or -1 (a program ends when every
- * result in flight has landed). */
-static inline int simd_any_waiting(const SimdUnit *u)
+/* The cause of the first register still waiting for a result at cycle at, or -1 (a program ends
+ * when every result in flight has landed). */
+static inline int simd_any_waiting(const SimdUnit *u, uint64_t at)
 {
     for (int r = 0; r < SIMD_NREGS; r++)
-        if (u->pending[r])
+        if (u->ready[r] > at)
             return u->rcause[r];
     return -1;
+}
+
+/* The first cycle after at when one of regs[0..n) (all registers when n < 0) gets its result,
+ * or UINT64_MAX: the next change of the register hazards. */
+static inline uint64_t simd_next_landing(const SimdUnit *u, const uint8_t *regs, int n, uint64_t at)
+{
+    uint64_t next = UINT64_MAX;
+    if (n < 0) {
+        for (int r = 0; r < SIMD_NREGS; r++)
+            if (u->ready[r] > at && u->ready[r] < next)
+                next = u->ready[r];
+        return next;
+    }
+    for (int i = 0; i < n; i++)
+        if (u->ready[regs[i]] > at && u->ready[regs[i]] < next)
+            next = u->ready[regs[i]];
+    return next;
 }
 
 /* Result of a class issued at cycle at, by its latency. */
@@ -104,26 +122,12 @@ static inline uint64_t simd_result_ready(const SimdUnit *u, int unit, uint64_t a
     return at + (uint64_t)u->p.lat[unit];
 }
 
-/* Register reg gets its value at cycle ready; `end` is the next issue slot. Returns 1 when an
- * instruction could wait for it (then *tag names this write for its event, and a wait is charged
- * to cause), 0 when it is ready by then. */
-static inline int simd_result(SimdUnit *u, int reg, uint64_t ready, uint64_t end, int cause, uint32_t *tag)
+/* Register reg gets its value at cycle ready; a wait for it is charged to cause. (The result's
+ * landing is this table entry, not an event on the queue: the common case costs no heap work.) */
+static inline void simd_result(SimdUnit *u, int reg, uint64_t ready, int cause)
 {
-    if (ready <= end) { /* ready by the next issue slot: nothing can wait for it */
-        u->pending[reg] = 0;
-        return 0;
-    }
-    u->pending[reg] = 1;
+    u->ready[reg] = ready;
     u->rcause[reg] = (uint8_t)cause;
-    *tag = u->rtag[reg] = ++u->tagseq;
-    return 1;
-}
-
-/* The event of a result: only the register's latest write clears it. */
-static inline void simd_result_landed(SimdUnit *u, int reg, uint32_t tag)
-{
-    if (u->rtag[reg] == tag)
-        u->pending[reg] = 0;
 }
 
 /* After an instruction of class unit issued at cycle at (next issue slot end): 1 when the class

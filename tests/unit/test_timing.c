@@ -192,3 +192,68 @@ Test(timing, every_cause_has_a_key_and_a_description)
     }
     cr_expect_eq(TM_CAUSE_COUNT, 10, "the ten causes of ARCHITECTURE.md Sec. 3");
 }
+
+/* A kernels/bench program and the one define it needs. */
+typedef struct BenchProg {
+    const char *file, *define;
+    long long value;
+} BenchProg;
+
+/* prog's stats on a fresh model, or, with `after`, on a model that ran `after` first
+ * (timing_reset between, as a worker does for each pass). */
+static TimingStats run_on(const BenchProg *prog, const BenchProg *after)
+{
+    CfgMachine cfg;
+    cfg_defaults(&cfg);
+    CoreParams cp;
+    cfg_core_params(&cfg, &cp);
+    TimingParams tp;
+    timing_params(&cfg, &tp);
+    char err[512];
+    Timing *t = timing_new(&tp, err, sizeof err);
+    cr_assert(t, "%s", err);
+    TimingStats before = {0};
+    for (int k = after ? 0 : 1; k < 2; k++) {
+        const BenchProg *p = k == 0 ? after : prog;
+        AsmDefine def = {p->define, p->value};
+        AsmOptions opt = {&def, p->define ? 1 : 0, NULL, 0, NULL};
+        AsmObject obj;
+        cr_assert(asm_assemble_file(p->file, &opt, &obj) == 0, "%s does not assemble", p->file);
+        Core *c = core_new(&cp, &obj, err, sizeof err);
+        cr_assert(c, "%s: %s", p->file, err);
+        timing_reset(t);
+        before = *timing_stats(t);
+        core_set_hook(c, timing_hook, t);
+        cr_assert_eq(core_run(c, 1000000), CORE_EXIT_HALT, "%s: %s", p->file, core_trap_message(c));
+        timing_end(t);
+        cr_assert_null(timing_error(t), "%s: %s", p->file, timing_error(t));
+        core_free(c);
+        asm_object_free(&obj);
+    }
+    TimingStats s = *timing_stats(t);
+    uint64_t *a = (uint64_t *)&s;
+    const uint64_t *b = (const uint64_t *)&before;
+    for (size_t i = 0; i < sizeof s / sizeof(uint64_t); i++)
+        a[i] -= b[i];
+    timing_free(t);
+    return s;
+}
+
+Test(timing, a_model_reused_for_another_program_times_it_as_a_fresh_one)
+{
+    /* The timing core keeps each instruction's scoreboard registers by pc for the run; a new run
+     * (timing_reset) on another program must not reuse them. */
+    static const BenchProg progs[] = {{"kernels/bench/chains.s", "CLASS", 3},
+                                      {"kernels/bench/gather_banks.s", "PATTERN", 1},
+                                      {"kernels/bench/partition.s", "N8", 0},
+                                      {"kernels/bench/branch.s", NULL, 0},
+                                      {"kernels/bench/scene.s", "PATTERN", 0}};
+    const int n = (int)(sizeof progs / sizeof progs[0]);
+    for (int i = 0; i < n; i++) {
+        const BenchProg *p = &progs[i], *prev = &progs[(i + 1) % n];
+        TimingStats fresh = run_on(p, NULL), reused = run_on(p, prev);
+        cr_expect_gt(fresh.cycles, 0u, "%s", p->file);
+        cr_expect(memcmp(&fresh, &reused, sizeof fresh) == 0, "%s after %s: cycles %llu, fresh %llu", p->file,
+                  prev->file, (unsigned long long)reused.cycles, (unsigned long long)fresh.cycles);
+    }
+}
