@@ -14,10 +14,14 @@
 ;   0 viota  1 vshli v1, v1, 9 (ready 2)  2 rgat: cycles 2..17, bank_conflict 15, ready 17 + 3 = 20
 ;   18 halt waits 18, 19: cycles 21 = busy 4 + bank_conflict 15 + data_dependency 2
 ; PATTERN 3, the worst case as a scatter (no result to wait for): halt at 18, cycles 19.
+; PATTERN 2 with 3 banks (not a power of two): line 32 l is in bank 2 l mod 3, so bank 0 holds
+;   lanes 0, 3, .., 15 (6 lines) and banks 1, 2 five each: rgat cycles 2..7, bank_conflict 5, ready
+;   7 + 3 = 10; halt waits 8, 9: cycles 11 = busy 4 + bank_conflict 5 + data_dependency 2
 ;
 ;@ run none    define PATTERN=0 set core.simd_width=16 expect cycles=5 busy=3 data_dependency=2 rb_conflicted=0
 ;@ run one     define PATTERN=1 set core.simd_width=16 expect cycles=10 busy=7 bank_conflict=1 data_dependency=2 rb_conflicted=1
 ;@ run worst   define PATTERN=2 set core.simd_width=16 expect cycles=21 busy=4 bank_conflict=15 data_dependency=2 rb_conflicted=1
+;@ run worst3  define PATTERN=2 set core.simd_width=16 set raybuf.banks=3 expect cycles=11 busy=4 bank_conflict=5 data_dependency=2 rb_conflicted=1
 ;@ run scatter define PATTERN=3 set core.simd_width=16 expect cycles=19 busy=4 bank_conflict=15 rb_conflicted=1
 
         .text

@@ -28,34 +28,56 @@ int rb_init(RayBufs *rb, const RbParams *p)
     rb->shift = lines_log2(p->line);
     rb->bank_cnt = calloc((size_t)p->banks, sizeof *rb->bank_cnt);
     rb->bank_stamp = calloc((size_t)p->banks, sizeof *rb->bank_stamp);
-    return rb->bank_cnt && rb->bank_stamp ? 0 : -1;
+    rb->bank_head = calloc((size_t)p->banks, sizeof *rb->bank_head);
+    return rb->bank_cnt && rb->bank_stamp && rb->bank_head ? 0 : -1;
 }
 
 void rb_free(RayBufs *rb)
 {
     free(rb->bank_cnt);
     free(rb->bank_stamp);
+    free(rb->bank_head);
     rb->bank_cnt = NULL;
     rb->bank_stamp = NULL;
+    rb->bank_head = NULL;
 }
 
+/* Each distinct line is found through its own bank's list of the lines seen so far (usually
+ * empty or one long), so an access costs about one probe per lane rather than one per pair of
+ * lines; the counts are those of the distinct lines, in any order. */
 int rb_access(RayBufs *rb, const uint32_t *addr, int naddr, TimingStats *st)
 {
-    uint64_t lines[ISA_MAX_LANES], d[ISA_MAX_LANES];
-    for (int i = 0; i < naddr; i++)
-        lines[i] = addr[i] >> rb->shift;
-    int k = lines_distinct(lines, naddr, d);
+    uint32_t line_of[ISA_MAX_LANES];
+    int8_t next[ISA_MAX_LANES];
     if (++rb->stamp == 0) {
         memset(rb->bank_stamp, 0, (size_t)rb->p.banks * sizeof *rb->bank_stamp);
         rb->stamp = 1;
     }
-    int worst = 0; /* lanes in one line share an access; lines of one bank serialize */
-    for (int i = 0; i < k; i++) {
-        uint32_t b = (uint32_t)(d[i] % (uint64_t)rb->p.banks);
+    const uint32_t banks = (uint32_t)rb->p.banks;
+    const int pow2 = (banks & (banks - 1)) == 0; /* the usual case: a mask, not a division */
+    int k = 0, worst = 0; /* lanes in one line share an access; lines of one bank serialize */
+    for (int i = 0; i < naddr; i++) {
+        const uint32_t line = addr[i] >> rb->shift;
+        if (k && line_of[k - 1] == line) /* the lane before's line: neighbouring IDs */
+            continue;
+        const uint32_t b = pow2 ? line & (banks - 1) : line % banks;
         if (rb->bank_stamp[b] != rb->stamp) {
             rb->bank_stamp[b] = rb->stamp;
             rb->bank_cnt[b] = 0;
+            rb->bank_head[b] = -1;
         }
+        int seen = 0;
+        for (int e = rb->bank_head[b]; e >= 0; e = next[e])
+            if (line_of[e] == line) {
+                seen = 1;
+                break;
+            }
+        if (seen)
+            continue;
+        line_of[k] = line;
+        next[k] = rb->bank_head[b];
+        rb->bank_head[b] = (int8_t)k;
+        k++;
         if (++rb->bank_cnt[b] > worst)
             worst = rb->bank_cnt[b];
     }

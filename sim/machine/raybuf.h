@@ -34,6 +34,7 @@ typedef struct RayBufs {
     RbParams p;
     int shift;                 /* byte address -> line */
     uint16_t *bank_cnt;        /* lines per bank in the current access, valid where stamped */
+    int8_t *bank_head;         /* the bank's first line in the access's list, valid where stamped */
     uint32_t *bank_stamp, stamp;
 } RayBufs;
 
