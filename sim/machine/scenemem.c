@@ -33,6 +33,7 @@ void mem_init(SceneMem *m, const SceneMemParams *p)
     m->line_shift = s;
     m->xfer = (p->line_bytes + p->bytes_per_cycle - 1) / p->bytes_per_cycle;
     m->sets = p->cache_bytes > 0 ? p->cache_bytes / (p->line_bytes * p->ways) : 0;
+    m->set_mask = m->sets > 1 && (m->sets & (m->sets - 1)) == 0 ? (uint64_t)m->sets - 1 : 0;
 }
 
 void mem_free(SceneMem *m)
@@ -93,7 +94,7 @@ uint64_t mem_access(SceneMem *m, int space, uint32_t addr, uint64_t t, int write
     if (!m->instantiated && instantiate(m))
         return UINT64_MAX;
     uint64_t line = mem_line(m, space, addr);
-    size_t set = (size_t)(line % (uint64_t)m->sets), w = (size_t)m->p.ways;
+    size_t set = (size_t)(m->set_mask ? line & m->set_mask : line % (uint64_t)m->sets), w = (size_t)m->p.ways;
     uint64_t *tag = m->tag + set * w;
     m->stamp++;
     for (size_t i = 0; i < w; i++)
@@ -132,8 +133,13 @@ uint64_t mem_issue(SceneMem *m, uint32_t flags, const uint32_t *addr, int naddr,
         lines[i] = mem_line(m, space, addr[i]);
     int k = lines_distinct(lines, naddr, d);
     *ready = 0;
-    for (int i = 0; i < k; i++) { /* one line per port-slot */
-        uint64_t slot = at + (uint64_t)(i / m->p.ports);
+    uint64_t slot = at;
+    for (int i = 0, in_slot = 0; i < k; i++) { /* one line per port-slot: slot = at + i / ports */
+        if (in_slot == m->p.ports) {
+            slot++;
+            in_slot = 0;
+        }
+        in_slot++;
         uint32_t a = (uint32_t)((d[i] << m->line_shift) & 0xffffffffu);
         uint64_t r = mem_access(m, space, a, slot, write);
         if (r > *ready)

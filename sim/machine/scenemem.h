@@ -40,6 +40,8 @@ typedef struct SceneMemStats {
 typedef struct SceneMem {
     SceneMemParams p;
     int sets, line_shift, xfer;   /* xfer: bus cycles per line */
+    uint64_t set_mask;            /* sets - 1 when sets is a power of two (a mask, not a
+                                     division, per access), else 0 */
     uint64_t *tag;                /* sets x ways; line address + 1, 0 = empty */
     uint64_t *ready;              /* fill completion time per way */
     uint64_t *lru;                /* last-use stamp per way */

@@ -161,6 +161,31 @@ Test(timing, event_queue_orders_by_time_then_insertion)
     evq_free(&q);
 }
 
+Test(timing, scene_ports_serve_lines_in_slots)
+{
+    /* 64 sets x 4 ways (a power of two: the set is a mask) and 3 sets x 4 ways (a division); 3
+     * ports; hit latency 2. Seven lines are filled, then one gather of the same seven hits them:
+     * line i goes through slot at + i / 3, so the last is served at 100 + 2, ready 104, and the
+     * gather needs ceil(7 / 3) = 3 issue cycles. */
+    static const int cache_bytes[2] = {64 * 4 * 64, 3 * 4 * 64};
+    for (int c = 0; c < 2; c++) {
+        SceneMemParams p = {10, 16, 64, 2, cache_bytes[c], 4, 3};
+        SceneMem m;
+        mem_init(&m, &p);
+        uint32_t addr[7];
+        for (int i = 0; i < 7; i++) {
+            addr[i] = 64u * (uint32_t)i + 4u;
+            mem_access(&m, 0, addr[i], 0, 0);
+        }
+        TimingStats st = {0};
+        uint64_t ready = 0;
+        cr_expect_eq(mem_issue(&m, 0, addr, 7, 100, &ready, &st), 3, "cache of %d bytes", cache_bytes[c]);
+        cr_expect_eq(ready, 104, "cache of %d bytes: ready %llu", cache_bytes[c], (unsigned long long)ready);
+        cr_expect_eq(m.st.hits, 7, "cache of %d bytes", cache_bytes[c]);
+        mem_free(&m);
+    }
+}
+
 Test(timing, scene_cache_lru_and_bus)
 {
     /* 2 sets x 2 ways of 64-byte lines; latency 10, 16 bytes per cycle (4 cycles a line); one port. */
