@@ -364,9 +364,10 @@ static inline uint64_t bits_of_bytes8(const uint8_t *b)
                 (void)l;                                                                        \
                 t_.OUT[k_] = (EXPR);                                                            \
             }                                                                                   \
-            if (E == c->all)                                                                    \
-                memcpy(A_->u + b_ * CORE_BLOCK, t_.u,                                           \
-                       sizeof(uint32_t) * (size_t)(n - b_ * CORE_BLOCK < CORE_BLOCK ? n - b_ * CORE_BLOCK : CORE_BLOCK)); \
+            if (E == c->all && n - b_ * CORE_BLOCK >= CORE_BLOCK) /* a whole block: inline */ \
+                memcpy(A_->u + b_ * CORE_BLOCK, t_.u, sizeof(uint32_t) * CORE_BLOCK);          \
+            else if (E == c->all)                                                               \
+                memcpy(A_->u + b_ * CORE_BLOCK, t_.u, sizeof(uint32_t) * (size_t)(n - b_ * CORE_BLOCK)); \
             else                                                                                \
                 block_merge(A_->u, t_.u, E, b_ * CORE_BLOCK);                                   \
         }                                                                                       \
