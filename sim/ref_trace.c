@@ -432,11 +432,7 @@ static inline __attribute__((always_inline)) int walk_body(const PackedScene *p,
                  * primitive index wins a tie whatever the visiting order. */
                 if (!hit_prim(prims, i, &R, ptmax, &t, &u, &v))
                     continue;
-                if (hit->prim == REF_NO_HIT || t < hit->t || (t == hit->t && i < hit->prim)) {
-                    hit->t = t;
-                    hit->u = u;
-                    hit->v = v;
-                    hit->prim = i;
+                if (ref_hit_keep(hit, t, u, v, i)) {
                     far = box_far(t);
                     if (closest)
                         ptmax = ref_tie_probe(t);
