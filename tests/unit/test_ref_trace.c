@@ -251,8 +251,10 @@ Test(ref_traversal, matches_brute_force)
     free(tm);
 }
 
-/* A query without stats takes the fast walk (both children's boxes tested at once, the far one's
- * entry distance kept on the stack); one with stats takes the plain walk, the reference order.
+/* On an AVX host a query without stats takes the fast walk (both children's boxes tested at once,
+ * the far one's entry distance kept on the stack); one with stats takes the plain walk, whose
+ * counts sampled mode uses (a baseline build takes the plain walk for both: the test then holds
+ * trivially).
  * Their hits must agree bit for bit (prim, t, u, v) and so must the any-hit answers, on rays
  * that start inside and outside the scene, run along axes (zero and negative-zero components)
  * and carry odd tmax values. */
