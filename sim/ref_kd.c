@@ -152,17 +152,11 @@ static int trace(const PackedScene *p, const KdTree *t, RefKdVariant v, int dept
             float th, u, w;
             if (st)
                 st->prims_tested++;
-            float ptmax = q.tmax;
-            if (hit->prim != REF_NO_HIT)
-                ptmax = closest ? ref_tie_probe(hit->t) : hit->t;
-            if (!ref_hit_prim_pre(p, pr, &pre, ptmax, &th, &u, &w))
+            /* An any-hit query returns at its first hit, so only a closest-hit query ever tests
+             * with a hit in hand (the tie probe). */
+            if (!ref_hit_prim_pre(p, pr, &pre, ref_hit_tmax(hit, q.tmax), &th, &u, &w))
                 continue;
-            if (hit->prim == REF_NO_HIT || th < hit->t || (th == hit->t && pr < hit->prim)) {
-                hit->t = th;
-                hit->u = u;
-                hit->v = w;
-                hit->prim = pr;
-            }
+            ref_hit_keep(hit, th, u, w, pr);
             if (!closest)
                 return 1;
         }
@@ -406,17 +400,8 @@ static void packet_leaf(Packet *k, const KdNode *nd, const PEntry *cur)
             float th, u, w;
             if (st)
                 st->prims_tested++;
-            float ptmax = k->q[i].tmax;
-            if (h->prim != REF_NO_HIT)
-                ptmax = ref_tie_probe(h->t);
-            if (!ref_hit_prim_pre(k->p, pr, &k->pre[i], ptmax, &th, &u, &w))
-                continue;
-            if (h->prim == REF_NO_HIT || th < h->t || (th == h->t && pr < h->prim)) {
-                h->t = th;
-                h->u = u;
-                h->v = w;
-                h->prim = pr;
-            }
+            if (ref_hit_prim_pre(k->p, pr, &k->pre[i], ref_hit_tmax(h, k->q[i].tmax), &th, &u, &w))
+                ref_hit_keep(h, th, u, w, pr);
         }
     }
 }

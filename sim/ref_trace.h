@@ -101,6 +101,28 @@ static inline float ref_tie_probe(float t)
     return t;
 }
 
+/* The closest-hit rule every traversal shares (BVH, kd-trees, packets): a primitive hit at t
+ * replaces the best hit so far when there is none, when t is lower, or when t ties and the
+ * primitive index is lower -- so the answer does not depend on the order of the tests. 1 when
+ * it replaced *best. */
+static inline int ref_hit_keep(RefHit *best, float t, float u, float v, uint32_t prim)
+{
+    if (!(best->prim == REF_NO_HIT || t < best->t || (t == best->t && prim < best->prim)))
+        return 0;
+    best->t = t;
+    best->u = u;
+    best->v = v;
+    best->prim = prim;
+    return 1;
+}
+
+/* The tmax to test the next primitive with, given the best hit so far: the ray's own tmax, or
+ * once there is a hit the tie probe past it (ref_tie_probe), so a tie or a closer hit is seen. */
+static inline float ref_hit_tmax(const RefHit *best, float tmax)
+{
+    return best->prim == REF_NO_HIT ? tmax : ref_tie_probe(best->t);
+}
+
 /* The primitive tests themselves (exposed for the hard-case tests). */
 int ref_hit_triangle(const float *v0, const float *v1, const float *v2, const RefRay *r,
                      float *t, float *u, float *v);

@@ -3,6 +3,7 @@
  * definition on random and special values, shared-edge watertightness, and traversal against
  * brute force over every primitive. */
 #include <criterion/criterion.h>
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -248,4 +249,67 @@ Test(ref_traversal, matches_brute_force)
     pack_free(&p);
     free(pos);
     free(tm);
+}
+
+/* On an AVX host a query without stats takes the fast walk (both children's boxes tested at once,
+ * the far one's entry distance kept on the stack); one with stats takes the plain walk, whose
+ * counts sampled mode uses (a baseline build takes the plain walk for both: the test then holds
+ * trivially).
+ * Their hits must agree bit for bit (prim, t, u, v) and so must the any-hit answers, on rays
+ * that start inside and outside the scene, run along axes (zero and negative-zero components)
+ * and carry odd tmax values. */
+static void fast_walk_matches_plain(const char *path, int nrays)
+{
+    Scene s;
+    PackedScene p;
+    char err[4096];
+    cr_assert_eq(pack_load_file(path, 0, 0, 0, &s, &p, err, sizeof err), 0, "%s", err);
+    uint32_t nodes = sm_u32(&p, sm_hdr(&p, SM_HDR_NODES));
+    float lo[3], hi[3];
+    for (int k = 0; k < 3; k++) {
+        lo[k] = sm_f32(&p, sm_rec(nodes, SM_NODE_WORDS, 0, SM_NODE_BMIN) + 4u * (uint32_t)k);
+        hi[k] = sm_f32(&p, sm_rec(nodes, SM_NODE_WORDS, 0, SM_NODE_BMAX) + 4u * (uint32_t)k);
+    }
+    static const float tmaxes[] = {INFINITY, 0.0f, -1.0f, 1e-30f, 0.5f, 3.0f, FLT_MAX};
+    unsigned st = 12345u;
+    int differ = 0, occl_differ = 0, hits = 0;
+    uint64_t visited = 0;
+    for (int i = 0; i < nrays; i++) {
+        RefRay r;
+        for (int k = 0; k < 3; k++) {
+            st = st * 1664525u + 1013904223u;
+            float f = (float)(st >> 8) / 16777216.0f;
+            r.org[k] = lo[k] + (f * 1.4f - 0.2f) * (hi[k] - lo[k]);
+            st = st * 1664525u + 1013904223u;
+            r.dir[k] = (float)(st >> 8) / 16777216.0f * 2.0f - 1.0f;
+            if ((st >> 4) % 16 == 0)
+                r.dir[k] = (st >> 9) % 2 ? 0.0f : -0.0f;
+        }
+        st = st * 1664525u + 1013904223u;
+        r.tmax = (st >> 8) % 4 ? INFINITY : tmaxes[(st >> 12) % (sizeof tmaxes / sizeof *tmaxes)];
+        if (r.tmax > 0.0f && r.tmax < 10.0f)
+            r.tmax *= hi[0] - lo[0];
+        RefHit fast, plain;
+        RefTraceStats ts = {0};
+        ref_closest_hit(&p, &r, &fast, NULL);
+        ref_closest_hit(&p, &r, &plain, &ts);
+        visited += ts.nodes_visited;
+        hits += plain.prim != REF_NO_HIT;
+        differ += memcmp(&fast, &plain, sizeof fast) != 0;
+        occl_differ += ref_any_hit(&p, &r, NULL) != ref_any_hit(&p, &r, &ts);
+    }
+    cr_log_info("%s: %d rays, %d hits, %.1f nodes per ray", path, nrays, hits, (double)visited / nrays);
+    cr_expect_gt(hits, nrays / 4, "%s: the test rays should hit something", path);
+    cr_expect_eq(differ, 0, "%s: %d closest hits differ between the walks", path, differ);
+    cr_expect_eq(occl_differ, 0, "%s: %d any-hit answers differ between the walks", path, occl_differ);
+    pack_free(&p);
+    scene_free(&s);
+}
+
+Test(ref_traversal, fast_walk_matches_plain_walk)
+{
+    fast_walk_matches_plain("scenes/cornell/scene.ini", 20000);
+    fast_walk_matches_plain("scenes/cornell/spheres.ini", 20000);
+    fast_walk_matches_plain("scenes/sponza-dabrovic/scene.ini", 20000);
+    fast_walk_matches_plain("scenes/conference/scene.ini", 20000);
 }
