@@ -118,6 +118,24 @@ static inline float box_area(const Box *b)
     return 2.0f * (dx * dy + dy * dz + dz * dx);
 }
 
+/* box_area of a box in registers. With AVX the three extents are taken in the lanes of one
+ * vector (hi > lo ? hi - lo : 0 as a mask on the difference) and their products and sums are
+ * those of box_area, in its order. */
+#if defined(__AVX__)
+static inline float vbox_area(Vbox b)
+{
+    __m128 lo = _mm256_castps256_ps128(b);
+    __m128 hi = _mm_xor_ps(_mm256_extractf128_ps(b, 1), _mm_set1_ps(-0.0f));
+    __m128 d = _mm_and_ps(_mm_cmpgt_ps(hi, lo), _mm_sub_ps(hi, lo));
+    __m128 p = _mm_mul_ps(d, _mm_shuffle_ps(d, d, _MM_SHUFFLE(3, 0, 2, 1))); /* dx dy, dy dz, dz dx */
+    float sum = _mm_cvtss_f32(p) + _mm_cvtss_f32(_mm_shuffle_ps(p, p, 1));
+    sum = sum + _mm_cvtss_f32(_mm_movehl_ps(p, p));
+    return 2.0f * sum;
+}
+#else
+static inline float vbox_area(Vbox b) { return box_area(&b); }
+#endif
+
 /* A node to build: its own box is already in nodes[node]; cb is its centroids' box. */
 typedef struct Task {
     Box cb;
@@ -149,6 +167,24 @@ static inline int bin_of(float c, float cmin, float scale, int bins)
  * count), from which the cost is computed by a chain of operations that never decrease. */
 typedef struct Split { int axis, bin; float cost, x; } Split;
 
+/* The indices of the non-empty bins among the first nb, in increasing order; their number. */
+static int list_nonempty(const uint32_t *count, int nb, int *list)
+{
+    int m = 0, i = 0;
+#if defined(__SSE2__)
+    for (; i + 4 <= nb; i += 4) {
+        __m128i zero = _mm_cmpeq_epi32(_mm_loadu_si128((const __m128i *)&count[i]), _mm_setzero_si128());
+        unsigned mask = ~(unsigned)_mm_movemask_ps(_mm_castsi128_ps(zero)) & 15u;
+        for (; mask; mask &= mask - 1)
+            list[m++] = i + __builtin_ctz(mask);
+    }
+#endif
+    for (; i < nb; i++)
+        if (count[i] > 0)
+            list[m++] = i;
+    return m;
+}
+
 /* The best split of one axis's bins into (best->bin and below, the rest), if it beats best.
  * Only non-empty bins are visited: a split after an empty bin has the same left box, right
  * box and counts, hence the same cost, as the split before it, and only a strictly lower cost
@@ -160,24 +196,21 @@ typedef struct Split { int axis, bin; float cost, x; } Split;
 static void sweep_axis(const BvhParams *p, const Bins *bins, int axis, uint32_t total, float parea,
                        Split *best)
 {
-    int nonempty[256], m = 0;
-    for (int i = 0; i < p->bins; i++)
-        if (bins->count[i] > 0)
-            nonempty[m++] = i;
+    int nonempty[256], m = list_nonempty(bins->count, p->bins, nonempty);
     /* right_area[r]: the area of the union of the non-empty bins r .. m-1, grown from the right */
     float right_area[256];
-    Box acc = box_none;
+    Vbox none = vbox_load(&box_none), acc = none;
     for (int r = m - 1; r > 0; r--) {
-        box_grow(&acc, &bins->box[nonempty[r]]);
-        right_area[r] = box_area(&acc);
+        acc = vbox_grow(acc, vbox_load(&bins->box[nonempty[r]]));
+        right_area[r] = vbox_area(acc);
     }
-    Box left = box_none;
+    Vbox left = none;
     uint32_t nleft = 0;
     for (int r = 0; r < m - 1; r++) {
-        box_grow(&left, &bins->box[nonempty[r]]);
+        left = vbox_grow(left, vbox_load(&bins->box[nonempty[r]]));
         nleft += bins->count[nonempty[r]];
         uint32_t nright = total - nleft;
-        float x = box_area(&left) * (float)nleft + right_area[r + 1] * (float)nright;
+        float x = vbox_area(left) * (float)nleft + right_area[r + 1] * (float)nright;
         if (!(x < best->x))
             continue;
         float cost = p->cost_traversal + p->cost_intersect * x / parea;
