@@ -152,6 +152,8 @@ typedef struct Builder {
     const BvhParams *p;
     Box *prim;   /* n, in prim_index order (which the partition permutes with them) */
     Bins *bins;  /* 4: one per axis, and a sink for the axes that give no split */
+    uint8_t (*bin)[4]; /* n: each position's bin on the three axes in the last binning that
+                        * covered it, moved with the primitives by the partition */
     Bvh *b;
 } Builder;
 
@@ -277,6 +279,9 @@ static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box 
         int i0 = _mm_cvtsi128_si32(bi);
         int i1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 1));
         int i2 = _mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 2));
+        /* the four lanes (0..255) as bytes */
+        uint32_t packed = (uint32_t)_mm_cvtsi128_si32(_mm_packus_epi16(_mm_packs_epi32(bi, bi), bi));
+        memcpy(B->bin[j], &packed, 4);
         bin_put(dst[0], i0, q);
         bin_put(dst[1], i1, q);
         bin_put(dst[2], i2, q);
@@ -286,11 +291,15 @@ static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box 
 static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, const float *scale, int live)
 {
     int nb = B->p->bins;
-    for (uint32_t j = begin; j < end; j++)
-        for (int axis = 0; axis < 3; axis++)
-            if (live & 1 << axis)
-                bin_put(&B->bins[axis], bin_of(centroid_of(&B->prim[j], axis), box_lo(cbox, axis), scale[axis], nb),
-                        &B->prim[j]);
+    for (uint32_t j = begin; j < end; j++) {
+        for (int axis = 0; axis < 3; axis++) {
+            if (live & 1 << axis) {
+                int i = bin_of(centroid_of(&B->prim[j], axis), box_lo(cbox, axis), scale[axis], nb);
+                B->bin[j][axis] = (uint8_t)i;
+                bin_put(&B->bins[axis], i, &B->prim[j]);
+            }
+        }
+    }
 }
 #endif
 
@@ -326,21 +335,19 @@ typedef struct Halves { Box box[2], cbox[2]; } Halves;
 /* Partition [begin, end) so primitives whose bin <= split.bin come first; returns mid. The
  * halves' boxes are grown on the way: a left position is final once passed, in increasing order;
  * a right position once filled, in decreasing order (hence vbox_grow_backwards). */
-static uint32_t partition(Builder *B, uint32_t begin, uint32_t end, const Box *cbox, Split s, Halves *h)
+static uint32_t partition(Builder *B, uint32_t begin, uint32_t end, Split s, Halves *h)
 {
-    float scale = (float)B->p->bins / (box_hi(cbox, s.axis) - box_lo(cbox, s.axis));
-    float cmin = box_lo(cbox, s.axis);
-    int bins = B->p->bins;
-    Vlane axis = vbox_lane_index(s.axis);
     Box *prim = B->prim;
     uint32_t *id = B->b->prim_index;
+    uint8_t(*bins)[4] = B->bin;
+    int axis = s.axis;
     Vbox none = vbox_load(&box_none);
     Vbox box0 = none, cbox0 = none, box1 = none, cbox1 = none;
     uint32_t i = begin, j = end;
     while (i < j) {
         Vbox q = vbox_load(&prim[i]);
         Vbox cc = vbox_centroid(q);
-        if (bin_of(vbox_lane(cc, axis), cmin, scale, bins) <= s.bin) {
+        if (bins[i][axis] <= s.bin) {
             box0 = vbox_grow(box0, q);
             cbox0 = vbox_grow(cbox0, cc);
             i++;
@@ -351,6 +358,10 @@ static uint32_t partition(Builder *B, uint32_t begin, uint32_t end, const Box *c
             uint32_t qi = id[i];
             id[i] = id[j];
             id[j] = qi;
+            uint8_t qb[4];
+            memcpy(qb, bins[i], 4);
+            memcpy(bins[i], bins[j], 4);
+            memcpy(bins[j], qb, 4);
             box1 = vbox_grow_backwards(box1, q);
             cbox1 = vbox_grow_backwards(cbox1, cc);
         }
@@ -430,7 +441,7 @@ static uint32_t split_node(Builder *B, const Task *t, const Box *nb, Halves *h, 
     float leaf_cost = p->cost_intersect * (float)count;
     if (s.axis >= 0 && (s.cost < leaf_cost || count > (uint32_t)p->max_leaf_size)) {
         *axis = (uint32_t)s.axis;
-        return partition(B, t->begin, t->end, &t->cb, s, h);
+        return partition(B, t->begin, t->end, s, h);
     }
     if (s.axis < 0 && count > (uint32_t)p->max_leaf_size) {
         /* All centroids coincide: no box split can separate them; halve by index so leaves
@@ -520,16 +531,18 @@ int bvh_build(const BvhParams *p, const float *bmin, const float *bmax, uint32_t
     if (n == 0)
         return 0;
 
-    Builder B = {p, aligned_alloc(32, sizeof(Box) * n), aligned_alloc(32, sizeof(Bins) * 4), out};
+    Builder B = {p, aligned_alloc(32, sizeof(Box) * n), aligned_alloc(32, sizeof(Bins) * 4), malloc(4 * (size_t)n),
+                 out};
     out->prim_index = malloc(sizeof(uint32_t) * n);
     out->nodes = malloc(sizeof(BvhNode) * (2 * (size_t)n - 1));
     /* Every task on the stack is the right sibling pending at a distinct depth of the path
      * being built, and a tree of n primitives has at most n levels. */
     Task *stack = aligned_alloc(32, sizeof(Task) * ((size_t)n + 1));
-    if (!B.prim || !B.bins || !out->prim_index || !out->nodes || !stack) {
+    if (!B.prim || !B.bins || !B.bin || !out->prim_index || !out->nodes || !stack) {
         snprintf(err, errlen, "bvh: out of memory for %u primitives", n);
         free(B.prim);
         free(B.bins);
+        free(B.bin);
         free(stack);
         bvh_free(out);
         return -1;
@@ -539,6 +552,7 @@ int bvh_build(const BvhParams *p, const float *bmin, const float *bmax, uint32_t
     free(stack);
     free(B.prim);
     free(B.bins);
+    free(B.bin);
     out->sah_cost = bvh_sah_cost(out, p);
     return 0;
 }
