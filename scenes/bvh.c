@@ -274,6 +274,7 @@ static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box 
     const Box *prim = B->prim;
     for (uint32_t j = begin; j < end; j++) {
         const Box *q = &prim[j];
+        _mm_prefetch((const char *)&prim[j + 16], _MM_HINT_T0);
         __m128 c = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(q->v), _mm_load_ps(q->v + 4)), half);
         __m128i bi = bin_of3(c, cmin, sc, top);
         int i0 = _mm_cvtsi128_si32(bi);
