@@ -22,6 +22,9 @@
 #if defined(__SSE2__)
 #include <immintrin.h>
 #endif
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 void bvh_default_params(BvhParams *p)
 {
@@ -522,6 +525,21 @@ static void build_nodes(Builder *B, Task *stack, uint32_t n)
     }
 }
 
+void *bvh_big_alloc(size_t size)
+{
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    const size_t huge = (size_t)2 << 20;
+    if (size >= huge) {
+        size_t rounded = (size + huge - 1) & ~(huge - 1);
+        void *m = aligned_alloc(huge, rounded);
+        if (m)
+            madvise(m, rounded, MADV_HUGEPAGE);
+        return m;
+    }
+#endif
+    return aligned_alloc(32, (size + 31) & ~(size_t)31);
+}
+
 int bvh_build(const BvhParams *p, const float *bmin, const float *bmax, uint32_t n, Bvh *out,
               char *err, size_t errlen)
 {
@@ -532,10 +550,9 @@ int bvh_build(const BvhParams *p, const float *bmin, const float *bmax, uint32_t
     if (n == 0)
         return 0;
 
-    Builder B = {p, aligned_alloc(32, sizeof(Box) * n), aligned_alloc(32, sizeof(Bins) * 4), malloc(4 * (size_t)n),
-                 out};
-    out->prim_index = malloc(sizeof(uint32_t) * n);
-    out->nodes = malloc(sizeof(BvhNode) * (2 * (size_t)n - 1));
+    Builder B = {p, bvh_big_alloc(sizeof(Box) * n), aligned_alloc(32, sizeof(Bins) * 4), bvh_big_alloc(4 * (size_t)n), out};
+    out->prim_index = bvh_big_alloc(sizeof(uint32_t) * n);
+    out->nodes = bvh_big_alloc(sizeof(BvhNode) * (2 * (size_t)n - 1));
     /* Every task on the stack is the right sibling pending at a distinct depth of the path
      * being built, and a tree of n primitives has at most n levels. */
     Task *stack = aligned_alloc(32, sizeof(Task) * ((size_t)n + 1));

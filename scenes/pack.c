@@ -159,8 +159,8 @@ static inline float tri_max(float a, float b, float c)
 static int pack_build_bvh(const Scene *s, const BvhParams *bp, uint32_t nprims, Bvh *bvh, char *err,
                           size_t errlen)
 {
-    float *lo = malloc(sizeof(float) * 3 * (nprims ? nprims : 1));
-    float *hi = malloc(sizeof(float) * 3 * (nprims ? nprims : 1));
+    float *lo = bvh_big_alloc(sizeof(float) * 3 * (nprims ? nprims : 1));
+    float *hi = bvh_big_alloc(sizeof(float) * 3 * (nprims ? nprims : 1));
     if (!lo || !hi) {
         free(lo);
         free(hi);
