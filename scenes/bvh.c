@@ -7,11 +7,11 @@
  * unstable sorts), so images and cycle counts do not change from run to run.
  *
  * The build is written for speed (primitives copied into build order as 32-byte boxes, one
- * binning pass for the three axes with their bin indices computed in the lanes of one vector,
- * children's boxes grown during the partition, only non-empty bins swept, a split's cost divided
- * out only when it can win) and must give the trees of the plain algorithm in
- * tests/support/bvh_ref.c, bit for bit, zeros' signs included: tests/unit/test_bvh.c compares
- * them.
+ * binning pass for the three axes with their bin indices computed in the lanes of one vector and
+ * kept for the partition, children's boxes grown during the partition, only non-empty bins swept,
+ * a split's cost divided out only when it can win, large arrays on huge pages) and must give the
+ * trees of the plain algorithm in tests/support/bvh_ref.c, bit for bit, zeros' signs included:
+ * tests/unit/test_bvh.c compares them, on random and degenerate boxes and on real meshes.
  */
 #include "bvh.h"
 
