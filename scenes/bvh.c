@@ -6,10 +6,12 @@
  * Deterministic: the same boxes and parameters give the same tree, bit for bit (no threads, no
  * unstable sorts), so images and cycle counts do not change from run to run.
  *
- * The build is written for speed (primitives copied into build order, one binning pass for the
- * three axes, children's boxes grown during the partition, only non-empty bins swept, inline
- * min/max) and must give the trees of the plain algorithm in tests/support/bvh_ref.c, bit for bit,
- * zeros' signs included: tests/unit/test_bvh.c compares them.
+ * The build is written for speed (primitives copied into build order as 32-byte boxes, one
+ * binning pass for the three axes with their bin indices computed in the lanes of one vector and
+ * kept for the partition, children's boxes grown during the partition, only non-empty bins swept,
+ * a split's cost divided out only when it can win, large arrays on huge pages) and must give the
+ * trees of the plain algorithm in tests/support/bvh_ref.c, bit for bit, zeros' signs included:
+ * tests/unit/test_bvh.c compares them, on random and degenerate boxes and on real meshes.
  */
 #include "bvh.h"
 
@@ -17,6 +19,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 void bvh_default_params(BvhParams *p)
 {
@@ -26,71 +34,129 @@ void bvh_default_params(BvhParams *p)
     p->cost_intersect = 1.0f;
 }
 
-/* Lane 3 is padding (4 lanes let the compiler grow a box with two vector min/max operations); it
- * is never read back. */
-typedef struct Box { _Alignas(16) float lo[4]; float hi[4]; } Box;
-
-/* The minimum and maximum the trees were first built with, bit for bit. That build called libm's
+/* A box in 8 lanes: lo in lanes 0-2 and the NEGATED hi in lanes 4-6 (lanes 3 and 7 are padding,
+ * never read back). Negation is exact and turns the maximum into a minimum, so growing a box is
+ * one 8-lane minimum (one AVX instruction). A primitive during the build is such a box, and so is
+ * a centroid c as [c, -c].
+ *
+ * The minimum is the one the trees were first built with, bit for bit. That build called libm's
  * fminf(new, held) / fmaxf(new, held) (GCC orders the operands of these commutative calls so) and
  * glibc's x86-64 fminf / fmaxf (minss / maxss) return their second operand on a tie: so the value
- * already held stays, which decides between -0.0 and +0.0 and so the bytes stored. No NaN reaches
- * them: bvh_build rejects NaN boxes, and centroids of finite boxes are finite or infinite. */
-static inline float min_keep(float held, float x) { return x < held ? x : held; }
-static inline float max_keep(float held, float x) { return x > held ? x : held; }
-/* The same result over a sequence visited backwards: on a tie take the new value (it comes
- * earlier in the forward order). */
-static inline float min_take(float held, float x) { return held < x ? held : x; }
-static inline float max_take(float held, float x) { return held > x ? held : x; }
+ * already held stays, which decides between -0.0 and +0.0 and so the bytes stored. The negated
+ * lanes keep that rule: -(x > h ? x : h) is (-x < -h ? -x : -h). No NaN reaches them: bvh_build
+ * rejects NaN boxes, and centroids of finite boxes are finite or infinite. */
+typedef struct Box { _Alignas(32) float v[8]; } Box;
 
-static const Box box_none = {{INFINITY, INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY, -INFINITY}};
+static const Box box_none = {{INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, INFINITY}};
 
-static void box_empty(Box *b) { *b = box_none; }
-
-/* Grow b by the box [lo, hi] (4 lanes each). */
-static inline void box_grow(Box *restrict b, const float *restrict lo, const float *restrict hi)
+/* A box in registers: one AVX register, or the struct where there is no AVX. */
+#if defined(__AVX__)
+typedef __m256 Vbox;
+static inline Vbox vbox_load(const Box *b) { return _mm256_load_ps(b->v); }
+static inline void vbox_store(Box *b, Vbox x) { _mm256_store_ps(b->v, x); }
+/* x86 minps(a, b) is a < b ? a : b: on a tie, the second operand. */
+static inline Vbox vbox_grow(Vbox held, Vbox x) { return _mm256_min_ps(x, held); }
+static inline Vbox vbox_grow_backwards(Vbox held, Vbox x) { return _mm256_min_ps(held, x); }
+/* The centroid box [c, -c] of primitive q: c = 0.5f * (lo + hi), computed as 0.5f * (lo - (-hi)),
+ * which IEEE arithmetic defines to be the same value. */
+static inline Vbox vbox_centroid(Vbox q)
 {
+    __m128 c = _mm_mul_ps(_mm_sub_ps(_mm256_castps256_ps128(q), _mm256_extractf128_ps(q, 1)), _mm_set1_ps(0.5f));
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(c), _mm_xor_ps(c, _mm_set1_ps(-0.0f)), 1);
+}
+/* Lane k (0..2) of a centroid box. */
+static inline float vbox_lane(Vbox b, __m128i k) { return _mm_cvtss_f32(_mm_permutevar_ps(_mm256_castps256_ps128(b), k)); }
+typedef __m128i Vlane;
+static inline Vlane vbox_lane_index(int k) { return _mm_set1_epi32(k); }
+#else
+typedef Box Vbox;
+static inline Vbox vbox_load(const Box *b) { return *b; }
+static inline void vbox_store(Box *b, Vbox x) { *b = x; }
+static inline Vbox vbox_grow(Vbox held, Vbox x)
+{
+    for (int k = 0; k < 8; k++)
+        held.v[k] = x.v[k] < held.v[k] ? x.v[k] : held.v[k];
+    return held;
+}
+static inline Vbox vbox_grow_backwards(Vbox held, Vbox x)
+{
+    for (int k = 0; k < 8; k++)
+        held.v[k] = held.v[k] < x.v[k] ? held.v[k] : x.v[k];
+    return held;
+}
+static inline Vbox vbox_centroid(Vbox q)
+{
+    Vbox cc;
     for (int k = 0; k < 4; k++) {
-        b->lo[k] = min_keep(b->lo[k], lo[k]);
-        b->hi[k] = max_keep(b->hi[k], hi[k]);
+        cc.v[k] = 0.5f * (q.v[k] - q.v[4 + k]);
+        cc.v[4 + k] = -cc.v[k];
     }
+    return cc;
+}
+typedef int Vlane;
+static inline float vbox_lane(Vbox b, int k) { return b.v[k]; }
+static inline Vlane vbox_lane_index(int k) { return k; }
+#endif
+
+/* Grow b by x; on a tie b keeps the value it holds. */
+static inline void box_grow(Box *restrict b, const Box *restrict x)
+{
+    vbox_store(b, vbox_grow(vbox_load(b), vbox_load(x)));
 }
 
-/* box_grow for primitives visited in decreasing position: the box box_grow gives in increasing
- * position, bit for bit. */
-static inline void box_grow_backwards(Box *restrict b, const float *restrict lo, const float *restrict hi)
-{
-    for (int k = 0; k < 4; k++) {
-        b->lo[k] = min_take(b->lo[k], lo[k]);
-        b->hi[k] = max_take(b->hi[k], hi[k]);
-    }
-}
+static inline float box_lo(const Box *b, int k) { return b->v[k]; }
+static inline float box_hi(const Box *b, int k) { return -b->v[4 + k]; }
+
+static inline float centroid_of(const Box *q, int axis) { return 0.5f * (q->v[axis] - q->v[4 + axis]); }
+
+static inline float extent_of(float lo, float hi) { return hi > lo ? hi - lo : 0.0f; }
 
 /* Written out: GCC -O2 does not unroll the three-axis loop, and the sweep calls this twice per
  * candidate split. */
 static inline float box_area(const Box *b)
 {
-    float dx = b->hi[0] > b->lo[0] ? b->hi[0] - b->lo[0] : 0.0f;
-    float dy = b->hi[1] > b->lo[1] ? b->hi[1] - b->lo[1] : 0.0f;
-    float dz = b->hi[2] > b->lo[2] ? b->hi[2] - b->lo[2] : 0.0f;
+    float dx = extent_of(box_lo(b, 0), box_hi(b, 0));
+    float dy = extent_of(box_lo(b, 1), box_hi(b, 1));
+    float dz = extent_of(box_lo(b, 2), box_hi(b, 2));
     return 2.0f * (dx * dy + dy * dz + dz * dx);
 }
 
-/* A primitive during the build, kept in prim_index order so that every pass over a node reads
- * memory in sequence; the partition moves the records themselves. */
-typedef struct BuildPrim {
-    float lo[4], hi[4];
-    float c[4]; /* centroid */
-} BuildPrim;
+/* box_area of a box in registers. With AVX the three extents are taken in the lanes of one
+ * vector (hi > lo ? hi - lo : 0 as a mask on the difference) and their products and sums are
+ * those of box_area, in its order. */
+#if defined(__AVX__)
+static inline float vbox_area(Vbox b)
+{
+    __m128 lo = _mm256_castps256_ps128(b);
+    __m128 hi = _mm_xor_ps(_mm256_extractf128_ps(b, 1), _mm_set1_ps(-0.0f));
+    __m128 d = _mm_and_ps(_mm_cmpgt_ps(hi, lo), _mm_sub_ps(hi, lo));
+    __m128 p = _mm_mul_ps(d, _mm_shuffle_ps(d, d, _MM_SHUFFLE(3, 0, 2, 1))); /* dx dy, dy dz, dz dx */
+    float sum = _mm_cvtss_f32(p) + _mm_cvtss_f32(_mm_shuffle_ps(p, p, 1));
+    sum = sum + _mm_cvtss_f32(_mm_movehl_ps(p, p));
+    return 2.0f * sum;
+}
+#else
+static inline float vbox_area(Vbox b) { return box_area(&b); }
+#endif
 
 /* A node to build: its own box is already in nodes[node]; cb is its centroids' box. */
 typedef struct Task {
-    uint32_t node, begin, end, depth;
     Box cb;
+    uint32_t node, begin, end, depth;
 } Task;
+
+/* The bins of one axis: their boxes and primitive counts. */
+typedef struct Bins {
+    Box box[256];
+    uint32_t count[256];
+} Bins;
 
 typedef struct Builder {
     const BvhParams *p;
-    BuildPrim *prim; /* n, in prim_index order (which the partition permutes with them) */
+    Box *prim;   /* n, in prim_index order (which the partition permutes with them) */
+    Bins *bins;  /* 4: one per axis, and a sink for the axes that give no split */
+    uint8_t (*bin)[4]; /* n: each position's bin on the three axes in the last binning that
+                        * covered it, moved with the primitives by the partition */
     Bvh *b;
 } Builder;
 
@@ -102,48 +168,62 @@ static inline int bin_of(float c, float cmin, float scale, int bins)
     return i < 0 ? 0 : (i >= bins ? bins - 1 : i);
 }
 
-typedef struct Split { int axis, bin; float cost; } Split;
+/* The best split so far: its cost, and x, the cost's numerator (left area x count + right area x
+ * count), from which the cost is computed by a chain of operations that never decrease. */
+typedef struct Split { int axis, bin; float cost, x; } Split;
 
-/* The bins of one axis: their boxes and primitive counts. */
-typedef struct Bins {
-    Box box[256];
-    uint32_t count[256];
-} Bins;
+/* The indices of the non-empty bins among the first nb, in increasing order; their number. */
+static int list_nonempty(const uint32_t *count, int nb, int *list)
+{
+    int m = 0, i = 0;
+#if defined(__SSE2__)
+    for (; i + 4 <= nb; i += 4) {
+        __m128i zero = _mm_cmpeq_epi32(_mm_loadu_si128((const __m128i *)&count[i]), _mm_setzero_si128());
+        unsigned mask = ~(unsigned)_mm_movemask_ps(_mm_castsi128_ps(zero)) & 15u;
+        for (; mask; mask &= mask - 1)
+            list[m++] = i + __builtin_ctz(mask);
+    }
+#endif
+    for (; i < nb; i++)
+        if (count[i] > 0)
+            list[m++] = i;
+    return m;
+}
 
 /* The best split of one axis's bins into (best->bin and below, the rest), if it beats best.
  * Only non-empty bins are visited: a split after an empty bin has the same left box, right
  * box and counts, hence the same cost, as the split before it, and only a strictly lower cost
  * replaces best; growing a box by an empty bin leaves it unchanged, bit for bit. So the cost and
- * the bin found are those of sweeping every bin. */
+ * the bin found are those of sweeping every bin. The cost is cost_traversal + cost_intersect * x
+ * / parea, each step non-decreasing in x (cost_intersect > 0, parea > 0): a candidate whose x is
+ * not below the best's cannot cost strictly less, so its division is skipped (NaN costs, from an
+ * infinite parea, compare false either way). */
 static void sweep_axis(const BvhParams *p, const Bins *bins, int axis, uint32_t total, float parea,
                        Split *best)
 {
-    int nonempty[256], m = 0;
-    for (int i = 0; i < p->bins; i++)
-        if (bins->count[i] > 0)
-            nonempty[m++] = i;
+    int nonempty[256], m = list_nonempty(bins->count, p->bins, nonempty);
     /* right_area[r]: the area of the union of the non-empty bins r .. m-1, grown from the right */
     float right_area[256];
-    Box acc = box_none;
+    Vbox none = vbox_load(&box_none), acc = none;
     for (int r = m - 1; r > 0; r--) {
-        const Box *bx = &bins->box[nonempty[r]];
-        box_grow(&acc, bx->lo, bx->hi);
-        right_area[r] = box_area(&acc);
+        acc = vbox_grow(acc, vbox_load(&bins->box[nonempty[r]]));
+        right_area[r] = vbox_area(acc);
     }
-    Box left = box_none;
+    Vbox left = none;
     uint32_t nleft = 0;
     for (int r = 0; r < m - 1; r++) {
-        const Box *bx = &bins->box[nonempty[r]];
-        box_grow(&left, bx->lo, bx->hi);
+        left = vbox_grow(left, vbox_load(&bins->box[nonempty[r]]));
         nleft += bins->count[nonempty[r]];
         uint32_t nright = total - nleft;
-        float cost = p->cost_traversal +
-                     p->cost_intersect * (box_area(&left) * (float)nleft + right_area[r + 1] * (float)nright) /
-                         parea;
+        float x = vbox_area(left) * (float)nleft + right_area[r + 1] * (float)nright;
+        if (!(x < best->x))
+            continue;
+        float cost = p->cost_traversal + p->cost_intersect * x / parea;
         if (cost < best->cost) {
             best->axis = axis;
             best->bin = nonempty[r];
             best->cost = cost;
+            best->x = x;
         }
     }
 }
@@ -153,60 +233,103 @@ static void sweep_axis(const BvhParams *p, const Bins *bins, int axis, uint32_t 
  * every centroid would fall in bin 0). */
 static float bin_scale(const Box *cbox, int axis, int bins)
 {
-    float extent = cbox->hi[axis] - cbox->lo[axis];
+    float extent = box_hi(cbox, axis) - box_lo(cbox, axis);
     if (!(extent > 0.0f))
         return 0.0f;
     float scale = (float)bins / extent;
     return isfinite(scale) ? scale : 0.0f;
 }
 
-/* Put primitive q in its bin on one axis. */
-static inline void bin_add(Bins *bins, const BuildPrim *q, int axis, float cmin, float scale, int nb)
+static inline void bin_put(Bins *bins, int i, const Box *q)
 {
-    int i = bin_of(q->c[axis], cmin, scale, nb);
-    box_grow(&bins->box[i], q->lo, q->hi);
+    box_grow(&bins->box[i], q);
     bins->count[i]++;
 }
+
+#if defined(__SSE2__)
+/* bin_of on the three axes at once, lane by lane the same operations (subtract, multiply,
+ * truncate, clamp). A lane whose scale is 0 gets bin 0, or, from an infinite centroid (NaN,
+ * which cvttps turns into INT_MIN), the clamp's 0: defined here, where the scalar conversion
+ * would not be, and never used. */
+static inline __m128i bin_of3(__m128 c, __m128 cmin, __m128 scale, __m128i top)
+{
+    __m128i i = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, cmin), scale));
+#if defined(__SSE4_1__)
+    return _mm_min_epi32(_mm_max_epi32(i, _mm_setzero_si128()), top);
+#else
+    i = _mm_andnot_si128(_mm_cmpgt_epi32(_mm_setzero_si128(), i), i);
+    __m128i big = _mm_cmpgt_epi32(i, top);
+    return _mm_or_si128(_mm_and_si128(big, top), _mm_andnot_si128(big, i));
+#endif
+}
+
+/* One pass puts every primitive in its bin on each axis; each bin still grows in primitive order.
+ * An axis that gives no split bins into the sink, bins[3]. */
+static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, const float *scale, int live)
+{
+    Bins *dst[3];
+    for (int axis = 0; axis < 3; axis++)
+        dst[axis] = &B->bins[live & 1 << axis ? axis : 3];
+    __m128 cmin = _mm_setr_ps(box_lo(cbox, 0), box_lo(cbox, 1), box_lo(cbox, 2), 0.0f);
+    __m128 sc = _mm_setr_ps(scale[0], scale[1], scale[2], 0.0f);
+    __m128 half = _mm_set1_ps(0.5f);
+    __m128i top = _mm_set1_epi32(B->p->bins - 1);
+    const Box *prim = B->prim;
+    for (uint32_t j = begin; j < end; j++) {
+        const Box *q = &prim[j];
+        _mm_prefetch((const char *)&prim[j + 16], _MM_HINT_T0);
+        __m128 c = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(q->v), _mm_load_ps(q->v + 4)), half);
+        __m128i bi = bin_of3(c, cmin, sc, top);
+        int i0 = _mm_cvtsi128_si32(bi);
+        int i1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 1));
+        int i2 = _mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 2));
+        /* the four lanes (0..255) as bytes */
+        uint32_t packed = (uint32_t)_mm_cvtsi128_si32(_mm_packus_epi16(_mm_packs_epi32(bi, bi), bi));
+        memcpy(B->bin[j], &packed, 4);
+        bin_put(dst[0], i0, q);
+        bin_put(dst[1], i1, q);
+        bin_put(dst[2], i2, q);
+    }
+}
+#else
+static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, const float *scale, int live)
+{
+    int nb = B->p->bins;
+    for (uint32_t j = begin; j < end; j++) {
+        for (int axis = 0; axis < 3; axis++) {
+            if (live & 1 << axis) {
+                int i = bin_of(centroid_of(&B->prim[j], axis), box_lo(cbox, axis), scale[axis], nb);
+                B->bin[j][axis] = (uint8_t)i;
+                bin_put(&B->bins[axis], i, &B->prim[j]);
+            }
+        }
+    }
+}
+#endif
 
 static Split find_split(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, float parea)
 {
     const BvhParams *p = B->p;
     int nb = p->bins;
-    Split best = {-1, 0, INFINITY};
+    Split best = {-1, 0, INFINITY, INFINITY};
     float scale[3];
     int live = 0;
-    Bins bins[3];
     for (int axis = 0; axis < 3; axis++) {
         scale[axis] = bin_scale(cbox, axis, nb);
         if (scale[axis] > 0.0f) {
             live |= 1 << axis;
-            for (int i = 0; i < nb; i++) {
-                bins[axis].box[i] = box_none;
-                bins[axis].count[i] = 0;
-            }
+            Bins *bins = &B->bins[axis];
+            for (int i = 0; i < nb; i++)
+                bins->box[i] = box_none;
+            memset(bins->count, 0, sizeof(uint32_t) * (size_t)nb);
         }
     }
     if (!live)
         return best;
-    /* One pass bins every axis; each bin still grows in primitive order. */
-    const BuildPrim *prim = B->prim;
-    if (live == 7) { /* the common case, unrolled */
-        float lo0 = cbox->lo[0], lo1 = cbox->lo[1], lo2 = cbox->lo[2];
-        float s0 = scale[0], s1 = scale[1], s2 = scale[2];
-        for (uint32_t j = begin; j < end; j++) {
-            bin_add(&bins[0], &prim[j], 0, lo0, s0, nb);
-            bin_add(&bins[1], &prim[j], 1, lo1, s1, nb);
-            bin_add(&bins[2], &prim[j], 2, lo2, s2, nb);
-        }
-    } else {
-        for (uint32_t j = begin; j < end; j++)
-            for (int axis = 0; axis < 3; axis++)
-                if (live & 1 << axis)
-                    bin_add(&bins[axis], &prim[j], axis, cbox->lo[axis], scale[axis], nb);
-    }
+    bin_prims(B, begin, end, cbox, scale, live);
     for (int axis = 0; axis < 3; axis++)
         if (live & 1 << axis)
-            sweep_axis(p, &bins[axis], axis, end - begin, parea, &best);
+            sweep_axis(p, &B->bins[axis], axis, end - begin, parea, &best);
     return best;
 }
 
@@ -215,53 +338,64 @@ typedef struct Halves { Box box[2], cbox[2]; } Halves;
 
 /* Partition [begin, end) so primitives whose bin <= split.bin come first; returns mid. The
  * halves' boxes are grown on the way: a left position is final once passed, in increasing order;
- * a right position once filled, in decreasing order (hence box_grow_backwards). */
-static uint32_t partition(Builder *B, uint32_t begin, uint32_t end, const Box *cbox, Split s, Halves *h)
+ * a right position once filled, in decreasing order (hence vbox_grow_backwards). */
+static uint32_t partition(Builder *B, uint32_t begin, uint32_t end, Split s, Halves *h)
 {
-    float scale = (float)B->p->bins / (cbox->hi[s.axis] - cbox->lo[s.axis]);
-    float cmin = cbox->lo[s.axis];
-    int bins = B->p->bins;
-    BuildPrim *prim = B->prim;
+    Box *prim = B->prim;
     uint32_t *id = B->b->prim_index;
-    /* locals, not *h, so that the compiler keeps the four boxes in registers */
-    Box box0 = box_none, cbox0 = box_none, box1 = box_none, cbox1 = box_none;
+    uint8_t(*bins)[4] = B->bin;
+    int axis = s.axis;
+    Vbox none = vbox_load(&box_none);
+    Vbox box0 = none, cbox0 = none, box1 = none, cbox1 = none;
     uint32_t i = begin, j = end;
     while (i < j) {
-        BuildPrim q = prim[i];
-        if (bin_of(q.c[s.axis], cmin, scale, bins) <= s.bin) {
-            box_grow(&box0, q.lo, q.hi);
-            box_grow(&cbox0, q.c, q.c);
+        Vbox q = vbox_load(&prim[i]);
+        Vbox cc = vbox_centroid(q);
+        if (bins[i][axis] <= s.bin) {
+            box0 = vbox_grow(box0, q);
+            cbox0 = vbox_grow(cbox0, cc);
             i++;
         } else {
             j--;
             prim[i] = prim[j];
-            prim[j] = q;
+            vbox_store(&prim[j], q);
             uint32_t qi = id[i];
             id[i] = id[j];
             id[j] = qi;
-            box_grow_backwards(&box1, q.lo, q.hi);
-            box_grow_backwards(&cbox1, q.c, q.c);
+            uint8_t qb[4];
+            memcpy(qb, bins[i], 4);
+            memcpy(bins[i], bins[j], 4);
+            memcpy(bins[j], qb, 4);
+            box1 = vbox_grow_backwards(box1, q);
+            cbox1 = vbox_grow_backwards(cbox1, cc);
         }
     }
-    *h = (Halves){{box0, box1}, {cbox0, cbox1}};
+    vbox_store(&h->box[0], box0);
+    vbox_store(&h->box[1], box1);
+    vbox_store(&h->cbox[0], cbox0);
+    vbox_store(&h->cbox[1], cbox1);
     return i;
 }
 
 /* The box and centroid box of [begin, end), scanned in order. */
-static void scan_bounds(const BuildPrim *prim, uint32_t begin, uint32_t end, Box *box, Box *cbox)
+static void scan_bounds(const Box *prim, uint32_t begin, uint32_t end, Box *box, Box *cbox)
 {
-    box_empty(box);
-    box_empty(cbox);
+    Vbox b = vbox_load(&box_none), cb = b;
     for (uint32_t j = begin; j < end; j++) {
-        box_grow(box, prim[j].lo, prim[j].hi);
-        box_grow(cbox, prim[j].c, prim[j].c);
+        Vbox q = vbox_load(&prim[j]);
+        b = vbox_grow(b, q);
+        cb = vbox_grow(cb, vbox_centroid(q));
     }
+    vbox_store(box, b);
+    vbox_store(cbox, cb);
 }
 
 static void set_box(BvhNode *n, const Box *b)
 {
-    memcpy(n->bmin, b->lo, sizeof n->bmin);
-    memcpy(n->bmax, b->hi, sizeof n->bmax);
+    for (int k = 0; k < 3; k++) {
+        n->bmin[k] = box_lo(b, k);
+        n->bmax[k] = box_hi(b, k);
+    }
 }
 
 static void make_leaf(BvhNode *n, uint32_t begin, uint32_t end)
@@ -297,7 +431,8 @@ static int check_boxes(const float *bmin, const float *bmax, uint32_t n, char *e
     return 0;
 }
 
-/* Where node t splits: mid, or 0 for a leaf; the halves' bounds in h, the axis in *axis. */
+/* Where node t with box nb splits: mid, or 0 for a leaf; the halves' bounds in h, the axis in
+ * *axis. */
 static uint32_t split_node(Builder *B, const Task *t, const Box *nb, Halves *h, uint32_t *axis)
 {
     const BvhParams *p = B->p;
@@ -310,7 +445,7 @@ static uint32_t split_node(Builder *B, const Task *t, const Box *nb, Halves *h, 
     float leaf_cost = p->cost_intersect * (float)count;
     if (s.axis >= 0 && (s.cost < leaf_cost || count > (uint32_t)p->max_leaf_size)) {
         *axis = (uint32_t)s.axis;
-        return partition(B, t->begin, t->end, &t->cb, s, h);
+        return partition(B, t->begin, t->end, s, h);
     }
     if (s.axis < 0 && count > (uint32_t)p->max_leaf_size) {
         /* All centroids coincide: no box split can separate them; halve by index so leaves
@@ -323,44 +458,43 @@ static uint32_t split_node(Builder *B, const Task *t, const Box *nb, Halves *h, 
     return 0;
 }
 
-int bvh_build(const BvhParams *p, const float *bmin, const float *bmax, uint32_t n, Bvh *out,
-              char *err, size_t errlen)
+/* The build's copy of the primitives: [lo, 0, -hi, 0] each, in prim_index order (the identity). */
+static void load_prims(Builder *B, const float *bmin, const float *bmax, uint32_t n)
 {
-    memset(out, 0, sizeof *out);
-    if (check_params(p, err, errlen) != 0 || check_boxes(bmin, bmax, n, err, errlen) != 0)
-        return -1;
-    out->nprims = n;
-    if (n == 0)
-        return 0;
-
-    Builder B = {p, malloc(sizeof(BuildPrim) * n), out};
-    out->prim_index = malloc(sizeof(uint32_t) * n);
-    out->nodes = malloc(sizeof(BvhNode) * (2 * (size_t)n - 1));
-    /* Every task on the stack is the right sibling pending at a distinct depth of the path
-     * being built, and a tree of n primitives has at most n levels. */
-    Task *stack = malloc(sizeof(Task) * ((size_t)n + 1));
-    if (!B.prim || !out->prim_index || !out->nodes || !stack) {
-        snprintf(err, errlen, "bvh: out of memory for %u primitives", n);
-        free(B.prim);
-        free(stack);
-        bvh_free(out);
-        return -1;
-    }
     for (uint32_t i = 0; i < n; i++) {
-        BuildPrim *q = &B.prim[i];
-        out->prim_index[i] = i;
+        Box *q = &B->prim[i];
+        B->b->prim_index[i] = i;
         for (int k = 0; k < 3; k++) {
-            q->lo[k] = bmin[3 * i + k];
-            q->hi[k] = bmax[3 * i + k];
-            q->c[k] = 0.5f * (bmin[3 * i + k] + bmax[3 * i + k]);
+            q->v[k] = bmin[3 * i + k];
+            q->v[4 + k] = -bmax[3 * i + k];
         }
-        q->lo[3] = q->hi[3] = q->c[3] = 0.0f;
+        q->v[3] = q->v[7] = 0.0f;
     }
+    for (int a = 0; a < 4; a++) {
+        for (int i = 0; i < 256; i++)
+            B->bins[a].box[i] = box_none;
+        memset(B->bins[a].count, 0, sizeof B->bins[a].count);
+    }
+}
 
+/* Node t's box, read back from the node written when its parent was split. */
+static void node_box(const BvhNode *n, Box *b)
+{
+    *b = box_none;
+    for (int k = 0; k < 3; k++) {
+        b->v[k] = n->bmin[k];
+        b->v[4 + k] = -n->bmax[k];
+    }
+}
+
+/* Split or close every node, depth first, left child first. */
+static void build_nodes(Builder *B, Task *stack, uint32_t n)
+{
+    Bvh *out = B->b;
     Box root;
     uint32_t sp = 0;
-    stack[sp] = (Task){0, 0, n, 1, box_none};
-    scan_bounds(B.prim, 0, n, &root, &stack[sp].cb);
+    stack[sp] = (Task){box_none, 0, 0, n, 1};
+    scan_bounds(B->prim, 0, n, &root, &stack[sp].cb);
     set_box(&out->nodes[0], &root);
     sp++;
     out->nnodes = 1;
@@ -369,12 +503,11 @@ int bvh_build(const BvhParams *p, const float *bmin, const float *bmax, uint32_t
         BvhNode *node = &out->nodes[t.node];
         if (t.depth > out->depth)
             out->depth = t.depth;
-        Box nb = box_none;
-        memcpy(nb.lo, node->bmin, sizeof node->bmin);
-        memcpy(nb.hi, node->bmax, sizeof node->bmax);
+        Box nb;
+        node_box(node, &nb);
         Halves h;
         uint32_t axis;
-        uint32_t mid = split_node(&B, &t, &nb, &h, &axis);
+        uint32_t mid = split_node(B, &t, &nb, &h, &axis);
         if (mid == 0) {
             make_leaf(node, t.begin, t.end);
             out->nleaves++;
@@ -387,11 +520,57 @@ int bvh_build(const BvhParams *p, const float *bmin, const float *bmax, uint32_t
         node->axis = axis;
         set_box(&out->nodes[left], &h.box[0]);
         set_box(&out->nodes[left + 1], &h.box[1]);
-        stack[sp++] = (Task){left + 1, mid, t.end, t.depth + 1, h.cbox[1]};
-        stack[sp++] = (Task){left, t.begin, mid, t.depth + 1, h.cbox[0]};
+        stack[sp++] = (Task){h.cbox[1], left + 1, mid, t.end, t.depth + 1};
+        stack[sp++] = (Task){h.cbox[0], left, t.begin, mid, t.depth + 1};
     }
+}
+
+void *bvh_big_alloc(size_t size)
+{
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    const size_t huge = (size_t)2 << 20;
+    if (size >= huge) {
+        size_t rounded = (size + huge - 1) & ~(huge - 1);
+        void *m = aligned_alloc(huge, rounded);
+        if (m)
+            madvise(m, rounded, MADV_HUGEPAGE);
+        return m;
+    }
+#endif
+    return aligned_alloc(32, (size + 31) & ~(size_t)31);
+}
+
+int bvh_build(const BvhParams *p, const float *bmin, const float *bmax, uint32_t n, Bvh *out,
+              char *err, size_t errlen)
+{
+    memset(out, 0, sizeof *out);
+    if (check_params(p, err, errlen) != 0 || check_boxes(bmin, bmax, n, err, errlen) != 0)
+        return -1;
+    out->nprims = n;
+    if (n == 0)
+        return 0;
+
+    Builder B = {p, bvh_big_alloc(sizeof(Box) * n), aligned_alloc(32, sizeof(Bins) * 4), bvh_big_alloc(4 * (size_t)n), out};
+    out->prim_index = bvh_big_alloc(sizeof(uint32_t) * n);
+    out->nodes = bvh_big_alloc(sizeof(BvhNode) * (2 * (size_t)n - 1));
+    /* Every task on the stack is the right sibling pending at a distinct depth of the path
+     * being built, and a tree of n primitives has at most n levels. */
+    Task *stack = aligned_alloc(32, sizeof(Task) * ((size_t)n + 1));
+    if (!B.prim || !B.bins || !B.bin || !out->prim_index || !out->nodes || !stack) {
+        snprintf(err, errlen, "bvh: out of memory for %u primitives", n);
+        free(B.prim);
+        free(B.bins);
+        free(B.bin);
+        free(stack);
+        bvh_free(out);
+        return -1;
+    }
+    load_prims(&B, bmin, bmax, n);
+    build_nodes(&B, stack, n);
     free(stack);
     free(B.prim);
+    free(B.bins);
+    free(B.bin);
     out->sah_cost = bvh_sah_cost(out, p);
     return 0;
 }

@@ -54,4 +54,11 @@ int bvh_check(const Bvh *b, const float *bmin, const float *bmax, char *err, siz
  * cost_intersect x count for leaves). */
 double bvh_sah_cost(const Bvh *b, const BvhParams *p);
 
+/* malloc for large host arrays, released by free(), aligned to 32 bytes at least; from 2 MiB on
+ * (on Linux) aligned to 2 MiB and marked for transparent huge pages, so that first touching fresh
+ * memory takes one page fault per 2 MiB instead of one per 4 KiB: page faults were about a tenth
+ * of the conference room's build and pack. The build's arrays and scenes/pack.c's box arrays use
+ * it. */
+void *bvh_big_alloc(size_t size);
+
 #endif

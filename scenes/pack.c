@@ -159,8 +159,8 @@ static inline float tri_max(float a, float b, float c)
 static int pack_build_bvh(const Scene *s, const BvhParams *bp, uint32_t nprims, Bvh *bvh, char *err,
                           size_t errlen)
 {
-    float *lo = malloc(sizeof(float) * 3 * (nprims ? nprims : 1));
-    float *hi = malloc(sizeof(float) * 3 * (nprims ? nprims : 1));
+    float *lo = bvh_big_alloc(sizeof(float) * 3 * (nprims ? nprims : 1));
+    float *hi = bvh_big_alloc(sizeof(float) * 3 * (nprims ? nprims : 1));
     if (!lo || !hi) {
         free(lo);
         free(hi);
@@ -428,12 +428,12 @@ static void pack_emissive_lights(Writer *w, const Scene *s, const Layout *l)
     }
 }
 
-/* n floats from src at address at, when the table is present (at != 0). */
+/* n floats from src at address at, when the table is present (at != 0): their bytes as they are,
+ * in one copy (put_f32 stores a float's bytes too). */
 static void pack_floats(Writer *w, uint32_t at, const float *src, uint32_t n)
 {
-    if (at)
-        for (uint32_t i = 0; i < n; i++)
-            put_f32(w, at + 4 * i, src[i]);
+    if (at && n)
+        memcpy(w->mem + (at - w->base), src, sizeof(float) * (size_t)n);
 }
 
 /* Per-vertex attributes (normals, UVs, emissive UVs, colours) and the sRGB decoding table. */
