@@ -30,11 +30,14 @@ typedef union VReg {
     float f[ISA_MAX_LANES];
 } VReg;
 
+#define CORE_MASK_ALL ISA_NUM_MREGS /* the hidden mask register unmasked instructions read */
+
 typedef struct Dec {
     IsaInstr in;
     uint8_t cat;      /* IsaCategory */
     uint8_t vec;      /* ISA_FL_VEC */
-    uint8_t masked;   /* format takes an exec mask */
+    uint8_t emask;    /* the mask register its exec mask is read from: the instruction's for a
+                         masked format, else CORE_MASK_ALL */
 } Dec;
 
 /* The counters: step adds an execution to its opcode's column (and a vector instruction's
@@ -49,7 +52,7 @@ struct Core {
     uint64_t all;                 /* mask of the N lanes */
     uint32_t r[ISA_NUM_SREGS];
     VReg v[ISA_NUM_VREGS];
-    uint64_t m[ISA_NUM_MREGS];
+    uint64_t m[ISA_NUM_MREGS + 1]; /* + CORE_MASK_ALL: always the N lanes, no instruction names it */
     uint32_t pc;
     uint8_t stage;
     uint8_t gen;                  /* statistics generation (sgen) */
@@ -196,7 +199,7 @@ Core *core_new(const CoreParams *p, const AsmObject *obj, char *err, size_t errl
         const IsaOpInfo *oi = &isa_ops[c->code[i].in.op];
         c->code[i].cat = (uint8_t)oi->category;
         c->code[i].vec = (oi->flags & ISA_FL_VEC) != 0;
-        c->code[i].masked = (uint8_t)isa_formats[oi->format].masked;
+        c->code[i].emask = isa_formats[oi->format].masked ? c->code[i].in.mask : CORE_MASK_ALL;
     }
     /* The sentinel after the last instruction: reaching it (pc == ncode: a fall-through or a
      * branch to the end) traps, so step needs no bounds test of pc. */
@@ -206,6 +209,7 @@ Core *core_new(const CoreParams *p, const AsmObject *obj, char *err, size_t errl
     if (obj->nspad)
         memcpy(c->mem[CORE_MEM_SPAD], obj->spad, obj->nspad);
     c->m[0] = c->all;
+    c->m[CORE_MASK_ALL] = c->all;
     count_select_row(c);
     return c;
 }
@@ -216,6 +220,7 @@ void core_restart(Core *c)
     memset(c->v, 0, sizeof c->v);
     memset(c->m, 0, sizeof c->m);
     c->m[0] = c->all;
+    c->m[CORE_MASK_ALL] = c->all;
     c->pc = 0;
     c->stage = 0;
     c->gen = 0;
@@ -1008,7 +1013,7 @@ static ALWAYS_INLINE int step(Core *c, const int hooked)
     const int n = c->n;
     if (n < 1 || n > ISA_MAX_LANES) /* core_new guarantees it; tells the compiler the lane bound */
         __builtin_unreachable();
-    const uint64_t E = dc->masked ? c->m[in->mask] & c->all : c->all;
+    const uint64_t E = c->m[dc->emask] & c->all;
     Exec x = {.in = in, .E = E, .n = n, .next = c->pc + 1, .lanes = E, .hooked = hooked};
     if (hooked)
         record_reset(&c->rec, c->pc, in, c->stage, c->gen, E);
