@@ -71,6 +71,7 @@ void simd_init(SimdUnit *u, const SimdParams *p)
 void simd_reset(SimdUnit *u)
 {
     memset(u->ready, 0, sizeof u->ready);
+    u->horizon = 0;
     memset(u->unit_pending, 0, sizeof u->unit_pending);
     u->fetch_pending = 0;
 }

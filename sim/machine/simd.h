@@ -43,6 +43,8 @@ typedef struct SimdUnit {
     uint64_t ready[SIMD_NREGS];        /* the cycle the register's latest write lands: an
                                           instruction needing it waits while ready > its cycle */
     uint8_t rcause[SIMD_NREGS];        /* what a wait for it is charged to (its producer's cause) */
+    uint64_t horizon;                  /* the latest ready cycle of any register: at or after it,
+                                          nothing waits (the common case needs no loop) */
     uint8_t unit_pending[ISA_U_COUNT]; /* the class is inside its issue interval */
     uint8_t fetch_pending;             /* the bubble after a taken branch */
 } SimdUnit;
@@ -83,6 +85,8 @@ static inline int simd_operands(const SimdUnit *u, const IsaInstr *in, uint8_t *
 /* The cause of the first of regs[0..n) still waiting for a result at cycle at, or -1. */
 static inline int simd_waiting_operand(const SimdUnit *u, const uint8_t *regs, int n, uint64_t at)
 {
+    if (u->horizon <= at)
+        return -1;
     for (int i = 0; i < n; i++)
         if (u->ready[regs[i]] > at)
             return u->rcause[regs[i]];
@@ -93,6 +97,8 @@ static inline int simd_waiting_operand(const SimdUnit *u, const uint8_t *regs, i
  * when every result in flight has landed). */
 static inline int simd_any_waiting(const SimdUnit *u, uint64_t at)
 {
+    if (u->horizon <= at)
+        return -1;
     for (int r = 0; r < SIMD_NREGS; r++)
         if (u->ready[r] > at)
             return u->rcause[r];
@@ -128,6 +134,8 @@ static inline void simd_result(SimdUnit *u, int reg, uint64_t ready, int cause)
 {
     u->ready[reg] = ready;
     u->rcause[reg] = (uint8_t)cause;
+    if (ready > u->horizon)
+        u->horizon = ready;
 }
 
 /* After an instruction of class unit issued at cycle at (next issue slot end): 1 when the class
