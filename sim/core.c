@@ -336,23 +336,14 @@ static inline int popcount64(uint64_t x) { return __builtin_popcountll(x); }
 #define CORE_BLOCK 16
 _Static_assert(ISA_MAX_LANES % CORE_BLOCK == 0, "vector registers must hold whole blocks");
 
-/* lane_sel[b] has, for each of 8 lanes, all ones where bit l of byte b is set: the merge of a
- * block under a mask becomes an and/or the compiler vectorizes. A constant table (no start-up
- * work, nothing shared written by threads). */
-#define LANE_SEL1(b, l) ((((b) >> (l)) & 1) ? 0xFFFFFFFFu : 0u)
-#define LANE_SEL_ROW(b)                                                                           \
-    {LANE_SEL1(b, 0), LANE_SEL1(b, 1), LANE_SEL1(b, 2), LANE_SEL1(b, 3),                          \
-     LANE_SEL1(b, 4), LANE_SEL1(b, 5), LANE_SEL1(b, 6), LANE_SEL1(b, 7)}
-#define LANE_SEL4(b) LANE_SEL_ROW(b), LANE_SEL_ROW((b) + 1), LANE_SEL_ROW((b) + 2), LANE_SEL_ROW((b) + 3)
-#define LANE_SEL16(b) LANE_SEL4(b), LANE_SEL4((b) + 4), LANE_SEL4((b) + 8), LANE_SEL4((b) + 12)
-#define LANE_SEL64(b) LANE_SEL16(b), LANE_SEL16((b) + 16), LANE_SEL16((b) + 32), LANE_SEL16((b) + 48)
-static const uint32_t lane_sel[256][8] = {LANE_SEL64(0), LANE_SEL64(64), LANE_SEL64(128), LANE_SEL64(192)};
-
-/* The 32-bit lane selects of lanes [l0, l0 + CORE_BLOCK) from mask bits. */
+/* The 32-bit lane selects of lanes [l0, l0 + CORE_BLOCK): all ones where the mask bit is set, so
+ * the merge of a block under a mask is an and/or; a per-lane shift of one 32-bit word, which the
+ * compiler vectorizes (variable shifts, AVX2 and later). */
 static inline void block_sel(uint32_t *sel, uint64_t mask, int l0)
 {
-    for (int g = 0; g < CORE_BLOCK / 8; g++)
-        memcpy(sel + 8 * g, lane_sel[(mask >> (l0 + 8 * g)) & 0xFFu], sizeof lane_sel[0]);
+    const uint32_t bits = (uint32_t)(mask >> l0); /* the block's 16 bits, in 32-bit lanes */
+    for (int l = 0; l < CORE_BLOCK; l++)
+        sel[l] = 0u - ((bits >> l) & 1u);
 }
 
 /* Blocks covering lanes 0..n-1. */
