@@ -1,7 +1,8 @@
-// sim/heatmap.cpp -- heat-map images (cost.png) drawn with OpenImageIO's ImageBufAlgo.
+// sim/heatmap.cpp -- heat-map images (cost.png) drawn with OpenImageIO's ImageBufAlgo; part of
+// the image library libsfsim-img.so with sim/img.cpp (sim/imgshim.h).
 //
 // Owns: the colormap table, the layout documented in heatmap.h, the font search. Must not: open
-// image files itself (img_write_rgb8 in img.cpp does, so errors read the same everywhere) or
+// image files itself (imgshim_write_rgb8 in img.cpp does, so errors read the same everywhere) or
 // know what the values measure.
 #include <OpenImageIO/imagebufalgo.h>
 
@@ -14,10 +15,7 @@
 #include <string>
 #include <vector>
 
-extern "C" {
-#include "heatmap.h"
-#include "img.h"
-}
+#include "imgshim.h"
 
 namespace {
 
@@ -172,14 +170,14 @@ bool render(ImageBuf &canvas, const std::vector<float> &t, int w, int h, double 
 
 } // namespace
 
-extern "C" void heatmap_set_font(const char *font_path)
+extern "C" void imgshim_heatmap_set_font(const char *font_path)
 {
     font_overridden = font_path != nullptr;
     font_override = font_path ? font_path : "";
 }
 
-extern "C" int heatmap_write(OutSet *set, const char *path, const double *values, int width, int height,
-                             const char *title, const char *unit, char *err, size_t errlen)
+extern "C" int imgshim_heatmap_write(const ImgSink *sink, const char *path, const double *values, int width,
+                                     int height, const char *title, const char *unit, char *err, size_t errlen)
 {
     if (width <= 0 || height <= 0 || width > MAX_SIDE || height > MAX_SIDE)
         return fail(err, errlen, path, "heat map size " + std::to_string(width) + " x " +
@@ -213,7 +211,7 @@ extern "C" int heatmap_write(OutSet *set, const char *path, const double *values
         std::vector<float> px((size_t)spec.width * spec.height * 3);
         if (!canvas.get_pixels(OIIO::ROI::All(), TypeDesc::FLOAT, px.data()))
             return fail(err, errlen, path, "drawing the heat map: " + canvas.geterror());
-        return img_write_rgb8(set, path, px.data(), spec.width, spec.height, err, errlen);
+        return imgshim_write_rgb8(sink, path, px.data(), spec.width, spec.height, err, errlen);
     } catch (const std::exception &e) {
         return fail(err, errlen, path, std::string("drawing the heat map: ") + e.what());
     }
