@@ -56,6 +56,8 @@ int imgshim_write_rgb8(const ImgSink *sink, const char *path, const float *rgb, 
 int imgshim_heatmap_write(const ImgSink *sink, const char *path, const double *values, int width, int height,
                           const char *title, const char *unit, char *err, size_t errlen);
 void imgshim_heatmap_set_font(const char *font_path);
+/* A display-ready value in [0, 1] as 8 bits: lround(clamp(x, 0, 1) * 255), 0 for NaN and Inf. */
+unsigned char imgshim_to_u8(float x);
 
 #ifdef __cplusplus
 }

@@ -1,11 +1,14 @@
 /* tests/io/test_imglib.c -- the loader of the image library (sim/imglib.h): where it looks, the
  * errors of a library that is missing, not a shared object or not sfsim's, and the built
- * libsfsim-img.so against the copy this binary links in (the same bytes out).
+ * libsfsim-img.so against the copy this binary links in (the same bytes out); and the library's
+ * 8-bit conversion against the lround expression it replaced.
  *
  * The built library's path comes from $SFSIM_TEST_IMGLIB (make sets it); run by hand without
  * it, that test is skipped. bin/sfsim's own loading is tested by tests/cli/standalone.sh.
  */
 #include <criterion/criterion.h>
+#include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -113,4 +116,46 @@ Test(imglib, the_built_library_writes_what_the_linked_copy_writes)
         free(a.data);
         free(b.data);
     }
+}
+
+/* The reference imgshim_to_u8 replaced (sim/img.cpp). */
+static unsigned char to_u8_reference(float x)
+{
+    float v = isfinite(x) ? fminf(fmaxf(x, 0.0f), 1.0f) : 0.0f;
+    return (unsigned char)lroundf(v * 255.0f);
+}
+
+static float float_of(uint32_t bits)
+{
+    float f;
+    memcpy(&f, &bits, sizeof f);
+    return f;
+}
+
+static uint32_t bits_of(float f)
+{
+    uint32_t b;
+    memcpy(&b, &f, sizeof b);
+    return b;
+}
+
+Test(imglib, to_u8_rounds_as_lround_of_the_clamped_value)
+{
+    /* around every rounding boundary (k + 0.5) / 255 and every k / 255, 4096 floats either side */
+    for (int k = 0; k <= 510; k++) {
+        uint32_t mid = bits_of((float)k / 510.0f);
+        for (uint32_t d = 0; d < 4096; d++) {
+            float a = float_of(mid + d), b = float_of(mid - d);
+            cr_assert_eq(imgshim_to_u8(a), to_u8_reference(a), "x = %.9g", (double)a);
+            cr_assert_eq(imgshim_to_u8(b), to_u8_reference(b), "x = %.9g", (double)b);
+        }
+    }
+    const float special[] = {0.0f, -0.0f, 1.0f, -1.0f, 2.0f, 0.49999997f / 255.0f, 0.5f / 255.0f, 1e-45f, -1e-45f,
+                             1e30f, -1e30f, INFINITY, -INFINITY, NAN, -NAN, 0.99999994f, 1.0000001f};
+    for (size_t i = 0; i < sizeof special / sizeof special[0]; i++)
+        cr_expect_eq(imgshim_to_u8(special[i]), to_u8_reference(special[i]), "x = %.9g", (double)special[i]);
+    /* every float bit pattern, in a stride that visits each exponent many times */
+    for (uint64_t b = 0; b < 0x100000000ull; b += 65537)
+        cr_assert_eq(imgshim_to_u8(float_of((uint32_t)b)), to_u8_reference(float_of((uint32_t)b)), "bits 0x%08x",
+                     (unsigned)b);
 }
