@@ -137,9 +137,10 @@ $(BUILD)/shim/%.o: %.cpp $(FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS) -fPIC -fvisibility=hidden -MMD -MP -c $< -o $@
 
-# -z defs: the library needs nothing of the program (it writes through an ImgSink); the version
-# script keeps the template instances of OpenImageIO's headers out of its symbol table.
-# Beside it, the order in which sim/imglib.c opens its dependencies (scripts/imglib_deps.sh).
+# The image library. -z defs: it needs nothing of the program (it writes through an ImgSink); the
+# version script keeps the template instances of OpenImageIO's headers out of its symbol table.
+# Beside it, IMGLIB.deps: the order in which sim/imglib.c opens its dependencies
+# (scripts/imglib_deps.sh).
 $(IMGLIB): $(SHIM_OBJ) sim/imgshim.map scripts/imglib_deps.sh
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS) -shared -Wl,-z,defs -Wl,--as-needed -Wl,--version-script=sim/imgshim.map $(SHIM_OBJ) -o $@.tmp $(OIIO)

@@ -11,6 +11,7 @@
 #include <errno.h>
 #include <limits.h>
 #include <pthread.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -140,9 +141,14 @@ int imglib_preload(char *err, size_t errlen)
         return -1;
     }
     /* Joined at exit, so that exit never runs while the library's constructors do. Without the
-     * thread (or the handler) the first image call loads the library itself. */
+     * thread (or the handler) the first image call loads the library itself. The thread blocks
+     * every signal, so ^C and the held signals of sim/outfile.c reach the main thread as before. */
+    sigset_t all, old;
+    sigfillset(&all);
+    pthread_sigmask(SIG_SETMASK, &all, &old);
     if (atexit(join_loader) == 0 && pthread_create(&loader, NULL, load_in_background, NULL) == 0)
         loader_running = 1;
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
     return 0;
 }
 
