@@ -20,7 +20,9 @@ CXXFLAGS := -std=c++17 $(OPT) $(ARCH) -g $(CXXWARN) $(EXTRA_CXXFLAGS)
 GLTF    := $(shell pkg-config --libs tinygltf 2>/dev/null || echo -ltinygltf)
 OIIO    := $(shell pkg-config --libs OpenImageIO 2>/dev/null || echo -lOpenImageIO -lOpenImageIO_Util)
 CJSON   := $(shell pkg-config --libs libcjson 2>/dev/null || echo -lcjson)
-LDLIBS  := $(GLTF) $(OIIO) $(CJSON) -lstdc++ -lpthread -lm
+# OpenImageIO is not in LDLIBS: bin/sfsim loads it with dlopen, inside the image library (IMGLIB
+# below); the test and tool binaries that write or read images link its objects and $(OIIO).
+LDLIBS  := $(GLTF) $(CJSON) -lstdc++ -lpthread -ldl -lm
 INIH    := $(shell pkg-config --cflags --libs inih 2>/dev/null || echo -linih)
 CRIT    := $(shell pkg-config --libs criterion 2>/dev/null || echo -lcriterion)
 EMBREE  := -lembree3
@@ -38,11 +40,16 @@ ISA_SRC := isa/isa.c
 ASM_SRC := $(filter-out asm/main_sfasm.c,$(wildcard asm/*.c))
 SIM_SRC := $(filter-out sim/main.c,$(wildcard sim/*.c sim/*/*.c))
 SCN_SRC := $(wildcard scenes/*.c)
-CXX_SRC := $(wildcard scenes/*.cpp sim/*.cpp)
+# The image library (sim/imgshim.h): the only code that links OpenImageIO. Not in libsfsim.a:
+# bin/sfsim loads it as IMGLIB with dlopen when it first needs an image (sim/imglib.c), because
+# OpenImageIO's ~260 shared libraries cost ~0.2 s at every start (docs/performance.md). Binaries
+# that link libsfsim.a and write or read images link SHIM_OBJ instead (sim/imglib.c uses that copy).
+SHIM_SRC := sim/img.cpp sim/heatmap.cpp
+CXX_SRC := $(filter-out $(SHIM_SRC),$(wildcard scenes/*.cpp sim/*.cpp))
 LIB_SRC := $(ISA_SRC) $(ASM_SRC) $(SIM_SRC) $(SCN_SRC)
 # An archive keeps members by file name only: two sources with one name in different folders
 # (sim/a/x.c, sim/b/x.c) would silently replace each other in libsfsim.a.
-LIB_NAMES := $(notdir $(basename $(LIB_SRC) $(CXX_SRC)))
+LIB_NAMES := $(notdir $(basename $(LIB_SRC) $(CXX_SRC) $(SHIM_SRC)))
 ifneq ($(words $(LIB_NAMES)),$(words $(sort $(LIB_NAMES))))
 $(error two library sources share a file name: $(shell echo $(LIB_NAMES) | tr ' ' '\n' | sort | uniq -d))
 endif
@@ -58,10 +65,17 @@ LDAS    := -Wl,--as-needed
 ASMLIB_OBJ = $(patsubst %.c,$(BUILD)/obj/%.o,$(ISA_SRC) $(ASM_SRC))
 LIB_OBJ  = $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/obj/%.o,$(CXX_SRC))
 ASAN_OBJ = $(patsubst %.c,$(BUILD)/asan/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/asan/%.o,$(CXX_SRC))
+# The image library's objects: position-independent, every symbol hidden but its table.
+SHIM_OBJ = $(patsubst %.cpp,$(BUILD)/shim/%.o,$(SHIM_SRC))
+SHIM_ASAN_OBJ = $(patsubst %.cpp,$(BUILD)/asan/%.o,$(SHIM_SRC))
+# Beside the binaries' folder, as installed (PREFIX/bin, PREFIX/lib/sfsim): lib/sfsim/ for bin/,
+# build/portable/lib/sfsim/ for build/portable/bin/ (sim/imglib.h, docs/install.md).
+LIBDIR  := $(patsubst ./%,%,$(dir $(BIN))lib)
+IMGLIB  := $(LIBDIR)/sfsim/libsfsim-img.so
 
 .PHONY: all deps install run test test-standalone test-asan test-unit test-hard test-slurm test-portable fuzz fuzz-run bench validation paper docs check-docs clean run-built test-built check-outputs help
 
-all: $(BIN)/sfasm $(BIN)/sfsim
+all: $(BIN)/sfasm $(BIN)/sfsim $(IMGLIB)
 
 help:
 	@echo "make run        install deps, build, run the example program"
@@ -119,6 +133,20 @@ $(BUILD)/asan/%.o: %.cpp $(FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS) $(SAN) -MMD -MP -c $< -o $@
 
+$(BUILD)/shim/%.o: %.cpp $(FLAGS_STAMP)
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS) -fPIC -fvisibility=hidden -MMD -MP -c $< -o $@
+
+# The image library. -z defs: it needs nothing of the program (it writes through an ImgSink); the
+# version script keeps the template instances of OpenImageIO's headers out of its symbol table.
+# Beside it, IMGLIB.deps: the order in which sim/imglib.c opens its dependencies
+# (scripts/imglib_deps.sh).
+$(IMGLIB): $(SHIM_OBJ) sim/imgshim.map scripts/imglib_deps.sh
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS) -shared -Wl,-z,defs -Wl,--as-needed -Wl,--version-script=sim/imgshim.map $(SHIM_OBJ) -o $@.tmp $(OIIO)
+	bash scripts/imglib_deps.sh $@.tmp > $@.deps
+	mv $@.tmp $@
+
 $(BUILD)/libsfasm.a: $(ASMLIB_OBJ)
 	@mkdir -p $(dir $@)
 	@rm -f $@
@@ -138,7 +166,8 @@ $(BIN)/sfasm: $(BUILD)/obj/asm/main_sfasm.o $(BUILD)/libsfasm.a
 	@mkdir -p $(BIN)
 	$(CC) $(CFLAGS) $^ -o $@ -lm
 
-$(BIN)/sfsim: $(BUILD)/obj/sim/main.o $(BUILD)/libsfsim.a
+# Its image library is built with it (order-only: not linked; sim/imglib.c loads it).
+$(BIN)/sfsim: $(BUILD)/obj/sim/main.o $(BUILD)/libsfsim.a | $(IMGLIB)
 	@mkdir -p $(BIN)
 	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
 
@@ -159,8 +188,8 @@ $(BUILD)/gen_reportdoc: tools/gen_reportdoc.c $(BUILD)/libsfsim.a
 	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
 
 # The same-outputs table's digest of a run folder (tests/outputs/check.sh).
-$(BUILD)/outputs_digest: tools/outputs_digest.c $(BUILD)/libsfsim.a
-	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
+$(BUILD)/outputs_digest: tools/outputs_digest.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
+	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
 
 # The kernel's shared numbers (stages, workloads, kd variants, material and light kinds).
 $(BUILD)/gen_kconst: tools/gen_kconst.c $(BUILD)/libsfsim.a
@@ -182,27 +211,27 @@ docs: $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_e
 	$(BUILD)/gen_kconst > kernels/lib/kconst.inc
 
 # ---- tests ----------------------------------------------------------------------------------
-$(BUILD)/tests/unit: $(TEST_SRC) $(BUILD)/libsfsim.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_exitdoc $(BUILD)/gen_reportdoc
+$(BUILD)/tests/unit: $(TEST_SRC) $(BUILD)/libsfsim.a $(SHIM_OBJ) $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_exitdoc $(BUILD)/gen_reportdoc
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(LDAS) $(TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
+	$(CC) $(CFLAGS) $(LDAS) $(TEST_SRC) $(SHIM_OBJ) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(INIH) $(LDLIBS) $(OIIO)
 
-$(BUILD)/tests/io: $(IO_TEST_SRC) $(BUILD)/libsfsim.a
+$(BUILD)/tests/io: $(IO_TEST_SRC) $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(LDAS) $(IO_TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(EMBREE) $(INIH) $(LDLIBS)
+	$(CC) $(CFLAGS) $(LDAS) $(IO_TEST_SRC) $(SHIM_OBJ) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(EMBREE) $(INIH) $(LDLIBS) $(OIIO)
 
-$(BUILD)/tests/unit-asan: $(TEST_SRC) $(BUILD)/libsfsim-asan.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_exitdoc $(BUILD)/gen_reportdoc
+$(BUILD)/tests/unit-asan: $(TEST_SRC) $(BUILD)/libsfsim-asan.a $(SHIM_ASAN_OBJ) $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_exitdoc $(BUILD)/gen_reportdoc
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(SAN) $(LDAS) $(TEST_SRC) $(BUILD)/libsfsim-asan.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
+	$(CC) $(CFLAGS) $(SAN) $(LDAS) $(TEST_SRC) $(SHIM_ASAN_OBJ) $(BUILD)/libsfsim-asan.a -o $@ $(CRIT) $(INIH) $(LDLIBS) $(OIIO)
 
-$(BUILD)/tests/io-asan: $(IO_TEST_SRC) $(BUILD)/libsfsim-asan.a
+$(BUILD)/tests/io-asan: $(IO_TEST_SRC) $(BUILD)/libsfsim-asan.a $(SHIM_ASAN_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(SAN) $(LDAS) $(IO_TEST_SRC) $(BUILD)/libsfsim-asan.a -o $@ $(CRIT) $(EMBREE) $(INIH) $(LDLIBS)
+	$(CC) $(CFLAGS) $(SAN) $(LDAS) $(IO_TEST_SRC) $(SHIM_ASAN_OBJ) $(BUILD)/libsfsim-asan.a -o $@ $(CRIT) $(EMBREE) $(INIH) $(LDLIBS) $(OIIO)
 
 HARD_TEST_SRC := $(wildcard tests/hard/*.c) tests/support/numerics.c tests/support/shared.c
 
-$(BUILD)/tests/hard: $(HARD_TEST_SRC) tests/support/numerics.h $(BUILD)/libsfsim.a
+$(BUILD)/tests/hard: $(HARD_TEST_SRC) tests/support/numerics.h $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(LDAS) $(HARD_TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
+	$(CC) $(CFLAGS) $(LDAS) $(HARD_TEST_SRC) $(SHIM_OBJ) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(INIH) $(LDLIBS) $(OIIO)
 
 # The slow hard numerics cases (docs/numerics.md gives the run time).
 test-hard: deps
@@ -210,7 +239,7 @@ test-hard: deps
 	@$(TEST_ENV) bash tests/run_criterion.sh $(BUILD)/tests/hard --jobs 2
 
 # CLI tests first, Criterion last: its synthesis line closes the run.
-TEST_ENV = SFSIM_BUILD=$(BUILD) SFSIM_GEN_ISADOC=$(BUILD)/gen_isadoc
+TEST_ENV = SFSIM_BUILD=$(BUILD) SFSIM_GEN_ISADOC=$(BUILD)/gen_isadoc SFSIM_TEST_IMGLIB=$(IMGLIB)
 
 # The tools the test suite does not run are still built (-Werror), so they cannot rot.
 test-built: all $(BUILD)/tests/unit $(BUILD)/tests/io $(BUILD)/gen_cornell $(BUILD)/outputs_digest \
@@ -239,7 +268,7 @@ test-slurm: deps
 ASAN_ENV = ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp
 
 test-asan: deps
-	@$(MAKE) --no-print-directory $(BUILD)/tests/unit-asan $(BUILD)/tests/io-asan
+	@$(MAKE) --no-print-directory $(BUILD)/tests/unit-asan $(BUILD)/tests/io-asan $(IMGLIB)
 	@$(TEST_ENV) $(ASAN_ENV) bash tests/run_criterion.sh $(BUILD)/tests/io-asan --jobs 2
 	@$(TEST_ENV) $(ASAN_ENV) bash tests/run_criterion.sh $(BUILD)/tests/unit-asan --jobs 2
 
@@ -283,38 +312,38 @@ fuzz-run: fuzz
 	$(BUILD)/fuzz/fuzz_config -max_total_time=$(FUZZ_SECONDS) -max_len=4096 $(BUILD)/fuzz/config_corpus tests/fuzz/config_seeds
 
 # ---- benchmarks -----------------------------------------------------------------------------
-$(BUILD)/bench/core_speed: bench/core_speed.c $(BUILD)/libsfsim.a
+$(BUILD)/bench/core_speed: bench/core_speed.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
+	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
 
-$(BUILD)/bench/embree_xcheck: bench/embree_xcheck.c tests/support/xcheck.c tests/support/shared.c $(BUILD)/libsfsim.a
+$(BUILD)/bench/embree_xcheck: bench/embree_xcheck.c tests/support/xcheck.c tests/support/shared.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $^ -o $@ $(EMBREE) $(INIH) $(LDLIBS)
+	$(CC) $(CFLAGS) $^ -o $@ $(EMBREE) $(INIH) $(LDLIBS) $(OIIO)
 
-$(BUILD)/bench/per_ray: bench/per_ray.c tests/support/xcheck.c tests/support/shared.c $(BUILD)/libsfsim.a
+$(BUILD)/bench/per_ray: bench/per_ray.c tests/support/xcheck.c tests/support/shared.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $^ -o $@ $(EMBREE) $(INIH) $(LDLIBS)
+	$(CC) $(CFLAGS) $^ -o $@ $(EMBREE) $(INIH) $(LDLIBS) $(OIIO)
 
-$(BUILD)/bench/functional_speed: bench/functional_speed.c tests/support/shared.c $(BUILD)/libsfsim.a
+$(BUILD)/bench/functional_speed: bench/functional_speed.c tests/support/shared.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
+	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
 
-$(BUILD)/bench/detailed_speed: bench/detailed_speed.c tests/support/shared.c $(BUILD)/libsfsim.a
+$(BUILD)/bench/detailed_speed: bench/detailed_speed.c tests/support/shared.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
+	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
 
-$(BUILD)/bench/speed_vs_error: bench/speed_vs_error.c tests/support/shared.c $(BUILD)/libsfsim.a
+$(BUILD)/bench/speed_vs_error: bench/speed_vs_error.c tests/support/shared.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
+	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
 
-$(BUILD)/validation: tools/validation.c $(BUILD)/libsfsim.a
+$(BUILD)/validation: tools/validation.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
+	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
 
 # The utilization experiments of docs/validation.md (several minutes on 2 cores).
-$(BUILD)/paper: tools/paper.c $(BUILD)/libsfsim.a
+$(BUILD)/paper: tools/paper.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
+	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
 
 # The utilization experiments of docs/validation.md (several minutes on 2 cores). The section
 # `make paper` wrote is kept.
@@ -357,8 +386,9 @@ run-built: all
 	@grep -E '^cycles +[0-9]' out/report.txt | sed 's/^/== headline: /'
 
 # ---- installation (docs/install.md) ---------------------------------------------------------
-# PREFIX/bin: sfsim, sfasm; PREFIX/share/sfsim: kernels, configs, the default scene (sfsim finds
-# them from its own folder); PREFIX/share/doc/sfsim: README and docs.
+# PREFIX/bin: sfsim, sfasm; PREFIX/lib/sfsim: the image library sfsim loads when it needs images;
+# PREFIX/share/sfsim: kernels, configs, the default scene (sfsim finds these and the library from
+# its own folder); PREFIX/share/doc/sfsim: README and docs.
 PREFIX  ?= /usr/local
 DATADIR := $(DESTDIR)$(PREFIX)/share/sfsim
 DOCDIR  := $(DESTDIR)$(PREFIX)/share/doc/sfsim
@@ -366,9 +396,10 @@ SHIPPED_SCENES := scenes/cornell/scene.ini scenes/cornell/glossy.ini scenes/corn
                   scenes/cornell/cornell-box.gltf scenes/cornell/cornell-box.bin
 
 install: all
-	install -d $(DESTDIR)$(PREFIX)/bin $(DATADIR)/kernels/lib $(DATADIR)/kernels/filters $(DATADIR)/kernels/bench $(DATADIR)/kernels/examples \
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/sfsim $(DATADIR)/kernels/lib $(DATADIR)/kernels/filters $(DATADIR)/kernels/bench $(DATADIR)/kernels/examples \
 	    $(DATADIR)/configs/sweeps $(DATADIR)/scenes/cornell $(DOCDIR)/docs
 	install -m 755 bin/sfsim bin/sfasm $(DESTDIR)$(PREFIX)/bin/
+	install -m 644 $(IMGLIB) $(IMGLIB).deps $(DESTDIR)$(PREFIX)/lib/sfsim/
 	install -m 644 kernels/*.s $(DATADIR)/kernels/
 	install -m 644 kernels/lib/* $(DATADIR)/kernels/lib/
 	install -m 644 kernels/filters/* $(DATADIR)/kernels/filters/
@@ -382,6 +413,6 @@ install: all
 	@echo "installed sfsim into $(DESTDIR)$(PREFIX) (data: $(PREFIX)/share/sfsim)"
 
 clean:
-	rm -rf $(BUILD) bin
+	rm -rf $(BUILD) bin lib
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

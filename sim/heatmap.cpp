@@ -1,7 +1,9 @@
-// sim/heatmap.cpp -- heat-map images (cost.png) drawn with OpenImageIO's ImageBufAlgo.
+// sim/heatmap.cpp -- heat-map images (cost.png) drawn with OpenImageIO's ImageBufAlgo (colour
+// map, frame lines, text) and plain copies (background, enlarged map, bar); part of
+// the image library libsfsim-img.so with sim/img.cpp (sim/imgshim.h).
 //
 // Owns: the colormap table, the layout documented in heatmap.h, the font search. Must not: open
-// image files itself (img_write_rgb8 in img.cpp does, so errors read the same everywhere) or
+// image files itself (imgshim_write_rgb8 in img.cpp does, so errors read the same everywhere) or
 // know what the values measure.
 #include <OpenImageIO/imagebufalgo.h>
 
@@ -14,10 +16,7 @@
 #include <string>
 #include <vector>
 
-extern "C" {
-#include "heatmap.h"
-#include "img.h"
-}
+#include "imgshim.h"
 
 namespace {
 
@@ -121,10 +120,11 @@ bool render(ImageBuf &canvas, const std::vector<float> &t, int w, int h, double 
         knots[i] = RAMP[i / 3][i % 3] / 255.0f;
 
     ImageBuf norm(ImageSpec(w, h, 1, TypeDesc::FLOAT)), rgb;
-    ImageBuf map(ImageSpec(map_w, map_h, 3, TypeDesc::FLOAT));
+    std::vector<float> cells((size_t)w * h * 3);
     if (!norm.set_pixels(OIIO::ROI::All(), TypeDesc::FLOAT, t.data()) ||
-        !IBA::color_map(rgb, norm, 0, NRAMP, 3, knots) || !IBA::resample(map, rgb, false)) {
-        why = norm.has_error() ? norm.geterror() : rgb.has_error() ? rgb.geterror() : map.geterror();
+        !IBA::color_map(rgb, norm, 0, NRAMP, 3, knots) ||
+        !rgb.get_pixels(OIIO::ROI::All(), TypeDesc::FLOAT, cells.data())) {
+        why = norm.has_error() ? norm.geterror() : rgb.geterror();
         return false;
     }
 
@@ -132,15 +132,30 @@ bool render(ImageBuf &canvas, const std::vector<float> &t, int w, int h, double 
     ImageBuf ramp(ImageSpec(BAR_W, bar_h, 1, TypeDesc::FLOAT)), bar;
     const bool flat = !(hi > lo);
     const float one = flat ? 0.5f : 1.0f, zero = flat ? 0.5f : 0.0f;
+    std::vector<float> bar_px((size_t)BAR_W * bar_h * 3);
     if (!IBA::fill(ramp, {&one, 1}, {&zero, 1}) ||
-        !IBA::color_map(bar, ramp, 0, NRAMP, 3, knots)) {
+        !IBA::color_map(bar, ramp, 0, NRAMP, 3, knots) ||
+        !bar.get_pixels(OIIO::ROI::All(), TypeDesc::FLOAT, bar_px.data())) {
         why = ramp.has_error() ? ramp.geterror() : bar.geterror();
         return false;
     }
 
+    // Background, the map (each cell an s x s block: what a nearest-neighbour resample gives,
+    // since (x + 0.5) / s is never within rounding of a whole number) and the bar, copied into
+    // a plain buffer: the same values as ImageBufAlgo's fill, resample and paste, which walked
+    // the ~730 x 600 canvas pixel by pixel (11 ms of a 32 x 32 run's cost.png, now 5 ms; the
+    // run's critical path, docs/performance.md "Start-up").
+    std::vector<float> px((size_t)cw * ch * 3);
+    for (size_t i = 0; i < px.size(); i += 3)
+        std::copy(BACKGROUND, BACKGROUND + 3, &px[i]);
+    for (int y = 0; y < map_h; y++)
+        for (int x = 0; x < map_w; x++)
+            std::copy_n(&cells[((size_t)(y / s) * w + x / s) * 3], 3, &px[((size_t)(top + y) * cw + map_x + x) * 3]);
+    for (int y = 0; y < bar_h; y++)
+        std::copy_n(&bar_px[(size_t)y * BAR_W * 3], BAR_W * 3, &px[((size_t)(top + y) * cw + bar_x) * 3]);
+
     canvas.reset(ImageSpec(cw, ch, 3, TypeDesc::FLOAT));
-    bool ok = IBA::fill(canvas, BACKGROUND) && IBA::paste(canvas, map_x, top, 0, 0, map) &&
-              IBA::paste(canvas, bar_x, top, 0, 0, bar) &&
+    bool ok = canvas.set_pixels(OIIO::ROI::All(), TypeDesc::FLOAT, px.data()) &&
               IBA::render_box(canvas, map_x - 1, top - 1, map_x + map_w, top + map_h, FRAME) &&
               IBA::render_box(canvas, bar_x - 1, top - 1, bar_x + BAR_W, top + bar_h, FRAME);
 
@@ -172,14 +187,14 @@ bool render(ImageBuf &canvas, const std::vector<float> &t, int w, int h, double 
 
 } // namespace
 
-extern "C" void heatmap_set_font(const char *font_path)
+extern "C" void imgshim_heatmap_set_font(const char *font_path)
 {
     font_overridden = font_path != nullptr;
     font_override = font_path ? font_path : "";
 }
 
-extern "C" int heatmap_write(OutSet *set, const char *path, const double *values, int width, int height,
-                             const char *title, const char *unit, char *err, size_t errlen)
+extern "C" int imgshim_heatmap_write(const ImgSink *sink, const char *path, const double *values, int width,
+                                     int height, const char *title, const char *unit, char *err, size_t errlen)
 {
     if (width <= 0 || height <= 0 || width > MAX_SIDE || height > MAX_SIDE)
         return fail(err, errlen, path, "heat map size " + std::to_string(width) + " x " +
@@ -213,7 +228,7 @@ extern "C" int heatmap_write(OutSet *set, const char *path, const double *values
         std::vector<float> px((size_t)spec.width * spec.height * 3);
         if (!canvas.get_pixels(OIIO::ROI::All(), TypeDesc::FLOAT, px.data()))
             return fail(err, errlen, path, "drawing the heat map: " + canvas.geterror());
-        return img_write_rgb8(set, path, px.data(), spec.width, spec.height, err, errlen);
+        return imgshim_write_rgb8(sink, path, px.data(), spec.width, spec.height, err, errlen);
     } catch (const std::exception &e) {
         return fail(err, errlen, path, std::string("drawing the heat map: ") + e.what());
     }

@@ -1,5 +1,6 @@
 /* sim/heatmap.h -- heat-map images of a per-pixel quantity (cost.png: simulated cycles per
- * pixel), drawn through OpenImageIO in sim/heatmap.cpp and written by img_write_rgb8 (img.h).
+ * pixel), drawn through OpenImageIO in sim/heatmap.cpp (part of the image library that
+ * sim/imglib.c loads) and written like img_write_rgb8 (img.h).
  *
  * Owns: the colormap, the layout of map, legend bar and labels, the choice of font.
  * Must not: measure anything or know where the values come from; tone-map (the colours are

@@ -1,5 +1,7 @@
-/* sim/img.h -- images in and out (through OpenImageIO, in sim/img.cpp) and image comparison
- * (sim/img_compare.c).
+/* sim/img.h -- images in and out (through OpenImageIO, in sim/img.cpp, reached through the image
+ * library that sim/imglib.c loads when first needed) and image comparison (sim/img_compare.c).
+ * The file functions fail, with "path: cannot load the image library ..." in err, when that
+ * library cannot be loaded (sim/imglib.h).
  *
  * Owns: file formats, tone mapping for display images, comparison statistics.
  * Must not: render or know about the simulated machine.

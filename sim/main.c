@@ -19,6 +19,7 @@
 #include "exitcodes.h"
 #include "exithelp.h"
 #include "img.h"
+#include "imglib.h"
 #include "render.h"
 #include "run/timedcore.h"
 #include "stats.h"
@@ -521,7 +522,8 @@ static void usage_compare(FILE *out)
             "difference, both means and the NaN/Inf counts. The values are compared as stored, never\n"
             "converted: a linear image (EXR, HDR, PFM) against a display image (PNG, JPEG) gets a warning\n"
             "on stderr, since PNG's values are sRGB-encoded, exposure-scaled and clamped. Exit 0 when it\n"
-            "could compare, 1 when an image cannot be read or the sizes differ.\n");
+            "could compare, 1 when an image cannot be read or the sizes differ, 4 when sfsim's image library\n"
+            "does not load.\n");
 }
 
 static int cmd_compare(int argc, char **argv)
@@ -536,7 +538,12 @@ static int cmd_compare(int argc, char **argv)
     }
     float *a = NULL, *b = NULL;
     int wa, ha, wb, hb;
-    char err[1024];
+    char err[8192];
+    /* A missing or broken image library is sfsim's fault, not the images': EXIT_IO as for run. */
+    if (!imglib_get(err, sizeof err)) {
+        fprintf(stderr, "sfsim compare: %s\n", err);
+        return EXIT_IO;
+    }
     int rc = EXIT_INPUT;
     if (img_read(argv[0], &a, &wa, &ha, err, sizeof err) != 0 || img_read(argv[1], &b, &wb, &hb, err, sizeof err) != 0) {
         fprintf(stderr, "sfsim compare: %s\n", err);
@@ -697,6 +704,13 @@ static int cmd_run(int argc, char **argv)
     o.cfg = &cfg;
     o.config_path = ca.path;
     static char err[65536];
+    /* Every run writes an image (frame.exr and frame.png, cost.png, or frame.partial.exr): the image
+     * library loads on a thread now, overlapping the scene, the BVH and the simulation
+     * (docs/performance.md); a missing one stops the run before its work. */
+    if (imglib_preload(err, sizeof err) != 0) {
+        fprintf(stderr, "sfsim run: %s\n", err);
+        return EXIT_IO;
+    }
     int rrc = render_run(&o, err, sizeof err);
     if (rrc != 0) {
         fprintf(stderr, "sfsim run: %s\n", err);

@@ -2,7 +2,8 @@
 # tests/cli/standalone.sh -- the repository on its own: the shipped Cornell box is what
 # tools/gen_cornell.c writes, bin/sfsim finds its kernel and default scene from any folder, and
 # `make install PREFIX=...` gives a tree whose sfsim works from any folder, with no source tree
-# and no ../shared. `make test` runs it (SFSIM_GEN_CORNELL names the generator it built).
+# and no ../shared; sfsim loads its image library (lib/sfsim/libsfsim-img.so) from beside its
+# folder only when it needs images, and says clearly when it cannot (sim/imglib.h). `make test` runs it (SFSIM_GEN_CORNELL names the generator it built).
 # Exit status: 0 when every case passed.
 set -u
 
@@ -64,7 +65,7 @@ end
 begin "make install PREFIX=... installs binaries, kernels, configs, the default scene and docs"
 run make --no-print-directory install PREFIX="$T/prefix"
 want_rc 0
-for f in bin/sfsim bin/sfasm share/sfsim/kernels/pathtrace.s share/sfsim/kernels/lib/layout.inc \
+for f in bin/sfsim bin/sfasm lib/sfsim/libsfsim-img.so lib/sfsim/libsfsim-img.so.deps share/sfsim/kernels/pathtrace.s share/sfsim/kernels/lib/layout.inc \
     share/sfsim/kernels/lib/kconst.inc share/sfsim/kernels/lib/frames.inc share/sfsim/kernels/filters/traverse.inc \
     share/sfsim/configs/streamray.ini share/sfsim/configs/sweeps/width.ini share/sfsim/scenes/cornell/scene.ini \
     share/sfsim/scenes/cornell/cornell-box.gltf share/sfsim/scenes/cornell/cornell-box.bin \
@@ -80,6 +81,14 @@ want_rc 0
 [ -s "$T/user/out/frame.png" ] || no "no frame.png"
 [ "$(scene_file "$T/user/out")" = "$T/prefix/share/sfsim/scenes/cornell/scene.ini" ] ||
     no "report.json names scene '$(scene_file "$T/user/out")', not the installed one"
+end
+
+begin "the installed sfsim loads the installed image library, and bin/sfsim links no OpenImageIO"
+run env -C "$T/user" LD_DEBUG=files "$T/prefix/bin/sfsim" run --mode reference -o out-ld "${SMALL[@]}"
+want_rc 0
+grep -q "file=$T/prefix/lib/sfsim/libsfsim-img.so " "$T/err" || no "the installed library was not the one loaded"
+grep -q "file=$ROOT/lib/sfsim/" "$T/err" && no "the build tree's library was loaded"
+readelf -d "$T/prefix/bin/sfsim" | grep -q "NEEDED.*OpenImageIO" && no "sfsim links OpenImageIO"
 end
 
 begin "the installed sfsim takes the installed machine config and a scene by path"
@@ -104,10 +113,40 @@ want_err "data files are missing|default scene is missing"
 [ -e "$T/lonely/out" ] && no "an output folder was left behind"
 end
 
-begin "SFSIM_DATA_DIR points sfsim at another data folder"
-run env -C "$T/lonely" SFSIM_DATA_DIR="$T/prefix/share/sfsim" "$T/lonely/bin/sfsim" run --mode reference -o out "${SMALL[@]}"
+begin "SFSIM_DATA_DIR points sfsim at another data folder (and SFSIM_IMG_LIB at the image library)"
+run env -C "$T/lonely" SFSIM_DATA_DIR="$T/prefix/share/sfsim" SFSIM_IMG_LIB="$T/prefix/lib/sfsim/libsfsim-img.so" "$T/lonely/bin/sfsim" run --mode reference -o out "${SMALL[@]}"
 want_rc 0
 [ -s "$T/lonely/out/frame.png" ] || no "no frame.png"
+end
+
+begin "an sfsim without its image library names the path it tried (exit 4) before any work, no crash"
+run env -C "$T/lonely" SFSIM_DATA_DIR="$T/prefix/share/sfsim" "$T/lonely/bin/sfsim" run -o out-noimg "${SMALL[@]}"
+want_rc 4
+want_err "cannot load the image library $T/lonely/lib/sfsim/libsfsim-img.so: No such file"
+[ -e "$T/lonely/out-noimg" ] && no "an output folder was left behind"
+run env -C "$T/lonely" "$T/lonely/bin/sfsim" compare "$T/lonely/out/frame.exr" "$T/lonely/out/frame.exr"
+want_rc 4
+want_err "cannot load the image library $T/lonely/lib/sfsim/libsfsim-img.so"
+end
+
+begin "an image library that does not load is named with the loader's reason (exit 4), nothing written"
+printf 'not a shared object\n' > "$T/bogus.so"
+run env SFSIM_IMG_LIB="$T/bogus.so" "$SFSIM" run -o "$T/out-bogus" "${SMALL[@]}"
+want_rc 4
+want_err "frame.exr: cannot load the image library $T/bogus.so: .*(ELF|too short)"
+[ -e "$T/out-bogus" ] && no "an output folder was left behind"
+run env SFSIM_IMG_LIB=/lib/x86_64-linux-gnu/libm.so.6 "$SFSIM" compare "$T/from-root/frame.exr" "$T/from-root/frame.exr"
+want_rc 4
+want_err "libm.so.6: it has no img_shim table"
+end
+
+begin "commands that write no image never load the image library (help, config, exec, trace)"
+run_ld() { run env SFSIM_IMG_LIB=/nonexistent/lib.so LD_DEBUG=files "$@"; want_rc 0; grep -q "OpenImageIO\|libsfsim-img" "$T/err" && no "$2 loaded the image library"; }
+run_ld "$SFSIM" --help
+run_ld "$SFSIM" config --dump
+"$ROOT/bin/sfasm" kernels/examples/filter_demo.s -o "$T/demo.sfo" || no "sfasm failed"
+run_ld "$SFSIM" exec "$T/demo.sfo"
+run_ld "$SFSIM" trace -s scenes/cornell/scene.ini --rays tests/cli/cornell_rays.txt -o "$T/hits.txt"
 end
 
 cli_summary standalone
