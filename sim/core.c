@@ -16,9 +16,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
 
 const char *const core_mem_names[CORE_MEM_COUNT] = {"rb0", "rb1", "idm", "spad", "scene", "fb"};
 static const char *const mem_long[CORE_MEM_COUNT] = {"ray buffer 0", "ray buffer 1", "ID-stream memory",
@@ -118,22 +115,6 @@ static void count_fold(Core *c)
     count_select_row(c);
 }
 
-/* A large simulated memory (scene memory: 256 MiB by default, tens of MB of it written with the
- * scene image at every run's start) asks Linux for transparent huge pages: one page fault per
- * 2 MiB instead of per 4 KiB. Only advice: the memory is calloc's either way, zero until written. */
-static void mem_advise_huge(void *p, size_t bytes)
-{
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    const uintptr_t huge = (uintptr_t)2 << 20;
-    uintptr_t lo = ((uintptr_t)p + huge - 1) & ~(huge - 1), hi = ((uintptr_t)p + bytes) & ~(huge - 1);
-    if (hi > lo)
-        (void)madvise((void *)lo, hi - lo, MADV_HUGEPAGE);
-#else
-    (void)p;
-    (void)bytes;
-#endif
-}
-
 /* ---- construction ---------------------------------------------------------------------------- */
 
 Core *core_new(const CoreParams *p, const AsmObject *obj, char *err, size_t errlen)
@@ -174,8 +155,6 @@ Core *core_new(const CoreParams *p, const AsmObject *obj, char *err, size_t errl
         c->last[m] = (int64_t)p->mem_bytes[m] - 4;
         c->mem[m] = calloc(p->mem_bytes[m] ? p->mem_bytes[m] : 4, 1);
         ok = c->mem[m] != NULL;
-        if (ok)
-            mem_advise_huge(c->mem[m], p->mem_bytes[m]);
     }
     c->counts = ok ? calloc((size_t)COUNT_ROWS * COUNT_COLS, sizeof(uint64_t)) : NULL;
     ok = ok && c->counts;
