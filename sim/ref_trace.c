@@ -422,26 +422,43 @@ static inline const uint8_t *image_at(const PackedScene *p, uint32_t addr)
     return p->mem + (addr - p->base);
 }
 
+/* What both walks set up before the first node: no hit yet, the node and primitive arrays, the
+ * per-ray record and the slab test's ray. 0 for a scene without nodes (nothing to walk). */
+typedef struct WalkStart {
+    const uint8_t *nodes, *prims;
+    RefRayPre R;
+    BoxRay B;
+} WalkStart;
+
+static inline __attribute__((always_inline)) int walk_start(const PackedScene *p, const RefRay *r, RefHit *hit,
+                                                             WalkStart *ws)
+{
+    hit->prim = REF_NO_HIT;
+    hit->t = r->tmax;
+    hit->u = hit->v = 0.0f;
+    if (sm_u32(p, sm_hdr(p, SM_HDR_NNODES)) == 0)
+        return 0;
+    ws->nodes = image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_NODES)));
+    ws->prims = image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_PRIMS)));
+    ref_ray_prepare(&ws->R, r);
+    float inv[3];
+    ref_inv_dir(ws->R.dir, inv);
+    box_ray(&ws->B, ws->R.org, inv);
+    return 1;
+}
+
 /* Depth-first walk; closest != 0 keeps searching for the nearest hit, else stops at the first.
  * count: where box tests and leaf entries are also counted (st->count), or NULL. Inlined into
  * both walks below, so the one without counts has no test for them on its per-node path. */
 static inline __attribute__((always_inline)) int walk_body(const PackedScene *p, const RefRay *r, RefHit *hit,
                                                             int closest, RefTraceStats *st, RefSetCount *count)
 {
-    hit->prim = REF_NO_HIT;
-    hit->t = r->tmax;
-    hit->u = hit->v = 0.0f;
-    uint32_t nnodes = sm_u32(p, sm_hdr(p, SM_HDR_NNODES));
-    if (nnodes == 0)
+    WalkStart ws;
+    if (!walk_start(p, r, hit, &ws))
         return 0;
-    const uint8_t *nodes = image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_NODES)));
-    const uint8_t *prims = image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_PRIMS)));
-    RefRayPre R;
-    ref_ray_prepare(&R, r);
-    BoxRay B;
-    float inv[3];
-    ref_inv_dir(R.dir, inv);
-    box_ray(&B, R.org, inv);
+    const uint8_t *nodes = ws.nodes, *prims = ws.prims;
+    const RefRayPre R = ws.R;
+    const BoxRay B = ws.B;
     BoxFar far = box_far(r->tmax); /* boxes: the closest hit so far, widened */
     float ptmax = r->tmax;         /* primitives: tmax, then the tie probe past the closest hit */
     Walk w;
@@ -518,20 +535,12 @@ typedef struct Pending {
  * the boxes tested and missed differ, which nobody counts here. */
 static int walk_fast(const PackedScene *p, const RefRay *r, RefHit *hit, int closest)
 {
-    hit->prim = REF_NO_HIT;
-    hit->t = r->tmax;
-    hit->u = hit->v = 0.0f;
-    uint32_t nnodes = sm_u32(p, sm_hdr(p, SM_HDR_NNODES));
-    if (nnodes == 0)
+    WalkStart ws;
+    if (!walk_start(p, r, hit, &ws))
         return 0;
-    const uint8_t *nodes = image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_NODES)));
-    const uint8_t *prims = image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_PRIMS)));
-    RefRayPre R;
-    ref_ray_prepare(&R, r);
-    BoxRay B;
-    float inv[3];
-    ref_inv_dir(R.dir, inv);
-    box_ray(&B, R.org, inv);
+    const uint8_t *nodes = ws.nodes, *prims = ws.prims;
+    const RefRayPre R = ws.R;
+    const BoxRay B = ws.B;
     BoxRay2 B2;
     box_ray2(&B2, &B);
     if (!box_hit_node(nodes, &B, box_far(r->tmax)))
