@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "../../sim/ref_trace.h"
+#include "../support/shared.h"
 
 Test(ref_box, zero_direction_components_and_slab_planes)
 {
@@ -310,6 +311,12 @@ Test(ref_traversal, fast_walk_matches_plain_walk)
 {
     fast_walk_matches_plain("scenes/cornell/scene.ini", 20000);
     fast_walk_matches_plain("scenes/cornell/spheres.ini", 20000);
+}
+
+Test(ref_traversal, fast_walk_matches_plain_walk_on_shared_scenes)
+{
+    NEEDS_SCENE("scenes/sponza-dabrovic/scene.ini");
+    NEEDS_SCENE("scenes/conference/scene.ini");
     fast_walk_matches_plain("scenes/sponza-dabrovic/scene.ini", 20000);
     fast_walk_matches_plain("scenes/conference/scene.ini", 20000);
 }
