@@ -10,8 +10,9 @@
  *            triangle; a scene without lights: a random point inside its bounds.
  * Each batch goes through Embree 3 (rtcIntersect1 / rtcOccluded1, robust, the high-quality build,
  * one thread), the golden model, functional mode and detailed mode (the kernel's traversal and
- * intersection, `sfsim trace`'s path; N = 16, M = 4096), best of REPS runs each, and the bench
- * prints ns per ray, the kernel's instructions per ray and each engine's ratio to Embree.
+ * intersection, `sfsim trace`'s path; N = 16, M = 4096), best of REPS runs each (the engines take
+ * turns, one run each per round), and the bench prints ns per ray, the kernel's instructions per
+ * ray and each engine's ratio to Embree.
  * The three engines of ours must return identical hits and Embree must agree with them (the rule
  * of tests/support/xcheck.c), or the bench fails.
  *
@@ -271,7 +272,9 @@ static double ours_time(const RunScene *sc, RunMode mode, const Batch *bt, int r
     return best;
 }
 
-/* Every engine over one batch. 0, or -1 after printing why. */
+/* Every engine over one batch, best of reps each. The engines take turns, one run each per round,
+ * so a busy spell on a shared host weighs on all of them alike rather than on whichever ran then.
+ * Embree's agreement is counted in the first round. 0, or -1 after printing why. */
 static int batch_time(const RunScene *sc, const XcheckEmbree *e, const Batch *bt, int reps, Timing *tm)
 {
     memset(tm, 0, sizeof *tm);
@@ -282,18 +285,32 @@ static int batch_time(const RunScene *sc, const XcheckEmbree *e, const Batch *bt
         fprintf(stderr, "per_ray: out of memory for %u hits\n", n);
         goto out;
     }
-    if ((tm->seconds[ENG_GOLDEN] = ours_time(sc, RUN_REFERENCE, bt, reps, golden, NULL)) < 0)
-        goto out;
-    if ((tm->seconds[ENG_EMBREE] = embree_time(sc, e, bt, golden, reps, tm)) < 0)
-        goto out;
+    for (int k = 0; k < ENG_COUNT; k++)
+        tm->seconds[k] = INFINITY;
     static const RunMode kernel_modes[2] = {RUN_FUNCTIONAL, RUN_DETAILED};
-    for (int m = 0; m < 2; m++) {
-        uint64_t instr = 0;
-        if ((tm->seconds[ENG_FUNCTIONAL + m] = ours_time(sc, kernel_modes[m], bt, reps, other, &instr)) < 0)
+    for (int rep = 0; rep < reps; rep++) {
+        double s;
+        if ((s = ours_time(sc, RUN_REFERENCE, bt, 1, golden, NULL)) < 0)
             goto out;
-        if (m == 0)
-            tm->instructions = instr;
-        tm->ours_differ |= memcmp(golden, other, sizeof *golden * bt->b.count) != 0;
+        tm->seconds[ENG_GOLDEN] = fmin(tm->seconds[ENG_GOLDEN], s);
+        Timing agree = {0};
+        if ((s = embree_time(sc, e, bt, golden, 1, &agree)) < 0)
+            goto out;
+        tm->seconds[ENG_EMBREE] = fmin(tm->seconds[ENG_EMBREE], s);
+        if (rep == 0) {
+            tm->agree = agree.agree;
+            tm->ties = agree.ties;
+            tm->disagree = agree.disagree;
+        }
+        for (int m = 0; m < 2; m++) {
+            uint64_t instr = 0;
+            if ((s = ours_time(sc, kernel_modes[m], bt, 1, other, &instr)) < 0)
+                goto out;
+            tm->seconds[ENG_FUNCTIONAL + m] = fmin(tm->seconds[ENG_FUNCTIONAL + m], s);
+            if (m == 0)
+                tm->instructions = instr;
+            tm->ours_differ |= memcmp(golden, other, sizeof *golden * bt->b.count) != 0;
+        }
     }
     rc = 0;
 out:

@@ -43,16 +43,27 @@ const char *const tm_cause_descs[TM_CAUSE_COUNT] = {
  * waiting instruction needs (wait_hazards). */
 enum { EV_UNIT, EV_FETCH, EV_PART };
 
-/* The scoreboard registers of one program instruction (simd_operands), worked out the first time
- * the instruction runs and kept by its pc: they depend only on the instruction. */
-typedef struct TmOperands {
-    uint32_t run;                            /* the run (timing_reset) they were made in: a
-                                                run's program is fixed, so pc names its
-                                                instruction; a new run works them out again */
+/* What the timing core needs of one program instruction, worked out the first time the
+ * instruction runs in a run and kept by its pc (describe()): its ISA table row's unit and flags as
+ * the few facts the hook branches on, its unit class's latency and issue interval, and its
+ * scoreboard registers (simd_operands). All depend only on the instruction and the machine, so
+ * the hook does no table walk for an instruction it has seen. */
+typedef struct TmDesc {
+    uint32_t run;                            /* the run (timing_reset) it was made in: a run's
+                                                program is fixed, so pc names its instruction; a
+                                                new run works it out again */
+    uint8_t op, unit;
+    uint8_t is_halt;                         /* ISA_FL_END */
+    uint8_t vec;                             /* ISA_FL_VEC: counts toward stage_vec_busy */
+    uint8_t mem;                             /* a memory unit: issue_units() when lanes touched memory */
+    uint8_t special;                         /* its result time is not latency-after-issue
+                                                (result_time()) */
     uint8_t nregs, ndst;
+    uint32_t lat;                            /* the unit class's result latency */
+    uint32_t issue;                          /* its issue interval when > 1 (else 0: never held) */
     uint8_t regs[2 * ISA_MAX_OPERANDS + 1];  /* sources, exec mask, destinations */
     uint8_t dsts[ISA_MAX_OPERANDS];
-} TmOperands;
+} TmDesc;
 
 struct Timing {
     EvQueue q;
@@ -64,10 +75,14 @@ struct Timing {
     PartUnit part;
     Spad spad;
     SceneMem mem;
-    TmOperands *ops;               /* by pc (operands()); grown to the program's size once */
-    uint32_t ops_cap;
-    uint32_t run;                  /* runs since timing_new, from 1 (TmOperands.run) */
-    TmOperands spare;              /* operands() when the table cannot grow */
+    TmDesc *desc;                  /* by pc (describe()); grown to the program's size once */
+    uint32_t desc_cap;
+    uint32_t run;                  /* runs since timing_new, from 1 (TmDesc.run) */
+    TmDesc spare;                  /* describe() when the table cannot grow */
+    /* Issue cycles by stage, statistics generation and vector flag: one count per instruction;
+     * timing_stats() folds them into TimingStats' busy counters and the cycles per stage and
+     * generation (busy + stalls). */
+    uint64_t issues[ISA_STAGE_COUNT][CORE_GENERATIONS][2];
     int halted;
     char err[256];
     TimingStats st;
@@ -113,7 +128,7 @@ void timing_free(Timing *t)
     if (!t)
         return;
     evq_free(&t->q);
-    free(t->ops);
+    free(t->desc);
     mem_free(&t->mem);
     rb_free(&t->rb);
     free(t);
@@ -130,17 +145,40 @@ void timing_reset(Timing *t)
     mem_reset(&t->mem);
     t->halted = 0;
     if (++t->run == 0) { /* wrapped: no entry may look current */
-        if (t->ops)
-            memset(t->ops, 0, sizeof *t->ops * t->ops_cap);
+        if (t->desc)
+            memset(t->desc, 0, sizeof *t->desc * t->desc_cap);
         t->run = 1;
     }
 }
 
 const TimingStats *timing_stats(const Timing *t)
 {
+    TimingStats *s = &((Timing *)t)->st;
     /* The scene-memory counters live in SceneMem; copy them in. */
-    ((Timing *)t)->st.scene = t->mem.st;
-    return &t->st;
+    s->scene = t->mem.st;
+    /* The busy counters and the cycles per stage and generation, from the issue counts and the
+     * stalls charged. */
+    s->busy = 0;
+    memset(s->gen_busy, 0, sizeof s->gen_busy);
+    for (int g = 0; g < ISA_STAGE_COUNT; g++) {
+        s->stage_busy[g] = s->stage_vec_busy[g] = 0;
+        for (int k = 0; k < CORE_GENERATIONS; k++) {
+            uint64_t n = t->issues[g][k][0] + t->issues[g][k][1];
+            s->stage_busy[g] += n;
+            s->stage_vec_busy[g] += t->issues[g][k][1];
+            s->gen_busy[k] += n;
+        }
+        s->busy += s->stage_busy[g];
+        s->stage_cycles[g] = s->stage_busy[g];
+        for (int c = 0; c < TM_CAUSE_COUNT; c++)
+            s->stage_cycles[g] += s->stage_stalls[g][c];
+    }
+    for (int k = 0; k < CORE_GENERATIONS; k++) {
+        s->gen_cycles[k] = s->gen_busy[k];
+        for (int c = 0; c < TM_CAUSE_COUNT; c++)
+            s->gen_cycles[k] += s->gen_stalls[k][c];
+    }
+    return s;
 }
 
 const char *timing_error(const Timing *t)
@@ -156,22 +194,15 @@ static inline void charge(Timing *t, int cause, uint64_t cycles, int stage, int 
         return;
     t->st.stalls[cause] += cycles;
     t->st.stage_stalls[stage][cause] += cycles;
-    t->st.stage_cycles[stage] += cycles;
-    t->st.gen_cycles[gen] += cycles;
     t->st.gen_stalls[gen][cause] += cycles;
 }
 
-/* One issue cycle of an instruction of class unit. */
-static inline void count_issue(Timing *t, const IsaOpInfo *oi, int stage, int gen)
+/* One issue cycle of the instruction d (the cycles per stage and generation are folded in
+ * timing_stats()). */
+static inline void count_issue(Timing *t, const TmDesc *d, int stage, int gen)
 {
-    t->st.busy++;
-    t->st.stage_busy[stage]++;
-    t->st.stage_cycles[stage]++;
-    t->st.gen_cycles[gen]++;
-    t->st.gen_busy[gen]++;
-    if (oi->flags & ISA_FL_VEC)
-        t->st.stage_vec_busy[stage]++;
-    t->st.unit_uses[oi->unit]++;
+    t->issues[stage][gen][d->vec]++;
+    t->st.unit_uses[d->unit]++;
 }
 
 static void internal_error(Timing *t, const char *msg)
@@ -189,7 +220,7 @@ static void push(Timing *t, uint64_t time, int kind, int arg, uint32_t tag, int 
 }
 
 /* Apply every event due by cycle `at`. */
-static void drain(Timing *t, uint64_t at)
+static __attribute__((noinline)) void drain_due(Timing *t, uint64_t at)
 {
     const EvEvent *e;
     while ((e = evq_top(&t->q)) && e->time <= at) {
@@ -202,43 +233,52 @@ static void drain(Timing *t, uint64_t at)
     }
 }
 
+static inline void drain(Timing *t, uint64_t at)
+{
+    if (t->q.n && t->q.h[0].time <= at)
+        drain_due(t, at);
+}
+
 /* ---- 1. hazards that an event clears ------------------------------------------------------ */
 
-/* The highest-priority hazard at cycle at that an event will clear, or -1 (docs/model.md, "Stall
- * causes"). */
-static int hazard(const Timing *t, const IsaOpInfo *oi, const CoreRecord *rec, const TmOperands *o, int is_halt,
-                  uint64_t at)
+/* The hazards after the registers': the unit's issue interval, the partition unit, and for a
+ * halt everything in flight (waiting: the cause of a register still waiting, or -1). -1 if none. */
+static inline int hazard_units(const Timing *t, const TmDesc *d, const CoreRecord *rec, int waiting)
 {
-    if (t->simd.fetch_pending)
-        return TM_CONTROL;
-    int cause = simd_waiting_operand(&t->simd, o->regs, o->nregs, at);
-    if (cause >= 0)
-        return cause;
-    if (t->simd.unit_pending[oi->unit])
+    if (t->simd.unit_pending[d->unit])
         return TM_FU_BUSY;
-    if (t->part.busy && part_blocks(&t->part, oi, rec))
+    if (t->part.busy && part_blocks(&t->part, &isa_ops[d->op], rec))
         return TM_PARTITION;
-    if (is_halt) { /* the program ends when every result in flight has landed */
+    if (d->is_halt) { /* the program ends when every result in flight has landed */
         if (t->part.busy)
             return TM_PARTITION;
-        return simd_any_waiting(&t->simd, at);
+        return waiting;
     }
     return -1;
 }
 
-/* From t->now, jump from event to event while a hazard holds; returns the first cycle free of them.
- * The next event is the queue's top or a register landing the hazards read, whichever is first:
- * between two such events no hazard changes, so each interval goes to one cause. */
-static uint64_t wait_hazards(Timing *t, const IsaOpInfo *oi, const CoreRecord *rec, const TmOperands *o,
-                             int is_halt)
+/* The highest-priority hazard at cycle at that an event will clear, or -1 (docs/model.md, "Stall
+ * causes"): fetch after a taken branch, then the instruction's registers (sources, mask,
+ * destinations), then the units (hazard_units). */
+static inline int hazard(const Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at)
 {
-    uint64_t at = t->now;
+    if (t->simd.fetch_pending)
+        return TM_CONTROL;
+    int cause = simd_waiting_operand(&t->simd, d->regs, d->nregs, at);
+    if (cause >= 0)
+        return cause;
+    return hazard_units(t, d, rec, d->is_halt ? simd_any_waiting(&t->simd, at) : -1);
+}
+
+/* A hazard (cause) holds at cycle at: jump from event to event while one holds; returns the first
+ * cycle free of them. The next event is the queue's top or a register landing the hazards read,
+ * whichever is first: between two such events no hazard changes, so each interval goes to one
+ * cause. */
+static __attribute__((noinline)) uint64_t wait_hazards(Timing *t, const TmDesc *d, const CoreRecord *rec,
+                                                       uint64_t at, int cause)
+{
     for (;;) {
-        drain(t, at);
-        int cause = hazard(t, oi, rec, o, is_halt, at);
-        if (cause < 0)
-            break;
-        uint64_t next = simd_next_landing(&t->simd, o->regs, is_halt ? -1 : o->nregs, at);
+        uint64_t next = simd_next_landing(&t->simd, d->regs, d->is_halt ? -1 : d->nregs, at);
         const EvEvent *e = evq_top(&t->q);
         if (e && e->time < next)
             next = e->time;
@@ -248,38 +288,67 @@ static uint64_t wait_hazards(Timing *t, const IsaOpInfo *oi, const CoreRecord *r
         }
         charge(t, cause, next - at, rec->stage, rec->gen);
         at = next;
+        drain(t, at);
+        cause = hazard(t, d, rec, at);
+        if (cause < 0)
+            break;
     }
     return at;
 }
 
-/* The scoreboard registers of the instruction at rec->pc: from the table, filled on first use. A
- * failed allocation works them out into *spare instead (slower, same answer). */
-static const TmOperands *operands(Timing *t, const CoreRecord *rec)
+/* Works out d for the instruction at rec->pc (see TmDesc). */
+static void describe_fill(Timing *t, TmDesc *d, const CoreRecord *rec)
 {
-    TmOperands *o;
-    if (__builtin_expect(rec->pc < t->ops_cap, 1)) {
-        o = &t->ops[rec->pc];
-        if (o->run == t->run)
-            return o;
+    const IsaOpInfo *oi = &isa_ops[rec->in->op];
+    d->op = (uint8_t)rec->in->op;
+    d->unit = (uint8_t)oi->unit;
+    d->is_halt = (oi->flags & ISA_FL_END) != 0;
+    d->vec = (oi->flags & ISA_FL_VEC) != 0;
+    d->mem = oi->unit == ISA_U_AGU || oi->unit == ISA_U_RBUF || oi->unit == ISA_U_SPAD ||
+             oi->unit == ISA_U_SCENE || oi->unit == ISA_U_FB;
+    d->special = oi->unit == ISA_U_AGU || oi->unit == ISA_U_RBUF || oi->unit == ISA_U_SPAD ||
+                 oi->unit == ISA_U_PART;
+    d->lat = (uint32_t)t->simd.p.lat[oi->unit];
+    d->issue = t->simd.p.issue[oi->unit] > 1 ? (uint32_t)t->simd.p.issue[oi->unit] : 0;
+    int ndst;
+    d->nregs = (uint8_t)simd_operands(&t->simd, rec->in, d->regs, d->dsts, &ndst);
+    d->ndst = (uint8_t)ndst;
+}
+
+/* The description of the instruction at rec->pc: from the table, filled on first use. A failed
+ * allocation works it out into t->spare instead (slower, same answer). */
+static __attribute__((noinline)) const TmDesc *describe_slow(Timing *t, const CoreRecord *rec)
+{
+    TmDesc *d;
+    if (rec->pc < t->desc_cap) {
+        d = &t->desc[rec->pc];
     } else {
-        uint32_t cap = t->ops_cap ? t->ops_cap : 256;
+        uint32_t cap = t->desc_cap ? t->desc_cap : 256;
         while (cap <= rec->pc && cap < UINT32_MAX / 2)
             cap *= 2;
-        TmOperands *g = cap > rec->pc ? realloc(t->ops, sizeof *g * cap) : NULL;
+        TmDesc *g = cap > rec->pc ? realloc(t->desc, sizeof *g * cap) : NULL;
         if (g) {
-            memset(g + t->ops_cap, 0, sizeof *g * (cap - t->ops_cap));
-            t->ops = g;
-            t->ops_cap = cap;
-            o = &t->ops[rec->pc];
+            memset(g + t->desc_cap, 0, sizeof *g * (cap - t->desc_cap));
+            t->desc = g;
+            t->desc_cap = cap;
+            d = &t->desc[rec->pc];
         } else {
-            o = &t->spare;
+            d = &t->spare;
         }
     }
-    int ndst;
-    o->nregs = (uint8_t)simd_operands(&t->simd, rec->in, o->regs, o->dsts, &ndst);
-    o->ndst = (uint8_t)ndst;
-    o->run = o == &t->spare ? 0 : t->run;
-    return o;
+    describe_fill(t, d, rec);
+    d->run = d == &t->spare ? 0 : t->run;
+    return d;
+}
+
+static inline const TmDesc *describe(Timing *t, const CoreRecord *rec)
+{
+    if (__builtin_expect(rec->pc < t->desc_cap, 1)) {
+        const TmDesc *d = &t->desc[rec->pc];
+        if (__builtin_expect(d->run == t->run, 1))
+            return d;
+    }
+    return describe_slow(t, rec);
 }
 
 /* ---- 2, 3. the units an instruction uses as it issues ------------------------------------- */
@@ -310,8 +379,6 @@ static void dp_transfer(Timing *t, Issue *is, uint64_t len, const CoreRecord *re
 static void issue_units(Timing *t, const IsaOpInfo *oi, const CoreRecord *rec, Issue *is)
 {
     const uint32_t fl = oi->flags;
-    if (rec->naddr == 0) /* no lane touched memory */
-        return;
     switch (oi->unit) {
     case ISA_U_AGU:
         if (isa_id_fetch(fl)) { /* sfetch: the vector the AGUs fetched ahead, or a fetch now */
@@ -401,30 +468,40 @@ static uint64_t result_time(Timing *t, const IsaOpInfo *oi, const CoreRecord *re
 void timing_hook(void *ctx, const CoreRecord *rec)
 {
     Timing *t = ctx;
-    const IsaOpInfo *oi = &isa_ops[rec->in->op];
-    const int is_halt = (oi->flags & ISA_FL_END) != 0;
-    if (t->halted) { /* a halted core is not run again before timing_reset */
+    if (__builtin_expect(t->halted, 0)) { /* a halted core is not run again before timing_reset */
         internal_error(t, "instruction after halt");
         return;
     }
-    const TmOperands *o = operands(t, rec);
+    const TmDesc *d = describe(t, rec);
 
-    Issue is = {wait_hazards(t, oi, rec, o, is_halt), 0, 0, TM_DATA_DEPENDENCY};
-    issue_units(t, oi, rec, &is);
-    count_issue(t, oi, rec->stage, rec->gen);
+    uint64_t at = t->now;
+    drain(t, at);
+    int cause = hazard(t, d, rec, at);
+    if (__builtin_expect(cause >= 0, 0))
+        at = wait_hazards(t, d, rec, at, cause);
+    Issue is = {at, 0, 0, TM_DATA_DEPENDENCY};
+    if (d->mem && rec->naddr)
+        issue_units(t, &isa_ops[d->op], rec, &is);
+    count_issue(t, d, rec->stage, rec->gen);
     const uint64_t last = is.at + is.ext; /* the instruction's last issue cycle */
     const uint64_t end = last + 1;        /* the next instruction's earliest issue cycle */
 
-    const uint64_t ready = result_time(t, oi, rec, &is, last, end);
-    for (int i = 0; i < o->ndst; i++)
-        simd_result(&t->simd, o->dsts[i], ready, is.res_cause);
-    uint64_t until;
-    if (simd_hold_unit(&t->simd, oi->unit, is.at, end, &until))
-        push(t, until, EV_UNIT, oi->unit, 0, TM_FU_BUSY);
-    if (rec->taken && simd_redirect(&t->simd, end, &until))
-        push(t, until, EV_FETCH, 0, 0, TM_CONTROL);
+    const uint64_t ready = d->special ? result_time(t, &isa_ops[d->op], rec, &is, last, end)
+                                      : is.ready ? is.ready : is.at + d->lat;
+    for (int i = 0; i < d->ndst; i++)
+        simd_result(&t->simd, d->dsts[i], ready, is.res_cause);
+    if (d->issue && is.at + d->issue > end) { /* the class is still inside its issue interval */
+        uint64_t until;
+        if (simd_hold_unit(&t->simd, d->unit, is.at, end, &until))
+            push(t, until, EV_UNIT, d->unit, 0, TM_FU_BUSY);
+    }
+    if (__builtin_expect(rec->taken, 0)) {
+        uint64_t until;
+        if (simd_redirect(&t->simd, end, &until))
+            push(t, until, EV_FETCH, 0, 0, TM_CONTROL);
+    }
     t->now = end;
-    if (is_halt) {
+    if (__builtin_expect(d->is_halt, 0)) {
         t->st.cycles += end;
         t->st.runs++;
         t->halted = 1;
