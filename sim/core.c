@@ -4,10 +4,11 @@
  * 1..ISA_MAX_LANES, and counting them per stage and category. Must not: count cycles, model
  * latency or change behaviour with timing (the timing model reads CoreRecord).
  *
- * The program is decoded once in core_new; core_run allocates nothing. step() keeps what every
- * instruction shares (exec mask, record, counters); its dispatch switch is isa/opcodes.def
- * expanded, each row calling the family function of its UNIT class, where the opcode's
- * semantics are (see "the semantics" below for why this shape and how it stays one switch).
+ * The program is decoded once in core_new; core_run allocates nothing. The run loop
+ * (sim/core_loop.h) keeps what every instruction shares (exec mask, record, counters); its
+ * dispatch is isa/opcodes.def expanded into one label per opcode, each calling the family
+ * function of its UNIT class, where the opcode's semantics are (see "the semantics" below for why
+ * this shape).
  */
 #include "core.h"
 
@@ -37,7 +38,7 @@ typedef struct Dec {
                          masked format, else CORE_MASK_ALL */
 } Dec;
 
-/* The counters: step adds an execution to its opcode's column (and a vector instruction's
+/* The counters: the run loop adds an execution to its opcode's column (and a vector instruction's
  * active lanes to the last column) of the row of the current statistics stage and generation,
  * which STAGE and SGEN select; CoreStats is folded from the rows when read (core_stats). Two
  * additions per instruction instead of up to eight into CoreStats's arrays. */
@@ -85,7 +86,7 @@ static void count_select_row(Core *c)
     c->touched[r / 64] |= 1ull << (r % 64);
 }
 
-/* Add every touched row into st and clear it: the same sums step used to add one by one. */
+/* Add every touched row into st and clear it: the same sums the step used to add one by one. */
 static void count_fold(Core *c)
 {
     for (uint32_t r = 0; r < COUNT_ROWS; r++) {
@@ -181,7 +182,7 @@ Core *core_new(const CoreParams *p, const AsmObject *obj, char *err, size_t errl
         c->code[i].emask = isa_formats[oi->format].masked ? c->code[i].in.mask : CORE_MASK_ALL;
     }
     /* The sentinel after the last instruction: reaching it (pc == ncode: a fall-through or a
-     * branch to the end) traps, so step needs no bounds test of pc. */
+     * branch to the end) traps, so the run loop needs no bounds test of pc. */
     c->code[obj->ntext].in.op = ISA_OP_COUNT;
     if (obj->ndata)
         memcpy(c->mem[CORE_MEM_SCENE], obj->data, obj->ndata);
@@ -452,18 +453,17 @@ static int do_part(Core *c, const IsaInstr *in, int hooked)
 /* ---- the semantics: one family per group of unit classes --------------------------------------- */
 /* Each family is a switch over the opcodes of some of isa/opcodes.def's UNIT classes (the
  * machine's functional-unit classes, which the timing model dispatches on too), one line of
- * semantics per opcode where the ISA allows. step() expands opcodes.def into its dispatch switch:
- * every row becomes a case that calls its unit's family (CORE_EXEC_<UNIT>) with the opcode as a
- * constant. The families are always_inline, so each call folds to that opcode's case and the
- * compiler still builds one flat switch with one indirect jump, the code of a single hand-written
- * switch (about the same size and host instructions per simulated instruction, by callgrind); a
- * switch on the family and then on the opcode would add a second indirect jump per instruction.
- * Because the cases come from the table, every opcode has one; a unit class without a CORE_EXEC_
+ * semantics per opcode where the ISA allows. The run loop (sim/core_loop.h) expands opcodes.def
+ * into its dispatch: every row becomes a label that calls its unit's family (CORE_EXEC_<UNIT>)
+ * with the opcode as a constant. The families are always_inline, so each call folds to that
+ * opcode's case, the code a hand-written interpreter would have for it; a dispatch on the family
+ * and then on the opcode would add a second indirect jump per instruction.
+ * Because the labels come from the table, every opcode has one; a unit class without a CORE_EXEC_
  * line below fails the build; an opcode its family does not handle reaches the family's default,
  * an internal-error trap that test_isa_programs.c (a program per opcode) hits. */
 
-/* What a family reads and changes besides the architectural state: a local of step, which the
- * inlined families leave to the compiler to keep in registers. */
+/* What a family reads and changes besides the architectural state: a local of the run loop, which
+ * the inlined families leave to the compiler to keep in registers. */
 typedef struct Exec {
     const IsaInstr *in;
     uint64_t E;       /* exec mask as applied */
@@ -472,7 +472,7 @@ typedef struct Exec {
     uint64_t lanes;   /* the lanes counted active for a vector instruction (E; sfetch: the
                          lanes that received an ID), popcounted only when counted */
     int halt;
-    int hooked;       /* a timing hook wants the CoreRecord: a constant in each copy of step */
+    int hooked;       /* a timing hook wants the CoreRecord: a constant in each copy of the run loop */
 } Exec;
 
 #define ALWAYS_INLINE inline __attribute__((always_inline))
@@ -973,65 +973,31 @@ static ALWAYS_INLINE int exec_memory(Core *c, Exec *x, IsaOp op)
 
 /* ---- execution ----------------------------------------------------------------------------- */
 
-/* Execute the instruction at pc. Returns 0 to go on, 1 on halt, -1 on a trap. Inlined twice into
- * core_run_slice, once with hooked = 0 (functional mode: no record is built, no hook test is
- * left in the code) and once with hooked = 1 (the timed modes). */
-static ALWAYS_INLINE int step(Core *c, const int hooked)
-{
-    const Dec *dc = &c->code[c->pc]; /* pc <= ncode always: code[ncode] is the end sentinel */
-    const IsaInstr *in = &dc->in;
-    const int n = c->n;
-    if (n < 1 || n > ISA_MAX_LANES) /* core_new guarantees it; tells the compiler the lane bound */
-        __builtin_unreachable();
-    const uint64_t E = c->m[dc->emask] & c->all;
-    Exec x = {.in = in, .E = E, .n = n, .next = c->pc + 1, .lanes = E, .hooked = hooked};
-    if (hooked)
-        record_reset(&c->rec, c->pc, in, c->stage, c->gen, E);
-    uint64_t *const row = c->row; /* counted in the stage and generation before the instruction */
-
-    int r = 0;
-    switch ((IsaOp)in->op) {
-#define ISA_OP(name, code, mnem, fmt, acc, unit, cat, flags, desc) \
-    case ISA_OP_##name: r = CORE_EXEC_##unit(c, &x, ISA_OP_##name); break;
-#include "../isa/opcodes.def"
-#undef ISA_OP
-    case ISA_OP_COUNT: /* not an opcode: only the sentinel after the program carries it */
-        return -trap(c, "pc past the end of the program (%u instructions)", c->ncode);
-    }
-    if (r)
-        return -1;
-
-    row[in->op]++;
-    if (dc->vec)
-        row[ISA_OP_COUNT] += (uint64_t)popcount64(x.lanes);
-    c->total++;
-    if (hooked) {
-        c->rec.next_pc = x.halt ? c->pc : x.next;
-        c->hook(c->hook_ctx, &c->rec);
-    }
-    if (!x.halt) /* a halted core stays on its halt */
-        c->pc = x.next;
-    return x.halt;
-}
-
-/* The run loop for one value of hooked (a constant after inlining). */
-static ALWAYS_INLINE CoreExit run_loop(Core *c, uint64_t max_instr, uint64_t limit, const int hooked)
-{
-    for (uint64_t done = 0; max_instr == 0 || done < max_instr; done++) {
-        int r = step(c, hooked);
-        if (r > 0)
-            return CORE_EXIT_HALT;
-        if (r < 0)
-            return CORE_EXIT_TRAP;
-    }
-    trap(c, "instruction limit of %llu reached", (unsigned long long)limit);
-    return CORE_EXIT_LIMIT;
-}
+/* The run loop with threaded dispatch (sim/core_loop.h), once per hook state (plain: functional
+ * mode; hooked: the timed modes) and lane count (16, the default machine's N, and any N). */
+#define CORE_LOOP_NAME run_loop_plain
+#define CORE_LOOP_HOOKED 0
+#define CORE_LOOP_LANES 0
+#include "core_loop.h"
+#define CORE_LOOP_NAME run_loop_hooked
+#define CORE_LOOP_HOOKED 1
+#define CORE_LOOP_LANES 0
+#include "core_loop.h"
+#define CORE_LOOP_NAME run_loop_plain16
+#define CORE_LOOP_HOOKED 0
+#define CORE_LOOP_LANES 16
+#include "core_loop.h"
+#define CORE_LOOP_NAME run_loop_hooked16
+#define CORE_LOOP_HOOKED 1
+#define CORE_LOOP_LANES 16
+#include "core_loop.h"
 
 CoreExit core_run_slice(Core *c, uint64_t max_instr, uint64_t limit)
 {
     c->trap[0] = 0;
-    return c->hook ? run_loop(c, max_instr, limit, 1) : run_loop(c, max_instr, limit, 0);
+    if (c->n == 16)
+        return c->hook ? run_loop_hooked16(c, max_instr, limit) : run_loop_plain16(c, max_instr, limit);
+    return c->hook ? run_loop_hooked(c, max_instr, limit) : run_loop_plain(c, max_instr, limit);
 }
 
 CoreExit core_run(Core *c, uint64_t max_instr)

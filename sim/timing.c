@@ -465,6 +465,49 @@ static uint64_t result_time(Timing *t, const IsaOpInfo *oi, const CoreRecord *re
 
 /* ---- one instruction ---------------------------------------------------------------------- */
 
+/* The instruction d issued in cycle at and holds the issue slot until end; its results are ready
+ * at ready (a wait for them charged to res_cause): the scoreboard, the unit's issue interval, a
+ * taken branch's bubble, and the end of the program at a halt. */
+static inline void complete(Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at, uint64_t end,
+                            uint64_t ready, int res_cause)
+{
+    for (int i = 0; i < d->ndst; i++)
+        simd_result(&t->simd, d->dsts[i], ready, res_cause);
+    if (d->issue && at + d->issue > end) { /* the class is still inside its issue interval */
+        uint64_t until;
+        if (simd_hold_unit(&t->simd, d->unit, at, end, &until))
+            push(t, until, EV_UNIT, d->unit, 0, TM_FU_BUSY);
+    }
+    if (__builtin_expect(rec->taken, 0)) {
+        uint64_t until;
+        if (simd_redirect(&t->simd, end, &until))
+            push(t, until, EV_FETCH, 0, 0, TM_CONTROL);
+    }
+    t->now = end;
+    if (__builtin_expect(d->is_halt, 0)) {
+        t->st.cycles += end;
+        t->st.runs++;
+        t->halted = 1;
+    }
+}
+
+/* Issue and completion of an instruction that uses a memory unit, or whose result time is not its
+ * class's latency (result_time()), free of hazards from cycle at. */
+static __attribute__((noinline)) void issue_units_complete(Timing *t, const TmDesc *d, const CoreRecord *rec,
+                                                           uint64_t at)
+{
+    const IsaOpInfo *oi = &isa_ops[d->op];
+    Issue is = {at, 0, 0, TM_DATA_DEPENDENCY};
+    if (d->mem && rec->naddr)
+        issue_units(t, oi, rec, &is);
+    count_issue(t, d, rec->stage, rec->gen);
+    const uint64_t last = is.at + is.ext; /* the instruction's last issue cycle */
+    const uint64_t end = last + 1;        /* the next instruction's earliest issue cycle */
+    const uint64_t ready = d->special ? result_time(t, oi, rec, &is, last, end)
+                                      : is.ready ? is.ready : is.at + d->lat;
+    complete(t, d, rec, is.at, end, ready, is.res_cause);
+}
+
 void timing_hook(void *ctx, const CoreRecord *rec)
 {
     Timing *t = ctx;
@@ -479,33 +522,13 @@ void timing_hook(void *ctx, const CoreRecord *rec)
     int cause = hazard(t, d, rec, at);
     if (__builtin_expect(cause >= 0, 0))
         at = wait_hazards(t, d, rec, at, cause);
-    Issue is = {at, 0, 0, TM_DATA_DEPENDENCY};
-    if (d->mem && rec->naddr)
-        issue_units(t, &isa_ops[d->op], rec, &is);
+    if ((d->mem && rec->naddr) || d->special) {
+        issue_units_complete(t, d, rec, at);
+        return;
+    }
+    /* The common case: one issue cycle, the result after the class's latency. */
     count_issue(t, d, rec->stage, rec->gen);
-    const uint64_t last = is.at + is.ext; /* the instruction's last issue cycle */
-    const uint64_t end = last + 1;        /* the next instruction's earliest issue cycle */
-
-    const uint64_t ready = d->special ? result_time(t, &isa_ops[d->op], rec, &is, last, end)
-                                      : is.ready ? is.ready : is.at + d->lat;
-    for (int i = 0; i < d->ndst; i++)
-        simd_result(&t->simd, d->dsts[i], ready, is.res_cause);
-    if (d->issue && is.at + d->issue > end) { /* the class is still inside its issue interval */
-        uint64_t until;
-        if (simd_hold_unit(&t->simd, d->unit, is.at, end, &until))
-            push(t, until, EV_UNIT, d->unit, 0, TM_FU_BUSY);
-    }
-    if (__builtin_expect(rec->taken, 0)) {
-        uint64_t until;
-        if (simd_redirect(&t->simd, end, &until))
-            push(t, until, EV_FETCH, 0, 0, TM_CONTROL);
-    }
-    t->now = end;
-    if (__builtin_expect(d->is_halt, 0)) {
-        t->st.cycles += end;
-        t->st.runs++;
-        t->halted = 1;
-    }
+    complete(t, d, rec, at, at + 1, at + d->lat, TM_DATA_DEPENDENCY);
 }
 
 void timing_end(Timing *t)
