@@ -12,6 +12,7 @@
 #include <limits.h>
 #include <pthread.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -29,6 +30,8 @@ static const ImgShim *loaded;
 static char load_err[PATH_MAX + 1024];
 static pthread_t loader;
 static int loader_running, preloaded;
+/* Set before the first dlopen of the library or its dependencies (on either thread). */
+static atomic_int dlopen_used;
 
 const char *imglib_locate(char *buf, size_t len, char *err, size_t errlen)
 {
@@ -108,6 +111,7 @@ static void load_library(void)
     char path[PATH_MAX + 64];
     if (!imglib_locate(path, sizeof path, load_err, sizeof load_err))
         return;
+    atomic_store(&dlopen_used, 1);
     open_dependencies(path);
     loaded = imglib_open(path, load_err, sizeof load_err);
 }
@@ -143,6 +147,7 @@ int imglib_preload(char *err, size_t errlen)
     /* Joined at exit, so that exit never runs while the library's constructors do. Without the
      * thread (or the handler) the first image call loads the library itself. The thread blocks
      * every signal, so ^C and the held signals of sim/outfile.c reach the main thread as before. */
+    atomic_store(&dlopen_used, 1);
     sigset_t all, old;
     sigfillset(&all);
     pthread_sigmask(SIG_SETMASK, &all, &old);
@@ -150,6 +155,11 @@ int imglib_preload(char *err, size_t errlen)
         loader_running = 1;
     pthread_sigmask(SIG_SETMASK, &old, NULL);
     return 0;
+}
+
+int imglib_dlopened(void)
+{
+    return atomic_load(&dlopen_used);
 }
 
 const ImgShim *imglib_get(char *err, size_t errlen)

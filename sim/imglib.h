@@ -31,6 +31,12 @@ const char *imglib_locate(char *buf, size_t len, char *err, size_t errlen);
  * not load is reported by the first image call. The thread is joined at exit. Main thread only. */
 int imglib_preload(char *err, size_t errlen);
 
+/* 1 once this process has started loading the library with dlopen (imglib_preload, or a first
+ * image call in a binary without the library's objects), else 0. Such a process may end with
+ * _exit after flushing stdio, as bin/sfsim does (sim/main.c): exit would run the destructors of
+ * OpenImageIO's ~260 libraries, or first wait for a load still running. */
+int imglib_dlopened(void);
+
 /* The loaded library (joining the background load if one runs, else loading now), or NULL with
  * "cannot load the image library PATH: why" in err; the answer is the same for the whole run. */
 const ImgShim *imglib_get(char *err, size_t errlen);

@@ -58,6 +58,8 @@ int imgshim_heatmap_write(const ImgSink *sink, const char *path, const double *v
 void imgshim_heatmap_set_font(const char *font_path);
 /* A display-ready value in [0, 1] as 8 bits: lround(clamp(x, 0, 1) * 255), 0 for NaN and Inf. */
 unsigned char imgshim_to_u8(float x);
+/* out[i] = imgshim_to_u8(x[i]) for i < n (imgshim_write_rgb8's conversion, vectorized). */
+void imgshim_to_u8_n(const float *x, unsigned char *out, size_t n);
 
 #ifdef __cplusplus
 }

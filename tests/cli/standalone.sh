@@ -140,6 +140,21 @@ want_rc 4
 want_err "libm.so.6: it has no img_shim table"
 end
 
+begin "a run that loaded the image library ends with _exit: its summary still reaches stdout, no library's fini runs"
+# sim/main.c: exit would run the destructors of OpenImageIO's ~260 libraries (docs/performance.md,
+# "Start-up"). stdout is a file here, so the summary is in stdio's buffer until main flushes it.
+run env LD_DEBUG=files "$SFSIM" run -o "$T/out-exit" "${SMALL[@]}"
+want_rc 0
+want_out "^sfsim run: wrote $T/out-exit/frame.png, frame.exr, report.txt, report.json, cost.png$"
+grep -q "calling fini" "$T/err" && no "destructors ran at exit: $(grep -m1 'calling fini' "$T/err")"
+[ -s "$T/out-exit/cost.png" ] || no "no cost.png"
+run env LD_DEBUG=files "$SFSIM" run -s "$T/no-such-scene.ini" -o "$T/out-exit2" "${SMALL[@]}"
+want_rc 1
+want_err "no-such-scene.ini: cannot open"
+grep -q "calling fini" "$T/err" && no "a failed run ran the destructors (or waited for the load) at exit"
+[ -e "$T/out-exit2" ] && no "an output folder was left behind"
+end
+
 begin "commands that write no image never load the image library (help, config, exec, trace)"
 run_ld() { run env SFSIM_IMG_LIB=/nonexistent/lib.so LD_DEBUG=files "$@"; want_rc 0; grep -q "OpenImageIO\|libsfsim-img" "$T/err" && no "$2 loaded the image library"; }
 run_ld "$SFSIM" --help

@@ -159,3 +159,51 @@ Test(imglib, to_u8_rounds_as_lround_of_the_clamped_value)
         cr_assert_eq(imgshim_to_u8(float_of((uint32_t)b)), to_u8_reference(float_of((uint32_t)b)), "bits 0x%08x",
                      (unsigned)b);
 }
+
+/* imgshim_to_u8_n (eight lanes at a time, then one by one) gives imgshim_to_u8's reference
+ * value for every channel: each rounding boundary and special value, and a stride through every
+ * float bit pattern, at each start and length modulo 8 so that the vector blocks and the tail
+ * both meet every value. (Checked once over all 2^32 floats when written.) */
+Test(imglib, to_u8_n_converts_as_to_u8_does)
+{
+    enum { N = 511 * 2 * 64 + 17 + 65536 };
+    float *x = malloc(sizeof(float) * N);
+    unsigned char *out = malloc(N + 8);
+    cr_assert(x && out);
+    size_t n = 0;
+    for (int k = 0; k <= 510; k++) {
+        uint32_t mid = bits_of((float)k / 510.0f);
+        for (uint32_t d = 0; d < 64; d++) {
+            x[n++] = float_of(mid + d);
+            x[n++] = float_of(mid - d);
+        }
+    }
+    const float special[] = {0.0f, -0.0f, 1.0f, -1.0f, 2.0f, 0.49999997f / 255.0f, 0.5f / 255.0f, 1e-45f, -1e-45f,
+                             1e30f, -1e30f, INFINITY, -INFINITY, NAN, -NAN, 0.99999994f, 1.0000001f};
+    for (size_t i = 0; i < sizeof special / sizeof special[0]; i++)
+        x[n++] = special[i];
+    for (uint64_t b = 0; b < 0x100000000ull && n < N; b += 65537)
+        x[n++] = float_of((uint32_t)b);
+    for (size_t start = 0; start < 8; start++) {
+        size_t len = n - 8 - start; /* every length modulo 8 too */
+        memset(out, 0xaa, N + 8);
+        imgshim_to_u8_n(x + start, out + start, len);
+        for (size_t i = 0; i < start; i++)
+            cr_assert_eq(out[i], 0xaa, "wrote before the start");
+        for (size_t i = start; i < start + len; i++)
+            cr_assert_eq(out[i], to_u8_reference(x[i]), "x = %.9g (bits 0x%08x), start %zu", (double)x[i],
+                         (unsigned)bits_of(x[i]), start);
+        cr_assert_eq(out[start + len], 0xaa, "wrote past the end");
+    }
+    free(x);
+    free(out);
+}
+
+/* The test binary links the library's objects, so nothing was dlopen'ed and sfsim's _exit at
+ * the end (sim/main.c) would not apply to it. */
+Test(imglib, a_binary_with_the_linked_copy_has_not_dlopened_it)
+{
+    char err[1024];
+    cr_assert_not_null(imglib_get(err, sizeof err), "%s", err);
+    cr_assert_eq(imglib_dlopened(), 0);
+}
