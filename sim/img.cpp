@@ -42,6 +42,12 @@ int write_image(const ImgSink *sink, const char *path, int w, int h, OIIO::TypeD
     std::vector<unsigned char> bytes;
     OIIO::Filesystem::IOVecOutput mem(bytes);
     OIIO::ImageSpec spec(w, h, 3, type);
+    // PNG: one row filter (Sub, libpng's PNG_FILTER_SUB) rather than libpng's trial of all five
+    // per row, and zlib's fastest level. The pixels are the same either way (the same-outputs
+    // table hashes pixels, not file bytes); the defaults took 170 M instructions of a 32 x 32
+    // run's cost.png, on the critical path of a small run (docs/performance.md, "Start-up").
+    spec.attribute("png:filter", 0x10);
+    spec.attribute("png:compressionLevel", 1);
     if (!out->set_ioproxy(&mem) || !out->open(path, spec))
         return fail(err, errlen, path, out->geterror());
     if (!out->write_image(type, pixels) || !out->close())
