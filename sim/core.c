@@ -12,11 +12,14 @@
  */
 #include "core.h"
 
+#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
+#include <unistd.h>
 
 const char *const core_mem_names[CORE_MEM_COUNT] = {"rb0", "rb1", "idm", "spad", "scene", "fb"};
 static const char *const mem_long[CORE_MEM_COUNT] = {"ray buffer 0", "ray buffer 1", "ID-stream memory",
@@ -118,6 +121,118 @@ static void count_fold(Core *c)
 
 /* ---- construction ---------------------------------------------------------------------------- */
 
+/* The simulated memories are anonymous mappings, not calloc: the kernel zeroes a page when it is
+ * first touched, so the 256 MiB scene memory, the ray buffers and the framebuffer cost a page
+ * fault per page a run uses instead of a memset of all of them (calloc of a block under malloc's
+ * mmap threshold, which grows past the ray buffers' size once one is freed, clears it in full),
+ * and the scene memory can take a shared image's pages (core_load_image). */
+static size_t page_bytes(void)
+{
+    long pg = sysconf(_SC_PAGESIZE);
+    return pg > 0 ? (size_t)pg : 4096;
+}
+
+static size_t mem_span(uint32_t bytes)
+{
+    size_t pg = page_bytes(), n = bytes ? bytes : 4;
+    return (n + pg - 1) / pg * pg;
+}
+
+static uint8_t *mem_alloc(uint32_t bytes)
+{
+    void *m = mmap(NULL, mem_span(bytes), PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    return m == MAP_FAILED ? NULL : m;
+}
+
+static void mem_release(uint8_t *m, uint32_t bytes)
+{
+    if (m)
+        munmap(m, mem_span(bytes));
+}
+
+/* ---- scene images ---------------------------------------------------------------------------- */
+
+struct CoreImage {
+    int fd;                   /* a sealed memfd holding the bytes (zero to the page's end), or -1 */
+    const uint8_t *bytes;     /* the caller's bytes: the copy when there is no fd */
+    uint32_t size;
+};
+
+CoreImage *core_image_new(const void *bytes, uint32_t size, int flags)
+{
+    CoreImage *im = calloc(1, sizeof *im);
+    if (!im)
+        return NULL;
+    im->fd = -1;
+    im->bytes = bytes;
+    im->size = size;
+#ifdef MFD_CLOEXEC
+    if (!(flags & CORE_IMAGE_COPY) && size) {
+        int fd = memfd_create("sfsim-scene", MFD_CLOEXEC | MFD_ALLOW_SEALING);
+        size_t span = mem_span(size), done = 0;
+        int ok = fd >= 0 && ftruncate(fd, (off_t)span) == 0;
+        while (ok && done < size) {
+            ssize_t w = pwrite(fd, (const uint8_t *)bytes + done, size - done, (off_t)done);
+            ok = w > 0;
+            done += ok ? (size_t)w : 0;
+        }
+        /* Sealed: nothing can change the image under the cores that map it. */
+        if (ok && fcntl(fd, F_ADD_SEALS, F_SEAL_SHRINK | F_SEAL_GROW | F_SEAL_WRITE | F_SEAL_SEAL) != 0)
+            ok = 0;
+        if (ok)
+            im->fd = fd;
+        else if (fd >= 0)
+            close(fd);
+    }
+#else
+    (void)flags;
+#endif
+    return im;
+}
+
+void core_image_free(CoreImage *im)
+{
+    if (!im)
+        return;
+    if (im->fd >= 0)
+        close(im->fd);
+    free(im);
+}
+
+int core_image_shared(const CoreImage *im) { return im && im->fd >= 0; }
+
+int core_load_image(Core *c, const CoreImage *im)
+{
+    uint32_t n = im->size;
+    if (n > c->size[CORE_MEM_SCENE])
+        return -1;
+    uint8_t *sm = c->mem[CORE_MEM_SCENE];
+    if (im->fd < 0 || !n) {
+        if (n)
+            memcpy(sm, im->bytes, n);
+        return 0;
+    }
+    /* The image's pages replace the first span bytes of scene memory; the bytes of the last page
+     * past n are put back as they were, so the result is that of the copy. */
+    size_t span = mem_span(n), tail = span - n;
+    uint8_t *keep = malloc(tail ? tail : 1);
+    if (!keep)
+        return -1;
+    memcpy(keep, sm + n, tail);
+    int rc = 0;
+    if (mmap(sm, span, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_FIXED, im->fd, 0) == MAP_FAILED) {
+        /* MAP_FIXED may have dropped the old pages: fresh zero pages and the copy. */
+        if (mmap(sm, span, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_FIXED | MAP_ANONYMOUS, -1, 0) != MAP_FAILED)
+            memcpy(sm, im->bytes, n);
+        else
+            rc = -1;
+    }
+    if (rc == 0 && tail && memcmp(sm + n, keep, tail) != 0)
+        memcpy(sm + n, keep, tail);
+    free(keep);
+    return rc;
+}
+
 Core *core_new(const CoreParams *p, const AsmObject *obj, char *err, size_t errlen)
 {
     if (p->lanes < 1 || p->lanes > ISA_MAX_LANES) {
@@ -154,7 +269,7 @@ Core *core_new(const CoreParams *p, const AsmObject *obj, char *err, size_t errl
     for (int m = 0; ok && m < CORE_MEM_COUNT; m++) {
         c->size[m] = p->mem_bytes[m];
         c->last[m] = (int64_t)p->mem_bytes[m] - 4;
-        c->mem[m] = calloc(p->mem_bytes[m] ? p->mem_bytes[m] : 4, 1);
+        c->mem[m] = mem_alloc(p->mem_bytes[m]);
         ok = c->mem[m] != NULL;
     }
     c->counts = ok ? calloc((size_t)COUNT_ROWS * COUNT_COLS, sizeof(uint64_t)) : NULL;
@@ -215,7 +330,7 @@ void core_free(Core *c)
     if (!c)
         return;
     for (int m = 0; m < CORE_MEM_COUNT; m++)
-        free(c->mem[m]);
+        mem_release(c->mem[m], c->size[m]);
     free(c->code);
     free(c->pq);
     free(c->part_tmp);

@@ -76,6 +76,20 @@ typedef struct Core Core;
  * NULL with a message on failure. obj must outlive the core. */
 Core *core_new(const CoreParams *p, const AsmObject *obj, char *err, size_t errlen);
 void core_free(Core *c);
+/* A read-only image of scene memory that cores share instead of each copying it: the bytes in a
+ * sealed memfd, which a core maps copy-on-write, so it costs a page fault per page a run reads
+ * and a private page per page it writes (only that core sees the write). Without memfd (or with
+ * CORE_IMAGE_COPY) the cores copy the bytes. bytes must outlive the image and not change; NULL
+ * when out of memory. */
+typedef struct CoreImage CoreImage;
+enum { CORE_IMAGE_COPY = 1 };     /* flags: never a memfd (the fallback, for tests) */
+CoreImage *core_image_new(const void *bytes, uint32_t size, int flags);
+void core_image_free(CoreImage *im);
+int core_image_shared(const CoreImage *im); /* 1: a memfd the cores map; 0: the cores copy */
+/* Scene memory from address 0 as memcpy(scene memory, bytes, size) would leave it, the rest of it
+ * unchanged. 0, or -1 (the image does not fit scene memory, or out of memory; the memory may then
+ * have lost its first pages). */
+int core_load_image(Core *c, const CoreImage *im);
 /* Back to the reset state for another run of the same program: registers 0, m0 all lanes,
  * pc 0, stage other, RB0 current, partition queue empty. Memories and statistics are kept
  * (the host rewrites what it needs; statistics keep accumulating). */

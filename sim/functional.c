@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 #include "run/kernel.h"
+#include "run/run.h"
 #include "run/tiles.h"
 #include "run/timedcore.h"
 
@@ -380,9 +381,19 @@ static int worker_begin(void *ctx, int index)
         fail(j, msg, 0);
         return -1;
     }
-    uint32_t size;
-    uint8_t *sm = core_mem(w->tc.core, CORE_MEM_SCENE, &size);
-    memcpy(sm, j->p->mem, j->p->size);
+    /* The packed scene into scene memory: mapped copy-on-write from the open scene's image
+     * (run_scene_image), or copied. */
+    const CoreImage *im = run_scene_image(j->p);
+    if (im) {
+        if (core_load_image(w->tc.core, im) != 0) {
+            fail(j, "out of memory loading the scene into scene memory", 0);
+            return -1;
+        }
+    } else {
+        uint32_t size;
+        uint8_t *sm = core_mem(w->tc.core, CORE_MEM_SCENE, &size);
+        memcpy(sm, j->p->mem, j->p->size);
+    }
     return 0;
 }
 

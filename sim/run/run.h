@@ -21,6 +21,7 @@
 #include "../../scenes/pack.h"
 #include "../../scenes/scene.h"
 #include "../config.h"
+#include "../core.h"
 #include "../functional.h"
 #include "../raybatch.h"
 #include "../sampling.h"
@@ -53,6 +54,7 @@ typedef struct RunScene {
     PackedScene p;
     AccelInfo accel;           /* what was built, and its host time */
     double load_seconds;       /* reading the scene file */
+    CoreImage *image;          /* p's bytes, which the kernel modes' cores share (run_scene_image) */
 } RunScene;
 
 /* Load path, print the scene's warnings on stderr as "<who>: warning: ..." (who NULL: not printed;
@@ -63,6 +65,10 @@ typedef struct RunScene {
 int run_scene_open(RunScene *sc, const char *path, const RunSize *size, const CfgMachine *cfg, RunMode mode,
                    const char *who, char *err, size_t errlen);
 void run_scene_close(RunScene *sc);
+/* The shared image of the packed bytes of an open scene (a RunScene's p, its bytes unchanged since
+ * run_scene_open), for the kernel modes' cores to map instead of copying (sim/core.h); NULL for
+ * any other PackedScene, whose bytes the cores copy. The bytes of an open scene must not change. */
+const CoreImage *run_scene_image(const PackedScene *p);
 
 /* How to run: the mode, the machine and the host. Zero-initialised fields take the defaults. */
 typedef struct RunSpec {

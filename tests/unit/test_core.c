@@ -6,8 +6,8 @@
  * must not) happen come from the specification. Programs are built in C as IsaInstr arrays and
  * encoded with isa_encode into a text-only AsmObject, so the assembler is not under test here.
  *
- * Suites: core_new (construction and reset state), core_trap (every trap class and its message)
- * here; core_sfetch (ID-stream fetch), core_part (partition unit), core_mask (merge masking and
+ * Suites: core_new (construction and reset state), core_trap (every trap class and its message),
+ * core_image (a scene image shared copy-on-write, and its copy fallback) here; core_sfetch (ID-stream fetch), core_part (partition unit), core_mask (merge masking and
  * compares) in test_core_lanes.c; core_stats (counters), core_hook (the timing model's record),
  * core_run (limits, determinism) in test_core_run.c. The program-building macros and helpers are
  * tests/support/core_prog.h's.
@@ -485,4 +485,123 @@ Test(core_trap, message_names_source_line)
     tc_run(&t, 100);
     expect_trap(&t, CORE_EXIT_TRAP, "integer division by zero", 1, "divu r1, r2, r3", "kernels/lib/math.inc:42");
     tc_free(&t);
+}
+
+/* ---- core_image: one scene image shared copy-on-write (core_image_new, core_load_image) ------- */
+
+enum { IMG_SCENE = 3 * 4096, IMG_BYTES = 5000 }; /* the image ends inside the second page */
+
+static void img_params(CoreParams *p)
+{
+    tc_params(p, 4);
+    p->mem_bytes[CORE_MEM_SCENE] = IMG_SCENE;
+}
+
+static void img_bytes(uint8_t *b)
+{
+    uint32_t s = 12345;
+    for (int i = 0; i < IMG_BYTES; i++)
+        b[i] = (uint8_t)tc_lcg(&s);
+}
+
+/* Scene memory must read as memcpy(scene memory, bytes, IMG_BYTES) over `before` would leave it. */
+static void expect_scene(Core *c, const uint8_t *bytes, const uint8_t *before, const char *what)
+{
+    uint32_t size;
+    const uint8_t *sm = core_mem(c, CORE_MEM_SCENE, &size);
+    cr_assert_eq(size, (uint32_t)IMG_SCENE);
+    cr_expect(memcmp(sm, bytes, IMG_BYTES) == 0, "%s: the image's bytes differ", what);
+    cr_expect(memcmp(sm + IMG_BYTES, before + IMG_BYTES, IMG_SCENE - IMG_BYTES) == 0,
+              "%s: scene memory past the image changed", what);
+}
+
+/* A store by one core goes to its own page: neither the image nor another core sharing it sees it. */
+static void stores_stay_private(int flags)
+{
+    static uint8_t bytes[IMG_BYTES], zero[IMG_SCENE];
+    img_bytes(bytes);
+    uint8_t orig[IMG_BYTES];
+    memcpy(orig, bytes, sizeof orig);
+    CoreImage *im = core_image_new(bytes, IMG_BYTES, flags);
+    cr_assert_not_null(im);
+    cr_expect_eq(core_image_shared(im), !(flags & CORE_IMAGE_COPY), "memfd image expected on Linux");
+    CoreParams p;
+    img_params(&p);
+    TcCore a, b;
+    /* a: SM[8] := 0xdeadbeef, SM[4100] := 0xdeadbeef (two pages of the image) */
+    tc_init_p(&a, PROG(I_AI(LI, 1, 0xdeadbeef), I_AI(LI, 2, 0), I_ABI(ST, 1, 2, 8), I_ABI(ST, 1, 2, 4100),
+                       I_ABI(LD, 3, 2, 12), I_0(HALT)), &p);
+    tc_init_p(&b, PROG(I_0(HALT)), &p);
+    cr_assert_eq(core_load_image(a.c, im), 0);
+    cr_assert_eq(core_load_image(b.c, im), 0);
+    expect_scene(a.c, bytes, zero, "core a, loaded");
+    tc_run_halt(&a);
+    uint32_t w12;
+    memcpy(&w12, bytes + 12, 4);
+    cr_expect_eq(core_sreg(a.c, 3), w12, "core a read SM[12] = %08x, the image holds %08x", core_sreg(a.c, 3), w12);
+    cr_expect_eq(tc_peek(a.c, CORE_MEM_SCENE, 8), 0xdeadbeefu);
+    cr_expect_eq(tc_peek(a.c, CORE_MEM_SCENE, 4100), 0xdeadbeefu);
+    expect_scene(b.c, bytes, zero, "core b, after a's stores");
+    cr_expect(memcmp(bytes, orig, sizeof orig) == 0, "the image's source bytes changed");
+    /* a core loading the image afterwards sees it as it was */
+    TcCore c;
+    tc_init_p(&c, PROG(I_0(HALT)), &p);
+    cr_assert_eq(core_load_image(c.c, im), 0);
+    expect_scene(c.c, bytes, zero, "core c, loaded after a's stores");
+    tc_free(&a);
+    tc_free(&b);
+    core_image_free(im);
+    /* the cores' mappings outlive the image */
+    expect_scene(c.c, bytes, zero, "core c, after the image is freed");
+    tc_free(&c);
+}
+
+Test(core_image, a_store_is_seen_by_its_core_only)
+{
+    stores_stay_private(0);
+}
+
+Test(core_image, the_copy_fallback_keeps_stores_private_too)
+{
+    stores_stay_private(CORE_IMAGE_COPY);
+}
+
+/* core_load_image leaves scene memory as the copy does: what was past the image's last byte on
+ * its last page (and beyond) stays. */
+Test(core_image, loading_is_the_copy_even_on_the_last_page)
+{
+    static uint8_t bytes[IMG_BYTES];
+    img_bytes(bytes);
+    CoreParams p;
+    img_params(&p);
+    for (int flags = 0; flags <= CORE_IMAGE_COPY; flags++) {
+        CoreImage *im = core_image_new(bytes, IMG_BYTES, flags);
+        TcCore t;
+        tc_init_p(&t, PROG(I_0(HALT)), &p);
+        tc_poke(t.c, CORE_MEM_SCENE, 0, 0x11111111u);
+        tc_poke(t.c, CORE_MEM_SCENE, IMG_BYTES + 4, 0x22222222u);     /* the image's last page */
+        tc_poke(t.c, CORE_MEM_SCENE, IMG_SCENE - 4, 0x33333333u);     /* a page past it */
+        uint8_t before[IMG_SCENE];
+        memcpy(before, core_mem(t.c, CORE_MEM_SCENE, NULL), sizeof before);
+        cr_assert_eq(core_load_image(t.c, im), 0);
+        expect_scene(t.c, bytes, before, flags ? "copy" : "memfd");
+        cr_expect_eq(tc_peek(t.c, CORE_MEM_SCENE, IMG_BYTES + 4), 0x22222222u);
+        tc_free(&t);
+        core_image_free(im);
+    }
+}
+
+Test(core_image, an_image_larger_than_scene_memory_is_refused)
+{
+    static uint8_t bytes[IMG_SCENE + 4];
+    CoreParams p;
+    img_params(&p);
+    for (int flags = 0; flags <= CORE_IMAGE_COPY; flags++) {
+        CoreImage *im = core_image_new(bytes, sizeof bytes, flags);
+        TcCore t;
+        tc_init_p(&t, PROG(I_0(HALT)), &p);
+        cr_expect_eq(core_load_image(t.c, im), -1);
+        tc_free(&t);
+        core_image_free(im);
+    }
 }
