@@ -772,6 +772,23 @@ static QTree *qtree_build(const PackedScene *p)
     const uint8_t *nodes = image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_NODES)));
     const uint8_t *prims = image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_PRIMS)));
     t->stack_len = 3 * (p->bvh.depth + 2) + 8;
+    /* room for every inner node and every leaf's blocks, so the arrays never grow */
+    uint32_t ninner = 0, nblocks = 0;
+    for (uint32_t n = 0; n < nnodes; n++) {
+        uint32_t info = node_word(nodes, n, SM_NODE_INFO);
+        if (info & SM_NODE_INNER)
+            ninner++;
+        else
+            nblocks += (info + 3) / 4;
+    }
+    t->capq = ninner ? ninner : 1;
+    t->captb = nblocks ? nblocks : 1;
+    t->q = aligned_alloc(64, sizeof *t->q * (size_t)t->capq);
+    t->tb = aligned_alloc(64, sizeof *t->tb * (size_t)t->captb);
+    if (!t->q || !t->tb) {
+        qtree_free(&t->host);
+        return NULL;
+    }
     /* work: (binary inner node, its QNode) pairs still to fill */
     uint32_t *work = malloc(sizeof *work * 2 * (size_t)(nnodes + 1)), nw = 0;
     if (!work || nnodes == 0) {
@@ -836,19 +853,22 @@ static QTree *qtree_build(const PackedScene *p)
             q->child[c] = ref[c];
             q->valid |= 1u << c;
         }
+        /* The binary walks' order: the near side first (the right one when dir[axis] < 0), and
+         * within a side of two slots its near one first; unused slots fill the last positions, in
+         * order, so each slot appears once (their valid bit is clear: never pushed). 2 bits a slot. */
+        uint32_t side[2][2], unused = 0;
+        for (uint32_t s = 0; s < 2; s++) {
+            uint32_t a = sidefirst[s];
+            side[s][0] = sidecount[s] == 2 ? (a | (a + 1) << 2) : a;
+            side[s][1] = sidecount[s] == 2 ? ((a + 1) | a << 2) : a;
+        }
+        for (uint32_t c = ns; c < 4; c++)
+            unused |= c << (2 * c);
         for (uint32_t o = 0; o < 8; o++) {
-            /* the binary walks: near child first (the right one when dir[axis] < 0), recursively */
-            uint32_t list[4], nl = 0;
-            for (uint32_t j = 0; j < 2; j++) {
-                uint32_t s = (o >> axis & 1u) ? 1 - j : j;
-                for (uint32_t g = 0; g < sidecount[s]; g++) {
-                    uint32_t gg = sidecount[s] == 2 && (o >> sideaxis[s] & 1u) ? 1 - g : g;
-                    list[nl++] = sidefirst[s] + gg;
-                }
-            }
-            for (uint32_t c = ns; c < 4; c++)
-                list[nl++] = c; /* unused slots last: never pushed (valid), but each slot once */
-            q->order[o] = (uint8_t)(list[0] | list[1] << 2 | list[2] << 4 | list[3] << 6);
+            uint32_t sa = o >> axis & 1u, sb = 1 - sa;
+            uint32_t fa = sidecount[sa] == 2 ? (o >> sideaxis[sa] & 1u) : 0;
+            uint32_t fb = sidecount[sb] == 2 ? (o >> sideaxis[sb] & 1u) : 0;
+            q->order[o] = (uint8_t)(side[sa][fa] | side[sb][fb] << (2 * sidecount[sa]) | unused);
         }
     }
     free(work);

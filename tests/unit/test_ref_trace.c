@@ -367,6 +367,8 @@ static void soup_pack(uint32_t n, int max_leaf, Scene *s, SceneMaterial *m, Pack
     BvhParams bp;
     bvh_default_params(&bp);
     bp.max_leaf_size = max_leaf;
+    if (max_leaf > 4)
+        bp.cost_traversal = 40.0f; /* a costly node: the build then fills its leaves */
     char err[256];
     cr_assert_eq(pack_scene(s, &bp, 0, p, err, sizeof err), 0, "%s", err);
 }
@@ -385,6 +387,12 @@ Test(ref_traversal, fast_walk_matches_plain_walk_on_leaf_sizes)
         PackedScene p;
         soup_pack(cases[c].n, cases[c].max_leaf, &s, &m, &p);
         cr_expect(ref_trace_layout_usable(&p), "leaves of %d: the 4-wide layout should be in use", cases[c].max_leaf);
+        uint32_t nodes = sm_u32(&p, sm_hdr(&p, SM_HDR_NODES)), big = 0;
+        for (uint32_t n = 0; n < sm_u32(&p, sm_hdr(&p, SM_HDR_NNODES)); n++) {
+            uint32_t info = sm_u32(&p, sm_rec(nodes, SM_NODE_WORDS, n, SM_NODE_INFO));
+            big += !(info & SM_NODE_INNER) && info > 4;
+        }
+        cr_expect_eq(big > 0, cases[c].max_leaf > 4, "leaves of up to %d: %u leaves of more than 4", cases[c].max_leaf, big);
         char name[64];
         snprintf(name, sizeof name, "soup of %u, leaves of %d", cases[c].n, cases[c].max_leaf);
         walks_agree(&p, name, 20000, cases[c].n > 100 ? 20000 / 4 : 20);
