@@ -553,6 +553,8 @@ int pack_add_kd(PackedScene *p, const KdTree *t, char *err, size_t errlen)
 
 void pack_free(PackedScene *p)
 {
+    if (p->host)
+        p->host->free(p->host);
     free(p->mem);
     bvh_free(&p->bvh);
     memset(p, 0, sizeof *p);

@@ -38,6 +38,13 @@ typedef enum SmLightKind {
     SM_LIGHT_TRIANGLE = 4
 } SmLightKind;
 
+/* A reader's private, host-only structure derived from a packed scene once (sim/ref_trace.c's
+ * 4-wide BVH for the golden model's queries): its first member frees it, so pack_free can without
+ * knowing what it is. Never part of the image. */
+typedef struct PackHost {
+    void (*free)(struct PackHost *h);
+} PackHost;
+
 typedef struct PackedScene {
     uint8_t *mem;        /* the packed bytes; address `base` of scene memory is mem[0] */
     uint32_t size;       /* bytes */
@@ -46,6 +53,7 @@ typedef struct PackedScene {
     uint32_t nprims;     /* triangles + spheres */
     uint32_t nlights;
     uint32_t kd_depth;   /* levels of the kd-tree pack_add_kd appended (root = 1); 0: none */
+    PackHost *host;      /* NULL, or built on first use by its reader (atomically published); freed by pack_free */
 } PackedScene;
 
 /* Pack s with a BVH built by bp, for loading at scene-memory address base (a multiple of 64).

@@ -9,6 +9,8 @@
  */
 #include "ref_trace.h"
 
+#include "util.h"
+
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -609,14 +611,608 @@ done:
 
 #endif
 
-/* Batches of rays (sfsim trace, run_trace, per_ray) ask without stats: no test for them per node. */
-static int walk_bare(const PackedScene *p, const RefRay *r, RefHit *hit, int closest)
+
+/* ---- The 4-wide walk: a private, host-only layout derived from the packed BVH ----
+ *
+ * The packed tree is binary (scenes/layout.def), one box test per node. The golden model's queries
+ * without stats (walk_bare) instead walk a 4-wide copy of it that sim/ref_trace.c builds once per
+ * scene, on the first such query, and hangs on the PackedScene (p->host; pack_free frees it): each
+ * QNode stands for a binary inner node and holds its grandchildren (or a child, where that child
+ * is a leaf), so one SIMD test covers the boxes of two binary levels, their boxes in SoA floats;
+ * each leaf's triangles are copied into TriBlocks of 4 in SoA, so one SIMD test covers them. The
+ * scene memory the kernels read is untouched.
+ *
+ * Same hits bit for bit as walk_fast (and so walk_body):
+ *  - boxes: each lane computes box_hit_v's expressions on one child's box (the ISA min/max,
+ *    operand order included), and the axis reductions are order-free as box_hit_v says;
+ *  - a binary grandchild G of node N through child C is visited when G's box hits and its entry
+ *    distance is still within the closest hit at its turn; the binary walks also need C's box to
+ *    hit. C's box contains G's (checked at the build: with a child outside its parent's box the
+ *    scene keeps walk_fast), the slab distances are monotone in the planes (rounding is), so G's
+ *    [tn, tf] lies inside C's and "G hits" implies "C hits" at any far end: the same nodes;
+ *  - order: each QNode keeps, per octant of the ray's direction signs, its children in the binary
+ *    walks' near-first order (the split axes of N and of C), pushed far to near: the same order;
+ *  - triangles: each lane computes tri_hit's expressions; the lanes that hit with the tmax at the
+ *    leaf's entry are then taken in index order and re-tested against the tmax of that moment
+ *    (T < tmax det and t < tmax, tri_hit's only tests of tmax, on the same T, det and t), which is
+ *    what the sequential loop does. A block holding a sphere is tested lane by lane with hit_prim.
+ * Rays with a non-finite origin or direction component take walk_fast (the containment argument
+ * needs finite slab distances). */
+
+#define QLEAF 0x80000000u   /* QNode child / pending entry: a leaf's first TriBlock */
+#define QB_LAST 1u          /* TriBlock flags: the leaf's last block */
+#define QB_SPHERE 2u        /* a lane holds a sphere: test the block lane by lane */
+
+typedef struct QNode {
+    float b[6][4];          /* bmin x, y, z, bmax x, y, z; lane = child slot (unused slots: 0) */
+    uint32_t child[4];      /* QNode index, or QLEAF | first TriBlock */
+    uint8_t order[8];       /* per octant (bit k: dir[k] < 0): 4 x 2 bits, slot of the j-th nearest at bits 2j */
+    uint32_t valid;         /* bit c: slot c used */
+    uint32_t pad[1];
+} __attribute__((aligned(64))) QNode;
+
+typedef struct TriBlock {
+    float v[9][4];          /* v0 x, y, z, v1 x, y, z, v2 x, y, z; lane = primitive (unused: 0) */
+    uint32_t prim[4];       /* packed primitive index */
+    uint32_t valid, flags;
+    uint32_t pad[2];
+} __attribute__((aligned(64))) TriBlock;
+
+typedef struct QTree {
+    PackHost host;          /* first: p->host points here */
+    int usable;             /* 0: the binary walks (a child's box outside its parent's) */
+    QNode *q;
+    TriBlock *tb;
+    uint32_t nq, ntb, capq, captb;
+    uint32_t root;          /* QNode index or QLEAF | block (the root's box is tested first, as walk_fast does) */
+    uint32_t stack_len;     /* pending entries a walk may need, plus 4 for the branch-free pushes */
+    double build_seconds;
+} QTree;
+
+static void qtree_free(PackHost *h)
+{
+    QTree *t = (QTree *)h;
+    free(t->q);
+    free(t->tb);
+    free(t);
+}
+
+static void *aligned_grow(void *old, uint32_t n, uint32_t cap, size_t size)
+{
+    void *p = aligned_alloc(64, (size_t)cap * size);
+    if (p && old)
+        memcpy(p, old, (size_t)n * size);
+    free(old);
+    return p;
+}
+
+static inline void node_box(const uint8_t *nodes, uint32_t n, float *lo, float *hi)
+{
+    memcpy(lo, nodes + 4 * SM_NODE_WORDS * (size_t)n + 4 * SM_NODE_BMIN, 12);
+    memcpy(hi, nodes + 4 * SM_NODE_WORDS * (size_t)n + 4 * SM_NODE_BMAX, 12);
+}
+
+static inline uint32_t node_word(const uint8_t *nodes, uint32_t n, int w)
+{
+    uint32_t x;
+    memcpy(&x, nodes + 4 * SM_NODE_WORDS * (size_t)n + 4 * (size_t)w, 4);
+    return x;
+}
+
+/* The leaf's primitives into TriBlocks; its reference, or QLEAF | 0 with t->usable = 0 when out of memory. */
+static uint32_t qtree_leaf(QTree *t, const uint8_t *prims, uint32_t first, uint32_t count)
+{
+    uint32_t nb = (count + 3) / 4;
+    if (t->ntb + nb > t->captb) {
+        uint32_t cap = t->captb ? t->captb * 2 : 1024;
+        while (cap < t->ntb + nb)
+            cap *= 2;
+        if (!(t->tb = aligned_grow(t->tb, t->ntb, cap, sizeof *t->tb))) {
+            t->usable = 0;
+            return QLEAF;
+        }
+        t->captb = cap;
+    }
+    uint32_t ref = QLEAF | t->ntb;
+    for (uint32_t b = 0; b < nb; b++) {
+        TriBlock *tb = &t->tb[t->ntb++];
+        memset(tb, 0, sizeof *tb);
+        for (uint32_t l = 0; l < 4 && 4 * b + l < count; l++) {
+            uint32_t i = first + 4 * b + l;
+            PrimRec pr;
+            prim_read(prims, i, &pr);
+            for (int k = 0; k < 9; k++)
+                tb->v[k][l] = pr.g[k];
+            tb->prim[l] = i;
+            tb->valid |= 1u << l;
+            if (pr.kind == 1) {
+                tb->flags |= QB_SPHERE;
+                for (int k = 0; k < 9; k++)
+                    tb->v[k][l] = 0.0f;
+            }
+        }
+        if (b + 1 == nb)
+            tb->flags |= QB_LAST;
+    }
+    return ref;
+}
+
+static int box_inside(const float *lo, const float *hi, const float *plo, const float *phi)
+{
+    for (int k = 0; k < 3; k++)
+        if (!(lo[k] >= plo[k] && hi[k] <= phi[k]))
+            return 0;
+    return 1;
+}
+
+static uint32_t qtree_node(QTree *t)
+{
+    if (t->nq == t->capq) {
+        uint32_t cap = t->capq ? t->capq * 2 : 1024;
+        if (!(t->q = aligned_grow(t->q, t->nq, cap, sizeof *t->q))) {
+            t->usable = 0;
+            return 0;
+        }
+        t->capq = cap;
+    }
+    memset(&t->q[t->nq], 0, sizeof *t->q);
+    return t->nq++;
+}
+
+/* The 4-wide tree of p; NULL when out of memory. */
+static QTree *qtree_build(const PackedScene *p)
+{
+    double t0 = util_now();
+    QTree *t = calloc(1, sizeof *t);
+    if (!t)
+        return NULL;
+    t->host.free = qtree_free;
+    t->usable = 1;
+    uint32_t nnodes = sm_u32(p, sm_hdr(p, SM_HDR_NNODES));
+    const uint8_t *nodes = image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_NODES)));
+    const uint8_t *prims = image_at(p, sm_u32(p, sm_hdr(p, SM_HDR_PRIMS)));
+    t->stack_len = 3 * (p->bvh.depth + 2) + 8;
+    /* room for every inner node and every leaf's blocks, so the arrays never grow */
+    uint32_t ninner = 0, nblocks = 0;
+    for (uint32_t n = 0; n < nnodes; n++) {
+        uint32_t info = node_word(nodes, n, SM_NODE_INFO);
+        if (info & SM_NODE_INNER)
+            ninner++;
+        else
+            nblocks += (info + 3) / 4;
+    }
+    t->capq = ninner ? ninner : 1;
+    t->captb = nblocks ? nblocks : 1;
+    t->q = aligned_alloc(64, sizeof *t->q * (size_t)t->capq);
+    t->tb = aligned_alloc(64, sizeof *t->tb * (size_t)t->captb);
+    if (!t->q || !t->tb) {
+        qtree_free(&t->host);
+        return NULL;
+    }
+    /* work: (binary inner node, its QNode) pairs still to fill */
+    uint32_t *work = malloc(sizeof *work * 2 * (size_t)(nnodes + 1)), nw = 0;
+    if (!work || nnodes == 0) {
+        t->usable = 0;
+        free(work);
+        return t;
+    }
+    uint32_t info0 = node_word(nodes, 0, SM_NODE_INFO);
+    if (!(info0 & SM_NODE_INNER)) {
+        t->root = qtree_leaf(t, prims, node_word(nodes, 0, SM_NODE_FIRST), info0);
+    } else {
+        t->root = qtree_node(t);
+        work[nw++] = 0;
+        work[nw++] = t->root;
+    }
+    while (nw && t->usable) {
+        uint32_t qi = work[--nw], bn = work[--nw];
+        uint32_t first = node_word(nodes, bn, SM_NODE_FIRST), axis = node_word(nodes, bn, SM_NODE_INFO) & 3u;
+        uint32_t slotnode[4], ns = 0, sidefirst[2], sidecount[2], sideaxis[2];
+        for (uint32_t s = 0; s < 2; s++) {
+            uint32_t c = first + s, ci = node_word(nodes, c, SM_NODE_INFO);
+            sidefirst[s] = ns;
+            if (ci & SM_NODE_INNER) {
+                uint32_t g0 = node_word(nodes, c, SM_NODE_FIRST);
+                float plo[3], phi[3], lo[3], hi[3];
+                node_box(nodes, c, plo, phi);
+                for (uint32_t g = 0; g < 2; g++) {
+                    node_box(nodes, g0 + g, lo, hi);
+                    if (!box_inside(lo, hi, plo, phi))
+                        t->usable = 0;
+                    slotnode[ns++] = g0 + g;
+                }
+                sidecount[s] = 2;
+                sideaxis[s] = ci & 3u;
+            } else {
+                slotnode[ns++] = c;
+                sidecount[s] = 1;
+                sideaxis[s] = 0;
+            }
+        }
+        uint32_t ref[4];
+        for (uint32_t c = 0; c < ns; c++) {
+            uint32_t n = slotnode[c], ni = node_word(nodes, n, SM_NODE_INFO);
+            if (ni & SM_NODE_INNER) {
+                ref[c] = qtree_node(t);
+                work[nw++] = n;
+                work[nw++] = ref[c];
+            } else {
+                ref[c] = qtree_leaf(t, prims, node_word(nodes, n, SM_NODE_FIRST), ni);
+            }
+        }
+        if (!t->usable)
+            break;
+        QNode *q = &t->q[qi];
+        for (uint32_t c = 0; c < ns; c++) {
+            float lo[3], hi[3];
+            node_box(nodes, slotnode[c], lo, hi);
+            for (int k = 0; k < 3; k++) {
+                q->b[k][c] = lo[k];
+                q->b[3 + k][c] = hi[k];
+            }
+            q->child[c] = ref[c];
+            q->valid |= 1u << c;
+        }
+        /* The binary walks' order: the near side first (the right one when dir[axis] < 0), and
+         * within a side of two slots its near one first; unused slots fill the last positions, in
+         * order, so each slot appears once (their valid bit is clear: never pushed). 2 bits a slot. */
+        uint32_t side[2][2], unused = 0;
+        for (uint32_t s = 0; s < 2; s++) {
+            uint32_t a = sidefirst[s];
+            side[s][0] = sidecount[s] == 2 ? (a | (a + 1) << 2) : a;
+            side[s][1] = sidecount[s] == 2 ? ((a + 1) | a << 2) : a;
+        }
+        for (uint32_t c = ns; c < 4; c++)
+            unused |= c << (2 * c);
+        for (uint32_t o = 0; o < 8; o++) {
+            uint32_t sa = o >> axis & 1u, sb = 1 - sa;
+            uint32_t fa = sidecount[sa] == 2 ? (o >> sideaxis[sa] & 1u) : 0;
+            uint32_t fb = sidecount[sb] == 2 ? (o >> sideaxis[sb] & 1u) : 0;
+            q->order[o] = (uint8_t)(side[sa][fa] | side[sb][fb] << (2 * sidecount[sa]) | unused);
+        }
+    }
+    free(work);
+    t->build_seconds = util_now() - t0;
+    return t;
+}
+
+/* p's 4-wide tree, built on the first call (thread-safe: a loser of the race frees its own);
+ * NULL when out of memory. */
+static const QTree *qtree_of(const PackedScene *p)
+{
+    PackedScene *mp = (PackedScene *)p; /* p->host is the reader's cache, not the scene */
+    PackHost *h = __atomic_load_n(&mp->host, __ATOMIC_ACQUIRE);
+    if (h)
+        return (const QTree *)h;
+    QTree *t = qtree_build(p);
+    if (!t)
+        return NULL;
+    PackHost *expected = NULL;
+    if (!__atomic_compare_exchange_n(&mp->host, &expected, &t->host, 0, __ATOMIC_ACQ_REL, __ATOMIC_ACQUIRE)) {
+        qtree_free(&t->host);
+        return (const QTree *)expected;
+    }
+    return t;
+}
+
+double ref_trace_layout_seconds(const PackedScene *p)
+{
+    const QTree *t = qtree_of(p);
+    return t ? t->build_seconds : -1.0;
+}
+
+int ref_trace_layout_usable(const PackedScene *p)
+{
+    const QTree *t = qtree_of(p);
+    return t && t->usable;
+}
+
+/* A pending node of the 4-wide walk: its reference and its box's entry distance. */
+typedef struct QPending {
+    uint32_t ref;
+    float tn;
+} QPending;
+
+#if defined(__SSE2__) && !defined(REF_TRACE_SCALAR)
+typedef struct QRay {
+    __m128 o[3], inv[3];
+    __m128 ko[3], s[3];     /* origin at kx, ky, kz; sx, sy, sz (tri_hit's) */
+} QRay;
+
+static inline void qray_make(QRay *q, const RefRayPre *R, const float *inv)
+{
+    for (int k = 0; k < 3; k++) {
+        q->o[k] = _mm_set1_ps(R->org[k]);
+        q->inv[k] = _mm_set1_ps(inv[k]);
+    }
+    q->ko[0] = _mm_set1_ps(R->org[R->kx]);
+    q->ko[1] = _mm_set1_ps(R->org[R->ky]);
+    q->ko[2] = _mm_set1_ps(R->org[R->kz]);
+    q->s[0] = _mm_set1_ps(R->sx);
+    q->s[1] = _mm_set1_ps(R->sy);
+    q->s[2] = _mm_set1_ps(R->sz);
+}
+
+/* box_hit_v on the 4 slots at once, far = box_far's value: bit c set when slot c's box hits; tn[c] its entry distance. */
+static inline unsigned qbox(const QNode *nd, const QRay *q, float far, float *tn_out)
+{
+    const __m128 zero = _mm_setzero_ps(), scale = _mm_set1_ps(REF_SLAB_FAR_SCALE), f = _mm_set1_ps(far);
+#define QBOX_AXIS(k, tnk, tfk)                                                                   \
+    __m128 tnk, tfk;                                                                             \
+    {                                                                                            \
+        __m128 t0 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(nd->b[k]), q->o[k]), q->inv[k]);          \
+        __m128 t1 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(nd->b[3 + k]), q->o[k]), q->inv[k]);      \
+        tnk = _mm_max_ps(_mm_min_ps(t1, t0), zero);                                              \
+        tfk = _mm_min_ps(_mm_mul_ps(_mm_max_ps(t1, t0), scale), f);                              \
+    }
+    QBOX_AXIS(0, tn0, tf0)
+    QBOX_AXIS(1, tn1, tf1)
+    QBOX_AXIS(2, tn2, tf2)
+#undef QBOX_AXIS
+    __m128 tn = _mm_max_ps(_mm_max_ps(tn0, tn1), tn2), tf = _mm_min_ps(_mm_min_ps(tf0, tf1), tf2);
+    _mm_storeu_ps(tn_out, tn);
+    return (unsigned)_mm_movemask_ps(_mm_cmple_ps(tn, tf)) & nd->valid;
+}
+
+/* tri_hit on the 4 lanes with tmax: bit l set when lane l hits; its T and det (after the flip), t, u, v. */
+static inline unsigned qtri(const TriBlock *tb, const RefRayPre *R, const QRay *q, float tmax, float *Tl, float *detl,
+                            float *tl, float *ul, float *vl)
+{
+    const __m128 zero = _mm_setzero_ps(), sign = _mm_set1_ps(-0.0f);
+    int kx = R->kx, ky = R->ky, kz = R->kz;
+    __m128 Akx = _mm_sub_ps(_mm_load_ps(tb->v[kx]), q->ko[0]), Aky = _mm_sub_ps(_mm_load_ps(tb->v[ky]), q->ko[1]),
+           Akz = _mm_sub_ps(_mm_load_ps(tb->v[kz]), q->ko[2]);
+    __m128 Bkx = _mm_sub_ps(_mm_load_ps(tb->v[3 + kx]), q->ko[0]),
+           Bky = _mm_sub_ps(_mm_load_ps(tb->v[3 + ky]), q->ko[1]),
+           Bkz = _mm_sub_ps(_mm_load_ps(tb->v[3 + kz]), q->ko[2]);
+    __m128 Ckx = _mm_sub_ps(_mm_load_ps(tb->v[6 + kx]), q->ko[0]),
+           Cky = _mm_sub_ps(_mm_load_ps(tb->v[6 + ky]), q->ko[1]),
+           Ckz = _mm_sub_ps(_mm_load_ps(tb->v[6 + kz]), q->ko[2]);
+    __m128 Ax = _mm_sub_ps(Akx, _mm_mul_ps(q->s[0], Akz)), Ay = _mm_sub_ps(Aky, _mm_mul_ps(q->s[1], Akz));
+    __m128 Bx = _mm_sub_ps(Bkx, _mm_mul_ps(q->s[0], Bkz)), By = _mm_sub_ps(Bky, _mm_mul_ps(q->s[1], Bkz));
+    __m128 Cx = _mm_sub_ps(Ckx, _mm_mul_ps(q->s[0], Ckz)), Cy = _mm_sub_ps(Cky, _mm_mul_ps(q->s[1], Ckz));
+    __m128 U = _mm_sub_ps(_mm_mul_ps(Cx, By), _mm_mul_ps(Cy, Bx));
+    __m128 V = _mm_sub_ps(_mm_mul_ps(Ax, Cy), _mm_mul_ps(Ay, Cx));
+    __m128 W = _mm_sub_ps(_mm_mul_ps(Bx, Ay), _mm_mul_ps(By, Ax));
+    __m128 out = _mm_and_ps(
+        _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(U, zero), _mm_cmplt_ps(V, zero)), _mm_cmplt_ps(W, zero)),
+        _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(U, zero), _mm_cmpgt_ps(V, zero)), _mm_cmpgt_ps(W, zero)));
+    unsigned m = ~(unsigned)_mm_movemask_ps(out) & tb->valid;
+    if (!m)
+        return 0;
+    __m128 det = _mm_add_ps(_mm_add_ps(U, V), W);
+    __m128 Az = _mm_mul_ps(q->s[2], Akz), Bz = _mm_mul_ps(q->s[2], Bkz), Cz = _mm_mul_ps(q->s[2], Ckz);
+    __m128 T = _mm_add_ps(_mm_add_ps(_mm_mul_ps(U, Az), _mm_mul_ps(V, Bz)), _mm_mul_ps(W, Cz));
+    __m128 flip = _mm_and_ps(_mm_cmplt_ps(det, zero), sign);
+    T = _mm_xor_ps(T, flip);
+    __m128 ok = _mm_cmpneq_ps(det, zero); /* det == 0 fails; NaN passes, as in tri_hit */
+    det = _mm_xor_ps(det, flip);
+    V = _mm_xor_ps(V, flip);
+    W = _mm_xor_ps(W, flip);
+    __m128 zmax = _mm_max_ps(_mm_andnot_ps(sign, Cz), _mm_max_ps(_mm_andnot_ps(sign, Bz), _mm_andnot_ps(sign, Az)));
+    __m128 tlo = _mm_mul_ps(_mm_mul_ps(zmax, _mm_set1_ps(REF_T_ROUND)), det);
+    __m128 tm = _mm_set1_ps(tmax);
+    ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpgt_ps(T, tlo), _mm_cmplt_ps(T, _mm_mul_ps(tm, det))));
+    __m128 rcp = _mm_div_ps(_mm_set1_ps(1.0f), det);
+    __m128 t = _mm_mul_ps(T, rcp);
+    ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpgt_ps(t, zero), _mm_cmplt_ps(t, tm)));
+    m &= (unsigned)_mm_movemask_ps(ok);
+    if (!m)
+        return 0;
+    _mm_storeu_ps(Tl, T);
+    _mm_storeu_ps(detl, det);
+    _mm_storeu_ps(tl, t);
+    _mm_storeu_ps(ul, _mm_mul_ps(V, rcp));
+    _mm_storeu_ps(vl, _mm_mul_ps(W, rcp));
+    return m;
+}
+#else
+/* Plain C: the same expressions lane by lane (ref_fmin / ref_fmax are the SSE min / max). */
+typedef struct QRay {
+    float o[3], inv[3];
+} QRay;
+
+static inline void qray_make(QRay *q, const RefRayPre *R, const float *inv)
+{
+    for (int k = 0; k < 3; k++) {
+        q->o[k] = R->org[k];
+        q->inv[k] = inv[k];
+    }
+}
+
+static inline unsigned qbox(const QNode *nd, const QRay *q, float far, float *tn_out)
+{
+    unsigned m = 0;
+    for (int c = 0; c < 4; c++) {
+        float tn = 0.0f, tf = far;
+        for (int k = 0; k < 3; k++) {
+            float t0 = (nd->b[k][c] - q->o[k]) * q->inv[k];
+            float t1 = (nd->b[3 + k][c] - q->o[k]) * q->inv[k];
+            float lo = ref_fmin(t0, t1), hi = ref_fmax(t0, t1) * REF_SLAB_FAR_SCALE;
+            float tnk = ref_fmax(0.0f, lo), tfk = ref_fmin(far, hi);
+            tn = k ? ref_fmax(tn, tnk) : tnk;
+            tf = k ? ref_fmin(tf, tfk) : tfk;
+        }
+        tn_out[c] = tn;
+        m |= (unsigned)(tn <= tf) << c;
+    }
+    return m & nd->valid;
+}
+
+static inline unsigned qtri(const TriBlock *tb, const RefRayPre *R, const QRay *q, float tmax, float *Tl, float *detl,
+                            float *tl, float *ul, float *vl)
+{
+    (void)q;
+    int kx = R->kx, ky = R->ky, kz = R->kz;
+    float sx = R->sx, sy = R->sy, sz = R->sz;
+    unsigned m = 0;
+    for (int l = 0; l < 4; l++) {
+        if (!(tb->valid >> l & 1u))
+            continue;
+        float Akx = tb->v[kx][l] - R->org[kx], Aky = tb->v[ky][l] - R->org[ky], Akz = tb->v[kz][l] - R->org[kz];
+        float Bkx = tb->v[3 + kx][l] - R->org[kx], Bky = tb->v[3 + ky][l] - R->org[ky],
+              Bkz = tb->v[3 + kz][l] - R->org[kz];
+        float Ckx = tb->v[6 + kx][l] - R->org[kx], Cky = tb->v[6 + ky][l] - R->org[ky],
+              Ckz = tb->v[6 + kz][l] - R->org[kz];
+        float Ax = Akx - sx * Akz, Ay = Aky - sy * Akz;
+        float Bx = Bkx - sx * Bkz, By = Bky - sy * Bkz;
+        float Cx = Ckx - sx * Ckz, Cy = Cky - sy * Ckz;
+        float U = Cx * By - Cy * Bx;
+        float V = Ax * Cy - Ay * Cx;
+        float W = Bx * Ay - By * Ax;
+        if (((U < 0.0f) | (V < 0.0f) | (W < 0.0f)) & ((U > 0.0f) | (V > 0.0f) | (W > 0.0f)))
+            continue;
+        float det = U + V + W;
+        if (det == 0.0f)
+            continue;
+        float Az = sz * Akz, Bz = sz * Bkz, Cz = sz * Ckz;
+        float T = U * Az + V * Bz + W * Cz;
+        if (det < 0.0f) {
+            T = -T;
+            det = -det;
+            V = -V;
+            W = -W;
+        }
+        float zmax = ref_fmax(ref_fmax(fabsf(Az), fabsf(Bz)), fabsf(Cz));
+        float tlo = zmax * REF_T_ROUND * det;
+        if (!(T > tlo) | !(T < tmax * det))
+            continue;
+        float rcp = 1.0f / det;
+        float t = T * rcp;
+        if (!(t > 0.0f && t < tmax))
+            continue;
+        Tl[l] = T;
+        detl[l] = det;
+        tl[l] = t;
+        ul[l] = V * rcp;
+        vl[l] = W * rcp;
+        m |= 1u << l;
+    }
+    return m;
+}
+#endif
+
+static inline int ray_finite(const RefRayPre *R)
+{
+    for (int k = 0; k < 3; k++)
+        if (!isfinite(R->org[k]) || !isfinite(R->dir[k]))
+            return 0;
+    return 1;
+}
+
+/* The 4-wide walk (see above); -1 when the ray or the scene must take the binary walk. */
+static int walk_quad(const PackedScene *p, const QTree *qt, const RefRay *r, RefHit *hit, int closest)
+{
+    WalkStart ws;
+    if (!walk_start(p, r, hit, &ws))
+        return 0;
+    const RefRayPre R = ws.R;
+    if (!ray_finite(&R))
+        return -1;
+    if (!box_hit_node(ws.nodes, &ws.B, box_far(r->tmax)))
+        return 0;
+    const uint8_t *prims = ws.prims;
+    float inv[3];
+    ref_inv_dir(R.dir, inv);
+    QRay Q;
+    qray_make(&Q, &R, inv);
+    const unsigned oct = (unsigned)(R.dir[0] < 0.0f) | (unsigned)(R.dir[1] < 0.0f) << 1 |
+                         (unsigned)(R.dir[2] < 0.0f) << 2;
+    const QNode *qn = qt->q;
+    const TriBlock *tbs = qt->tb;
+    float fars = r->tmax * REF_HIT_SCALE; /* box_far's value */
+    float ptmax = r->tmax;
+    QPending small[256], *stack = small;
+    if (qt->stack_len > 256 && !(stack = malloc(sizeof *stack * qt->stack_len)))
+        abort(); /* out of memory for a traversal stack: nothing sensible to return */
+    uint32_t sp = 0, ref = qt->root;
+    for (;;) {
+        if (!(ref & QLEAF)) {
+            const QNode *nd = &qn[ref];
+            float tn[4];
+            unsigned m = qbox(nd, &Q, fars, tn);
+            if (m & (m - 1)) {
+                unsigned ord = nd->order[oct];
+                for (int j = 3; j >= 0; j--) { /* far to near, so the nearest is popped first; branch-free */
+                    unsigned c = ord >> (2 * j) & 3u;
+                    stack[sp] = (QPending){nd->child[c], tn[c]};
+                    sp += m >> c & 1u;
+                }
+            } else if (m) { /* one child hit: it goes next, straight from a register */
+                ref = nd->child[__builtin_ctz(m)];
+                continue;
+            }
+        } else {
+            const TriBlock *tb = &tbs[ref & ~QLEAF];
+            for (;; tb++) {
+                if (tb->flags & QB_SPHERE) {
+                    for (unsigned l = 0; l < 4; l++) {
+                        float t, u, v;
+                        if (!(tb->valid >> l & 1u) || !hit_prim(prims, tb->prim[l], &R, ptmax, &t, &u, &v))
+                            continue;
+                        if (ref_hit_keep(hit, t, u, v, tb->prim[l])) {
+                            fars = t * REF_HIT_SCALE;
+                            if (closest)
+                                ptmax = ref_tie_probe(t);
+                        }
+                        if (!closest)
+                            goto done;
+                    }
+                } else {
+                    float T[4], det[4], t[4], u[4], v[4];
+                    unsigned m = qtri(tb, &R, &Q, ptmax, T, det, t, u, v);
+                    for (; m; m &= m - 1) {
+                        unsigned l = (unsigned)__builtin_ctz(m);
+                        /* tri_hit's tests of tmax, with the tmax of this moment */
+                        if (!(T[l] < ptmax * det[l]) || !(t[l] < ptmax))
+                            continue;
+                        if (ref_hit_keep(hit, t[l], u[l], v[l], tb->prim[l])) {
+                            fars = t[l] * REF_HIT_SCALE;
+                            if (closest)
+                                ptmax = ref_tie_probe(t[l]);
+                        }
+                        if (!closest)
+                            goto done;
+                    }
+                }
+                if (tb->flags & QB_LAST)
+                    break;
+            }
+        }
+        do {
+            if (sp == 0)
+                goto done;
+            --sp;
+        } while (!(stack[sp].tn <= fars));
+        ref = stack[sp].ref;
+    }
+done:
+    if (stack != small)
+        free(stack);
+    return hit->prim != REF_NO_HIT;
+}
+
+/* The binary walk without stats: the pair walk on AVX hosts, walk_body elsewhere. */
+static int walk_binary(const PackedScene *p, const RefRay *r, RefHit *hit, int closest)
 {
 #if REF_FAST_WALK
     return walk_fast(p, r, hit, closest);
 #else
     return walk_body(p, r, hit, closest, NULL, NULL);
 #endif
+}
+
+/* Batches of rays (sfsim trace, run_trace, per_ray) ask without stats: the 4-wide walk, or the
+ * binary one for a ray or scene it does not take. */
+static int walk_bare(const PackedScene *p, const RefRay *r, RefHit *hit, int closest)
+{
+    const QTree *qt = qtree_of(p);
+    if (qt && qt->usable) {
+        int rc = walk_quad(p, qt, r, hit, closest);
+        if (rc >= 0)
+            return rc;
+    }
+    return walk_binary(p, r, hit, closest);
 }
 
 static int walk_plain(const PackedScene *p, const RefRay *r, RefHit *hit, int closest, RefTraceStats *st)

@@ -57,6 +57,13 @@ void ref_closest_hit(const PackedScene *p, const RefRay *r, RefHit *hit, RefTrac
 /* Any hit with 0 < t < tmax (occlusion); returns 1 if occluded. */
 int ref_any_hit(const PackedScene *p, const RefRay *r, RefTraceStats *stats);
 
+/* Queries without stats walk a private, host-only 4-wide copy of p's BVH (sim/ref_trace.c), built
+ * on the first such query and freed by pack_free; the same hits bit for bit. Its build time in
+ * seconds (building it now if needed; -1 when out of memory), and whether p's queries use it
+ * (0: p has no nodes or a child box outside its parent's, and they take the binary walk). */
+double ref_trace_layout_seconds(const PackedScene *p);
+int ref_trace_layout_usable(const PackedScene *p);
+
 /* Test packed primitive i (triangle or sphere) with a sanitized ray: 1 with t, u, v on a hit
  * with 0 < t < r->tmax (the test every traversal uses). */
 int ref_hit_prim(const PackedScene *p, uint32_t i, const RefRay *r, float *t, float *u, float *v);

@@ -5,6 +5,7 @@
 #include <criterion/criterion.h>
 #include <float.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -252,26 +253,22 @@ Test(ref_traversal, matches_brute_force)
     free(tm);
 }
 
-/* On an AVX host a query without stats takes the fast walk (both children's boxes tested at once,
- * the far one's entry distance kept on the stack); one with stats takes the plain walk, whose
- * counts sampled mode uses (a baseline build takes the plain walk for both: the test then holds
- * trivially).
- * Their hits must agree bit for bit (prim, t, u, v) and so must the any-hit answers, on rays
- * that start inside and outside the scene, run along axes (zero and negative-zero components)
- * and carry odd tmax values. */
-static void fast_walk_matches_plain(const char *path, int nrays)
+/* A query without stats takes the 4-wide walk over the private layout (sim/ref_trace.c; the
+ * binary walks for rays with a non-finite component or a scene it refuses); one with stats takes
+ * the plain walk, whose counts sampled mode uses. Their hits must agree bit for bit (prim, t, u, v)
+ * and so must the any-hit answers, on rays that start inside and outside the scene, run along axes
+ * (zero and negative-zero components), carry odd tmax values and, one in 64, an infinite or NaN
+ * component. */
+static void walks_agree(const PackedScene *p, const char *name, int nrays, int min_hits)
 {
-    Scene s;
-    PackedScene p;
-    char err[4096];
-    cr_assert_eq(pack_load_file(path, 0, 0, 0, &s, &p, err, sizeof err), 0, "%s", err);
-    uint32_t nodes = sm_u32(&p, sm_hdr(&p, SM_HDR_NODES));
+    uint32_t nodes = sm_u32(p, sm_hdr(p, SM_HDR_NODES));
     float lo[3], hi[3];
     for (int k = 0; k < 3; k++) {
-        lo[k] = sm_f32(&p, sm_rec(nodes, SM_NODE_WORDS, 0, SM_NODE_BMIN) + 4u * (uint32_t)k);
-        hi[k] = sm_f32(&p, sm_rec(nodes, SM_NODE_WORDS, 0, SM_NODE_BMAX) + 4u * (uint32_t)k);
+        lo[k] = sm_f32(p, sm_rec(nodes, SM_NODE_WORDS, 0, SM_NODE_BMIN) + 4u * (uint32_t)k);
+        hi[k] = sm_f32(p, sm_rec(nodes, SM_NODE_WORDS, 0, SM_NODE_BMAX) + 4u * (uint32_t)k);
     }
     static const float tmaxes[] = {INFINITY, 0.0f, -1.0f, 1e-30f, 0.5f, 3.0f, FLT_MAX};
+    static const float odd[] = {INFINITY, -INFINITY, NAN};
     unsigned st = 12345u;
     int differ = 0, occl_differ = 0, hits = 0;
     uint64_t visited = 0;
@@ -290,19 +287,35 @@ static void fast_walk_matches_plain(const char *path, int nrays)
         r.tmax = (st >> 8) % 4 ? INFINITY : tmaxes[(st >> 12) % (sizeof tmaxes / sizeof *tmaxes)];
         if (r.tmax > 0.0f && r.tmax < 10.0f)
             r.tmax *= hi[0] - lo[0];
+        if (i % 64 == 63) {
+            float *c = (st >> 20) % 2 ? r.org : r.dir;
+            c[(st >> 21) % 3] = odd[(st >> 23) % 3];
+        }
         RefHit fast, plain;
         RefTraceStats ts = {0};
-        ref_closest_hit(&p, &r, &fast, NULL);
-        ref_closest_hit(&p, &r, &plain, &ts);
+        ref_closest_hit(p, &r, &fast, NULL);
+        ref_closest_hit(p, &r, &plain, &ts);
         visited += ts.nodes_visited;
         hits += plain.prim != REF_NO_HIT;
         differ += memcmp(&fast, &plain, sizeof fast) != 0;
-        occl_differ += ref_any_hit(&p, &r, NULL) != ref_any_hit(&p, &r, &ts);
+        occl_differ += ref_any_hit(p, &r, NULL) != ref_any_hit(p, &r, &ts);
     }
-    cr_log_info("%s: %d rays, %d hits, %.1f nodes per ray", path, nrays, hits, (double)visited / nrays);
-    cr_expect_gt(hits, nrays / 4, "%s: the test rays should hit something", path);
-    cr_expect_eq(differ, 0, "%s: %d closest hits differ between the walks", path, differ);
-    cr_expect_eq(occl_differ, 0, "%s: %d any-hit answers differ between the walks", path, occl_differ);
+    cr_log_info("%s: %d rays, %d hits, %.1f nodes per ray", name, nrays, hits, (double)visited / nrays);
+    cr_expect_geq(hits, min_hits, "%s: the test rays should hit something", name);
+    cr_expect_eq(differ, 0, "%s: %d closest hits differ between the walks", name, differ);
+    cr_expect_eq(occl_differ, 0, "%s: %d any-hit answers differ between the walks", name, occl_differ);
+}
+
+static void fast_walk_matches_plain(const char *path, int nrays)
+{
+    Scene s;
+    PackedScene p;
+    char err[4096];
+    cr_assert_eq(pack_load_file(path, 0, 0, 0, &s, &p, err, sizeof err), 0, "%s", err);
+    double sec = ref_trace_layout_seconds(&p);
+    cr_log_info("%s: 4-wide layout built in %.1f ms", path, 1e3 * sec);
+    cr_expect(sec >= 0.0 && ref_trace_layout_usable(&p), "%s: the 4-wide layout should be in use", path);
+    walks_agree(&p, path, nrays, nrays / 4);
     pack_free(&p);
     scene_free(&s);
 }
@@ -320,4 +333,96 @@ Test(ref_traversal, fast_walk_matches_plain_walk_on_shared_scenes)
     fast_walk_matches_plain("scenes/cornell/spheres.ini", 20000);
     fast_walk_matches_plain("scenes/sponza-dabrovic/scene.ini", 20000);
     fast_walk_matches_plain("scenes/conference/scene.ini", 20000);
+}
+
+/* A soup of n small random triangles in [-5, 5]^3 (the scene of matches_brute_force), packed with
+ * leaves of up to max_leaf primitives. */
+static void soup_pack(uint32_t n, int max_leaf, Scene *s, SceneMaterial *m, PackedScene *p)
+{
+    memset(s, 0, sizeof *s);
+    float *pos = malloc(sizeof(float) * 9 * n);
+    uint32_t *tm = calloc(n, sizeof(uint32_t));
+    cr_assert(pos && tm);
+    uint32_t st = 7;
+    for (uint32_t i = 0; i < n; i++) {
+        float c[3];
+        for (int k = 0; k < 3; k++) {
+            st = st * 1664525u + 1013904223u;
+            c[k] = (float)(st >> 8) / 16777216.0f * 10.0f - 5.0f;
+        }
+        for (int v = 0; v < 3; v++)
+            for (int k = 0; k < 3; k++) {
+                st = st * 1664525u + 1013904223u;
+                pos[9 * i + 3 * v + k] = c[k] + ((float)(st >> 8) / 16777216.0f - 0.5f) * 1.5f;
+            }
+    }
+    memset(m, 0, sizeof *m);
+    s->ntris = n;
+    s->pos = pos;
+    s->tri_material = tm;
+    s->materials = m;
+    s->nmaterials = 1;
+    s->camera = (SceneCamera){{0, 0, 10}, {0, 0, 0}, {0, 1, 0}, 45, 0, 0, 0};
+    s->render = (SceneRender){8, 8, 1, 1, {0, 0, 0}, {0, 0, 0}};
+    BvhParams bp;
+    bvh_default_params(&bp);
+    bp.max_leaf_size = max_leaf;
+    if (max_leaf > 4)
+        bp.cost_traversal = 40.0f; /* a costly node: the build then fills its leaves */
+    char err[256];
+    cr_assert_eq(pack_scene(s, &bp, 0, p, err, sizeof err), 0, "%s", err);
+}
+
+/* Leaves of 1 primitive, of up to 4 (one block of the layout) and of up to 11 (several blocks,
+ * the lanes of a leaf's last block partly empty), and a single leaf (the root is a leaf). */
+Test(ref_traversal, fast_walk_matches_plain_walk_on_leaf_sizes)
+{
+    static const struct {
+        uint32_t n;
+        int max_leaf;
+    } cases[] = {{3000, 1}, {3000, 4}, {3000, 11}, {3, 4}};
+    for (size_t c = 0; c < sizeof cases / sizeof *cases; c++) {
+        Scene s;
+        SceneMaterial m;
+        PackedScene p;
+        soup_pack(cases[c].n, cases[c].max_leaf, &s, &m, &p);
+        cr_expect(ref_trace_layout_usable(&p), "leaves of %d: the 4-wide layout should be in use", cases[c].max_leaf);
+        uint32_t nodes = sm_u32(&p, sm_hdr(&p, SM_HDR_NODES)), big = 0;
+        for (uint32_t n = 0; n < sm_u32(&p, sm_hdr(&p, SM_HDR_NNODES)); n++) {
+            uint32_t info = sm_u32(&p, sm_rec(nodes, SM_NODE_WORDS, n, SM_NODE_INFO));
+            big += !(info & SM_NODE_INNER) && info > 4;
+        }
+        cr_expect_eq(big > 0, cases[c].max_leaf > 4, "leaves of up to %d: %u leaves of more than 4", cases[c].max_leaf, big);
+        char name[64];
+        snprintf(name, sizeof name, "soup of %u, leaves of %d", cases[c].n, cases[c].max_leaf);
+        walks_agree(&p, name, 20000, cases[c].n > 100 ? 20000 / 4 : 20);
+        pack_free(&p);
+        free(s.pos);
+        free(s.tri_material);
+    }
+}
+
+/* The 4-wide walk skips the box tests of the binary levels it collapses, which gives the same
+ * nodes only when every child box lies inside its parent's: a scene where one does not (the
+ * image edited before the first query) must keep the binary walk, and the same hits. */
+Test(ref_traversal, child_box_outside_parent_keeps_the_binary_walk)
+{
+    Scene s;
+    SceneMaterial m;
+    PackedScene p;
+    soup_pack(3000, 4, &s, &m, &p);
+    uint32_t nodes = sm_u32(&p, sm_hdr(&p, SM_HDR_NODES));
+    uint32_t first = sm_u32(&p, sm_rec(nodes, SM_NODE_WORDS, 0, SM_NODE_FIRST));
+    uint32_t info = sm_u32(&p, sm_rec(nodes, SM_NODE_WORDS, first, SM_NODE_INFO));
+    cr_assert(info & SM_NODE_INNER, "the root's left child should be an inner node");
+    uint32_t g = sm_u32(&p, sm_rec(nodes, SM_NODE_WORDS, first, SM_NODE_FIRST));
+    /* grow grandchild g's box past its parent's on x by a unit: still a valid (larger) bound */
+    uint32_t a = sm_rec(nodes, SM_NODE_WORDS, g, SM_NODE_BMAX);
+    float x = sm_f32(&p, a) + 1.0f;
+    memcpy(p.mem + (a - p.base), &x, 4);
+    cr_expect_not(ref_trace_layout_usable(&p), "a child box outside its parent's should refuse the layout");
+    walks_agree(&p, "soup with a grown box", 20000, 20000 / 4);
+    pack_free(&p);
+    free(s.pos);
+    free(s.tri_material);
 }
