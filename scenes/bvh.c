@@ -154,11 +154,21 @@ typedef struct Bins {
 typedef struct Builder {
     const BvhParams *p;
     Box *prim;   /* n, in prim_index order (which the partition permutes with them) */
-    Bins *bins;  /* 4: one per axis, and a sink for the axes that give no split */
+    Bins *bins;  /* BIN_SETS sets of one per axis, then a sink for the axes that give no split;
+                  * empty (box_none, count 0) between nodes, except the sink, which is never read */
     uint8_t (*bin)[4]; /* n: each position's bin on the three axes in the last binning that
                         * covered it, moved with the primitives by the partition */
     Bvh *b;
 } Builder;
+
+/* Binning a large node spreads its primitives over BIN_SETS sets of bins (primitive j into set j
+ * mod BIN_SETS), merged before the sweep: growing one bin's box is a load, a minimum and a store,
+ * and consecutive primitives, neighbours in the mesh, fall in the same bin so often that each
+ * waited for the previous one's store. Order does not matter to a bin's box, up to the sign of
+ * a zero (a minimum of the same values), and zeros' signs do not change the areas the sweep
+ * computes (extent_of: hi > lo ? hi - lo : 0 is the same for -0 and +0), so the splits are the
+ * same. Smaller nodes use set 0 alone. */
+enum { BIN_SETS = 4, BIN_SETS_FROM = 64, BIN_SINK = 3 * BIN_SETS };
 
 /* Bin of a centroid on one axis; the same expression is used to count and to partition, so
  * the two always agree. */
@@ -198,7 +208,7 @@ static int list_nonempty(const uint32_t *count, int nb, int *list)
  * / parea, each step non-decreasing in x (cost_intersect > 0, parea > 0): a candidate whose x is
  * not below the best's cannot cost strictly less, so its division is skipped (NaN costs, from an
  * infinite parea, compare false either way). */
-static void sweep_axis(const BvhParams *p, const Bins *bins, int axis, uint32_t total, float parea,
+static void sweep_axis(const BvhParams *p, Bins *bins, int axis, uint32_t total, float parea,
                        Split *best)
 {
     int nonempty[256], m = list_nonempty(bins->count, p->bins, nonempty);
@@ -225,6 +235,11 @@ static void sweep_axis(const BvhParams *p, const Bins *bins, int axis, uint32_t 
             best->cost = cost;
             best->x = x;
         }
+    }
+    /* empty the bins for the next node: only the non-empty ones need it */
+    for (int r = 0; r < m; r++) {
+        bins->box[nonempty[r]] = box_none;
+        bins->count[nonempty[r]] = 0;
     }
 }
 
@@ -264,36 +279,54 @@ static inline __m128i bin_of3(__m128 c, __m128 cmin, __m128 scale, __m128i top)
 }
 
 /* One pass puts every primitive in its bin on each axis; each bin still grows in primitive order.
- * An axis that gives no split bins into the sink, bins[3]. */
-static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, const float *scale, int live)
+ * An axis that gives no split bins into the sink. With sets > 1, primitive j goes to set j mod sets
+ * (sets is a power of 2). */
+/* Primitive j into bins d (one per axis) and its bin bytes into B->bin[j]. */
+static inline void bin_one(const Builder *B, uint32_t j, Bins *const *d, __m128 cmin, __m128 sc, __m128i top)
 {
-    Bins *dst[3];
-    for (int axis = 0; axis < 3; axis++)
-        dst[axis] = &B->bins[live & 1 << axis ? axis : 3];
+    const Box *q = &B->prim[j];
+    _mm_prefetch((const char *)&B->prim[j + 16], _MM_HINT_T0);
+    __m128 c = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(q->v), _mm_load_ps(q->v + 4)), _mm_set1_ps(0.5f));
+    __m128i bi = bin_of3(c, cmin, sc, top);
+    int i0 = _mm_cvtsi128_si32(bi);
+    int i1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 1));
+    int i2 = _mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 2));
+    /* the four lanes (0..255) as bytes */
+    uint32_t packed = (uint32_t)_mm_cvtsi128_si32(_mm_packus_epi16(_mm_packs_epi32(bi, bi), bi));
+    memcpy(B->bin[j], &packed, 4);
+    bin_put(d[0], i0, q);
+    bin_put(d[1], i1, q);
+    bin_put(d[2], i2, q);
+}
+
+static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, const float *scale, int live,
+                      int sets)
+{
+    Bins *dst[BIN_SETS][3];
+    for (int set = 0; set < sets; set++)
+        for (int axis = 0; axis < 3; axis++)
+            dst[set][axis] = &B->bins[live & 1 << axis ? 3 * set + axis : BIN_SINK];
     __m128 cmin = _mm_setr_ps(box_lo(cbox, 0), box_lo(cbox, 1), box_lo(cbox, 2), 0.0f);
     __m128 sc = _mm_setr_ps(scale[0], scale[1], scale[2], 0.0f);
-    __m128 half = _mm_set1_ps(0.5f);
     __m128i top = _mm_set1_epi32(B->p->bins - 1);
-    const Box *prim = B->prim;
-    for (uint32_t j = begin; j < end; j++) {
-        const Box *q = &prim[j];
-        _mm_prefetch((const char *)&prim[j + 16], _MM_HINT_T0);
-        __m128 c = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(q->v), _mm_load_ps(q->v + 4)), half);
-        __m128i bi = bin_of3(c, cmin, sc, top);
-        int i0 = _mm_cvtsi128_si32(bi);
-        int i1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 1));
-        int i2 = _mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 2));
-        /* the four lanes (0..255) as bytes */
-        uint32_t packed = (uint32_t)_mm_cvtsi128_si32(_mm_packus_epi16(_mm_packs_epi32(bi, bi), bi));
-        memcpy(B->bin[j], &packed, 4);
-        bin_put(dst[0], i0, q);
-        bin_put(dst[1], i1, q);
-        bin_put(dst[2], i2, q);
+    uint32_t j = begin;
+    if (sets == BIN_SETS) {
+        _Static_assert(BIN_SETS == 4, "the loop below is unrolled for 4 sets");
+        for (; j + 4 <= end; j += 4) {
+            bin_one(B, j, dst[0], cmin, sc, top);
+            bin_one(B, j + 1, dst[1], cmin, sc, top);
+            bin_one(B, j + 2, dst[2], cmin, sc, top);
+            bin_one(B, j + 3, dst[3], cmin, sc, top);
+        }
     }
+    for (; j < end; j++)
+        bin_one(B, j, dst[0], cmin, sc, top);
 }
 #else
-static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, const float *scale, int live)
+static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, const float *scale, int live,
+                      int sets)
 {
+    (void)sets; /* one set: the sets exist to break the store-to-load chains of the vector loop */
     int nb = B->p->bins;
     for (uint32_t j = begin; j < end; j++) {
         for (int axis = 0; axis < 3; axis++) {
@@ -307,6 +340,19 @@ static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box 
 }
 #endif
 
+/* Grow bins `to` by bins `from` and empty `from`. */
+static void merge_bins(Bins *restrict to, Bins *restrict from, int nb)
+{
+    for (int i = 0; i < nb; i++) {
+        if (from->count[i]) {
+            box_grow(&to->box[i], &from->box[i]);
+            to->count[i] += from->count[i];
+            from->box[i] = box_none;
+            from->count[i] = 0;
+        }
+    }
+}
+
 static Split find_split(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, float parea)
 {
     const BvhParams *p = B->p;
@@ -316,17 +362,21 @@ static Split find_split(const Builder *B, uint32_t begin, uint32_t end, const Bo
     int live = 0;
     for (int axis = 0; axis < 3; axis++) {
         scale[axis] = bin_scale(cbox, axis, nb);
-        if (scale[axis] > 0.0f) {
+        if (scale[axis] > 0.0f)
             live |= 1 << axis;
-            Bins *bins = &B->bins[axis];
-            for (int i = 0; i < nb; i++)
-                bins->box[i] = box_none;
-            memset(bins->count, 0, sizeof(uint32_t) * (size_t)nb);
-        }
     }
     if (!live)
         return best;
-    bin_prims(B, begin, end, cbox, scale, live);
+#if defined(__SSE2__)
+    int sets = end - begin >= BIN_SETS_FROM ? BIN_SETS : 1;
+#else
+    int sets = 1;
+#endif
+    bin_prims(B, begin, end, cbox, scale, live, sets);
+    for (int set = 1; set < sets; set++)
+        for (int axis = 0; axis < 3; axis++)
+            if (live & 1 << axis)
+                merge_bins(&B->bins[axis], &B->bins[3 * set + axis], nb);
     for (int axis = 0; axis < 3; axis++)
         if (live & 1 << axis)
             sweep_axis(p, &B->bins[axis], axis, end - begin, parea, &best);
@@ -431,6 +481,50 @@ static int check_boxes(const float *bmin, const float *bmax, uint32_t n, char *e
     return 0;
 }
 
+/* split_node of two primitives, without bins: what binning them would find. On an axis with a
+ * split (bin_scale > 0: their centroids differ and the extent is finite, not denormal) the lower
+ * centroid lands in bin 0 ((c - cmin) * scale = 0) and the other in the last bin (extent x
+ * (bins / extent) rounds to within 2 ulp of bins >= 2, at least bins - 1 once truncated and
+ * clamped). So each such axis has the one candidate split, at bin 0, whose numerator
+ * area(lower) x 1 + area(upper) x 1 is the same sum on every axis (IEEE addition commutes):
+ * only the first such axis can win, when the cost is finite; the partition puts the lower
+ * centroid first, and the halves are the two primitives' own boxes. */
+static uint32_t split_two(Builder *B, const Task *t, float parea, Halves *h, uint32_t *axis)
+{
+    const BvhParams *p = B->p;
+    uint32_t i = t->begin;
+    int a = 0;
+    while (a < 3 && !(bin_scale(&t->cb, a, p->bins) > 0.0f))
+        a++;
+    float cost = INFINITY;
+    if (a < 3) {
+        float x = box_area(&B->prim[i]) * 1.0f + box_area(&B->prim[i + 1]) * 1.0f;
+        if (x < INFINITY)
+            cost = p->cost_traversal + p->cost_intersect * x / parea;
+    }
+    if (cost < INFINITY && (cost < p->cost_intersect * 2.0f || 2 > p->max_leaf_size)) {
+        *axis = (uint32_t)a;
+        if (centroid_of(&B->prim[i], a) > centroid_of(&B->prim[i + 1], a)) {
+            Box q = B->prim[i];
+            B->prim[i] = B->prim[i + 1];
+            B->prim[i + 1] = q;
+            uint32_t *id = B->b->prim_index, qi = id[i];
+            id[i] = id[i + 1];
+            id[i + 1] = qi;
+        }
+    } else if (!(cost < INFINITY) && 2 > p->max_leaf_size) {
+        *axis = 0; /* all centroids coincide: halved by index */
+    } else {
+        return 0;
+    }
+    for (int k = 0; k < 2; k++) {
+        Vbox q = vbox_load(&B->prim[i + (uint32_t)k]);
+        vbox_store(&h->box[k], q);
+        vbox_store(&h->cbox[k], vbox_centroid(q));
+    }
+    return i + 1;
+}
+
 /* Where node t with box nb splits: mid, or 0 for a leaf; the halves' bounds in h, the axis in
  * *axis. */
 static uint32_t split_node(Builder *B, const Task *t, const Box *nb, Halves *h, uint32_t *axis)
@@ -440,6 +534,10 @@ static uint32_t split_node(Builder *B, const Task *t, const Box *nb, Halves *h, 
     *axis = 0;
     if (count < 2)
         return 0;
+    if (count == 2) {
+        float parea = box_area(nb);
+        return split_two(B, t, parea > 0.0f ? parea : 1.0f, h, axis);
+    }
     float parea = box_area(nb);
     Split s = find_split(B, t->begin, t->end, &t->cb, parea > 0.0f ? parea : 1.0f);
     float leaf_cost = p->cost_intersect * (float)count;
@@ -470,7 +568,7 @@ static void load_prims(Builder *B, const float *bmin, const float *bmax, uint32_
         }
         q->v[3] = q->v[7] = 0.0f;
     }
-    for (int a = 0; a < 4; a++) {
+    for (int a = 0; a <= BIN_SINK; a++) {
         for (int i = 0; i < 256; i++)
             B->bins[a].box[i] = box_none;
         memset(B->bins[a].count, 0, sizeof B->bins[a].count);
@@ -550,7 +648,7 @@ int bvh_build(const BvhParams *p, const float *bmin, const float *bmax, uint32_t
     if (n == 0)
         return 0;
 
-    Builder B = {p, bvh_big_alloc(sizeof(Box) * n), aligned_alloc(32, sizeof(Bins) * 4), bvh_big_alloc(4 * (size_t)n), out};
+    Builder B = {p, bvh_big_alloc(sizeof(Box) * n), aligned_alloc(32, sizeof(Bins) * (BIN_SINK + 1)), bvh_big_alloc(4 * (size_t)n), out};
     out->prim_index = bvh_big_alloc(sizeof(uint32_t) * n);
     out->nodes = bvh_big_alloc(sizeof(BvhNode) * (2 * (size_t)n - 1));
     /* Every task on the stack is the right sibling pending at a distinct depth of the path
