@@ -340,17 +340,120 @@ static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box 
 }
 #endif
 
-/* Grow bins `to` by bins `from` and empty `from`. */
+/* Grow bins `to` by bins `from` and empty `from` (an empty bin's box_none changes no box). */
 static void merge_bins(Bins *restrict to, Bins *restrict from, int nb)
 {
     for (int i = 0; i < nb; i++) {
-        if (from->count[i]) {
-            box_grow(&to->box[i], &from->box[i]);
-            to->count[i] += from->count[i];
-            from->box[i] = box_none;
-            from->count[i] = 0;
+        box_grow(&to->box[i], &from->box[i]);
+        to->count[i] += from->count[i];
+        from->box[i] = box_none;
+        from->count[i] = 0;
+    }
+}
+
+/* find_split of a node of at most SMALL_MAX primitives, without bin arrays: on each axis the
+ * primitives are ranked by (bin, position), and the candidate splits are the ends of the runs of
+ * one bin but the last, each with the left box grown over the ranks up to it and the right box
+ * over the rest. These are the non-empty bins' unions, grown in another order, which can change
+ * only the sign of a zero in a box and so no area (extent_of); the counts, the numerators x, the
+ * costs and the order of the candidates (axis, then bin) are the sweep's, so the same split wins.
+ * Fixed-size loops over SMALL_MAX ranks, the ranks past the node's own holding empty boxes, so
+ * that no branch depends on the node: small nodes are most of the tree and their short
+ * data-dependent loops were mispredicted. The chosen axis's bins go to B->bin for partition. */
+enum { SMALL_MAX = 8 };
+
+static Split find_split_small(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, float parea)
+{
+    const BvhParams *p = B->p;
+    int nb = p->bins;
+    uint32_t k = end - begin;
+    Split best = {-1, 0, INFINITY, INFINITY};
+    float scale[3];
+    int live = 0;
+    for (int axis = 0; axis < 3; axis++) {
+        scale[axis] = bin_scale(cbox, axis, nb);
+        live |= (scale[axis] > 0.0f) << axis;
+    }
+    if (!live)
+        return best;
+    Box q[SMALL_MAX];
+    uint8_t bins[SMALL_MAX][4] = {{0}};
+#if defined(__SSE2__)
+    __m128 cmin = _mm_setr_ps(box_lo(cbox, 0), box_lo(cbox, 1), box_lo(cbox, 2), 0.0f);
+    __m128 sc = _mm_setr_ps(scale[0], scale[1], scale[2], 0.0f);
+    __m128i top = _mm_set1_epi32(nb - 1);
+#endif
+#pragma GCC unroll 8
+    for (uint32_t j = 0; j < SMALL_MAX; j++) {
+        /* the ranks past k hold empty boxes, binned as primitive 0 (and ranked last below) */
+        const Box *pj = &B->prim[begin + (j < k ? j : 0)];
+        q[j] = j < k ? *pj : box_none;
+#if defined(__SSE2__)
+        __m128 c = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(pj->v), _mm_load_ps(pj->v + 4)), _mm_set1_ps(0.5f));
+        __m128i bi = bin_of3(c, cmin, sc, top);
+        uint32_t packed = (uint32_t)_mm_cvtsi128_si32(_mm_packus_epi16(_mm_packs_epi32(bi, bi), bi));
+        memcpy(bins[j], &packed, 4);
+#else
+        for (int axis = 0; axis < 3; axis++)
+            if (live & 1 << axis)
+                bins[j][axis] = (uint8_t)bin_of(centroid_of(pj, axis), box_lo(cbox, axis), scale[axis], nb);
+#endif
+    }
+    for (int axis = 0; axis < 3; axis++) {
+        if (!(live & 1 << axis))
+            continue;
+        /* distinct keys (bin, position), the empty boxes' above every bin; a rank is the number
+         * of smaller keys */
+        uint16_t key[SMALL_MAX];
+#pragma GCC unroll 8
+        for (uint32_t j = 0; j < SMALL_MAX; j++)
+            key[j] = (uint16_t)(((uint32_t)bins[j][axis] | (uint32_t)(j >= k) << 9) << 3 | j);
+        uint32_t sorted_bin[SMALL_MAX];
+        Vbox sorted[SMALL_MAX];
+#if defined(__SSE2__)
+        _Static_assert(SMALL_MAX == 8, "the ranks are taken in one 8 x 16-bit vector");
+        __m128i keys;
+        memcpy(&keys, key, sizeof keys);
+#endif
+#pragma GCC unroll 8
+        for (uint32_t j = 0; j < SMALL_MAX; j++) {
+#if defined(__SSE2__)
+            /* keys < 2^12: the signed 16-bit compare is the unsigned one */
+            __m128i less = _mm_cmplt_epi16(keys, _mm_set1_epi16((short)key[j]));
+            uint32_t r = (uint32_t)__builtin_popcount((unsigned)_mm_movemask_epi8(less)) / 2;
+#else
+            uint32_t r = 0;
+            for (uint32_t i = 0; i < SMALL_MAX; i++)
+                r += key[i] < key[j];
+#endif
+            sorted_bin[r] = (uint32_t)key[j] >> 3;
+            sorted[r] = vbox_load(&q[j]);
+        }
+        float left_area[SMALL_MAX], right_area[SMALL_MAX];
+        Vbox left = vbox_load(&box_none), right = left;
+#pragma GCC unroll 8
+        for (int r = 0; r < SMALL_MAX - 1; r++) {
+            left = vbox_grow(left, sorted[r]);
+            left_area[r] = vbox_area(left);
+            right = vbox_grow(right, sorted[SMALL_MAX - 1 - r]);
+            right_area[SMALL_MAX - 1 - r] = vbox_area(right);
+        }
+#pragma GCC unroll 8
+        for (uint32_t r = 0; r + 1 < SMALL_MAX; r++) {
+            float x = left_area[r] * (float)(r + 1) + right_area[r + 1] * (float)(k - (r + 1));
+            /* best.x is not needed to skip divisions here: a candidate whose x is not below the
+             * best's cannot cost less (see sweep_axis) */
+            float cost = p->cost_traversal + p->cost_intersect * x / parea;
+            int wins = (r + 1 < k) & (sorted_bin[r] < sorted_bin[r + 1]) & (cost < best.cost);
+            best.axis = wins ? axis : best.axis;
+            best.bin = wins ? (int)sorted_bin[r] : best.bin;
+            best.cost = wins ? cost : best.cost;
+            best.x = wins ? x : best.x;
         }
     }
+    for (uint32_t j = 0; j < k; j++)
+        memcpy(B->bin[begin + j], bins[j], 4);
+    return best;
 }
 
 static Split find_split(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, float parea)
@@ -539,7 +642,9 @@ static uint32_t split_node(Builder *B, const Task *t, const Box *nb, Halves *h, 
         return split_two(B, t, parea > 0.0f ? parea : 1.0f, h, axis);
     }
     float parea = box_area(nb);
-    Split s = find_split(B, t->begin, t->end, &t->cb, parea > 0.0f ? parea : 1.0f);
+    parea = parea > 0.0f ? parea : 1.0f;
+    Split s = count <= SMALL_MAX ? find_split_small(B, t->begin, t->end, &t->cb, parea)
+                                 : find_split(B, t->begin, t->end, &t->cb, parea);
     float leaf_cost = p->cost_intersect * (float)count;
     if (s.axis >= 0 && (s.cost < leaf_cost || count > (uint32_t)p->max_leaf_size)) {
         *axis = (uint32_t)s.axis;
@@ -680,35 +785,35 @@ void bvh_free(Bvh *b)
     memset(b, 0, sizeof *b);
 }
 
-static int inside(const float *lo, const float *hi, const float *plo, const float *phi)
+/* Six comparisons, no branch between them (most boxes are inside). */
+static inline int inside(const float *lo, const float *hi, const float *plo, const float *phi)
 {
-    for (int k = 0; k < 3; k++)
-        if (lo[k] < plo[k] || hi[k] > phi[k])
-            return 0;
-    return 1;
+    return !((lo[0] < plo[0]) | (lo[1] < plo[1]) | (lo[2] < plo[2]) | (hi[0] > phi[0]) | (hi[1] > phi[1]) |
+             (hi[2] > phi[2]));
 }
 
+/* One pass over the nodes in index order. A child's index is above its parent's (checked), so a
+ * node other than the root that is some inner node's child exactly once is reached from the root
+ * exactly once: its parent, by induction on the index, is; so is every node, when each but the
+ * root has one parent and the root none (no child index is 0). Visiting every node, reachable or
+ * not, checks more than a walk from the root, and the pass keeps no stack. */
 int bvh_check(const Bvh *b, const float *bmin, const float *bmax, char *err, size_t errlen)
 {
     if (b->nprims == 0)
         return b->nnodes == 0 ? 0 : (snprintf(err, errlen, "bvh: nodes without primitives"), -1);
     int rc = -1;
     uint8_t *seen_prim = calloc(b->nprims, 1);
-    uint8_t *seen_node = calloc(b->nnodes, 1);
-    uint32_t *stack = malloc(sizeof(uint32_t) * (b->nnodes + 1));
-    if (!seen_prim || !seen_node || !stack) {
+    uint8_t *seen_node = calloc(b->nnodes ? b->nnodes : 1, 1);
+    if (!seen_prim || !seen_node) {
         snprintf(err, errlen, "bvh: out of memory");
         goto out;
     }
-    uint32_t sp = 0;
-    stack[sp++] = 0;
-    while (sp > 0) {
-        uint32_t i = stack[--sp];
+    if (b->nnodes == 0) {
+        snprintf(err, errlen, "bvh: primitive 0 is in no leaf");
+        goto out;
+    }
+    for (uint32_t i = 0; i < b->nnodes; i++) {
         const BvhNode *n = &b->nodes[i];
-        if (seen_node[i]++) {
-            snprintf(err, errlen, "bvh: node %u reached twice", i);
-            goto out;
-        }
         for (int k = 0; k < 3; k++) {
             if (isnan(n->bmin[k]) || isnan(n->bmax[k]) || n->bmin[k] > n->bmax[k]) {
                 snprintf(err, errlen, "bvh: node %u has a bad box on axis %d", i, k);
@@ -742,7 +847,10 @@ int bvh_check(const Bvh *b, const float *bmin, const float *bmax, char *err, siz
                     snprintf(err, errlen, "bvh: child %u sticks out of its parent %u", c, i);
                     goto out;
                 }
-                stack[sp++] = c;
+                if (seen_node[c]++) {
+                    snprintf(err, errlen, "bvh: node %u reached twice", c);
+                    goto out;
+                }
             }
         }
     }
@@ -752,7 +860,7 @@ int bvh_check(const Bvh *b, const float *bmin, const float *bmax, char *err, siz
             goto out;
         }
     }
-    for (uint32_t i = 0; i < b->nnodes; i++) {
+    for (uint32_t i = 1; i < b->nnodes; i++) {
         if (!seen_node[i]) {
             snprintf(err, errlen, "bvh: node %u is unreachable", i);
             goto out;
@@ -762,14 +870,13 @@ int bvh_check(const Bvh *b, const float *bmin, const float *bmax, char *err, siz
 out:
     free(seen_prim);
     free(seen_node);
-    free(stack);
     return rc;
 }
 
 /* Surface area in double: a box of finite floats has a finite area here (extents up to 7e38,
  * products up to 5e77), where the float area overflows from extents of about 1e19 on (a sphere of
  * radius 1e30 gave inf / inf = NaN as the cost). */
-static double node_area(const float *lo, const float *hi)
+static inline double node_area(const float *lo, const float *hi)
 {
     double d[3];
     for (int k = 0; k < 3; k++)
