@@ -9,7 +9,9 @@
  * The build is written for speed (primitives copied into build order as 32-byte boxes, one
  * binning pass for the three axes with their bin indices computed in the lanes of one vector and
  * kept for the partition, children's boxes grown during the partition, only non-empty bins swept,
- * a split's cost divided out only when it can win, large arrays on huge pages) and must give the
+ * a split's cost divided out only when it can win, large arrays on huge pages, large nodes binned
+ * into several sets of bins, nodes of two primitives and of up to eight split without bin arrays,
+ * only the bins used emptied) and must give the
  * trees of the plain algorithm in tests/support/bvh_ref.c, bit for bit, zeros' signs included:
  * tests/unit/test_bvh.c compares them, on random and degenerate boxes and on real meshes.
  */
