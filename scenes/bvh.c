@@ -9,7 +9,9 @@
  * The build is written for speed (primitives copied into build order as 32-byte boxes, one
  * binning pass for the three axes with their bin indices computed in the lanes of one vector and
  * kept for the partition, children's boxes grown during the partition, only non-empty bins swept,
- * a split's cost divided out only when it can win, large arrays on huge pages) and must give the
+ * a split's cost divided out only when it can win, large arrays on huge pages, large nodes binned
+ * into several sets of bins, nodes of two primitives and of up to eight split without bin arrays,
+ * only the bins used emptied) and must give the
  * trees of the plain algorithm in tests/support/bvh_ref.c, bit for bit, zeros' signs included:
  * tests/unit/test_bvh.c compares them, on random and degenerate boxes and on real meshes.
  */
@@ -154,11 +156,21 @@ typedef struct Bins {
 typedef struct Builder {
     const BvhParams *p;
     Box *prim;   /* n, in prim_index order (which the partition permutes with them) */
-    Bins *bins;  /* 4: one per axis, and a sink for the axes that give no split */
+    Bins *bins;  /* BIN_SETS sets of one per axis, then a sink for the axes that give no split;
+                  * empty (box_none, count 0) between nodes, except the sink, which is never read */
     uint8_t (*bin)[4]; /* n: each position's bin on the three axes in the last binning that
                         * covered it, moved with the primitives by the partition */
     Bvh *b;
 } Builder;
+
+/* Binning a large node spreads its primitives over BIN_SETS sets of bins (primitive j into set j
+ * mod BIN_SETS), merged before the sweep: growing one bin's box is a load, a minimum and a store,
+ * and consecutive primitives, neighbours in the mesh, fall in the same bin so often that each
+ * waited for the previous one's store. Order does not matter to a bin's box, up to the sign of
+ * a zero (a minimum of the same values), and zeros' signs do not change the areas the sweep
+ * computes (extent_of: hi > lo ? hi - lo : 0 is the same for -0 and +0), so the splits are the
+ * same. Smaller nodes use set 0 alone. */
+enum { BIN_SETS = 4, BIN_SETS_FROM = 64, BIN_SINK = 3 * BIN_SETS };
 
 /* Bin of a centroid on one axis; the same expression is used to count and to partition, so
  * the two always agree. */
@@ -198,7 +210,7 @@ static int list_nonempty(const uint32_t *count, int nb, int *list)
  * / parea, each step non-decreasing in x (cost_intersect > 0, parea > 0): a candidate whose x is
  * not below the best's cannot cost strictly less, so its division is skipped (NaN costs, from an
  * infinite parea, compare false either way). */
-static void sweep_axis(const BvhParams *p, const Bins *bins, int axis, uint32_t total, float parea,
+static void sweep_axis(const BvhParams *p, Bins *bins, int axis, uint32_t total, float parea,
                        Split *best)
 {
     int nonempty[256], m = list_nonempty(bins->count, p->bins, nonempty);
@@ -225,6 +237,11 @@ static void sweep_axis(const BvhParams *p, const Bins *bins, int axis, uint32_t 
             best->cost = cost;
             best->x = x;
         }
+    }
+    /* empty the bins for the next node: only the non-empty ones need it */
+    for (int r = 0; r < m; r++) {
+        bins->box[nonempty[r]] = box_none;
+        bins->count[nonempty[r]] = 0;
     }
 }
 
@@ -264,36 +281,54 @@ static inline __m128i bin_of3(__m128 c, __m128 cmin, __m128 scale, __m128i top)
 }
 
 /* One pass puts every primitive in its bin on each axis; each bin still grows in primitive order.
- * An axis that gives no split bins into the sink, bins[3]. */
-static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, const float *scale, int live)
+ * An axis that gives no split bins into the sink. With sets > 1, primitive j goes to set j mod sets
+ * (sets is a power of 2). */
+/* Primitive j into bins d (one per axis) and its bin bytes into B->bin[j]. */
+static inline void bin_one(const Builder *B, uint32_t j, Bins *const *d, __m128 cmin, __m128 sc, __m128i top)
 {
-    Bins *dst[3];
-    for (int axis = 0; axis < 3; axis++)
-        dst[axis] = &B->bins[live & 1 << axis ? axis : 3];
+    const Box *q = &B->prim[j];
+    _mm_prefetch((const char *)&B->prim[j + 16], _MM_HINT_T0);
+    __m128 c = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(q->v), _mm_load_ps(q->v + 4)), _mm_set1_ps(0.5f));
+    __m128i bi = bin_of3(c, cmin, sc, top);
+    int i0 = _mm_cvtsi128_si32(bi);
+    int i1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 1));
+    int i2 = _mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 2));
+    /* the four lanes (0..255) as bytes */
+    uint32_t packed = (uint32_t)_mm_cvtsi128_si32(_mm_packus_epi16(_mm_packs_epi32(bi, bi), bi));
+    memcpy(B->bin[j], &packed, 4);
+    bin_put(d[0], i0, q);
+    bin_put(d[1], i1, q);
+    bin_put(d[2], i2, q);
+}
+
+static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, const float *scale, int live,
+                      int sets)
+{
+    Bins *dst[BIN_SETS][3];
+    for (int set = 0; set < sets; set++)
+        for (int axis = 0; axis < 3; axis++)
+            dst[set][axis] = &B->bins[live & 1 << axis ? 3 * set + axis : BIN_SINK];
     __m128 cmin = _mm_setr_ps(box_lo(cbox, 0), box_lo(cbox, 1), box_lo(cbox, 2), 0.0f);
     __m128 sc = _mm_setr_ps(scale[0], scale[1], scale[2], 0.0f);
-    __m128 half = _mm_set1_ps(0.5f);
     __m128i top = _mm_set1_epi32(B->p->bins - 1);
-    const Box *prim = B->prim;
-    for (uint32_t j = begin; j < end; j++) {
-        const Box *q = &prim[j];
-        _mm_prefetch((const char *)&prim[j + 16], _MM_HINT_T0);
-        __m128 c = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(q->v), _mm_load_ps(q->v + 4)), half);
-        __m128i bi = bin_of3(c, cmin, sc, top);
-        int i0 = _mm_cvtsi128_si32(bi);
-        int i1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 1));
-        int i2 = _mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 2));
-        /* the four lanes (0..255) as bytes */
-        uint32_t packed = (uint32_t)_mm_cvtsi128_si32(_mm_packus_epi16(_mm_packs_epi32(bi, bi), bi));
-        memcpy(B->bin[j], &packed, 4);
-        bin_put(dst[0], i0, q);
-        bin_put(dst[1], i1, q);
-        bin_put(dst[2], i2, q);
+    uint32_t j = begin;
+    if (sets == BIN_SETS) {
+        _Static_assert(BIN_SETS == 4, "the loop below is unrolled for 4 sets");
+        for (; j + 4 <= end; j += 4) {
+            bin_one(B, j, dst[0], cmin, sc, top);
+            bin_one(B, j + 1, dst[1], cmin, sc, top);
+            bin_one(B, j + 2, dst[2], cmin, sc, top);
+            bin_one(B, j + 3, dst[3], cmin, sc, top);
+        }
     }
+    for (; j < end; j++)
+        bin_one(B, j, dst[0], cmin, sc, top);
 }
 #else
-static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, const float *scale, int live)
+static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, const float *scale, int live,
+                      int sets)
 {
+    (void)sets; /* one set: the sets exist to break the store-to-load chains of the vector loop */
     int nb = B->p->bins;
     for (uint32_t j = begin; j < end; j++) {
         for (int axis = 0; axis < 3; axis++) {
@@ -307,6 +342,122 @@ static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box 
 }
 #endif
 
+/* Grow bins `to` by bins `from` and empty `from` (an empty bin's box_none changes no box). */
+static void merge_bins(Bins *restrict to, Bins *restrict from, int nb)
+{
+    for (int i = 0; i < nb; i++) {
+        box_grow(&to->box[i], &from->box[i]);
+        to->count[i] += from->count[i];
+        from->box[i] = box_none;
+        from->count[i] = 0;
+    }
+}
+
+/* find_split of a node of at most SMALL_MAX primitives, without bin arrays: on each axis the
+ * primitives are ranked by (bin, position), and the candidate splits are the ends of the runs of
+ * one bin but the last, each with the left box grown over the ranks up to it and the right box
+ * over the rest. These are the non-empty bins' unions, grown in another order, which can change
+ * only the sign of a zero in a box and so no area (extent_of); the counts, the numerators x, the
+ * costs and the order of the candidates (axis, then bin) are the sweep's, so the same split wins.
+ * Fixed-size loops over SMALL_MAX ranks, the ranks past the node's own holding empty boxes, so
+ * that no branch depends on the node: small nodes are most of the tree and their short
+ * data-dependent loops were mispredicted. The chosen axis's bins go to B->bin for partition. */
+enum { SMALL_MAX = 8 };
+
+static Split find_split_small(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, float parea)
+{
+    const BvhParams *p = B->p;
+    int nb = p->bins;
+    uint32_t k = end - begin;
+    Split best = {-1, 0, INFINITY, INFINITY};
+    float scale[3];
+    int live = 0;
+    for (int axis = 0; axis < 3; axis++) {
+        scale[axis] = bin_scale(cbox, axis, nb);
+        live |= (scale[axis] > 0.0f) << axis;
+    }
+    if (!live)
+        return best;
+    Box q[SMALL_MAX];
+    uint8_t bins[SMALL_MAX][4] = {{0}};
+#if defined(__SSE2__)
+    __m128 cmin = _mm_setr_ps(box_lo(cbox, 0), box_lo(cbox, 1), box_lo(cbox, 2), 0.0f);
+    __m128 sc = _mm_setr_ps(scale[0], scale[1], scale[2], 0.0f);
+    __m128i top = _mm_set1_epi32(nb - 1);
+#endif
+#pragma GCC unroll 8
+    for (uint32_t j = 0; j < SMALL_MAX; j++) {
+        /* the ranks past k hold empty boxes, binned as primitive 0 (and ranked last below) */
+        const Box *pj = &B->prim[begin + (j < k ? j : 0)];
+        q[j] = j < k ? *pj : box_none;
+#if defined(__SSE2__)
+        __m128 c = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(pj->v), _mm_load_ps(pj->v + 4)), _mm_set1_ps(0.5f));
+        __m128i bi = bin_of3(c, cmin, sc, top);
+        uint32_t packed = (uint32_t)_mm_cvtsi128_si32(_mm_packus_epi16(_mm_packs_epi32(bi, bi), bi));
+        memcpy(bins[j], &packed, 4);
+#else
+        for (int axis = 0; axis < 3; axis++)
+            if (live & 1 << axis)
+                bins[j][axis] = (uint8_t)bin_of(centroid_of(pj, axis), box_lo(cbox, axis), scale[axis], nb);
+#endif
+    }
+    for (int axis = 0; axis < 3; axis++) {
+        if (!(live & 1 << axis))
+            continue;
+        /* distinct keys (bin, position), the empty boxes' above every bin; a rank is the number
+         * of smaller keys */
+        uint16_t key[SMALL_MAX];
+#pragma GCC unroll 8
+        for (uint32_t j = 0; j < SMALL_MAX; j++)
+            key[j] = (uint16_t)(((uint32_t)bins[j][axis] | (uint32_t)(j >= k) << 9) << 3 | j);
+        uint32_t sorted_bin[SMALL_MAX];
+        Vbox sorted[SMALL_MAX];
+#if defined(__SSE2__)
+        _Static_assert(SMALL_MAX == 8, "the ranks are taken in one 8 x 16-bit vector");
+        __m128i keys;
+        memcpy(&keys, key, sizeof keys);
+#endif
+#pragma GCC unroll 8
+        for (uint32_t j = 0; j < SMALL_MAX; j++) {
+#if defined(__SSE2__)
+            /* keys < 2^12: the signed 16-bit compare is the unsigned one */
+            __m128i less = _mm_cmplt_epi16(keys, _mm_set1_epi16((short)key[j]));
+            uint32_t r = (uint32_t)__builtin_popcount((unsigned)_mm_movemask_epi8(less)) / 2;
+#else
+            uint32_t r = 0;
+            for (uint32_t i = 0; i < SMALL_MAX; i++)
+                r += key[i] < key[j];
+#endif
+            sorted_bin[r] = (uint32_t)key[j] >> 3;
+            sorted[r] = vbox_load(&q[j]);
+        }
+        float left_area[SMALL_MAX], right_area[SMALL_MAX];
+        Vbox left = vbox_load(&box_none), right = left;
+#pragma GCC unroll 8
+        for (int r = 0; r < SMALL_MAX - 1; r++) {
+            left = vbox_grow(left, sorted[r]);
+            left_area[r] = vbox_area(left);
+            right = vbox_grow(right, sorted[SMALL_MAX - 1 - r]);
+            right_area[SMALL_MAX - 1 - r] = vbox_area(right);
+        }
+#pragma GCC unroll 8
+        for (uint32_t r = 0; r + 1 < SMALL_MAX; r++) {
+            float x = left_area[r] * (float)(r + 1) + right_area[r + 1] * (float)(k - (r + 1));
+            /* best.x is not needed to skip divisions here: a candidate whose x is not below the
+             * best's cannot cost less (see sweep_axis) */
+            float cost = p->cost_traversal + p->cost_intersect * x / parea;
+            int wins = (r + 1 < k) & (sorted_bin[r] < sorted_bin[r + 1]) & (cost < best.cost);
+            best.axis = wins ? axis : best.axis;
+            best.bin = wins ? (int)sorted_bin[r] : best.bin;
+            best.cost = wins ? cost : best.cost;
+            best.x = wins ? x : best.x;
+        }
+    }
+    for (uint32_t j = 0; j < k; j++)
+        memcpy(B->bin[begin + j], bins[j], 4);
+    return best;
+}
+
 static Split find_split(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, float parea)
 {
     const BvhParams *p = B->p;
@@ -316,17 +467,21 @@ static Split find_split(const Builder *B, uint32_t begin, uint32_t end, const Bo
     int live = 0;
     for (int axis = 0; axis < 3; axis++) {
         scale[axis] = bin_scale(cbox, axis, nb);
-        if (scale[axis] > 0.0f) {
+        if (scale[axis] > 0.0f)
             live |= 1 << axis;
-            Bins *bins = &B->bins[axis];
-            for (int i = 0; i < nb; i++)
-                bins->box[i] = box_none;
-            memset(bins->count, 0, sizeof(uint32_t) * (size_t)nb);
-        }
     }
     if (!live)
         return best;
-    bin_prims(B, begin, end, cbox, scale, live);
+#if defined(__SSE2__)
+    int sets = end - begin >= BIN_SETS_FROM ? BIN_SETS : 1;
+#else
+    int sets = 1;
+#endif
+    bin_prims(B, begin, end, cbox, scale, live, sets);
+    for (int set = 1; set < sets; set++)
+        for (int axis = 0; axis < 3; axis++)
+            if (live & 1 << axis)
+                merge_bins(&B->bins[axis], &B->bins[3 * set + axis], nb);
     for (int axis = 0; axis < 3; axis++)
         if (live & 1 << axis)
             sweep_axis(p, &B->bins[axis], axis, end - begin, parea, &best);
@@ -431,6 +586,50 @@ static int check_boxes(const float *bmin, const float *bmax, uint32_t n, char *e
     return 0;
 }
 
+/* split_node of two primitives, without bins: what binning them would find. On an axis with a
+ * split (bin_scale > 0: their centroids differ and the extent is finite, not denormal) the lower
+ * centroid lands in bin 0 ((c - cmin) * scale = 0) and the other in the last bin (extent x
+ * (bins / extent) rounds to within 2 ulp of bins >= 2, at least bins - 1 once truncated and
+ * clamped). So each such axis has the one candidate split, at bin 0, whose numerator
+ * area(lower) x 1 + area(upper) x 1 is the same sum on every axis (IEEE addition commutes):
+ * only the first such axis can win, when the cost is finite; the partition puts the lower
+ * centroid first, and the halves are the two primitives' own boxes. */
+static uint32_t split_two(Builder *B, const Task *t, float parea, Halves *h, uint32_t *axis)
+{
+    const BvhParams *p = B->p;
+    uint32_t i = t->begin;
+    int a = 0;
+    while (a < 3 && !(bin_scale(&t->cb, a, p->bins) > 0.0f))
+        a++;
+    float cost = INFINITY;
+    if (a < 3) {
+        float x = box_area(&B->prim[i]) * 1.0f + box_area(&B->prim[i + 1]) * 1.0f;
+        if (x < INFINITY)
+            cost = p->cost_traversal + p->cost_intersect * x / parea;
+    }
+    if (cost < INFINITY && (cost < p->cost_intersect * 2.0f || 2 > p->max_leaf_size)) {
+        *axis = (uint32_t)a;
+        if (centroid_of(&B->prim[i], a) > centroid_of(&B->prim[i + 1], a)) {
+            Box q = B->prim[i];
+            B->prim[i] = B->prim[i + 1];
+            B->prim[i + 1] = q;
+            uint32_t *id = B->b->prim_index, qi = id[i];
+            id[i] = id[i + 1];
+            id[i + 1] = qi;
+        }
+    } else if (!(cost < INFINITY) && 2 > p->max_leaf_size) {
+        *axis = 0; /* all centroids coincide: halved by index */
+    } else {
+        return 0;
+    }
+    for (int k = 0; k < 2; k++) {
+        Vbox q = vbox_load(&B->prim[i + (uint32_t)k]);
+        vbox_store(&h->box[k], q);
+        vbox_store(&h->cbox[k], vbox_centroid(q));
+    }
+    return i + 1;
+}
+
 /* Where node t with box nb splits: mid, or 0 for a leaf; the halves' bounds in h, the axis in
  * *axis. */
 static uint32_t split_node(Builder *B, const Task *t, const Box *nb, Halves *h, uint32_t *axis)
@@ -440,8 +639,14 @@ static uint32_t split_node(Builder *B, const Task *t, const Box *nb, Halves *h, 
     *axis = 0;
     if (count < 2)
         return 0;
+    if (count == 2) {
+        float parea = box_area(nb);
+        return split_two(B, t, parea > 0.0f ? parea : 1.0f, h, axis);
+    }
     float parea = box_area(nb);
-    Split s = find_split(B, t->begin, t->end, &t->cb, parea > 0.0f ? parea : 1.0f);
+    parea = parea > 0.0f ? parea : 1.0f;
+    Split s = count <= SMALL_MAX ? find_split_small(B, t->begin, t->end, &t->cb, parea)
+                                 : find_split(B, t->begin, t->end, &t->cb, parea);
     float leaf_cost = p->cost_intersect * (float)count;
     if (s.axis >= 0 && (s.cost < leaf_cost || count > (uint32_t)p->max_leaf_size)) {
         *axis = (uint32_t)s.axis;
@@ -470,7 +675,7 @@ static void load_prims(Builder *B, const float *bmin, const float *bmax, uint32_
         }
         q->v[3] = q->v[7] = 0.0f;
     }
-    for (int a = 0; a < 4; a++) {
+    for (int a = 0; a <= BIN_SINK; a++) {
         for (int i = 0; i < 256; i++)
             B->bins[a].box[i] = box_none;
         memset(B->bins[a].count, 0, sizeof B->bins[a].count);
@@ -550,7 +755,7 @@ int bvh_build(const BvhParams *p, const float *bmin, const float *bmax, uint32_t
     if (n == 0)
         return 0;
 
-    Builder B = {p, bvh_big_alloc(sizeof(Box) * n), aligned_alloc(32, sizeof(Bins) * 4), bvh_big_alloc(4 * (size_t)n), out};
+    Builder B = {p, bvh_big_alloc(sizeof(Box) * n), aligned_alloc(32, sizeof(Bins) * (BIN_SINK + 1)), bvh_big_alloc(4 * (size_t)n), out};
     out->prim_index = bvh_big_alloc(sizeof(uint32_t) * n);
     out->nodes = bvh_big_alloc(sizeof(BvhNode) * (2 * (size_t)n - 1));
     /* Every task on the stack is the right sibling pending at a distinct depth of the path
@@ -582,35 +787,35 @@ void bvh_free(Bvh *b)
     memset(b, 0, sizeof *b);
 }
 
-static int inside(const float *lo, const float *hi, const float *plo, const float *phi)
+/* Six comparisons, no branch between them (most boxes are inside). */
+static inline int inside(const float *lo, const float *hi, const float *plo, const float *phi)
 {
-    for (int k = 0; k < 3; k++)
-        if (lo[k] < plo[k] || hi[k] > phi[k])
-            return 0;
-    return 1;
+    return !((lo[0] < plo[0]) | (lo[1] < plo[1]) | (lo[2] < plo[2]) | (hi[0] > phi[0]) | (hi[1] > phi[1]) |
+             (hi[2] > phi[2]));
 }
 
+/* One pass over the nodes in index order. A child's index is above its parent's (checked), so a
+ * node other than the root that is some inner node's child exactly once is reached from the root
+ * exactly once: its parent, by induction on the index, is; so is every node, when each but the
+ * root has one parent and the root none (no child index is 0). Visiting every node, reachable or
+ * not, checks more than a walk from the root, and the pass keeps no stack. */
 int bvh_check(const Bvh *b, const float *bmin, const float *bmax, char *err, size_t errlen)
 {
     if (b->nprims == 0)
         return b->nnodes == 0 ? 0 : (snprintf(err, errlen, "bvh: nodes without primitives"), -1);
     int rc = -1;
     uint8_t *seen_prim = calloc(b->nprims, 1);
-    uint8_t *seen_node = calloc(b->nnodes, 1);
-    uint32_t *stack = malloc(sizeof(uint32_t) * (b->nnodes + 1));
-    if (!seen_prim || !seen_node || !stack) {
+    uint8_t *seen_node = calloc(b->nnodes ? b->nnodes : 1, 1);
+    if (!seen_prim || !seen_node) {
         snprintf(err, errlen, "bvh: out of memory");
         goto out;
     }
-    uint32_t sp = 0;
-    stack[sp++] = 0;
-    while (sp > 0) {
-        uint32_t i = stack[--sp];
+    if (b->nnodes == 0) {
+        snprintf(err, errlen, "bvh: primitive 0 is in no leaf");
+        goto out;
+    }
+    for (uint32_t i = 0; i < b->nnodes; i++) {
         const BvhNode *n = &b->nodes[i];
-        if (seen_node[i]++) {
-            snprintf(err, errlen, "bvh: node %u reached twice", i);
-            goto out;
-        }
         for (int k = 0; k < 3; k++) {
             if (isnan(n->bmin[k]) || isnan(n->bmax[k]) || n->bmin[k] > n->bmax[k]) {
                 snprintf(err, errlen, "bvh: node %u has a bad box on axis %d", i, k);
@@ -644,7 +849,10 @@ int bvh_check(const Bvh *b, const float *bmin, const float *bmax, char *err, siz
                     snprintf(err, errlen, "bvh: child %u sticks out of its parent %u", c, i);
                     goto out;
                 }
-                stack[sp++] = c;
+                if (seen_node[c]++) {
+                    snprintf(err, errlen, "bvh: node %u reached twice", c);
+                    goto out;
+                }
             }
         }
     }
@@ -654,7 +862,7 @@ int bvh_check(const Bvh *b, const float *bmin, const float *bmax, char *err, siz
             goto out;
         }
     }
-    for (uint32_t i = 0; i < b->nnodes; i++) {
+    for (uint32_t i = 1; i < b->nnodes; i++) {
         if (!seen_node[i]) {
             snprintf(err, errlen, "bvh: node %u is unreachable", i);
             goto out;
@@ -664,14 +872,13 @@ int bvh_check(const Bvh *b, const float *bmin, const float *bmax, char *err, siz
 out:
     free(seen_prim);
     free(seen_node);
-    free(stack);
     return rc;
 }
 
 /* Surface area in double: a box of finite floats has a finite area here (extents up to 7e38,
  * products up to 5e77), where the float area overflows from extents of about 1e19 on (a sphere of
  * radius 1e30 gave inf / inf = NaN as the cost). */
-static double node_area(const float *lo, const float *hi)
+static inline double node_area(const float *lo, const float *hi)
 {
     double d[3];
     for (int k = 0; k < 3; k++)

@@ -230,6 +230,15 @@ Test(bvh_errors, checker_catches_broken_trees)
     cr_expect_eq(bvh_check(&b, lo, hi, err, sizeof err), -1);
     cr_expect(strstr(err, "sticks out") != NULL, "%s", err);
     b.nodes[c].bmax[0] = old;
+    /* The root's children index pointing at another inner node's children: those are reached
+     * twice, the root's own unreachable. */
+    uint32_t x = 1;
+    while (b.nodes[x].count > 0)
+        x++;
+    b.nodes[0].first = b.nodes[x].first;
+    cr_expect_eq(bvh_check(&b, lo, hi, err, sizeof err), -1);
+    cr_expect(strstr(err, "reached twice") != NULL, "%s", err);
+    b.nodes[0].first = c;
     cr_expect_eq(bvh_check(&b, lo, hi, err, sizeof err), 0, "%s", err);
     bvh_free(&b);
     free(lo);
@@ -303,6 +312,37 @@ Test(bvh_build, matches_the_plain_reference_bit_for_bit)
     }
     free(lo);
     free(hi);
+}
+
+/* Small inputs, 2 to 20 primitives: the builder's own paths for nodes of two primitives and of up
+ * to eight (no bin arrays) decide every split here, against the plain reference, on every box
+ * family and parameter set, ties and zeros' signs included. */
+Test(bvh_build, small_nodes_match_the_plain_reference)
+{
+    static const BvhParams params[] = {{4, 16, 1.0f, 1.0f}, {1, 2, 1.0f, 1.0f}, {8, 256, 0.5f, 1.0f},
+                                       {2, 7, 1.0f, 2.0f}, {1, 16, 0.0f, 1.0f}, {4, 16, 4.0f, 1.0f}};
+    float lo[3 * 20], hi[3 * 20];
+    char err[256];
+    for (int f = 0; f < 5; f++) {
+        for (uint32_t n = 2; n <= 20; n++) {
+            for (int rep = 0; rep < 20; rep++) {
+                family_boxes(f, n, lo, hi);
+                for (size_t q = 0; q < sizeof params / sizeof params[0]; q++) {
+                    Bvh fast, ref;
+                    cr_assert_eq(bvh_build(&params[q], lo, hi, n, &fast, err, sizeof err), 0, "%s", err);
+                    cr_assert_eq(bvh_ref_build(&params[q], lo, hi, n, &ref), 0);
+                    cr_assert_eq(fast.nnodes, ref.nnodes, "family %d, n %u, parameters %zu", f, n, q);
+                    cr_assert_eq(memcmp(fast.nodes, ref.nodes, sizeof(BvhNode) * ref.nnodes), 0,
+                                 "family %d, n %u, parameters %zu: nodes differ", f, n, q);
+                    cr_assert_eq(memcmp(fast.prim_index, ref.prim_index, sizeof(uint32_t) * n), 0,
+                                 "family %d, n %u, parameters %zu: primitive order differs", f, n, q);
+                    cr_assert(fast.sah_cost == ref.sah_cost);
+                    bvh_free(&fast);
+                    bvh_free(&ref);
+                }
+            }
+        }
+    }
 }
 
 /* The tie rule the trees were first built with: a box keeps the zero it holds when the other
