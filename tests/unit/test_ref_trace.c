@@ -182,42 +182,57 @@ Test(ref_sphere, outside_inside_tangent)
     cr_expect_float_eq(t, 1e4f - 1e-2f, 1e-2f);
 }
 
+/* A soup of n small random triangles in [-5, 5]^3, each within spread of its centre, from the
+ * generator state *st (left where the soup ends, for the caller's rays), packed with leaves of up
+ * to max_leaf primitives (0: the default build). s->pos and s->tri_material are the caller's to
+ * free. */
+static void soup_pack(uint32_t n, float spread, uint32_t *st, int max_leaf, Scene *s, SceneMaterial *m,
+                      PackedScene *p)
+{
+    memset(s, 0, sizeof *s);
+    float *pos = malloc(sizeof(float) * 9 * n);
+    uint32_t *tm = calloc(n, sizeof(uint32_t));
+    cr_assert(pos && tm);
+    for (uint32_t i = 0; i < n; i++) {
+        float c[3];
+        for (int k = 0; k < 3; k++) {
+            *st = *st * 1664525u + 1013904223u;
+            c[k] = (float)(*st >> 8) / 16777216.0f * 10.0f - 5.0f;
+        }
+        for (int v = 0; v < 3; v++)
+            for (int k = 0; k < 3; k++) {
+                *st = *st * 1664525u + 1013904223u;
+                pos[9 * i + 3 * v + k] = c[k] + ((float)(*st >> 8) / 16777216.0f - 0.5f) * spread;
+            }
+    }
+    memset(m, 0, sizeof *m);
+    s->ntris = n;
+    s->pos = pos;
+    s->tri_material = tm;
+    s->materials = m;
+    s->nmaterials = 1;
+    s->camera = (SceneCamera){{0, 0, 10}, {0, 0, 0}, {0, 1, 0}, 45, 0, 0, 0};
+    s->render = (SceneRender){8, 8, 1, 1, {0, 0, 0}, {0, 0, 0}};
+    BvhParams bp;
+    bvh_default_params(&bp);
+    if (max_leaf > 0) {
+        bp.max_leaf_size = max_leaf;
+        if (max_leaf > 4)
+            bp.cost_traversal = 40.0f; /* a costly node: the build then fills its leaves */
+    }
+    char err[256];
+    cr_assert_eq(pack_scene(s, &bp, 0, p, err, sizeof err), 0, "%s", err);
+}
+
 /* Random triangle soup packed with the real packer; closest hits from traversal must equal
  * brute force over all primitives with the same tie rule. */
 Test(ref_traversal, matches_brute_force)
 {
-    uint32_t n = 3000;
+    uint32_t n = 3000, st = 99;
     Scene s;
-    memset(&s, 0, sizeof s);
-    float *pos = malloc(sizeof(float) * 9 * n);
-    uint32_t *tm = calloc(n, sizeof(uint32_t));
-    uint32_t st = 99;
-    for (uint32_t i = 0; i < n; i++) {
-        float c[3];
-        for (int k = 0; k < 3; k++) {
-            st = st * 1664525u + 1013904223u;
-            c[k] = (float)(st >> 8) / 16777216.0f * 10.0f - 5.0f;
-        }
-        for (int v = 0; v < 3; v++)
-            for (int k = 0; k < 3; k++) {
-                st = st * 1664525u + 1013904223u;
-                pos[9 * i + 3 * v + k] = c[k] + ((float)(st >> 8) / 16777216.0f - 0.5f) * 0.8f;
-            }
-    }
     SceneMaterial m;
-    memset(&m, 0, sizeof m);
-    s.ntris = n;
-    s.pos = pos;
-    s.tri_material = tm;
-    s.materials = &m;
-    s.nmaterials = 1;
-    s.camera = (SceneCamera){{0, 0, 10}, {0, 0, 0}, {0, 1, 0}, 45, 0, 0, 0};
-    s.render = (SceneRender){8, 8, 1, 1, {0, 0, 0}, {0, 0, 0}};
-    BvhParams bp;
-    bvh_default_params(&bp);
     PackedScene p;
-    char err[256];
-    cr_assert_eq(pack_scene(&s, &bp, 0, &p, err, sizeof err), 0, "%s", err);
+    soup_pack(n, 0.8f, &st, 0, &s, &m, &p);
     uint32_t prims = sm_u32(&p, sm_hdr(&p, SM_HDR_PRIMS));
     int mismatches = 0, hits = 0, occl_mismatch = 0;
     for (int i = 0; i < 2000; i++) {
@@ -249,8 +264,8 @@ Test(ref_traversal, matches_brute_force)
     cr_expect_eq(mismatches, 0);
     cr_expect_eq(occl_mismatch, 0);
     pack_free(&p);
-    free(pos);
-    free(tm);
+    free(s.pos);
+    free(s.tri_material);
 }
 
 /* A query without stats takes the 4-wide walk over the private layout (sim/ref_trace.c; the
@@ -335,43 +350,6 @@ Test(ref_traversal, fast_walk_matches_plain_walk_on_shared_scenes)
     fast_walk_matches_plain("scenes/conference/scene.ini", 20000);
 }
 
-/* A soup of n small random triangles in [-5, 5]^3 (the scene of matches_brute_force), packed with
- * leaves of up to max_leaf primitives. */
-static void soup_pack(uint32_t n, int max_leaf, Scene *s, SceneMaterial *m, PackedScene *p)
-{
-    memset(s, 0, sizeof *s);
-    float *pos = malloc(sizeof(float) * 9 * n);
-    uint32_t *tm = calloc(n, sizeof(uint32_t));
-    cr_assert(pos && tm);
-    uint32_t st = 7;
-    for (uint32_t i = 0; i < n; i++) {
-        float c[3];
-        for (int k = 0; k < 3; k++) {
-            st = st * 1664525u + 1013904223u;
-            c[k] = (float)(st >> 8) / 16777216.0f * 10.0f - 5.0f;
-        }
-        for (int v = 0; v < 3; v++)
-            for (int k = 0; k < 3; k++) {
-                st = st * 1664525u + 1013904223u;
-                pos[9 * i + 3 * v + k] = c[k] + ((float)(st >> 8) / 16777216.0f - 0.5f) * 1.5f;
-            }
-    }
-    memset(m, 0, sizeof *m);
-    s->ntris = n;
-    s->pos = pos;
-    s->tri_material = tm;
-    s->materials = m;
-    s->nmaterials = 1;
-    s->camera = (SceneCamera){{0, 0, 10}, {0, 0, 0}, {0, 1, 0}, 45, 0, 0, 0};
-    s->render = (SceneRender){8, 8, 1, 1, {0, 0, 0}, {0, 0, 0}};
-    BvhParams bp;
-    bvh_default_params(&bp);
-    bp.max_leaf_size = max_leaf;
-    if (max_leaf > 4)
-        bp.cost_traversal = 40.0f; /* a costly node: the build then fills its leaves */
-    char err[256];
-    cr_assert_eq(pack_scene(s, &bp, 0, p, err, sizeof err), 0, "%s", err);
-}
 
 /* Leaves of 1 primitive, of up to 4 (one block of the layout) and of up to 11 (several blocks,
  * the lanes of a leaf's last block partly empty), and a single leaf (the root is a leaf). */
@@ -385,7 +363,8 @@ Test(ref_traversal, fast_walk_matches_plain_walk_on_leaf_sizes)
         Scene s;
         SceneMaterial m;
         PackedScene p;
-        soup_pack(cases[c].n, cases[c].max_leaf, &s, &m, &p);
+        uint32_t st = 7;
+        soup_pack(cases[c].n, 1.5f, &st, cases[c].max_leaf, &s, &m, &p);
         cr_expect(ref_trace_layout_usable(&p), "leaves of %d: the 4-wide layout should be in use", cases[c].max_leaf);
         uint32_t nodes = sm_u32(&p, sm_hdr(&p, SM_HDR_NODES)), big = 0;
         for (uint32_t n = 0; n < sm_u32(&p, sm_hdr(&p, SM_HDR_NNODES)); n++) {
@@ -410,7 +389,8 @@ Test(ref_traversal, child_box_outside_parent_keeps_the_binary_walk)
     Scene s;
     SceneMaterial m;
     PackedScene p;
-    soup_pack(3000, 4, &s, &m, &p);
+    uint32_t st = 7;
+    soup_pack(3000, 1.5f, &st, 4, &s, &m, &p);
     uint32_t nodes = sm_u32(&p, sm_hdr(&p, SM_HDR_NODES));
     uint32_t first = sm_u32(&p, sm_rec(nodes, SM_NODE_WORDS, 0, SM_NODE_FIRST));
     uint32_t info = sm_u32(&p, sm_rec(nodes, SM_NODE_WORDS, first, SM_NODE_INFO));
