@@ -282,6 +282,10 @@ Test(core_trap, ray_buffers)
               "ray buffer 1 scatter out of range: address 0x00001000 (size 4096)", 2, "rsct v1, v2, r4, 0");
     trap_case(PROG(I_0(RSWAP), V_AI(VLI, 2, 1024, 0), V_ABCI(RSCTN, 1, 2, 4, 0, 0), I_0(HALT)), 4, NOREGS,
               "ray buffer 0 scatter out of range: address 0x00001000 (size 4096)", 2, "rsctn v1, v2, r4, 0");
+    /* N = 16 (the core's 16-lane copy): ids 0, 128, ..., 1920; lane 8 is the first bad one, and
+     * the lanes before it do not hide it */
+    trap_case(PROG(V_A(VIOTA, 3, 0), V_ABI(VMULI, 2, 3, 128, 0), V_ABCI(RGAT, 1, 2, 4, 0, 0), I_0(HALT)), 16, NOREGS,
+              "ray buffer 0 gather out of range: address 0x00001000 (size 4096)", 2, "rgat v1, v2, r4, 0");
     /* a bad id in a lane outside the exec mask is not an access */
     halt_case(PROG(V_A(VIOTA, 3, 0), V_ABI(VMULI, 2, 3, 1024, 0), I_AB(MTAIL, 1, 5), V_ABCI(RGAT, 1, 2, 4, 0, 1),
                    V_ABCI(RSCT, 1, 2, 4, 0, 1), I_0(HALT)),
