@@ -159,7 +159,8 @@ typedef struct Builder {
     Bins *bins;  /* BIN_SETS sets of one per axis, then a sink for the axes that give no split;
                   * empty (box_none, count 0) between nodes, except the sink, which is never read */
     uint8_t (*bin)[4]; /* n: each position's bin on the three axes in the last binning that
-                        * covered it, moved with the primitives by the partition */
+                        * covered it; partition reads the split axis's (and moves only those: every
+                        * node bins its own primitives again before it is split) */
     Bvh *b;
 } Builder;
 
@@ -517,10 +518,7 @@ static uint32_t partition(Builder *B, uint32_t begin, uint32_t end, Split s, Hal
             uint32_t qi = id[i];
             id[i] = id[j];
             id[j] = qi;
-            uint8_t qb[4];
-            memcpy(qb, bins[i], 4);
-            memcpy(bins[i], bins[j], 4);
-            memcpy(bins[j], qb, 4);
+            bins[i][axis] = bins[j][axis]; /* the other bytes are not read again */
             box1 = vbox_grow_backwards(box1, q);
             cbox1 = vbox_grow_backwards(cbox1, cc);
         }
