@@ -11,7 +11,8 @@
  * kept for the partition, children's boxes grown during the partition, only non-empty bins swept,
  * a split's cost divided out only when it can win, large arrays on huge pages, large nodes binned
  * into several sets of bins, nodes of two primitives and of up to eight split without bin arrays,
- * only the bins used emptied) and must give the
+ * with AVX2 the candidate splits costed eight at a time and the best picked without a branch)
+ * and must give the
  * trees of the plain algorithm in tests/support/bvh_ref.c, bit for bit, zeros' signs included:
  * tests/unit/test_bvh.c compares them, on random and degenerate boxes and on real meshes.
  */
@@ -70,6 +71,11 @@ static inline Vbox vbox_centroid(Vbox q)
 static inline float vbox_lane(Vbox b, __m128i k) { return _mm_cvtss_f32(_mm_permutevar_ps(_mm256_castps256_ps128(b), k)); }
 typedef __m128i Vlane;
 static inline Vlane vbox_lane_index(int k) { return _mm_set1_epi32(k); }
+/* c ? a : b, without a branch (c is 0 or 1) */
+static inline Vbox vbox_select(uint32_t c, Vbox a, Vbox b)
+{
+    return _mm256_blendv_ps(b, a, _mm256_castsi256_ps(_mm256_set1_epi32(-(int)c)));
+}
 #else
 typedef Box Vbox;
 static inline Vbox vbox_load(const Box *b) { return *b; }
@@ -98,6 +104,7 @@ static inline Vbox vbox_centroid(Vbox q)
 typedef int Vlane;
 static inline float vbox_lane(Vbox b, int k) { return b.v[k]; }
 static inline Vlane vbox_lane_index(int k) { return k; }
+static inline Vbox vbox_select(uint32_t c, Vbox a, Vbox b) { return c ? a : b; }
 #endif
 
 /* Grow b by x; on a tie b keeps the value it holds. */
@@ -246,6 +253,130 @@ static void sweep_axis(const BvhParams *p, Bins *bins, int axis, uint32_t total,
     }
 }
 
+#if defined(__AVX2__)
+/* The candidate splits in 8 lanes (AVX2 builds), every bin's instead of the non-empty ones', with
+ * no branch on a bin: lane by lane the operations of sweep_axis and box_area, so the same costs.
+ * A candidate after an empty bin repeats the cost of the one before it, so the first of the lowest
+ * costs, which is what the sweep keeps (only a strictly lower cost replaces the best), is a split
+ * sweep_axis considers, at the same bin. */
+
+/* The areas of boxes b[0 .. 7] in lanes 0 .. 7: the boxes transposed to one vector per
+ * coordinate, then box_area's extents, products and sums. */
+static inline __m256 area8(const Box *b)
+{
+    __m256 t0 = _mm256_unpacklo_ps(vbox_load(&b[0]), vbox_load(&b[1]));
+    __m256 t1 = _mm256_unpackhi_ps(vbox_load(&b[0]), vbox_load(&b[1]));
+    __m256 t2 = _mm256_unpacklo_ps(vbox_load(&b[2]), vbox_load(&b[3]));
+    __m256 t3 = _mm256_unpackhi_ps(vbox_load(&b[2]), vbox_load(&b[3]));
+    __m256 t4 = _mm256_unpacklo_ps(vbox_load(&b[4]), vbox_load(&b[5]));
+    __m256 t5 = _mm256_unpackhi_ps(vbox_load(&b[4]), vbox_load(&b[5]));
+    __m256 t6 = _mm256_unpacklo_ps(vbox_load(&b[6]), vbox_load(&b[7]));
+    __m256 t7 = _mm256_unpackhi_ps(vbox_load(&b[6]), vbox_load(&b[7]));
+    /* [x0..x3 | -X0..-X3] and so on: lo and negated hi of boxes 0-3, then of 4-7 */
+    __m256 x03 = _mm256_shuffle_ps(t0, t2, 0x44), y03 = _mm256_shuffle_ps(t0, t2, 0xee), z03 = _mm256_shuffle_ps(t1, t3, 0x44);
+    __m256 x47 = _mm256_shuffle_ps(t4, t6, 0x44), y47 = _mm256_shuffle_ps(t4, t6, 0xee), z47 = _mm256_shuffle_ps(t5, t7, 0x44);
+    __m256 sign = _mm256_set1_ps(-0.0f), d[3];
+    __m256 lo[3] = {_mm256_permute2f128_ps(x03, x47, 0x20), _mm256_permute2f128_ps(y03, y47, 0x20),
+                    _mm256_permute2f128_ps(z03, z47, 0x20)};
+    __m256 nhi[3] = {_mm256_permute2f128_ps(x03, x47, 0x31), _mm256_permute2f128_ps(y03, y47, 0x31),
+                     _mm256_permute2f128_ps(z03, z47, 0x31)};
+#pragma GCC unroll 3
+    for (int k = 0; k < 3; k++) {
+        __m256 hi = _mm256_xor_ps(nhi[k], sign);
+        d[k] = _mm256_and_ps(_mm256_cmp_ps(hi, lo[k], _CMP_GT_OQ), _mm256_sub_ps(hi, lo[k]));
+    }
+    __m256 sum = _mm256_add_ps(_mm256_mul_ps(d[0], d[1]), _mm256_mul_ps(d[1], d[2]));
+    sum = _mm256_add_ps(sum, _mm256_mul_ps(d[2], d[0]));
+    return _mm256_mul_ps(_mm256_set1_ps(2.0f), sum);
+}
+
+/* Eight candidates: left areas and counts, right areas and counts, which lanes are splits (all
+ * ones). The first of the lowest costs among them, if below best's, replaces it (but for its bin,
+ * which the caller sets): its lane, or 8 when best stays. Without a branch: which axis wins is
+ * not predictable. */
+static inline int pick8(const BvhParams *p, __m256 larea, __m256 nleft, __m256 rarea, __m256 nright, __m256 ok,
+                        float parea, int axis, Split *best)
+{
+    __m256 x = _mm256_add_ps(_mm256_mul_ps(larea, nleft), _mm256_mul_ps(rarea, nright));
+    __m256 cost = _mm256_add_ps(_mm256_set1_ps(p->cost_traversal),
+                                _mm256_div_ps(_mm256_mul_ps(_mm256_set1_ps(p->cost_intersect), x), _mm256_set1_ps(parea)));
+    ok = _mm256_and_ps(ok, _mm256_cmp_ps(cost, _mm256_set1_ps(best->cost), _CMP_LT_OQ));
+    /* no NaN among the lanes kept (cost < best->cost), the others at infinity */
+    __m256 c = _mm256_blendv_ps(_mm256_set1_ps(INFINITY), cost, ok);
+    __m256 low = _mm256_min_ps(c, _mm256_permute2f128_ps(c, c, 1));
+    low = _mm256_min_ps(low, _mm256_shuffle_ps(low, low, _MM_SHUFFLE(1, 0, 3, 2)));
+    low = _mm256_min_ps(low, _mm256_shuffle_ps(low, low, _MM_SHUFFLE(2, 3, 0, 1)));
+    unsigned m = (unsigned)_mm256_movemask_ps(ok);
+    int r = __builtin_ctz(((unsigned)_mm256_movemask_ps(_mm256_cmp_ps(c, low, _CMP_EQ_OQ)) & m) | 0x100u);
+    _Alignas(32) float costs[9], xs[9];
+    _mm256_store_ps(costs, cost);
+    _mm256_store_ps(xs, x);
+    costs[8] = best->cost;
+    xs[8] = best->x;
+    best->axis = m ? axis : best->axis;
+    best->cost = costs[r];
+    best->x = xs[r];
+    return r;
+}
+
+/* sweep_axis over every bin, eight candidates at a time; empties the bins. total < 2^31 (the
+ * counts are converted as signed integers). Inlined with nb a constant for the default 16 bins,
+ * where its loops unroll. */
+static inline __attribute__((always_inline)) void sweep_bins8(const BvhParams *p, Bins *bins, int nb, int axis,
+                                                              uint32_t total, float parea, Split *best)
+{
+    int nc = nb - 1, nc8 = (nc + 7) / 8 * 8; /* candidate c: bins 0 .. c left */
+    _Alignas(32) Box left[256], right[256];
+    _Alignas(32) int32_t nleft[256];
+    Vbox none = vbox_load(&box_none), acc = none;
+#pragma GCC unroll 16
+    for (int c = nc - 1; c >= 0; c--) {
+        acc = vbox_grow(acc, vbox_load(&bins->box[c + 1]));
+        vbox_store(&right[c], acc);
+    }
+    acc = none;
+    uint32_t n = 0;
+#pragma GCC unroll 16
+    for (int c = 0; c < nc; c++) {
+        acc = vbox_grow(acc, vbox_load(&bins->box[c]));
+        vbox_store(&left[c], acc);
+        n += bins->count[c];
+        nleft[c] = (int32_t)n;
+    }
+#pragma GCC unroll 8
+    for (int c = nc; c < nc8; c++) {
+        vbox_store(&left[c], none);
+        vbox_store(&right[c], none);
+        nleft[c] = 0; /* not a split */
+    }
+    __m256i all = _mm256_set1_epi32((int)total), zero = _mm256_setzero_si256();
+#pragma GCC unroll 2
+    for (int c = 0; c < nc; c += 8) {
+        __m256i nl = _mm256_load_si256((const __m256i *)&nleft[c]);
+        __m256i nr = _mm256_sub_epi32(all, nl);
+        /* a split has primitives on both sides */
+        __m256i no = _mm256_or_si256(_mm256_cmpeq_epi32(nl, zero), _mm256_cmpeq_epi32(nr, zero));
+        int r = pick8(p, area8(&left[c]), _mm256_cvtepi32_ps(nl), area8(&right[c]), _mm256_cvtepi32_ps(nr),
+                      _mm256_castsi256_ps(_mm256_xor_si256(no, _mm256_set1_epi32(-1))), parea, axis, best);
+        int won = -(r < 8); /* all ones when best changed (no branch) */
+        best->bin = (best->bin & ~won) | ((c + r) & won);
+    }
+#pragma GCC unroll 16
+    for (int i = 0; i < nb; i++) {
+        vbox_store(&bins->box[i], none);
+        bins->count[i] = 0;
+    }
+}
+
+static void sweep_axis8(const BvhParams *p, Bins *bins, int axis, uint32_t total, float parea, Split *best)
+{
+    if (p->bins == 16)
+        sweep_bins8(p, bins, 16, axis, total, parea, best);
+    else
+        sweep_bins8(p, bins, p->bins, axis, total, parea, best);
+}
+#endif
+
 /* The axis scale of the binning, or 0 when the axis gives no split: no extent, a denormal
  * extent (scale infinite: binning along it would be meaningless), or an infinite one (scale 0:
  * every centroid would fall in bin 0). */
@@ -362,7 +493,9 @@ static void merge_bins(Bins *restrict to, Bins *restrict from, int nb)
  * costs and the order of the candidates (axis, then bin) are the sweep's, so the same split wins.
  * Fixed-size loops over SMALL_MAX ranks, the ranks past the node's own holding empty boxes, so
  * that no branch depends on the node: small nodes are most of the tree and their short
- * data-dependent loops were mispredicted. The chosen axis's bins go to B->bin for partition. */
+ * data-dependent loops were mispredicted. With AVX2 the seven candidates of an axis are costed
+ * in the lanes of one vector and the best picked without a branch (area8, pick8). The chosen
+ * axis's bins go to B->bin for partition. */
 enum { SMALL_MAX = 8 };
 
 static Split find_split_small(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, float parea)
@@ -389,8 +522,9 @@ static Split find_split_small(const Builder *B, uint32_t begin, uint32_t end, co
 #pragma GCC unroll 8
     for (uint32_t j = 0; j < SMALL_MAX; j++) {
         /* the ranks past k hold empty boxes, binned as primitive 0 (and ranked last below) */
-        const Box *pj = &B->prim[begin + (j < k ? j : 0)];
-        q[j] = j < k ? *pj : box_none;
+        uint32_t in = (j - k) >> 31; /* j < k, without a branch */
+        const Box *pj = &B->prim[begin + j * in];
+        vbox_store(&q[j], vbox_select(in, vbox_load(pj), vbox_load(&box_none)));
 #if defined(__SSE2__)
         __m128 c = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(pj->v), _mm_load_ps(pj->v + 4)), _mm_set1_ps(0.5f));
         __m128i bi = bin_of3(c, cmin, sc, top);
@@ -407,11 +541,21 @@ static Split find_split_small(const Builder *B, uint32_t begin, uint32_t end, co
             continue;
         /* distinct keys (bin, position), the empty boxes' above every bin; a rank is the number
          * of smaller keys */
-        uint16_t key[SMALL_MAX];
+        _Alignas(16) uint16_t key[SMALL_MAX];
+#if defined(__AVX2__)
+        __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+        __m256i kb = _mm256_and_si256(_mm256_srl_epi32(_mm256_loadu_si256((const __m256i *)bins), _mm_cvtsi32_si128(8 * axis)),
+                                      _mm256_set1_epi32(0xff));
+        kb = _mm256_or_si256(kb, _mm256_and_si256(_mm256_cmpgt_epi32(iota, _mm256_set1_epi32((int)k - 1)), _mm256_set1_epi32(1 << 9)));
+        kb = _mm256_or_si256(_mm256_slli_epi32(kb, 3), iota);
+        _mm_store_si128((__m128i *)key, _mm_packs_epi32(_mm256_castsi256_si128(kb), _mm256_extracti128_si256(kb, 1)));
+#else
 #pragma GCC unroll 8
         for (uint32_t j = 0; j < SMALL_MAX; j++)
             key[j] = (uint16_t)(((uint32_t)bins[j][axis] | (uint32_t)(j >= k) << 9) << 3 | j);
-        uint32_t sorted_bin[SMALL_MAX];
+#endif
+        uint32_t sorted_bin[SMALL_MAX + 1];
+        sorted_bin[SMALL_MAX] = 1u << 12; /* above every key's bin, for the vector compare */
         Vbox sorted[SMALL_MAX];
 #if defined(__SSE2__)
         _Static_assert(SMALL_MAX == 8, "the ranks are taken in one 8 x 16-bit vector");
@@ -432,6 +576,30 @@ static Split find_split_small(const Builder *B, uint32_t begin, uint32_t end, co
             sorted_bin[r] = (uint32_t)key[j] >> 3;
             sorted[r] = vbox_load(&q[j]);
         }
+#if defined(__AVX2__)
+        /* candidate r: ranks 0 .. r left; lane by lane the operations below (area8, pick8) */
+        _Alignas(32) Box lbox[SMALL_MAX], rbox[SMALL_MAX];
+        Vbox left = vbox_load(&box_none), right = left;
+        vbox_store(&rbox[SMALL_MAX - 1], right);
+#pragma GCC unroll 8
+        for (int r = 0; r < SMALL_MAX - 1; r++) {
+            left = vbox_grow(left, sorted[r]);
+            vbox_store(&lbox[r], left);
+            right = vbox_grow(right, sorted[SMALL_MAX - 1 - r]);
+            vbox_store(&rbox[SMALL_MAX - 2 - r], right);
+        }
+        vbox_store(&lbox[SMALL_MAX - 1], left);
+        __m256i rank1 = _mm256_setr_epi32(1, 2, 3, 4, 5, 6, 7, 8);
+        __m256i sb = _mm256_loadu_si256((const __m256i *)sorted_bin);
+        __m256i sb_next = _mm256_loadu_si256((const __m256i *)(sorted_bin + 1));
+        /* r + 1 < k, and the end of a run of one bin */
+        __m256i ok = _mm256_and_si256(_mm256_cmpgt_epi32(_mm256_set1_epi32((int)k), rank1), _mm256_cmpgt_epi32(sb_next, sb));
+        sorted_bin[SMALL_MAX] = (uint32_t)best.bin; /* lane 8: best stays (the compare has read it) */
+        int r = pick8(p, area8(lbox), _mm256_cvtepi32_ps(rank1), area8(rbox),
+                      _mm256_cvtepi32_ps(_mm256_sub_epi32(_mm256_set1_epi32((int)k), rank1)), _mm256_castsi256_ps(ok),
+                      parea, axis, &best);
+        best.bin = (int)sorted_bin[r];
+#else
         float left_area[SMALL_MAX], right_area[SMALL_MAX];
         Vbox left = vbox_load(&box_none), right = left;
 #pragma GCC unroll 8
@@ -453,9 +621,14 @@ static Split find_split_small(const Builder *B, uint32_t begin, uint32_t end, co
             best.cost = wins ? cost : best.cost;
             best.x = wins ? x : best.x;
         }
+#endif
     }
-    for (uint32_t j = 0; j < k; j++)
-        memcpy(B->bin[begin + j], bins[j], 4);
+    /* partition reads the bytes of the node's own positions; those past it are the next nodes',
+     * which bin them again before they read them */
+    if (begin + SMALL_MAX <= B->b->nprims)
+        memcpy(B->bin[begin], bins, sizeof bins);
+    else
+        memcpy(B->bin[begin], bins, 4 * (size_t)k);
     return best;
 }
 
@@ -483,9 +656,17 @@ static Split find_split(const Builder *B, uint32_t begin, uint32_t end, const Bo
         for (int axis = 0; axis < 3; axis++)
             if (live & 1 << axis)
                 merge_bins(&B->bins[axis], &B->bins[3 * set + axis], nb);
-    for (int axis = 0; axis < 3; axis++)
-        if (live & 1 << axis)
-            sweep_axis(p, &B->bins[axis], axis, end - begin, parea, &best);
+    for (int axis = 0; axis < 3; axis++) {
+        if (!(live & 1 << axis))
+            continue;
+#if defined(__AVX2__)
+        if (end - begin < (uint32_t)1 << 31) {
+            sweep_axis8(p, &B->bins[axis], axis, end - begin, parea, &best);
+            continue;
+        }
+#endif
+        sweep_axis(p, &B->bins[axis], axis, end - begin, parea, &best);
+    }
     return best;
 }
 
