@@ -18,6 +18,7 @@
  */
 #include "bvh.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -750,8 +751,15 @@ static int check_params(const BvhParams *p, char *err, size_t errlen)
     return 0;
 }
 
+/* First one pass without a branch per value (finite and ordered: lo <= hi, |lo| and |hi| <= FLT_MAX,
+ * each false for a NaN), then, only when it fails, the loop that names the first bad box. */
 static int check_boxes(const float *bmin, const float *bmax, uint32_t n, char *err, size_t errlen)
 {
+    int ok = 1;
+    for (size_t t = 0; t < 3 * (size_t)n; t++)
+        ok &= (bmin[t] <= bmax[t]) & (fabsf(bmin[t]) <= FLT_MAX) & (fabsf(bmax[t]) <= FLT_MAX);
+    if (ok)
+        return 0;
     for (uint32_t i = 0; i < n; i++) {
         for (int k = 0; k < 3; k++) {
             float lo = bmin[3 * i + k], hi = bmax[3 * i + k];
@@ -973,6 +981,45 @@ static inline int inside(const float *lo, const float *hi, const float *plo, con
              (hi[2] > phi[2]));
 }
 
+/* bvh_check's conditions without a branch per condition, and without naming a violation: 1 when
+ * the tree passes them all, 0 otherwise (then bvh_check looks again, to name the first). seen_prim
+ * and seen_node are zeroed. A leaf's primitives and an inner node's children are marked seen once;
+ * with no mark made twice, every primitive is in a leaf when the leaves' counts add up to nprims,
+ * and every node but the root is some node's child when the inner nodes are (nnodes - 1) / 2. */
+static int check_fast(const Bvh *b, const float *bmin, const float *bmax, uint8_t *seen_prim, uint8_t *seen_node)
+{
+    uint32_t bad = 0, nprims = b->nprims, nnodes = b->nnodes, ninner = 0;
+    uint64_t listed = 0;
+    for (uint32_t i = 0; i < nnodes; i++) {
+        const BvhNode *n = &b->nodes[i];
+        /* not a NaN and not inverted */
+        bad |= !(n->bmin[0] <= n->bmax[0]) | !(n->bmin[1] <= n->bmax[1]) | !(n->bmin[2] <= n->bmax[2]);
+        if (n->count > 0) {
+            if (n->first > nprims || n->count > nprims - n->first)
+                return 0;
+            listed += n->count;
+            for (uint32_t j = n->first; j < n->first + n->count; j++) {
+                uint32_t pi = b->prim_index[j];
+                if (pi >= nprims)
+                    return 0;
+                bad |= seen_prim[pi];
+                seen_prim[pi] = 1;
+                bad |= !inside(&bmin[3 * pi], &bmax[3 * pi], n->bmin, n->bmax);
+            }
+        } else {
+            if (n->first + 1 >= nnodes || n->first <= i || n->axis > 2)
+                return 0;
+            ninner++;
+            for (uint32_t c = n->first; c <= n->first + 1; c++) {
+                bad |= !inside(b->nodes[c].bmin, b->nodes[c].bmax, n->bmin, n->bmax);
+                bad |= seen_node[c];
+                seen_node[c] = 1;
+            }
+        }
+    }
+    return !bad && listed == nprims && 2 * (uint64_t)ninner == (uint64_t)nnodes - 1;
+}
+
 /* One pass over the nodes in index order. A child's index is above its parent's (checked), so a
  * node other than the root that is some inner node's child exactly once is reached from the root
  * exactly once: its parent, by induction on the index, is; so is every node, when each but the
@@ -993,6 +1040,12 @@ int bvh_check(const Bvh *b, const float *bmin, const float *bmax, char *err, siz
         snprintf(err, errlen, "bvh: primitive 0 is in no leaf");
         goto out;
     }
+    if (check_fast(b, bmin, bmax, seen_prim, seen_node)) {
+        rc = 0;
+        goto out;
+    }
+    memset(seen_prim, 0, b->nprims);
+    memset(seen_node, 0, b->nnodes);
     for (uint32_t i = 0; i < b->nnodes; i++) {
         const BvhNode *n = &b->nodes[i];
         for (int k = 0; k < 3; k++) {
@@ -1060,8 +1113,12 @@ out:
 static inline double node_area(const float *lo, const float *hi)
 {
     double d[3];
-    for (int k = 0; k < 3; k++)
-        d[k] = hi[k] > lo[k] ? (double)hi[k] - (double)lo[k] : 0.0;
+    /* hi > lo exactly when the difference is above 0 (a positive difference of floats is not lost
+     * in double), so this is hi > lo ? hi - lo : 0, without a branch (maxsd) */
+    for (int k = 0; k < 3; k++) {
+        d[k] = (double)hi[k] - (double)lo[k];
+        d[k] = d[k] > 0.0 ? d[k] : 0.0;
+    }
     return 2.0 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]);
 }
 
