@@ -416,22 +416,27 @@ static inline __m128i bin_of3(__m128 c, __m128 cmin, __m128 scale, __m128i top)
 /* One pass puts every primitive in its bin on each axis; each bin still grows in primitive order.
  * An axis that gives no split bins into the sink. With sets > 1, primitive j goes to set j mod sets
  * (sets is a power of 2). */
-/* Primitive j into bins d (one per axis) and its bin bytes into B->bin[j]. */
-static inline void bin_one(const Builder *B, uint32_t j, Bins *const *d, __m128 cmin, __m128 sc, __m128i top)
+/* Primitive j into bins d (one per axis) and its bin bytes into bin[j]. The primitive is loaded
+ * once and the arrays are restrict: the bin stores could otherwise alias it and the Builder, which
+ * were read again after each. */
+static inline void bin_one(const Box *restrict prim, uint8_t (*restrict bin)[4], uint32_t j, Bins *const *d,
+                           __m128 cmin, __m128 sc, __m128i top)
 {
-    const Box *q = &B->prim[j];
-    _mm_prefetch((const char *)&B->prim[j + 16], _MM_HINT_T0);
-    __m128 c = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(q->v), _mm_load_ps(q->v + 4)), _mm_set1_ps(0.5f));
+    Vbox q = vbox_load(&prim[j]);
+    __m128 c = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(prim[j].v), _mm_load_ps(prim[j].v + 4)), _mm_set1_ps(0.5f));
     __m128i bi = bin_of3(c, cmin, sc, top);
-    int i0 = _mm_cvtsi128_si32(bi);
-    int i1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 1));
-    int i2 = _mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 2));
+    uint32_t i0 = (uint32_t)_mm_cvtsi128_si32(bi);
+    uint32_t i1 = (uint32_t)_mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 1));
+    uint32_t i2 = (uint32_t)_mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 2));
     /* the four lanes (0..255) as bytes */
     uint32_t packed = (uint32_t)_mm_cvtsi128_si32(_mm_packus_epi16(_mm_packs_epi32(bi, bi), bi));
-    memcpy(B->bin[j], &packed, 4);
-    bin_put(d[0], i0, q);
-    bin_put(d[1], i1, q);
-    bin_put(d[2], i2, q);
+    memcpy(bin[j], &packed, 4);
+    vbox_store(&d[0]->box[i0], vbox_grow(vbox_load(&d[0]->box[i0]), q));
+    d[0]->count[i0]++;
+    vbox_store(&d[1]->box[i1], vbox_grow(vbox_load(&d[1]->box[i1]), q));
+    d[1]->count[i1]++;
+    vbox_store(&d[2]->box[i2], vbox_grow(vbox_load(&d[2]->box[i2]), q));
+    d[2]->count[i2]++;
 }
 
 static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, const float *scale, int live,
@@ -441,6 +446,8 @@ static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box 
     for (int set = 0; set < sets; set++)
         for (int axis = 0; axis < 3; axis++)
             dst[set][axis] = &B->bins[live & 1 << axis ? 3 * set + axis : BIN_SINK];
+    const Box *prim = B->prim;
+    uint8_t(*bin)[4] = B->bin;
     __m128 cmin = _mm_setr_ps(box_lo(cbox, 0), box_lo(cbox, 1), box_lo(cbox, 2), 0.0f);
     __m128 sc = _mm_setr_ps(scale[0], scale[1], scale[2], 0.0f);
     __m128i top = _mm_set1_epi32(B->p->bins - 1);
@@ -448,14 +455,14 @@ static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box 
     if (sets == BIN_SETS) {
         _Static_assert(BIN_SETS == 4, "the loop below is unrolled for 4 sets");
         for (; j + 4 <= end; j += 4) {
-            bin_one(B, j, dst[0], cmin, sc, top);
-            bin_one(B, j + 1, dst[1], cmin, sc, top);
-            bin_one(B, j + 2, dst[2], cmin, sc, top);
-            bin_one(B, j + 3, dst[3], cmin, sc, top);
+            bin_one(prim, bin, j, dst[0], cmin, sc, top);
+            bin_one(prim, bin, j + 1, dst[1], cmin, sc, top);
+            bin_one(prim, bin, j + 2, dst[2], cmin, sc, top);
+            bin_one(prim, bin, j + 3, dst[3], cmin, sc, top);
         }
     }
     for (; j < end; j++)
-        bin_one(B, j, dst[0], cmin, sc, top);
+        bin_one(prim, bin, j, dst[0], cmin, sc, top);
 }
 #else
 static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, const float *scale, int live,
