@@ -1135,6 +1135,7 @@ static inline double node_area(const float *lo, const float *hi)
     double d[3];
     /* hi > lo exactly when the difference is above 0 (a positive difference of floats is not lost
      * in double), so this is hi > lo ? hi - lo : 0, without a branch (maxsd) */
+#pragma GCC unroll 3
     for (int k = 0; k < 3; k++) {
         d[k] = (double)hi[k] - (double)lo[k];
         d[k] = d[k] > 0.0 ? d[k] : 0.0;
@@ -1153,7 +1154,9 @@ double bvh_sah_cost(const Bvh *b, const BvhParams *p)
     for (uint32_t i = 0; i < b->nnodes; i++) {
         const BvhNode *n = &b->nodes[i];
         double a = node_area(n->bmin, n->bmax) / ra;
-        cost += a * (n->count > 0 ? (double)p->cost_intersect * n->count : (double)p->cost_traversal);
+        /* both weights computed, one selected: leaves and inner nodes alternate unpredictably */
+        double leaf = (double)p->cost_intersect * n->count, inner = (double)p->cost_traversal;
+        cost += a * (n->count > 0 ? leaf : inner);
     }
     return cost;
 }
