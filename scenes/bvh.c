@@ -167,8 +167,8 @@ typedef struct Builder {
     Bins *bins;  /* BIN_SETS sets of one per axis, then a sink for the axes that give no split;
                   * empty (box_none, count 0) between nodes, except the sink, which is never read */
     uint8_t (*bin)[4]; /* n: each position's bin on the three axes in the last binning that
-                        * covered it; partition reads the split axis's (and moves only those: every
-                        * node bins its own primitives again before it is split) */
+                        * covered it; partition reads the split axis's and does not move them
+                        * (every node bins its own primitives again before it is split) */
     Bvh *b;
 } Builder;
 
@@ -686,30 +686,40 @@ typedef struct Halves { Box box[2], cbox[2]; } Halves;
  * a right position once filled, in decreasing order (hence vbox_grow_backwards). */
 static uint32_t partition(Builder *B, uint32_t begin, uint32_t end, Split s, Halves *h)
 {
-    Box *prim = B->prim;
-    uint32_t *id = B->b->prim_index;
-    uint8_t(*bins)[4] = B->bin;
+    Box *restrict prim = B->prim;
+    uint32_t *restrict id = B->b->prim_index;
+    const uint8_t(*restrict bins)[4] = B->bin;
     int axis = s.axis;
     Vbox none = vbox_load(&box_none);
     Vbox box0 = none, cbox0 = none, box1 = none, cbox1 = none;
     uint32_t i = begin, j = end;
+    /* the primitive at i and its bin, kept in registers: after a swap it is the one just read
+     * from j - 1, which is not read back from memory (nor its bin byte written to i: no one reads
+     * it again) */
+    Vbox q = vbox_load(&prim[i]);
+    uint32_t qb = bins[i][axis];
     while (i < j) {
-        Vbox q = vbox_load(&prim[i]);
         Vbox cc = vbox_centroid(q);
-        if (bins[i][axis] <= s.bin) {
+        if (qb <= (uint32_t)s.bin) {
             box0 = vbox_grow(box0, q);
             cbox0 = vbox_grow(cbox0, cc);
             i++;
+            uint32_t next = i < j ? i : i - 1; /* the read past the last is not used */
+            q = vbox_load(&prim[next]);
+            qb = bins[next][axis];
         } else {
             j--;
-            prim[i] = prim[j];
+            Vbox r = vbox_load(&prim[j]);
+            uint32_t rb = bins[j][axis];
+            vbox_store(&prim[i], r);
             vbox_store(&prim[j], q);
             uint32_t qi = id[i];
             id[i] = id[j];
             id[j] = qi;
-            bins[i][axis] = bins[j][axis]; /* the other bytes are not read again */
             box1 = vbox_grow_backwards(box1, q);
             cbox1 = vbox_grow_backwards(cbox1, cc);
+            q = r;
+            qb = rb;
         }
     }
     vbox_store(&h->box[0], box0);
