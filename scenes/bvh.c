@@ -883,7 +883,19 @@ static uint32_t split_node(Builder *B, const Task *t, const Box *nb, Halves *h, 
 /* The build's copy of the primitives: [lo, 0, -hi, 0] each, in prim_index order (the identity). */
 static void load_prims(Builder *B, const float *bmin, const float *bmax, uint32_t n)
 {
-    for (uint32_t i = 0; i < n; i++) {
+    uint32_t i = 0;
+#if defined(__SSE2__)
+    /* four floats read from 3i (the fourth is the next primitive's: the last primitive is left to
+     * the loop below), lane 3 cleared, hi negated by its sign bit: the same values */
+    __m128 keep = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
+    __m128 sign = _mm_castsi128_ps(_mm_setr_epi32(INT32_MIN, INT32_MIN, INT32_MIN, 0));
+    for (; i + 1 < n; i++) {
+        B->b->prim_index[i] = i;
+        _mm_store_ps(B->prim[i].v, _mm_and_ps(_mm_loadu_ps(bmin + 3 * (size_t)i), keep));
+        _mm_store_ps(B->prim[i].v + 4, _mm_and_ps(_mm_xor_ps(_mm_loadu_ps(bmax + 3 * (size_t)i), sign), keep));
+    }
+#endif
+    for (; i < n; i++) {
         Box *q = &B->prim[i];
         B->b->prim_index[i] = i;
         for (int k = 0; k < 3; k++) {
@@ -893,8 +905,8 @@ static void load_prims(Builder *B, const float *bmin, const float *bmax, uint32_
         q->v[3] = q->v[7] = 0.0f;
     }
     for (int a = 0; a <= BIN_SINK; a++) {
-        for (int i = 0; i < 256; i++)
-            B->bins[a].box[i] = box_none;
+        for (int k = 0; k < 256; k++)
+            B->bins[a].box[k] = box_none;
         memset(B->bins[a].count, 0, sizeof B->bins[a].count);
     }
 }
