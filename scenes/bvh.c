@@ -11,12 +11,14 @@
  * kept for the partition, children's boxes grown during the partition, only non-empty bins swept,
  * a split's cost divided out only when it can win, large arrays on huge pages, large nodes binned
  * into several sets of bins, nodes of two primitives and of up to eight split without bin arrays,
- * only the bins used emptied) and must give the
+ * with AVX2 the candidate splits costed eight at a time and the best picked without a branch)
+ * and must give the
  * trees of the plain algorithm in tests/support/bvh_ref.c, bit for bit, zeros' signs included:
  * tests/unit/test_bvh.c compares them, on random and degenerate boxes and on real meshes.
  */
 #include "bvh.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -70,6 +72,11 @@ static inline Vbox vbox_centroid(Vbox q)
 static inline float vbox_lane(Vbox b, __m128i k) { return _mm_cvtss_f32(_mm_permutevar_ps(_mm256_castps256_ps128(b), k)); }
 typedef __m128i Vlane;
 static inline Vlane vbox_lane_index(int k) { return _mm_set1_epi32(k); }
+/* c ? a : b, without a branch (c is 0 or 1) */
+static inline Vbox vbox_select(uint32_t c, Vbox a, Vbox b)
+{
+    return _mm256_blendv_ps(b, a, _mm256_castsi256_ps(_mm256_set1_epi32(-(int)c)));
+}
 #else
 typedef Box Vbox;
 static inline Vbox vbox_load(const Box *b) { return *b; }
@@ -98,6 +105,7 @@ static inline Vbox vbox_centroid(Vbox q)
 typedef int Vlane;
 static inline float vbox_lane(Vbox b, int k) { return b.v[k]; }
 static inline Vlane vbox_lane_index(int k) { return k; }
+static inline Vbox vbox_select(uint32_t c, Vbox a, Vbox b) { return c ? a : b; }
 #endif
 
 /* Grow b by x; on a tie b keeps the value it holds. */
@@ -159,7 +167,8 @@ typedef struct Builder {
     Bins *bins;  /* BIN_SETS sets of one per axis, then a sink for the axes that give no split;
                   * empty (box_none, count 0) between nodes, except the sink, which is never read */
     uint8_t (*bin)[4]; /* n: each position's bin on the three axes in the last binning that
-                        * covered it, moved with the primitives by the partition */
+                        * covered it; partition reads the split axis's and does not move them
+                        * (every node bins its own primitives again before it is split) */
     Bvh *b;
 } Builder;
 
@@ -245,6 +254,130 @@ static void sweep_axis(const BvhParams *p, Bins *bins, int axis, uint32_t total,
     }
 }
 
+#if defined(__AVX2__)
+/* The candidate splits in 8 lanes (AVX2 builds), every bin's instead of the non-empty ones', with
+ * no branch on a bin: lane by lane the operations of sweep_axis and box_area, so the same costs.
+ * A candidate after an empty bin repeats the cost of the one before it, so the first of the lowest
+ * costs, which is what the sweep keeps (only a strictly lower cost replaces the best), is a split
+ * sweep_axis considers, at the same bin. */
+
+/* The areas of boxes b[0 .. 7] in lanes 0 .. 7: the boxes transposed to one vector per
+ * coordinate, then box_area's extents, products and sums. */
+static inline __m256 area8(const Box *b)
+{
+    __m256 t0 = _mm256_unpacklo_ps(vbox_load(&b[0]), vbox_load(&b[1]));
+    __m256 t1 = _mm256_unpackhi_ps(vbox_load(&b[0]), vbox_load(&b[1]));
+    __m256 t2 = _mm256_unpacklo_ps(vbox_load(&b[2]), vbox_load(&b[3]));
+    __m256 t3 = _mm256_unpackhi_ps(vbox_load(&b[2]), vbox_load(&b[3]));
+    __m256 t4 = _mm256_unpacklo_ps(vbox_load(&b[4]), vbox_load(&b[5]));
+    __m256 t5 = _mm256_unpackhi_ps(vbox_load(&b[4]), vbox_load(&b[5]));
+    __m256 t6 = _mm256_unpacklo_ps(vbox_load(&b[6]), vbox_load(&b[7]));
+    __m256 t7 = _mm256_unpackhi_ps(vbox_load(&b[6]), vbox_load(&b[7]));
+    /* [x0..x3 | -X0..-X3] and so on: lo and negated hi of boxes 0-3, then of 4-7 */
+    __m256 x03 = _mm256_shuffle_ps(t0, t2, 0x44), y03 = _mm256_shuffle_ps(t0, t2, 0xee), z03 = _mm256_shuffle_ps(t1, t3, 0x44);
+    __m256 x47 = _mm256_shuffle_ps(t4, t6, 0x44), y47 = _mm256_shuffle_ps(t4, t6, 0xee), z47 = _mm256_shuffle_ps(t5, t7, 0x44);
+    __m256 sign = _mm256_set1_ps(-0.0f), d[3];
+    __m256 lo[3] = {_mm256_permute2f128_ps(x03, x47, 0x20), _mm256_permute2f128_ps(y03, y47, 0x20),
+                    _mm256_permute2f128_ps(z03, z47, 0x20)};
+    __m256 nhi[3] = {_mm256_permute2f128_ps(x03, x47, 0x31), _mm256_permute2f128_ps(y03, y47, 0x31),
+                     _mm256_permute2f128_ps(z03, z47, 0x31)};
+#pragma GCC unroll 3
+    for (int k = 0; k < 3; k++) {
+        __m256 hi = _mm256_xor_ps(nhi[k], sign);
+        d[k] = _mm256_and_ps(_mm256_cmp_ps(hi, lo[k], _CMP_GT_OQ), _mm256_sub_ps(hi, lo[k]));
+    }
+    __m256 sum = _mm256_add_ps(_mm256_mul_ps(d[0], d[1]), _mm256_mul_ps(d[1], d[2]));
+    sum = _mm256_add_ps(sum, _mm256_mul_ps(d[2], d[0]));
+    return _mm256_mul_ps(_mm256_set1_ps(2.0f), sum);
+}
+
+/* Eight candidates: left areas and counts, right areas and counts, which lanes are splits (all
+ * ones). The first of the lowest costs among them, if below best's, replaces it (but for its bin,
+ * which the caller sets): its lane, or 8 when best stays. Without a branch: which axis wins is
+ * not predictable. */
+static inline int pick8(const BvhParams *p, __m256 larea, __m256 nleft, __m256 rarea, __m256 nright, __m256 ok,
+                        float parea, int axis, Split *best)
+{
+    __m256 x = _mm256_add_ps(_mm256_mul_ps(larea, nleft), _mm256_mul_ps(rarea, nright));
+    __m256 cost = _mm256_add_ps(_mm256_set1_ps(p->cost_traversal),
+                                _mm256_div_ps(_mm256_mul_ps(_mm256_set1_ps(p->cost_intersect), x), _mm256_set1_ps(parea)));
+    ok = _mm256_and_ps(ok, _mm256_cmp_ps(cost, _mm256_set1_ps(best->cost), _CMP_LT_OQ));
+    /* no NaN among the lanes kept (cost < best->cost), the others at infinity */
+    __m256 c = _mm256_blendv_ps(_mm256_set1_ps(INFINITY), cost, ok);
+    __m256 low = _mm256_min_ps(c, _mm256_permute2f128_ps(c, c, 1));
+    low = _mm256_min_ps(low, _mm256_shuffle_ps(low, low, _MM_SHUFFLE(1, 0, 3, 2)));
+    low = _mm256_min_ps(low, _mm256_shuffle_ps(low, low, _MM_SHUFFLE(2, 3, 0, 1)));
+    unsigned m = (unsigned)_mm256_movemask_ps(ok);
+    int r = __builtin_ctz(((unsigned)_mm256_movemask_ps(_mm256_cmp_ps(c, low, _CMP_EQ_OQ)) & m) | 0x100u);
+    _Alignas(32) float costs[9], xs[9];
+    _mm256_store_ps(costs, cost);
+    _mm256_store_ps(xs, x);
+    costs[8] = best->cost;
+    xs[8] = best->x;
+    best->axis = m ? axis : best->axis;
+    best->cost = costs[r];
+    best->x = xs[r];
+    return r;
+}
+
+/* sweep_axis over every bin, eight candidates at a time; empties the bins. total < 2^31 (the
+ * counts are converted as signed integers). Inlined with nb a constant for the default 16 bins,
+ * where its loops unroll. */
+static inline __attribute__((always_inline)) void sweep_bins8(const BvhParams *p, Bins *bins, int nb, int axis,
+                                                              uint32_t total, float parea, Split *best)
+{
+    int nc = nb - 1, nc8 = (nc + 7) / 8 * 8; /* candidate c: bins 0 .. c left */
+    _Alignas(32) Box left[256], right[256];
+    _Alignas(32) int32_t nleft[256];
+    Vbox none = vbox_load(&box_none), acc = none;
+#pragma GCC unroll 16
+    for (int c = nc - 1; c >= 0; c--) {
+        acc = vbox_grow(acc, vbox_load(&bins->box[c + 1]));
+        vbox_store(&right[c], acc);
+    }
+    acc = none;
+    uint32_t n = 0;
+#pragma GCC unroll 16
+    for (int c = 0; c < nc; c++) {
+        acc = vbox_grow(acc, vbox_load(&bins->box[c]));
+        vbox_store(&left[c], acc);
+        n += bins->count[c];
+        nleft[c] = (int32_t)n;
+    }
+#pragma GCC unroll 8
+    for (int c = nc; c < nc8; c++) {
+        vbox_store(&left[c], none);
+        vbox_store(&right[c], none);
+        nleft[c] = 0; /* not a split */
+    }
+    __m256i all = _mm256_set1_epi32((int)total), zero = _mm256_setzero_si256();
+#pragma GCC unroll 2
+    for (int c = 0; c < nc; c += 8) {
+        __m256i nl = _mm256_load_si256((const __m256i *)&nleft[c]);
+        __m256i nr = _mm256_sub_epi32(all, nl);
+        /* a split has primitives on both sides */
+        __m256i no = _mm256_or_si256(_mm256_cmpeq_epi32(nl, zero), _mm256_cmpeq_epi32(nr, zero));
+        int r = pick8(p, area8(&left[c]), _mm256_cvtepi32_ps(nl), area8(&right[c]), _mm256_cvtepi32_ps(nr),
+                      _mm256_castsi256_ps(_mm256_xor_si256(no, _mm256_set1_epi32(-1))), parea, axis, best);
+        int won = -(r < 8); /* all ones when best changed (no branch) */
+        best->bin = (best->bin & ~won) | ((c + r) & won);
+    }
+#pragma GCC unroll 16
+    for (int i = 0; i < nb; i++) {
+        vbox_store(&bins->box[i], none);
+        bins->count[i] = 0;
+    }
+}
+
+static void sweep_axis8(const BvhParams *p, Bins *bins, int axis, uint32_t total, float parea, Split *best)
+{
+    if (p->bins == 16)
+        sweep_bins8(p, bins, 16, axis, total, parea, best);
+    else
+        sweep_bins8(p, bins, p->bins, axis, total, parea, best);
+}
+#endif
+
 /* The axis scale of the binning, or 0 when the axis gives no split: no extent, a denormal
  * extent (scale infinite: binning along it would be meaningless), or an infinite one (scale 0:
  * every centroid would fall in bin 0). */
@@ -283,22 +416,27 @@ static inline __m128i bin_of3(__m128 c, __m128 cmin, __m128 scale, __m128i top)
 /* One pass puts every primitive in its bin on each axis; each bin still grows in primitive order.
  * An axis that gives no split bins into the sink. With sets > 1, primitive j goes to set j mod sets
  * (sets is a power of 2). */
-/* Primitive j into bins d (one per axis) and its bin bytes into B->bin[j]. */
-static inline void bin_one(const Builder *B, uint32_t j, Bins *const *d, __m128 cmin, __m128 sc, __m128i top)
+/* Primitive j into bins d (one per axis) and its bin bytes into bin[j]. The primitive is loaded
+ * once and the arrays are restrict: the bin stores could otherwise alias it and the Builder, which
+ * were read again after each. */
+static inline void bin_one(const Box *restrict prim, uint8_t (*restrict bin)[4], uint32_t j, Bins *const *d,
+                           __m128 cmin, __m128 sc, __m128i top)
 {
-    const Box *q = &B->prim[j];
-    _mm_prefetch((const char *)&B->prim[j + 16], _MM_HINT_T0);
-    __m128 c = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(q->v), _mm_load_ps(q->v + 4)), _mm_set1_ps(0.5f));
+    Vbox q = vbox_load(&prim[j]);
+    __m128 c = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(prim[j].v), _mm_load_ps(prim[j].v + 4)), _mm_set1_ps(0.5f));
     __m128i bi = bin_of3(c, cmin, sc, top);
-    int i0 = _mm_cvtsi128_si32(bi);
-    int i1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 1));
-    int i2 = _mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 2));
+    uint32_t i0 = (uint32_t)_mm_cvtsi128_si32(bi);
+    uint32_t i1 = (uint32_t)_mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 1));
+    uint32_t i2 = (uint32_t)_mm_cvtsi128_si32(_mm_shuffle_epi32(bi, 2));
     /* the four lanes (0..255) as bytes */
     uint32_t packed = (uint32_t)_mm_cvtsi128_si32(_mm_packus_epi16(_mm_packs_epi32(bi, bi), bi));
-    memcpy(B->bin[j], &packed, 4);
-    bin_put(d[0], i0, q);
-    bin_put(d[1], i1, q);
-    bin_put(d[2], i2, q);
+    memcpy(bin[j], &packed, 4);
+    vbox_store(&d[0]->box[i0], vbox_grow(vbox_load(&d[0]->box[i0]), q));
+    d[0]->count[i0]++;
+    vbox_store(&d[1]->box[i1], vbox_grow(vbox_load(&d[1]->box[i1]), q));
+    d[1]->count[i1]++;
+    vbox_store(&d[2]->box[i2], vbox_grow(vbox_load(&d[2]->box[i2]), q));
+    d[2]->count[i2]++;
 }
 
 static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, const float *scale, int live,
@@ -308,6 +446,8 @@ static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box 
     for (int set = 0; set < sets; set++)
         for (int axis = 0; axis < 3; axis++)
             dst[set][axis] = &B->bins[live & 1 << axis ? 3 * set + axis : BIN_SINK];
+    const Box *prim = B->prim;
+    uint8_t(*bin)[4] = B->bin;
     __m128 cmin = _mm_setr_ps(box_lo(cbox, 0), box_lo(cbox, 1), box_lo(cbox, 2), 0.0f);
     __m128 sc = _mm_setr_ps(scale[0], scale[1], scale[2], 0.0f);
     __m128i top = _mm_set1_epi32(B->p->bins - 1);
@@ -315,14 +455,14 @@ static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box 
     if (sets == BIN_SETS) {
         _Static_assert(BIN_SETS == 4, "the loop below is unrolled for 4 sets");
         for (; j + 4 <= end; j += 4) {
-            bin_one(B, j, dst[0], cmin, sc, top);
-            bin_one(B, j + 1, dst[1], cmin, sc, top);
-            bin_one(B, j + 2, dst[2], cmin, sc, top);
-            bin_one(B, j + 3, dst[3], cmin, sc, top);
+            bin_one(prim, bin, j, dst[0], cmin, sc, top);
+            bin_one(prim, bin, j + 1, dst[1], cmin, sc, top);
+            bin_one(prim, bin, j + 2, dst[2], cmin, sc, top);
+            bin_one(prim, bin, j + 3, dst[3], cmin, sc, top);
         }
     }
     for (; j < end; j++)
-        bin_one(B, j, dst[0], cmin, sc, top);
+        bin_one(prim, bin, j, dst[0], cmin, sc, top);
 }
 #else
 static void bin_prims(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, const float *scale, int live,
@@ -361,7 +501,9 @@ static void merge_bins(Bins *restrict to, Bins *restrict from, int nb)
  * costs and the order of the candidates (axis, then bin) are the sweep's, so the same split wins.
  * Fixed-size loops over SMALL_MAX ranks, the ranks past the node's own holding empty boxes, so
  * that no branch depends on the node: small nodes are most of the tree and their short
- * data-dependent loops were mispredicted. The chosen axis's bins go to B->bin for partition. */
+ * data-dependent loops were mispredicted. With AVX2 the seven candidates of an axis are costed
+ * in the lanes of one vector and the best picked without a branch (area8, pick8). The chosen
+ * axis's bins go to B->bin for partition. */
 enum { SMALL_MAX = 8 };
 
 static Split find_split_small(const Builder *B, uint32_t begin, uint32_t end, const Box *cbox, float parea)
@@ -388,8 +530,9 @@ static Split find_split_small(const Builder *B, uint32_t begin, uint32_t end, co
 #pragma GCC unroll 8
     for (uint32_t j = 0; j < SMALL_MAX; j++) {
         /* the ranks past k hold empty boxes, binned as primitive 0 (and ranked last below) */
-        const Box *pj = &B->prim[begin + (j < k ? j : 0)];
-        q[j] = j < k ? *pj : box_none;
+        uint32_t in = (j - k) >> 31; /* j < k, without a branch */
+        const Box *pj = &B->prim[begin + j * in];
+        vbox_store(&q[j], vbox_select(in, vbox_load(pj), vbox_load(&box_none)));
 #if defined(__SSE2__)
         __m128 c = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(pj->v), _mm_load_ps(pj->v + 4)), _mm_set1_ps(0.5f));
         __m128i bi = bin_of3(c, cmin, sc, top);
@@ -406,11 +549,21 @@ static Split find_split_small(const Builder *B, uint32_t begin, uint32_t end, co
             continue;
         /* distinct keys (bin, position), the empty boxes' above every bin; a rank is the number
          * of smaller keys */
-        uint16_t key[SMALL_MAX];
+        _Alignas(16) uint16_t key[SMALL_MAX];
+#if defined(__AVX2__)
+        __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+        __m256i kb = _mm256_and_si256(_mm256_srl_epi32(_mm256_loadu_si256((const __m256i *)bins), _mm_cvtsi32_si128(8 * axis)),
+                                      _mm256_set1_epi32(0xff));
+        kb = _mm256_or_si256(kb, _mm256_and_si256(_mm256_cmpgt_epi32(iota, _mm256_set1_epi32((int)k - 1)), _mm256_set1_epi32(1 << 9)));
+        kb = _mm256_or_si256(_mm256_slli_epi32(kb, 3), iota);
+        _mm_store_si128((__m128i *)key, _mm_packs_epi32(_mm256_castsi256_si128(kb), _mm256_extracti128_si256(kb, 1)));
+#else
 #pragma GCC unroll 8
         for (uint32_t j = 0; j < SMALL_MAX; j++)
             key[j] = (uint16_t)(((uint32_t)bins[j][axis] | (uint32_t)(j >= k) << 9) << 3 | j);
-        uint32_t sorted_bin[SMALL_MAX];
+#endif
+        uint32_t sorted_bin[SMALL_MAX + 1];
+        sorted_bin[SMALL_MAX] = 1u << 12; /* above every key's bin, for the vector compare */
         Vbox sorted[SMALL_MAX];
 #if defined(__SSE2__)
         _Static_assert(SMALL_MAX == 8, "the ranks are taken in one 8 x 16-bit vector");
@@ -431,6 +584,30 @@ static Split find_split_small(const Builder *B, uint32_t begin, uint32_t end, co
             sorted_bin[r] = (uint32_t)key[j] >> 3;
             sorted[r] = vbox_load(&q[j]);
         }
+#if defined(__AVX2__)
+        /* candidate r: ranks 0 .. r left; lane by lane the operations below (area8, pick8) */
+        _Alignas(32) Box lbox[SMALL_MAX], rbox[SMALL_MAX];
+        Vbox left = vbox_load(&box_none), right = left;
+        vbox_store(&rbox[SMALL_MAX - 1], right);
+#pragma GCC unroll 8
+        for (int r = 0; r < SMALL_MAX - 1; r++) {
+            left = vbox_grow(left, sorted[r]);
+            vbox_store(&lbox[r], left);
+            right = vbox_grow(right, sorted[SMALL_MAX - 1 - r]);
+            vbox_store(&rbox[SMALL_MAX - 2 - r], right);
+        }
+        vbox_store(&lbox[SMALL_MAX - 1], left);
+        __m256i rank1 = _mm256_setr_epi32(1, 2, 3, 4, 5, 6, 7, 8);
+        __m256i sb = _mm256_loadu_si256((const __m256i *)sorted_bin);
+        __m256i sb_next = _mm256_loadu_si256((const __m256i *)(sorted_bin + 1));
+        /* r + 1 < k, and the end of a run of one bin */
+        __m256i ok = _mm256_and_si256(_mm256_cmpgt_epi32(_mm256_set1_epi32((int)k), rank1), _mm256_cmpgt_epi32(sb_next, sb));
+        sorted_bin[SMALL_MAX] = (uint32_t)best.bin; /* lane 8: best stays (the compare has read it) */
+        int r = pick8(p, area8(lbox), _mm256_cvtepi32_ps(rank1), area8(rbox),
+                      _mm256_cvtepi32_ps(_mm256_sub_epi32(_mm256_set1_epi32((int)k), rank1)), _mm256_castsi256_ps(ok),
+                      parea, axis, &best);
+        best.bin = (int)sorted_bin[r];
+#else
         float left_area[SMALL_MAX], right_area[SMALL_MAX];
         Vbox left = vbox_load(&box_none), right = left;
 #pragma GCC unroll 8
@@ -452,9 +629,14 @@ static Split find_split_small(const Builder *B, uint32_t begin, uint32_t end, co
             best.cost = wins ? cost : best.cost;
             best.x = wins ? x : best.x;
         }
+#endif
     }
-    for (uint32_t j = 0; j < k; j++)
-        memcpy(B->bin[begin + j], bins[j], 4);
+    /* partition reads the bytes of the node's own positions; those past it are the next nodes',
+     * which bin them again before they read them */
+    if (begin + SMALL_MAX <= B->b->nprims)
+        memcpy(B->bin[begin], bins, sizeof bins);
+    else
+        memcpy(B->bin[begin], bins, 4 * (size_t)k);
     return best;
 }
 
@@ -482,9 +664,17 @@ static Split find_split(const Builder *B, uint32_t begin, uint32_t end, const Bo
         for (int axis = 0; axis < 3; axis++)
             if (live & 1 << axis)
                 merge_bins(&B->bins[axis], &B->bins[3 * set + axis], nb);
-    for (int axis = 0; axis < 3; axis++)
-        if (live & 1 << axis)
-            sweep_axis(p, &B->bins[axis], axis, end - begin, parea, &best);
+    for (int axis = 0; axis < 3; axis++) {
+        if (!(live & 1 << axis))
+            continue;
+#if defined(__AVX2__)
+        if (end - begin < (uint32_t)1 << 31) {
+            sweep_axis8(p, &B->bins[axis], axis, end - begin, parea, &best);
+            continue;
+        }
+#endif
+        sweep_axis(p, &B->bins[axis], axis, end - begin, parea, &best);
+    }
     return best;
 }
 
@@ -496,33 +686,40 @@ typedef struct Halves { Box box[2], cbox[2]; } Halves;
  * a right position once filled, in decreasing order (hence vbox_grow_backwards). */
 static uint32_t partition(Builder *B, uint32_t begin, uint32_t end, Split s, Halves *h)
 {
-    Box *prim = B->prim;
-    uint32_t *id = B->b->prim_index;
-    uint8_t(*bins)[4] = B->bin;
+    Box *restrict prim = B->prim;
+    uint32_t *restrict id = B->b->prim_index;
+    const uint8_t(*restrict bins)[4] = B->bin;
     int axis = s.axis;
     Vbox none = vbox_load(&box_none);
     Vbox box0 = none, cbox0 = none, box1 = none, cbox1 = none;
     uint32_t i = begin, j = end;
+    /* the primitive at i and its bin, kept in registers: after a swap it is the one just read
+     * from j - 1, which is not read back from memory (nor its bin byte written to i: no one reads
+     * it again) */
+    Vbox q = vbox_load(&prim[i]);
+    uint32_t qb = bins[i][axis];
     while (i < j) {
-        Vbox q = vbox_load(&prim[i]);
         Vbox cc = vbox_centroid(q);
-        if (bins[i][axis] <= s.bin) {
+        if (qb <= (uint32_t)s.bin) {
             box0 = vbox_grow(box0, q);
             cbox0 = vbox_grow(cbox0, cc);
             i++;
+            uint32_t next = i < j ? i : i - 1; /* the read past the last is not used */
+            q = vbox_load(&prim[next]);
+            qb = bins[next][axis];
         } else {
             j--;
-            prim[i] = prim[j];
+            Vbox r = vbox_load(&prim[j]);
+            uint32_t rb = bins[j][axis];
+            vbox_store(&prim[i], r);
             vbox_store(&prim[j], q);
             uint32_t qi = id[i];
             id[i] = id[j];
             id[j] = qi;
-            uint8_t qb[4];
-            memcpy(qb, bins[i], 4);
-            memcpy(bins[i], bins[j], 4);
-            memcpy(bins[j], qb, 4);
             box1 = vbox_grow_backwards(box1, q);
             cbox1 = vbox_grow_backwards(cbox1, cc);
+            q = r;
+            qb = rb;
         }
     }
     vbox_store(&h->box[0], box0);
@@ -571,8 +768,28 @@ static int check_params(const BvhParams *p, char *err, size_t errlen)
     return 0;
 }
 
+/* First one pass without a branch per value (finite and ordered: lo <= hi, |lo| and |hi| <= FLT_MAX,
+ * each false for a NaN), then, only when it fails, the loop that names the first bad box. */
 static int check_boxes(const float *bmin, const float *bmax, uint32_t n, char *err, size_t errlen)
 {
+    int ok = 1;
+    size_t t = 0, nt = 3 * (size_t)n;
+#if defined(__SSE2__)
+    /* the same comparisons, four values at a time (cmple is false for a NaN too) */
+    __m128 all = _mm_castsi128_ps(_mm_set1_epi32(-1)), magnitude = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    __m128 big = _mm_set1_ps(FLT_MAX), good = all;
+    for (; t + 4 <= nt; t += 4) {
+        __m128 lo = _mm_loadu_ps(bmin + t), hi = _mm_loadu_ps(bmax + t);
+        good = _mm_and_ps(good, _mm_cmple_ps(lo, hi));
+        good = _mm_and_ps(good, _mm_cmple_ps(_mm_and_ps(lo, magnitude), big));
+        good = _mm_and_ps(good, _mm_cmple_ps(_mm_and_ps(hi, magnitude), big));
+    }
+    ok = _mm_movemask_ps(good) == 15;
+#endif
+    for (; t < nt; t++)
+        ok &= (bmin[t] <= bmax[t]) & (fabsf(bmin[t]) <= FLT_MAX) & (fabsf(bmax[t]) <= FLT_MAX);
+    if (ok)
+        return 0;
     for (uint32_t i = 0; i < n; i++) {
         for (int k = 0; k < 3; k++) {
             float lo = bmin[3 * i + k], hi = bmax[3 * i + k];
@@ -666,7 +883,19 @@ static uint32_t split_node(Builder *B, const Task *t, const Box *nb, Halves *h, 
 /* The build's copy of the primitives: [lo, 0, -hi, 0] each, in prim_index order (the identity). */
 static void load_prims(Builder *B, const float *bmin, const float *bmax, uint32_t n)
 {
-    for (uint32_t i = 0; i < n; i++) {
+    uint32_t i = 0;
+#if defined(__SSE2__)
+    /* four floats read from 3i (the fourth is the next primitive's: the last primitive is left to
+     * the loop below), lane 3 cleared, hi negated by its sign bit: the same values */
+    __m128 keep = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
+    __m128 sign = _mm_castsi128_ps(_mm_setr_epi32(INT32_MIN, INT32_MIN, INT32_MIN, 0));
+    for (; i + 1 < n; i++) {
+        B->b->prim_index[i] = i;
+        _mm_store_ps(B->prim[i].v, _mm_and_ps(_mm_loadu_ps(bmin + 3 * (size_t)i), keep));
+        _mm_store_ps(B->prim[i].v + 4, _mm_and_ps(_mm_xor_ps(_mm_loadu_ps(bmax + 3 * (size_t)i), sign), keep));
+    }
+#endif
+    for (; i < n; i++) {
         Box *q = &B->prim[i];
         B->b->prim_index[i] = i;
         for (int k = 0; k < 3; k++) {
@@ -676,8 +905,8 @@ static void load_prims(Builder *B, const float *bmin, const float *bmax, uint32_
         q->v[3] = q->v[7] = 0.0f;
     }
     for (int a = 0; a <= BIN_SINK; a++) {
-        for (int i = 0; i < 256; i++)
-            B->bins[a].box[i] = box_none;
+        for (int k = 0; k < 256; k++)
+            B->bins[a].box[k] = box_none;
         memset(B->bins[a].count, 0, sizeof B->bins[a].count);
     }
 }
@@ -794,6 +1023,45 @@ static inline int inside(const float *lo, const float *hi, const float *plo, con
              (hi[2] > phi[2]));
 }
 
+/* bvh_check's conditions without a branch per condition, and without naming a violation: 1 when
+ * the tree passes them all, 0 otherwise (then bvh_check looks again, to name the first). seen_prim
+ * and seen_node are zeroed. A leaf's primitives and an inner node's children are marked seen once;
+ * with no mark made twice, every primitive is in a leaf when the leaves' counts add up to nprims,
+ * and every node but the root is some node's child when the inner nodes are (nnodes - 1) / 2. */
+static int check_fast(const Bvh *b, const float *bmin, const float *bmax, uint8_t *seen_prim, uint8_t *seen_node)
+{
+    uint32_t bad = 0, nprims = b->nprims, nnodes = b->nnodes, ninner = 0;
+    uint64_t listed = 0;
+    for (uint32_t i = 0; i < nnodes; i++) {
+        const BvhNode *n = &b->nodes[i];
+        /* not a NaN and not inverted */
+        bad |= !(n->bmin[0] <= n->bmax[0]) | !(n->bmin[1] <= n->bmax[1]) | !(n->bmin[2] <= n->bmax[2]);
+        if (n->count > 0) {
+            if (n->first > nprims || n->count > nprims - n->first)
+                return 0;
+            listed += n->count;
+            for (uint32_t j = n->first; j < n->first + n->count; j++) {
+                uint32_t pi = b->prim_index[j];
+                if (pi >= nprims)
+                    return 0;
+                bad |= seen_prim[pi];
+                seen_prim[pi] = 1;
+                bad |= !inside(&bmin[3 * pi], &bmax[3 * pi], n->bmin, n->bmax);
+            }
+        } else {
+            if (n->first + 1 >= nnodes || n->first <= i || n->axis > 2)
+                return 0;
+            ninner++;
+            for (uint32_t c = n->first; c <= n->first + 1; c++) {
+                bad |= !inside(b->nodes[c].bmin, b->nodes[c].bmax, n->bmin, n->bmax);
+                bad |= seen_node[c];
+                seen_node[c] = 1;
+            }
+        }
+    }
+    return !bad && listed == nprims && 2 * (uint64_t)ninner == (uint64_t)nnodes - 1;
+}
+
 /* One pass over the nodes in index order. A child's index is above its parent's (checked), so a
  * node other than the root that is some inner node's child exactly once is reached from the root
  * exactly once: its parent, by induction on the index, is; so is every node, when each but the
@@ -814,6 +1082,12 @@ int bvh_check(const Bvh *b, const float *bmin, const float *bmax, char *err, siz
         snprintf(err, errlen, "bvh: primitive 0 is in no leaf");
         goto out;
     }
+    if (check_fast(b, bmin, bmax, seen_prim, seen_node)) {
+        rc = 0;
+        goto out;
+    }
+    memset(seen_prim, 0, b->nprims);
+    memset(seen_node, 0, b->nnodes);
     for (uint32_t i = 0; i < b->nnodes; i++) {
         const BvhNode *n = &b->nodes[i];
         for (int k = 0; k < 3; k++) {
@@ -881,8 +1155,13 @@ out:
 static inline double node_area(const float *lo, const float *hi)
 {
     double d[3];
-    for (int k = 0; k < 3; k++)
-        d[k] = hi[k] > lo[k] ? (double)hi[k] - (double)lo[k] : 0.0;
+    /* hi > lo exactly when the difference is above 0 (a positive difference of floats is not lost
+     * in double), so this is hi > lo ? hi - lo : 0, without a branch (maxsd) */
+#pragma GCC unroll 3
+    for (int k = 0; k < 3; k++) {
+        d[k] = (double)hi[k] - (double)lo[k];
+        d[k] = d[k] > 0.0 ? d[k] : 0.0;
+    }
     return 2.0 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]);
 }
 
@@ -897,7 +1176,9 @@ double bvh_sah_cost(const Bvh *b, const BvhParams *p)
     for (uint32_t i = 0; i < b->nnodes; i++) {
         const BvhNode *n = &b->nodes[i];
         double a = node_area(n->bmin, n->bmax) / ra;
-        cost += a * (n->count > 0 ? (double)p->cost_intersect * n->count : (double)p->cost_traversal);
+        /* both weights computed, one selected: leaves and inner nodes alternate unpredictably */
+        double leaf = (double)p->cost_intersect * n->count, inner = (double)p->cost_traversal;
+        cost += a * (n->count > 0 ? leaf : inner);
     }
     return cost;
 }

@@ -9,6 +9,9 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 typedef struct Writer {
     uint8_t *mem;
@@ -168,7 +171,19 @@ static int pack_build_bvh(const Scene *s, const BvhParams *bp, uint32_t nprims, 
         snprintf(err, errlen, "pack: out of memory");
         return -1;
     }
-    for (uint32_t i = 0; i < s->ntris; i++) {
+    uint32_t i = 0;
+#if defined(__SSE2__)
+    /* tri_min and tri_max on the three axes at once: minps(b, a) is b < a ? b : a, lane by lane.
+     * Four floats are read from each vertex and stored at 3i (the fourth belongs to the next
+     * triangle, which overwrites it): the last triangle is left to the loop below. */
+    for (; i + 1 < s->ntris; i++) {
+        const float *p = &s->pos[9 * (size_t)i];
+        __m128 a = _mm_loadu_ps(p), b = _mm_loadu_ps(p + 3), c = _mm_loadu_ps(p + 6);
+        _mm_storeu_ps(&lo[3 * (size_t)i], _mm_min_ps(c, _mm_min_ps(b, a)));
+        _mm_storeu_ps(&hi[3 * (size_t)i], _mm_max_ps(c, _mm_max_ps(b, a)));
+    }
+#endif
+    for (; i < s->ntris; i++) {
         const float *p = &s->pos[9 * i];
         for (int k = 0; k < 3; k++) {
             lo[3 * i + k] = tri_min(p[k], p[3 + k], p[6 + k]);
@@ -297,6 +312,8 @@ static void pack_header(Writer *w, const Scene *s, const Layout *l)
     put_vec(w, hdr(h, SM_HDR_BOUNDS_MAX), s->bounds_max, 3);
 }
 
+enum { PACK_AHEAD = 16 };
+
 /* The BVH nodes, then the primitives in leaf order, so a leaf's primitives are one contiguous run. */
 static void pack_geometry(Writer *w, const Scene *s, const Bvh *bvh, const Layout *l)
 {
@@ -311,6 +328,14 @@ static void pack_geometry(Writer *w, const Scene *s, const Bvh *bvh, const Layou
     }
     for (uint32_t i = 0; i < l->nprims; i++) {
         uint32_t src = bvh->prim_index[i];
+        /* leaf order reads the triangles out of order: most of this loop's time was waiting for
+         * them, so the triangle PACK_AHEAD places on is requested now (both lines it may span) */
+        if (i + PACK_AHEAD < l->nprims) {
+            uint32_t ahead = bvh->prim_index[i + PACK_AHEAD];
+            const float *v = &s->pos[9 * (size_t)(ahead < s->ntris ? ahead : 0)];
+            __builtin_prefetch(v);
+            __builtin_prefetch(v + 8);
+        }
         if (src < s->ntris) {
             put_vec(w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_V0), &s->pos[9 * src], 9);
             put_u32(w, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_MAT), s->tri_material[src]);

@@ -2,6 +2,7 @@
  * and that the checker catches broken trees. */
 #include <criterion/criterion.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -198,6 +199,39 @@ Test(bvh_errors, nan_box_rejected)
     cr_expect(strstr(err, "bad parameters") != NULL, "%s", err);
 }
 
+/* check_boxes tests four values at a time, then the rest one by one: a bad value (NaN, either
+ * infinity, an inverted pair) at every coordinate of 7 primitives, in lo and in hi, is rejected
+ * and named. */
+Test(bvh_errors, every_bad_coordinate_is_named)
+{
+    BvhParams p;
+    bvh_default_params(&p);
+    const float bad[] = {NAN, INFINITY, -INFINITY};
+    enum { N = 7 };
+    for (int t = 0; t < 3 * N; t++) {
+        for (int v = 0; v < 4; v++) {
+            for (int side = 0; side < 2; side++) {
+                float lo[3 * N], hi[3 * N];
+                for (int u = 0; u < 3 * N; u++) {
+                    lo[u] = (float)u;
+                    hi[u] = (float)u + 1.0f;
+                }
+                if (v < 3)
+                    (side ? hi : lo)[t] = bad[v];
+                else if (side)
+                    hi[t] = lo[t] - 1.0f; /* inverted */
+                else
+                    lo[t] = hi[t] + 1.0f;
+                Bvh b;
+                char err[256], want[64];
+                cr_assert_eq(bvh_build(&p, lo, hi, N, &b, err, sizeof err), -1, "value %d at %d", v, t);
+                snprintf(want, sizeof want, "bvh: primitive %d has a bad box on axis %d:", t / 3, t % 3);
+                cr_expect(strncmp(err, want, strlen(want)) == 0, "%s (wanted %s)", err, want);
+            }
+        }
+    }
+}
+
 Test(bvh_errors, checker_catches_broken_trees)
 {
     BvhParams p;
@@ -239,6 +273,28 @@ Test(bvh_errors, checker_catches_broken_trees)
     cr_expect_eq(bvh_check(&b, lo, hi, err, sizeof err), -1);
     cr_expect(strstr(err, "reached twice") != NULL, "%s", err);
     b.nodes[0].first = c;
+    cr_expect_eq(bvh_check(&b, lo, hi, err, sizeof err), 0, "%s", err);
+    /* A NaN in a node's box, and an inverted one. */
+    float saved_lo = b.nodes[c].bmin[2];
+    b.nodes[c].bmin[2] = NAN;
+    cr_expect_eq(bvh_check(&b, lo, hi, err, sizeof err), -1);
+    cr_expect(strstr(err, "bad box on axis 2") != NULL, "%s", err);
+    b.nodes[c].bmin[2] = b.nodes[c].bmax[2] + 1.0f;
+    cr_expect_eq(bvh_check(&b, lo, hi, err, sizeof err), -1);
+    cr_expect(strstr(err, "bad box on axis 2") != NULL, "%s", err);
+    b.nodes[c].bmin[2] = saved_lo;
+    /* A leaf's count past the primitives; a node no node points to (a copy of a leaf, past the
+     * last: its primitives are listed twice). */
+    uint32_t saved_count = b.nodes[leaf].count;
+    b.nodes[leaf].count = b.nprims;
+    cr_expect_eq(bvh_check(&b, lo, hi, err, sizeof err), -1);
+    cr_expect(strstr(err, "outside") != NULL, "%s", err);
+    b.nodes[leaf].count = saved_count;
+    cr_assert_lt(b.nnodes, 2 * b.nprims - 1, "no room for one more node");
+    b.nodes[b.nnodes++] = b.nodes[leaf];
+    cr_expect_eq(bvh_check(&b, lo, hi, err, sizeof err), -1);
+    cr_expect(strstr(err, "listed twice") != NULL, "%s", err);
+    b.nnodes--;
     cr_expect_eq(bvh_check(&b, lo, hi, err, sizeof err), 0, "%s", err);
     bvh_free(&b);
     free(lo);
