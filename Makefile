@@ -20,9 +20,17 @@ CXXFLAGS := -std=c++17 $(OPT) $(ARCH) -g $(CXXWARN) $(EXTRA_CXXFLAGS)
 GLTF    := $(shell pkg-config --libs tinygltf 2>/dev/null || echo -ltinygltf)
 OIIO    := $(shell pkg-config --libs OpenImageIO 2>/dev/null || echo -lOpenImageIO -lOpenImageIO_Util)
 CJSON   := $(shell pkg-config --libs libcjson 2>/dev/null || echo -lcjson)
-# OpenImageIO is not in LDLIBS: bin/sfsim loads it with dlopen, inside the image library (IMGLIB
-# below); the test and tool binaries that write or read images link its objects and $(OIIO).
-LDLIBS  := $(GLTF) $(CJSON) -lstdc++ -lpthread -ldl -lm
+# The image writers (sim/img_write.c, sim/heatmap.c) are C on C libraries linked into bin/sfsim:
+# OpenEXR's C core (OpenEXR 3.1 has no .pc of its own, so its name is picked out of OpenEXR's),
+# libpng and FreeType, which load with zlib and brotli in about a millisecond (docs/install.md).
+IMGW_CFLAGS := $(shell pkg-config --cflags OpenEXR libpng freetype2 2>/dev/null || \
+                 echo -I/usr/include/OpenEXR -I/usr/include/libpng16 -I/usr/include/freetype2)
+IMGW_LIBS := $(or $(filter -L% -lOpenEXRCore%,$(shell pkg-config --libs OpenEXR 2>/dev/null)),-lOpenEXRCore-3_1) \
+             $(shell pkg-config --libs libpng freetype2 2>/dev/null || echo -lpng16 -lfreetype)
+# OpenImageIO is not in LDLIBS: it only reads images now, and bin/sfsim loads it with dlopen
+# inside the image library (IMGLIB below) when `sfsim compare` needs it; the test and tool
+# binaries that read images link its objects and $(OIIO).
+LDLIBS  := $(GLTF) $(CJSON) $(IMGW_LIBS) -lstdc++ -lpthread -ldl -lm
 INIH    := $(shell pkg-config --cflags --libs inih 2>/dev/null || echo -linih)
 CRIT    := $(shell pkg-config --libs criterion 2>/dev/null || echo -lcriterion)
 EMBREE  := -lembree3
@@ -40,11 +48,12 @@ ISA_SRC := isa/isa.c
 ASM_SRC := $(filter-out asm/main_sfasm.c,$(wildcard asm/*.c))
 SIM_SRC := $(filter-out sim/main.c,$(wildcard sim/*.c sim/*/*.c))
 SCN_SRC := $(wildcard scenes/*.c)
-# The image library (sim/imgshim.h): the only code that links OpenImageIO. Not in libsfsim.a:
-# bin/sfsim loads it as IMGLIB with dlopen when it first needs an image (sim/imglib.c), because
-# OpenImageIO's ~260 shared libraries cost ~0.2 s at every start (docs/performance.md). Binaries
-# that link libsfsim.a and write or read images link SHIM_OBJ instead (sim/imglib.c uses that copy).
-SHIM_SRC := sim/img.cpp sim/heatmap.cpp
+# The image library (sim/imgshim.h): the only code that links OpenImageIO, the image reader. Not
+# in libsfsim.a: bin/sfsim loads it as IMGLIB with dlopen when it first reads an image
+# (sim/imglib.c; `sfsim compare`), because OpenImageIO's ~265 shared libraries cost 120-250 ms at
+# every start (docs/performance.md). Binaries that link libsfsim.a and read images link SHIM_OBJ
+# instead (sim/imglib.c uses that copy).
+SHIM_SRC := sim/img.cpp
 CXX_SRC := $(filter-out $(SHIM_SRC),$(wildcard scenes/*.cpp sim/*.cpp))
 LIB_SRC := $(ISA_SRC) $(ASM_SRC) $(SIM_SRC) $(SCN_SRC)
 # An archive keeps members by file name only: two sources with one name in different folders
@@ -117,6 +126,10 @@ run: deps
 test: deps
 	@$(MAKE) --no-print-directory test-built
 
+# Only the image writers see the image libraries' headers.
+$(BUILD)/obj/sim/img_write.o $(BUILD)/obj/sim/heatmap.o $(BUILD)/asan/sim/img_write.o $(BUILD)/asan/sim/heatmap.o: \
+	CFLAGS += $(IMGW_CFLAGS)
+
 $(BUILD)/obj/%.o: %.c $(FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -MMD -MP -c $< -o $@
@@ -137,7 +150,7 @@ $(BUILD)/shim/%.o: %.cpp $(FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS) -fPIC -fvisibility=hidden -MMD -MP -c $< -o $@
 
-# The image library. -z defs: it needs nothing of the program (it writes through an ImgSink); the
+# The image library. -z defs: it needs nothing of the program; the
 # version script keeps the template instances of OpenImageIO's headers out of its symbol table.
 # Beside it, IMGLIB.deps: the order in which sim/imglib.c opens its dependencies
 # (scripts/imglib_deps.sh).
@@ -386,7 +399,7 @@ run-built: all
 	@grep -E '^cycles +[0-9]' out/report.txt | sed 's/^/== headline: /'
 
 # ---- installation (docs/install.md) ---------------------------------------------------------
-# PREFIX/bin: sfsim, sfasm; PREFIX/lib/sfsim: the image library sfsim loads when it needs images;
+# PREFIX/bin: sfsim, sfasm; PREFIX/lib/sfsim: the image library sfsim loads when it reads images;
 # PREFIX/share/sfsim: kernels, configs, the default scene (sfsim finds these and the library from
 # its own folder); PREFIX/share/doc/sfsim: README and docs.
 PREFIX  ?= /usr/local

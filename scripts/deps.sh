@@ -11,6 +11,7 @@ case "${1:-}" in
     build-essential pkg-config clang libclang-rt-14-dev
     libtinygltf-dev nlohmann-json3-dev libstb-dev
     libopenimageio-dev openimageio-tools
+    libopenexr-dev libpng-dev libfreetype-dev
     fonts-dejavu-core
     libinih-dev libcjson-dev libcriterion-dev
     libembree-dev gnuplot-nox parallel

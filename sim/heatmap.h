@@ -1,6 +1,6 @@
 /* sim/heatmap.h -- heat-map images of a per-pixel quantity (cost.png: simulated cycles per
- * pixel), drawn through OpenImageIO in sim/heatmap.cpp (part of the image library that
- * sim/imglib.c loads) and written like img_write_rgb8 (img.h).
+ * pixel), drawn by sim/heatmap.c (text through FreeType; the same pixels OpenImageIO's
+ * ImageBufAlgo drew until 2026-12) and written like img_write_rgb8 (img.h: a PNG through libpng).
  *
  * Owns: the colormap, the layout of map, legend bar and labels, the choice of font.
  * Must not: measure anything or know where the values come from; tone-map (the colours are
@@ -21,11 +21,11 @@
  * Colours: a viridis-like ramp (dark purple -> blue -> green -> yellow), luminance strictly
  * increasing with the value, linear between min and max of the values.
  *
- * Text: OpenImageIO on Debian 12 finds no default font, so the title and labels use
+ * Text: UTF-8, drawn with FreeType in DejaVu Sans, 18 px (title) and 14 px (labels):
  * /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf (fonts-dejavu-core, installed by
- * scripts/deps.sh), then any font OpenImageIO can find by the name "DejaVuSans" or by default.
- * If none loads, the map, bar and tick marks are still written, without text, and that is not
- * an error.
+ * scripts/deps.sh), else DejaVuSans.ttf in ~/.fonts, /usr/share/fonts/{TTF,dejavu,truetype} or
+ * /usr/local/share/fonts. If none loads, the map, bar and tick marks are still written, without
+ * text, and that is not an error.
  */
 #ifndef SFSIM_HEATMAP_H
 #define SFSIM_HEATMAP_H
@@ -39,7 +39,7 @@ extern "C" {
 #endif
 
 /* Write values (width x height, each 1..8192; row-major, top row first; each finite and >= 0)
- * as a heat-map PNG (or any 8-bit format the file name selects) laid out as above. title and
+ * as a heat-map PNG (path ending in .png) laid out as above. title and
  * unit may be NULL or empty; keep unit short (about 8 characters fit the label column).
  * Returns 0, or -1 with "path: what was wrong" in err (the first pixel, in row-major order,
  * that is NaN, infinite or negative is named by its x and y; then no file is written). The file

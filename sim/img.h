@@ -1,7 +1,8 @@
-/* sim/img.h -- images in and out (through OpenImageIO, in sim/img.cpp, reached through the image
- * library that sim/imglib.c loads when first needed) and image comparison (sim/img_compare.c).
- * The file functions fail, with "path: cannot load the image library ..." in err, when that
- * library cannot be loaded (sim/imglib.h).
+/* sim/img.h -- images out (EXR through OpenEXR, PNG through libpng: sim/img_write.c, linked into
+ * bin/sfsim), images in (through OpenImageIO, in sim/img.cpp, reached through the image library
+ * that sim/imglib.c loads when first needed) and image comparison (sim/img_compare.c). img_read
+ * fails, with "path: cannot load the image library ..." in err, when that library cannot be
+ * loaded (sim/imglib.h); the writers never need it.
  *
  * Owns: file formats, tone mapping for display images, comparison statistics.
  * Must not: render or know about the simulated machine.
@@ -16,18 +17,26 @@
 #include "outfile.h"
 
 /* The writers below encode in memory and write through sim/outfile.c: set NULL puts the file in
- * place at once (whole, or not at all); a set stages it until outset_commit. Errors name path. */
+ * place at once (whole, or not at all); a set stages it until outset_commit. Errors name path:
+ * a file name of another format than the writer's, a size that is not positive or too large to
+ * encode, no memory, or the write itself (a full disk, an unwritable folder). */
 
-/* Write linear float RGB as-is (an EXR keeps full float precision). */
+/* Write linear float RGB as-is: an EXR (path ending in .exr) with float channels R, G, B and
+ * ZIP compression, so full float precision. */
 int img_write_linear(OutSet *set, const char *path, const float *rgb, int width, int height, char *err,
                      size_t errlen);
-/* Write a display image (PNG, JPEG, ...): value x exposure, clamped to [0, 1], sRGB-encoded,
- * 8 bits per channel; NaN pixels become magenta so they cannot hide. */
+/* Write a display image (a PNG: path ending in .png): value x exposure, clamped to [0, 1],
+ * sRGB-encoded, 8 bits per channel; NaN pixels become magenta so they cannot hide. */
 int img_write_display(OutSet *set, const char *path, const float *rgb, int width, int height, float exposure,
                       char *err, size_t errlen);
-/* Write already display-ready RGB in [0, 1] (a heat map, say) as 8-bit without any transfer. */
+/* Write already display-ready RGB in [0, 1] (a heat map, say) as an 8-bit PNG without any
+ * transfer (img_to_u8_n). */
 int img_write_rgb8(OutSet *set, const char *path, const float *rgb, int width, int height, char *err,
                    size_t errlen);
+/* A display-ready value in [0, 1] as 8 bits: lround(clamp(x, 0, 1) * 255), 0 for NaN and Inf. */
+unsigned char img_to_u8(float x);
+/* out[i] = img_to_u8(x[i]) for i < n (img_write_rgb8's conversion, vectorized). */
+void img_to_u8_n(const float *x, unsigned char *out, size_t n);
 /* Read any format OpenImageIO knows into float RGB (*rgb malloc'ed; grey is replicated, alpha
  * dropped). Values are as stored: linear for EXR, encoded 0..1 for PNG. */
 int img_read(const char *path, float **rgb, int *width, int *height, char *err, size_t errlen);

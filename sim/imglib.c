@@ -1,9 +1,9 @@
 /* sim/imglib.c -- loads the image library libsfsim-img.so on demand (sim/imglib.h) and
- * implements img.h's file functions and heatmap.h through its table (sim/imgshim.h).
+ * implements img.h's img_read through its table (sim/imgshim.h). The writers do not need it
+ * (sim/img_write.c, sim/heatmap.c).
  *
- * Owns: the library's search order, the one load per process (pthread_once, so a background
- * load and a first image call on the main thread cannot both load it), the loader thread's
- * join at exit. Must not: touch pixels, or exit (the callers map a failure to EXIT_IO).
+ * Owns: the library's search order, the one load per process (pthread_once). Must not: touch
+ * pixels, or exit (the callers map a failure to EXIT_IO).
  */
 #include "imglib.h"
 
@@ -11,16 +11,12 @@
 #include <errno.h>
 #include <limits.h>
 #include <pthread.h>
-#include <signal.h>
-#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
-#include "heatmap.h"
 #include "img.h"
-#include "outfile.h"
 
 /* Defined when the binary links the library's objects in (tests and tools: sim/imgshim.h). */
 extern const ImgShim img_shim __attribute__((weak));
@@ -28,10 +24,8 @@ extern const ImgShim img_shim __attribute__((weak));
 static pthread_once_t load_once = PTHREAD_ONCE_INIT;
 static const ImgShim *loaded;
 static char load_err[PATH_MAX + 1024];
-static pthread_t loader;
-static int loader_running, preloaded;
-/* Set before the first dlopen of the library or its dependencies (on either thread). */
-static atomic_int dlopen_used;
+/* Set before the first dlopen of the library or its dependencies. */
+static int dlopen_used;
 
 const char *imglib_locate(char *buf, size_t len, char *err, size_t errlen)
 {
@@ -111,55 +105,14 @@ static void load_library(void)
     char path[PATH_MAX + 64];
     if (!imglib_locate(path, sizeof path, load_err, sizeof load_err))
         return;
-    atomic_store(&dlopen_used, 1);
+    dlopen_used = 1;
     open_dependencies(path);
     loaded = imglib_open(path, load_err, sizeof load_err);
 }
 
-static void *load_in_background(void *arg)
-{
-    (void)arg;
-    pthread_once(&load_once, load_library);
-    return NULL;
-}
-
-static void join_loader(void)
-{
-    if (loader_running) {
-        pthread_join(loader, NULL);
-        loader_running = 0;
-    }
-}
-
-int imglib_preload(char *err, size_t errlen)
-{
-    if (preloaded || &img_shim)
-        return 0;
-    preloaded = 1;
-    char path[PATH_MAX + 64];
-    if (!imglib_locate(path, sizeof path, err, errlen))
-        return -1;
-    if (access(path, R_OK) != 0) {
-        snprintf(err, errlen, "cannot load the image library %s: %s (make builds it; make install puts it in "
-                              "PREFIX/lib/sfsim; SFSIM_IMG_LIB names another)", path, strerror(errno));
-        return -1;
-    }
-    /* Joined at exit, so that exit never runs while the library's constructors do. Without the
-     * thread (or the handler) the first image call loads the library itself. The thread blocks
-     * every signal, so ^C and the held signals of sim/outfile.c reach the main thread as before. */
-    atomic_store(&dlopen_used, 1);
-    sigset_t all, old;
-    sigfillset(&all);
-    pthread_sigmask(SIG_SETMASK, &all, &old);
-    if (atexit(join_loader) == 0 && pthread_create(&loader, NULL, load_in_background, NULL) == 0)
-        loader_running = 1;
-    pthread_sigmask(SIG_SETMASK, &old, NULL);
-    return 0;
-}
-
 int imglib_dlopened(void)
 {
-    return atomic_load(&dlopen_used);
+    return dlopen_used;
 }
 
 const ImgShim *imglib_get(char *err, size_t errlen)
@@ -170,12 +123,7 @@ const ImgShim *imglib_get(char *err, size_t errlen)
     return loaded;
 }
 
-/* ---- img.h and heatmap.h through the library ------------------------------------------------ */
-
-static int sink_write(void *ctx, const char *path, const void *bytes, size_t n, char *err, size_t errlen)
-{
-    return outfile_write_file(ctx, path, bytes, n, err, errlen);
-}
+/* ---- img.h through the library ------------------------------------------------------------ */
 
 /* The library, or NULL with "path: cannot load the image library ..." in err. */
 static const ImgShim *shim_for(const char *path, char *err, size_t errlen)
@@ -187,49 +135,9 @@ static const ImgShim *shim_for(const char *path, char *err, size_t errlen)
     return t;
 }
 
-int img_write_linear(OutSet *set, const char *path, const float *rgb, int width, int height, char *err,
-                     size_t errlen)
-{
-    const ImgShim *t = shim_for(path, err, errlen);
-    ImgSink sink = {sink_write, set};
-    return t ? t->write_linear(&sink, path, rgb, width, height, err, errlen) : -1;
-}
-
-int img_write_display(OutSet *set, const char *path, const float *rgb, int width, int height, float exposure,
-                      char *err, size_t errlen)
-{
-    const ImgShim *t = shim_for(path, err, errlen);
-    ImgSink sink = {sink_write, set};
-    return t ? t->write_display(&sink, path, rgb, width, height, exposure, err, errlen) : -1;
-}
-
-int img_write_rgb8(OutSet *set, const char *path, const float *rgb, int width, int height, char *err,
-                   size_t errlen)
-{
-    const ImgShim *t = shim_for(path, err, errlen);
-    ImgSink sink = {sink_write, set};
-    return t ? t->write_rgb8(&sink, path, rgb, width, height, err, errlen) : -1;
-}
-
 int img_read(const char *path, float **rgb, int *width, int *height, char *err, size_t errlen)
 {
     *rgb = NULL;
     const ImgShim *t = shim_for(path, err, errlen);
     return t ? t->read(path, rgb, width, height, err, errlen) : -1;
-}
-
-int heatmap_write(OutSet *set, const char *path, const double *values, int width, int height, const char *title,
-                  const char *unit, char *err, size_t errlen)
-{
-    const ImgShim *t = shim_for(path, err, errlen);
-    ImgSink sink = {sink_write, set};
-    return t ? t->heatmap_write(&sink, path, values, width, height, title, unit, err, errlen) : -1;
-}
-
-void heatmap_set_font(const char *font_path)
-{
-    char err[sizeof load_err];
-    const ImgShim *t = imglib_get(err, sizeof err);
-    if (t)
-        t->heatmap_set_font(font_path);
 }

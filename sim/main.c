@@ -704,13 +704,9 @@ static int cmd_run(int argc, char **argv)
     o.cfg = &cfg;
     o.config_path = ca.path;
     static char err[65536];
-    /* Every run writes an image (frame.exr and frame.png, cost.png, or frame.partial.exr): the image
-     * library loads on a thread now, overlapping the scene, the BVH and the simulation
-     * (docs/performance.md); a missing one stops the run before its work. */
-    if (imglib_preload(err, sizeof err) != 0) {
-        fprintf(stderr, "sfsim run: %s\n", err);
-        return EXIT_IO;
-    }
+    /* The images a run writes (frame.exr, frame.png, cost.png, frame.partial.exr) go through
+     * OpenEXR, libpng and FreeType linked into this binary (sim/img_write.c, sim/heatmap.c): a run
+     * never loads the image library, OpenImageIO's reader (docs/performance.md, "Start-up"). */
     int rrc = render_run(&o, err, sizeof err);
     if (rrc != 0) {
         fprintf(stderr, "sfsim run: %s\n", err);
@@ -885,11 +881,10 @@ int main(int argc, char **argv)
         if (rc == EXIT_OK)
             rc = EXIT_IO;
     }
-    /* With the image library loaded (or loading), end without exit's clean-up: it would run the
-     * destructors of OpenImageIO's ~260 libraries (~8 ms of CPU, on the critical path of a small
-     * run: docs/performance.md, "Start-up"), or wait for a load still running when a run fails
-     * early. sfsim registers nothing else to run at exit (the loader's join is for exit alone),
-     * its outputs are written and closed by now, stdout is flushed above and stderr unbuffered. */
+    /* With the image library loaded (`sfsim compare`: a run never loads it), end without exit's
+     * clean-up: it would run the destructors of OpenImageIO's ~265 libraries (~8 ms of CPU:
+     * docs/performance.md, "Start-up"). sfsim registers nothing to run at exit, its outputs are
+     * written and closed by now, stdout is flushed above and stderr unbuffered. */
     if (imglib_dlopened()) {
         fflush(NULL);
         _exit(rc);

@@ -33,7 +33,7 @@ int main(void)
            "\n"
            "| command | codes |\n"
            "|---|---|\n"
-           "| `sfsim run` | `OK`; `INPUT` (scene, config, `--set`, `--mode`, `--exposure`, `-j` and the other option values); `USAGE`; `PROGRAM` (the kernel trapped or hit its instruction limit in a tile: the finished tiles are kept in `frame.partial.exr`); `IO` (an output could not be written, or the image library did not load) |\n"
+           "| `sfsim run` | `OK`; `INPUT` (scene, config, `--set`, `--mode`, `--exposure`, `-j` and the other option values); `USAGE`; `PROGRAM` (the kernel trapped or hit its instruction limit in a tile: the finished tiles are kept in `frame.partial.exr`); `IO` (an output could not be written, or an image could not be encoded: too large, out of memory) |\n"
            "| `sfsim exec` | `OK` (halted); `INPUT` (config, object file, a `--dump-mem` spec: checked before the program runs); `USAGE`; `PROGRAM` (trap, instruction limit, or the timing model failed its own check) |\n"
            "| `sfsim trace` | `OK` (0 rays included); `INPUT` (scene, ray file, config, option values); `USAGE`; `PROGRAM` (the kernel failed); `IO` (the hit file could not be written) |\n"
            "| `sfsim config` | `OK`; `INPUT` (the config or a `--set`); `USAGE` |\n"

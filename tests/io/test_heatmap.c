@@ -1,7 +1,9 @@
 /* tests/io/test_heatmap.c -- heat-map images (sim/heatmap.h): the documented geometry, the
- * colormap's order, constant maps, text or its absence, and every error path. */
+ * colormap's order, constant maps, text or its absence, every error path, and the pixels against
+ * those OpenImageIO drew before sim/heatmap.c replaced it. */
 #include <criterion/criterion.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -220,4 +222,95 @@ Test(heatmap, unwritable_paths_are_errors)
     cr_expect(strncmp(err, "/nonexistent-dir/cost.png: ", 27) == 0, "%s", err);
     cr_expect_eq(heatmap_write(NULL, "/tmp/cost.unknownformat", v, 2, 1, "t", "u", err, sizeof err), -1);
     cr_expect(strstr(err, "/tmp/cost.unknownformat: ") == err, "%s", err);
+}
+
+/* ---- the pixels OpenImageIO drew ------------------------------------------------------------ */
+
+/* FNV-1a over an image's 8-bit values, as read back. */
+static uint64_t pixel_hash(const Image *im)
+{
+    uint64_t x = 1469598103934665603ull;
+    for (size_t i = 0; i < (size_t)im->w * im->h * 3; i++) {
+        x ^= (uint64_t)lroundf(im->rgb[i] * 255.0f);
+        x *= 1099511628211ull;
+    }
+    return x;
+}
+
+/* Values for the cases below. */
+static void fill_case(double *v, int w, int h, int kind)
+{
+    for (int i = 0; i < w * h; i++) {
+        int x = i % w, y = i / w;
+        v[i] = kind == 0   ? 1000.0 + 37.0 * x * x + 11.0 * y * y + (i % 7) * 13.0
+               : kind == 1 ? 4200.0
+               : kind == 2 ? 0.0
+               : kind == 3 ? 37.0 * x * x + y
+               : kind == 4 ? 1e6 + 12345.678 * x + y
+                           : 1000.0 + 0.1 * i;
+    }
+}
+
+/* cost.png was drawn by OpenImageIO 2.4's ImageBufAlgo (color_map, fill, render_box, render_line,
+ * render_text with FreeType and DejaVu Sans) until 2026-12; sim/heatmap.c draws it itself. These
+ * hashes are of the old library's pictures of the same values (libsfsim-img.so at 60f9603, which
+ * the new code matched pixel for pixel in all of them): the geometry, the colour map and the
+ * bar's interpolation, frames, ticks, and the text's placement, coverage and blending, at both
+ * text sizes, with long titles, SI prefixes and extra digits. They depend on the font file and
+ * FreeType's rasterizer (Debian 12's fonts-dejavu-core 2.37, libfreetype6 2.12): a different
+ * version moves label pixels, not the map. */
+Test(heatmap, pixels_are_those_openimageio_drew, .init = mkdir_tmp, .fini = rm_tmp)
+{
+    if (access(DEJAVU, R_OK) != 0)
+        cr_skip_test("%s is missing (fonts-dejavu-core, scripts/deps.sh)", DEJAVU);
+    static const struct {
+        int w, h;
+        const char *title, *unit;
+        int kind, cw, ch;
+        uint64_t hash;
+    } cases[] = {
+        {32, 32, "simulated cycles per pixel (tiles of 8 x 8)", "cycles", 0, 728, 580, 0x1512b7ded91b5822ull},
+        {1, 1, "one tile", "cycles", 1, 728, 580, 0x9dee4a6137af6920ull},
+        {3, 2, NULL, NULL, 2, 729, 410, 0x7c77ee1e27ab3b7bull},
+        {1, 100, "tall", "cycles", 0, 236, 2068, 0x713de1f0151a1354ull},
+        {16, 4, "gradient", "cycles", 3, 728, 324, 0xbba5f97703e58bdeull},
+        {600, 3, "simulated cycles per pixel (tiles of 16 x 16; estimated from the sampled units)", "cycles", 4, 816,
+         324, 0xa306b729f574f2f1ull},
+        {4, 1, "close values", "cycles", 5, 728, 324, 0x9754cde8f68cc718ull},
+        {2048, 2, "wide", "", 0, 2264, 324, 0xcffb9f1d83099c66ull},
+    };
+    static double v[2048 * 2];
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char name[32];
+        snprintf(name, sizeof name, "case%zu.png", k);
+        fill_case(v, cases[k].w, cases[k].h, cases[k].kind);
+        Image im = write_and_read(name, v, cases[k].w, cases[k].h, cases[k].title, cases[k].unit);
+        cr_expect(im.w == cases[k].cw && im.h == cases[k].ch, "case %zu: %d x %d", k, im.w, im.h);
+        cr_expect_eq(pixel_hash(&im), cases[k].hash, "case %zu: pixels differ from OpenImageIO's (hash %016llx)", k,
+                     (unsigned long long)pixel_hash(&im));
+        free(im.rgb);
+    }
+}
+
+/* Text is UTF-8. OpenImageIO 2.4's render_text kept only the last byte's low six bits of a
+ * multi-byte character ("é" came out as ")", "µ" as "5"); sim/heatmap.c draws the character. */
+Test(heatmap, text_is_decoded_as_utf8, .init = mkdir_tmp, .fini = rm_tmp)
+{
+    if (access(DEJAVU, R_OK) != 0)
+        cr_skip_test("%s is missing (fonts-dejavu-core, scripts/deps.sh)", DEJAVU);
+    double v[2] = {1, 2};
+    Image a = write_and_read("a.png", v, 2, 1, "caf\xc3\xa9", NULL);
+    Image b = write_and_read("b.png", v, 2, 1, "caf)", NULL);
+    Image c = write_and_read("c.png", v, 2, 1, "caf", NULL);
+    /* the title's last letter: é differs from ")", and both add ink to "caf" */
+    int ink_a = dark_pixels(&a, 0, MAP_X + 512, 0, TOP - 1), ink_b = dark_pixels(&b, 0, MAP_X + 512, 0, TOP - 1),
+        ink_c = dark_pixels(&c, 0, MAP_X + 512, 0, TOP - 1);
+    cr_expect(ink_a > ink_c && ink_b > ink_c, "ink %d, %d, %d", ink_a, ink_b, ink_c);
+    cr_expect_neq(memcmp(a.rgb, b.rgb, sizeof(float) * 3 * (size_t)a.w * a.h), 0, "é drawn as )");
+    free(a.rgb);
+    free(b.rgb);
+    free(c.rgb);
+    /* malformed UTF-8 is drawn byte by byte, not an error */
+    Image d = write_and_read("d.png", v, 2, 1, "bad \xc3 \xff\xfe end", NULL);
+    free(d.rgb);
 }

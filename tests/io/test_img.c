@@ -1,6 +1,9 @@
-/* tests/unit/test_img.c -- image files through the OpenImageIO shim, and comparison statistics. */
+/* tests/io/test_img.c -- image files: written by sfsim's own writers (OpenEXR, libpng:
+ * sim/img_write.c) and read back through OpenImageIO (the image library's reader), the files'
+ * encodings, the writers' errors, and comparison statistics. */
 #include <criterion/criterion.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -39,6 +42,100 @@ Test(img_io, exr_round_trip_is_exact, .init = mkdir_tmp, .fini = rm_tmp)
     free(back);
 }
 
+/* The whole file, malloc'ed, its size in *n. */
+static unsigned char *read_all(const char *path, size_t *n)
+{
+    FILE *f = fopen(path, "rb");
+    cr_assert_not_null(f, "%s", path);
+    fseek(f, 0, SEEK_END);
+    long len = ftell(f);
+    rewind(f);
+    unsigned char *b = malloc((size_t)len);
+    cr_assert(b && fread(b, 1, (size_t)len, f) == (size_t)len);
+    fclose(f);
+    *n = (size_t)len;
+    return b;
+}
+
+/* Bits OpenImageIO's reader must give back exactly: every kind of float, over a size that is not
+ * a whole number of ZIP chunks (16 scanlines) in either direction. */
+Test(img_io, exr_keeps_every_float_bit_pattern, .init = mkdir_tmp, .fini = rm_tmp)
+{
+    enum { W = 37, H = 35 };
+    static float px[W * H * 3];
+    const float special[] = {0.0f, -0.0f, 1e-45f, -1e-40f, 1.17549435e-38f, 3.4028235e38f, -3.4028235e38f,
+                             INFINITY, -INFINITY, NAN, 0.99999994f, 65504.0f, 65520.0f, 1e-8f};
+    uint32_t state = 12345;
+    for (size_t i = 0; i < sizeof px / sizeof px[0]; i++) {
+        state = state * 1664525u + 1013904223u;
+        uint32_t bits = state;
+        if ((bits & 0x7f800000u) == 0x7f800000u)
+            bits &= ~0x00800000u; /* keep NaNs to the special ones below: their payloads are not promised */
+        memcpy(&px[i], &bits, sizeof bits);
+        if (i % 53 == 0)
+            px[i] = special[(i / 53) % (sizeof special / sizeof special[0])];
+    }
+    char path[128], err[256];
+    snprintf(path, sizeof path, "%s/bits.exr", dir);
+    cr_assert_eq(img_write_linear(NULL, path, px, W, H, err, sizeof err), 0, "%s", err);
+    float *back;
+    int w, h;
+    cr_assert_eq(img_read(path, &back, &w, &h, err, sizeof err), 0, "%s", err);
+    cr_assert(w == W && h == H, "%d x %d", w, h);
+    for (size_t i = 0; i < sizeof px / sizeof px[0]; i++) {
+        if (isnan(px[i]))
+            cr_assert(isnan(back[i]), "channel %zu: NaN read as %g", i, (double)back[i]);
+        else
+            cr_assert_eq(memcmp(&px[i], &back[i], sizeof(float)), 0, "channel %zu: %.9g read as %.9g", i,
+                         (double)px[i], (double)back[i]);
+    }
+    free(back);
+
+    /* The header says what OpenImageIO's writer said: ZIP compression (3) of float channels. */
+    size_t n;
+    unsigned char *bytes = read_all(path, &n);
+    cr_assert_not_null(bytes);
+    static const char comp[] = "compression\0compression\0\1\0\0\0";
+    unsigned char *at = memmem(bytes, n, comp, sizeof comp - 1);
+    cr_assert_not_null(at, "no compression attribute");
+    cr_expect_eq(at[sizeof comp - 1], 3, "compression %d, not ZIP (3)", at[sizeof comp - 1]);
+    cr_expect_not_null(memmem(bytes, n, "channels\0chlist\0", 16));
+    free(bytes);
+}
+
+/* Every 8-bit value through img_write_rgb8 comes back; the file is 8-bit RGB, its
+ * zlib stream at the fastest level (the writer's setting since docs/performance.md's round). */
+Test(img_io, png_holds_every_byte_value, .init = mkdir_tmp, .fini = rm_tmp)
+{
+    enum { W = 256, H = 3 };
+    static float px[W * H * 3];
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++)
+            for (int c = 0; c < 3; c++)
+                px[(y * W + x) * 3 + c] = (float)((x + 85 * c + 7 * y) % 256) / 255.0f;
+    char path[128], err[256];
+    snprintf(path, sizeof path, "%s/bytes.png", dir);
+    cr_assert_eq(img_write_rgb8(NULL, path, px, W, H, err, sizeof err), 0, "%s", err);
+    float *back;
+    int w, h;
+    cr_assert_eq(img_read(path, &back, &w, &h, err, sizeof err), 0, "%s", err);
+    cr_assert(w == W && h == H, "%d x %d", w, h);
+    for (size_t i = 0; i < sizeof px / sizeof px[0]; i++)
+        cr_assert_eq(lroundf(back[i] * 255.0f), lroundf(px[i] * 255.0f), "channel %zu: %.9g read as %.9g", i,
+                     (double)px[i], (double)back[i]);
+    free(back);
+
+    size_t n;
+    unsigned char *bytes = read_all(path, &n);
+    cr_assert(bytes && n > 33 && memcmp(bytes + 12, "IHDR", 4) == 0);
+    cr_expect_eq(bytes[24], 8, "bit depth %d", bytes[24]);
+    cr_expect_eq(bytes[25], 2, "colour type %d (2 is RGB)", bytes[25]);
+    unsigned char *idat = memmem(bytes, n, "IDAT", 4);
+    cr_assert(idat && idat + 6 <= bytes + n);
+    cr_expect((idat[4] & 0x0f) == 8 && (idat[5] >> 6) == 0, "zlib header %02x %02x: not the fastest level", idat[4], idat[5]);
+    free(bytes);
+}
+
 Test(img_io, png_is_clamped_srgb_and_marks_nan, .init = mkdir_tmp, .fini = rm_tmp)
 {
     /* linear 0, 0.5, 2.0 (clamps to 1), NaN pixel */
@@ -68,6 +165,21 @@ Test(img_io, errors_name_the_file)
     cr_expect(strncmp(err, "/nonexistent-dir/x.exr: ", 24) == 0, "%s", err);
     cr_expect_eq(img_write_linear(NULL, "/tmp/x.unknownformat", px, 1, 1, err, sizeof err), -1);
     cr_expect(strstr(err, "/tmp/x.unknownformat: ") == err, "%s", err);
+    /* each writer writes its one format */
+    cr_expect_eq(img_write_linear(NULL, "/tmp/x.png", px, 1, 1, err, sizeof err), -1);
+    cr_expect(strstr(err, "/tmp/x.png: no image writer") == err, "%s", err);
+    cr_expect_eq(img_write_display(NULL, "/tmp/x.exr", px, 1, 1, 1.0f, err, sizeof err), -1);
+    cr_expect(strstr(err, "/tmp/x.exr: no image writer") == err, "%s", err);
+    cr_expect_eq(img_write_rgb8(NULL, "/nonexistent-dir/x.png", px, 1, 1, err, sizeof err), -1);
+    cr_expect(strncmp(err, "/nonexistent-dir/x.png: ", 24) == 0, "%s", err);
+    /* sizes, refused before any pixel is read (px is far too small for them) */
+    cr_expect_eq(img_write_linear(NULL, "/tmp/x.exr", px, 0, 1, err, sizeof err), -1);
+    cr_expect(strstr(err, "/tmp/x.exr: image size 0 x 1") == err, "%s", err);
+    cr_expect_eq(img_write_linear(NULL, "/tmp/x.exr", px, 200000000, 1, err, sizeof err), -1);
+    cr_expect(strstr(err, "/tmp/x.exr: ") == err && strstr(err, "too large"), "%s", err);
+    cr_expect_eq(img_write_display(NULL, "/tmp/x.png", px, 2000000, 1, 1.0f, err, sizeof err), -1);
+    cr_expect(strstr(err, "/tmp/x.png: ") == err && strstr(err, "too large for PNG"), "%s", err);
+    cr_expect_eq(access("/tmp/x.png", F_OK), -1);
     float *back;
     int w, h;
     cr_expect_eq(img_read("/nonexistent-dir/y.png", &back, &w, &h, err, sizeof err), -1);
