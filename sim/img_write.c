@@ -285,15 +285,33 @@ static float srgb_encode(float x)
     return x <= 0.0031308f ? 12.92f * x : 1.055f * powf(x, 1.0f / 2.4f) - 0.055f;
 }
 
+/* The 8-bit buffer of a width x height PNG at path, after its checks; NULL with a message. */
+static unsigned char *png_pixels(const char *path, int width, int height, char *err, size_t errlen)
+{
+    if (check_png(path, width, height, err, errlen) != 0)
+        return NULL;
+    unsigned char *px = malloc((size_t)width * (size_t)height * 3);
+    if (!px)
+        fail(err, errlen, path, "out of memory encoding the image");
+    return px;
+}
+
+/* px (from png_pixels) encoded and written, then freed. */
+static int write_png_pixels(OutSet *set, const char *path, unsigned char *px, int width, int height, char *err,
+                            size_t errlen)
+{
+    int rc = write_u8(set, path, px, width, height, err, errlen);
+    free(px);
+    return rc;
+}
+
 int img_write_display(OutSet *set, const char *path, const float *rgb, int width, int height, float exposure,
                       char *err, size_t errlen)
 {
-    if (check_png(path, width, height, err, errlen) != 0)
+    unsigned char *px = png_pixels(path, width, height, err, errlen);
+    if (!px)
         return -1;
     size_t n = (size_t)width * (size_t)height * 3;
-    unsigned char *px = malloc(n);
-    if (!px)
-        return fail(err, errlen, path, "out of memory encoding the image");
     for (size_t i = 0; i < n; i += 3) {
         int bad = !isfinite(rgb[i]) || !isfinite(rgb[i + 1]) || !isfinite(rgb[i + 2]);
         for (int c = 0; c < 3; c++) {
@@ -301,24 +319,17 @@ int img_write_display(OutSet *set, const char *path, const float *rgb, int width
             px[i + c] = (unsigned char)lroundf((bad ? v : srgb_encode(v)) * 255.0f);
         }
     }
-    int rc = write_u8(set, path, px, width, height, err, errlen);
-    free(px);
-    return rc;
+    return write_png_pixels(set, path, px, width, height, err, errlen);
 }
 
 int img_write_rgb8(OutSet *set, const char *path, const float *rgb, int width, int height, char *err,
                    size_t errlen)
 {
-    if (check_png(path, width, height, err, errlen) != 0)
-        return -1;
-    size_t n = (size_t)width * (size_t)height * 3;
-    unsigned char *px = malloc(n);
+    unsigned char *px = png_pixels(path, width, height, err, errlen);
     if (!px)
-        return fail(err, errlen, path, "out of memory encoding the image");
-    img_to_u8_n(rgb, px, n);
-    int rc = write_u8(set, path, px, width, height, err, errlen);
-    free(px);
-    return rc;
+        return -1;
+    img_to_u8_n(rgb, px, (size_t)width * (size_t)height * 3);
+    return write_png_pixels(set, path, px, width, height, err, errlen);
 }
 
 /* ---- the 8-bit conversion --------------------------------------------------------------------- */
