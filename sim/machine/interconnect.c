@@ -46,6 +46,8 @@ static uint64_t earliest(const Xbar *x, uint64_t from, uint64_t len, XbarUser us
                 iv[n++] = x->agu[i];
     if (user != XBAR_DP && x->dp.e > from)
         iv[n++] = x->dp;
+    if (n < x->p.ports) /* fewer transfers than ports at or after from: a port is free at from */
+        return from;
     uint64_t s = from;
     for (;;) {
         /* The most ports taken at any cycle of [s, s + len): check s and every start inside. */

@@ -1,0 +1,145 @@
+/* tests/unit/test_raybuf.c -- the ray-buffer bank model (sim/machine/raybuf.c) against a plain
+ * reference, and the interconnect's port search (sim/machine/interconnect.c) in its corner cases.
+ *
+ * rb_access has a fast path for the common access (lines that never go down, over fewer lines
+ * than banks) beside the general count; both must give what the definition gives: the cycles are
+ * the most distinct lines any one bank serves, rb_lines counts distinct lines, rb_conflicted the
+ * accesses with a bank serving two or more. The reference here counts that by brute force, over
+ * random, ascending, repeated and conflicting address vectors of every length at several bank
+ * counts (a power of two and not).
+ */
+#include <criterion/criterion.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "../../sim/machine/interconnect.h"
+#include "../../sim/machine/raybuf.h"
+#include "../../sim/timing.h"
+
+/* The definition, by brute force: distinct lines, and the most of them in one bank. */
+static int reference(const uint32_t *addr, int n, int line_bytes, int banks, int *distinct)
+{
+    uint32_t lines[ISA_MAX_LANES];
+    int k = 0;
+    for (int i = 0; i < n; i++) {
+        uint32_t l = addr[i] / (uint32_t)line_bytes;
+        int seen = 0;
+        for (int j = 0; j < k; j++)
+            seen |= lines[j] == l;
+        if (!seen)
+            lines[k++] = l;
+    }
+    int worst = 0;
+    for (int b = 0; b < banks; b++) {
+        int c = 0;
+        for (int j = 0; j < k; j++)
+            c += (int)(lines[j] % (uint32_t)banks) == b;
+        if (c > worst)
+            worst = c;
+    }
+    *distinct = k;
+    return worst;
+}
+
+static uint64_t rng = 0x9e3779b97f4a7c15ull;
+static uint32_t next_u32(void)
+{
+    rng ^= rng << 13;
+    rng ^= rng >> 7;
+    rng ^= rng << 17;
+    return (uint32_t)(rng >> 16);
+}
+
+/* One address vector of n lanes of the given kind. */
+static void make_vector(uint32_t *a, int n, int kind, int line_bytes, int banks)
+{
+    uint32_t base = (next_u32() % 4096u) * 4u;
+    switch (kind) {
+    case 0: /* random words over 64 K */
+        for (int i = 0; i < n; i++)
+            a[i] = (next_u32() % 16384u) * 4u;
+        break;
+    case 1: /* ascending IDs with small gaps: the stream's usual gather (the fast path) */
+        for (int i = 0; i < n; i++) {
+            a[i] = base;
+            base += 4u * (next_u32() % 5u);
+        }
+        break;
+    case 2: /* ascending over a span near the bank count: the fast path's edge */
+        for (int i = 0; i < n; i++)
+            a[i] = base + (uint32_t)(i * (banks - 1 + (int)(next_u32() % 3u)) / (n > 1 ? n - 1 : 1)) *
+                              (uint32_t)line_bytes;
+        break;
+    case 3: /* ascending, then one lane going down */
+        for (int i = 0; i < n; i++)
+            a[i] = base + 4u * (uint32_t)i;
+        if (n > 1)
+            a[n - 1] = base > 0 ? base - 4u : 0;
+        break;
+    default: /* lanes a whole bank cycle apart: every line in one bank */
+        for (int i = 0; i < n; i++)
+            a[i] = base + (uint32_t)(i * banks * line_bytes) * (next_u32() % 2u);
+        break;
+    }
+}
+
+Test(raybuf, access_counts_match_the_definition_on_every_path)
+{
+    const int bank_counts[] = {32, 16, 24, 1};
+    for (size_t bi = 0; bi < sizeof bank_counts / sizeof *bank_counts; bi++) {
+        RbParams p = {.banks = bank_counts[bi], .line = 64, .access = 2, .align_cycles = 1};
+        RayBufs rb;
+        cr_assert_eq(rb_init(&rb, &p), 0);
+        int fast_seen = 0, conflict_seen = 0;
+        for (int iter = 0; iter < 4000; iter++) {
+            int n = 1 + iter % ISA_MAX_LANES;
+            if (iter % 3 == 0)
+                n = 16;
+            uint32_t a[ISA_MAX_LANES];
+            make_vector(a, n, iter % 5, p.line, p.banks);
+            int distinct;
+            int want = reference(a, n, p.line, p.banks, &distinct);
+            TimingStats st;
+            memset(&st, 0, sizeof st);
+            int got = rb_access(&rb, a, n, &st);
+            cr_assert_eq(got, want, "banks %d, kind %d, n %d: %d cycles, the definition gives %d", p.banks,
+                         iter % 5, n, got, want);
+            cr_assert_eq(st.rb_accesses, 1u);
+            cr_assert_eq(st.rb_lines, (uint64_t)distinct, "banks %d, kind %d, n %d: %llu lines, want %d",
+                         p.banks, iter % 5, n, (unsigned long long)st.rb_lines, distinct);
+            cr_assert_eq(st.rb_conflicted, (uint64_t)(want > 1));
+            fast_seen += want == 1 && distinct > 1;
+            conflict_seen += want > 1;
+        }
+        /* both kinds of access were exercised */
+        if (p.banks > 1)
+            cr_assert(fast_seen > 100 && conflict_seen > 100, "banks %d: %d one-cycle, %d conflicting", p.banks,
+                      fast_seen, conflict_seen);
+        rb_free(&rb);
+    }
+}
+
+Test(raybuf, interconnect_port_search_waits_only_when_every_port_is_taken)
+{
+    XbarParams p = {.latency = 1, .ports = 2};
+    Xbar x;
+    xbar_init(&x, &p);
+    TimingStats st;
+    memset(&st, 0, sizeof st);
+    /* one AGU transfer in flight: a port is left for the data path at once */
+    cr_assert_eq(xbar_transfer(&x, XBAR_AGU, 10, 4, 10, &st), 10u);
+    cr_assert_eq(xbar_transfer(&x, XBAR_DP, 11, 2, 11, &st), 11u);
+    /* the AGU and the data path hold both ports over [11, 13): the partition unit waits to 13 */
+    cr_assert_eq(xbar_transfer(&x, XBAR_PART, 11, 1, 11, &st), 13u);
+    cr_assert_eq(st.icn_unit_delay, 2u);
+    /* two transfers in the window, but only one at cycle 12 itself: no wait */
+    cr_assert_eq(xbar_transfer(&x, XBAR_AGU, 12, 1, 12, &st), 12u);
+    cr_assert_eq(st.icn_unit_delay, 2u);
+    /* the partition unit and the first AGU transfer hold both ports at 13: the data path waits */
+    cr_assert_eq(xbar_transfer(&x, XBAR_DP, 13, 1, 13, &st), 14u);
+    /* with one port every transfer serializes */
+    p.ports = 1;
+    xbar_init(&x, &p);
+    cr_assert_eq(xbar_transfer(&x, XBAR_AGU, 0, 3, 0, &st), 0u);
+    cr_assert_eq(xbar_transfer(&x, XBAR_DP, 1, 1, 1, &st), 3u);
+}
