@@ -277,6 +277,30 @@ static inline int hazard(const Timing *t, const TmDesc *d, const CoreRecord *rec
 static __attribute__((noinline)) uint64_t wait_hazards(Timing *t, const TmDesc *d, const CoreRecord *rec,
                                                        uint64_t at, int cause)
 {
+    /* The registers first, in one pass, when no taken-branch bubble is pending (the only hazard
+     * above them; no event can start one during a wait): while one waits, the interval goes to the
+     * first register in order still waiting, which is where the event-to-event walk below would
+     * put it too; events between landings only clear the units' hazards, which rank below the
+     * registers. So each register that lands past the time reached charges the span up to its
+     * landing to its cause, and the events due by then are applied once. A halt waits on every
+     * register and takes the walk. */
+    if (!t->simd.fetch_pending && !d->is_halt) {
+        uint64_t x = at;
+        for (int i = 0; i < d->nregs; i++) {
+            const uint64_t r = t->simd.ready[d->regs[i]];
+            if (r > x) {
+                charge(t, t->simd.rcause[d->regs[i]], r - x, rec->stage, rec->gen);
+                x = r;
+            }
+        }
+        if (x != at) {
+            at = x;
+            drain(t, at);
+            cause = hazard(t, d, rec, at);
+            if (cause < 0)
+                return at;
+        }
+    }
     for (;;) {
         uint64_t next = simd_next_landing(&t->simd, d->regs, d->is_halt ? -1 : d->nregs, at);
         const EvEvent *e = evq_top(&t->q);
