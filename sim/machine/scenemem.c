@@ -128,6 +128,12 @@ uint64_t mem_issue(SceneMem *m, uint32_t flags, const uint32_t *addr, int naddr,
                    TimingStats *st)
 {
     const int space = (flags & ISA_FL_FB) ? 1 : 0, write = (flags & ISA_FL_WRITE) != 0;
+    if (naddr == 1) { /* a scalar access: one line, no search for distinct lines */
+        const uint32_t a = (uint32_t)((mem_line(m, space, addr[0]) << m->line_shift) & 0xffffffffu);
+        *ready = mem_access(m, space, a, at, write);
+        st->scene_instr++;
+        return 1;
+    }
     uint64_t lines[ISA_MAX_LANES], d[ISA_MAX_LANES];
     for (int i = 0; i < naddr; i++)
         lines[i] = mem_line(m, space, addr[i]);
