@@ -335,7 +335,19 @@ static void describe_fill(Timing *t, TmDesc *d, const CoreRecord *rec)
     d->lat = (uint32_t)t->simd.p.lat[oi->unit];
     d->issue = t->simd.p.issue[oi->unit] > 1 ? (uint32_t)t->simd.p.issue[oi->unit] : 0;
     int ndst;
-    d->nregs = (uint8_t)simd_operands(&t->simd, rec->in, d->regs, d->dsts, &ndst);
+    int n = simd_operands(&t->simd, rec->in, d->regs, d->dsts, &ndst);
+    /* A register named twice (a source read twice, a destination also read) is checked once, at
+     * its first place: the hazard scans ask for the first register in order still waiting, and
+     * the second copy always has the first's ready cycle. */
+    int k = 0;
+    for (int i = 0; i < n; i++) {
+        int dup = 0;
+        for (int j = 0; j < k; j++)
+            dup |= d->regs[j] == d->regs[i];
+        if (!dup)
+            d->regs[k++] = d->regs[i];
+    }
+    d->nregs = (uint8_t)k;
     d->ndst = (uint8_t)ndst;
 }
 
