@@ -242,7 +242,7 @@ $(BUILD)/tests/io-asan: $(IO_TEST_SRC) $(BUILD)/libsfsim-asan.a $(SHIM_ASAN_OBJ)
 
 HARD_TEST_SRC := $(wildcard tests/hard/*.c) tests/support/numerics.c tests/support/shared.c
 
-$(BUILD)/tests/hard: $(HARD_TEST_SRC) tests/support/numerics.h $(BUILD)/libsfsim.a $(SHIM_OBJ)
+$(BUILD)/tests/hard: $(HARD_TEST_SRC) tests/support/numerics.h tests/support/rng.h $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(LDAS) $(HARD_TEST_SRC) $(SHIM_OBJ) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(INIH) $(LDLIBS) $(OIIO)
 

@@ -13,16 +13,11 @@
 #include "../../sim/functional.h"
 #include "../../sim/reference.h"
 #include "../support/numerics.h"
+#include "../support/rng.h"
 #include "../support/shared.h"
 
-static uint64_t rng = 0x9E3779B97F4A7C15ull;
-static double urand(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (double)(rng >> 11) * (1.0 / 9007199254740992.0);
-}
+static uint64_t rng = TEST_RNG_SEED;
+static double urand(void) { return test_rng_unit(&rng); }
 
 static void load_pack(const char *path, Scene *s, PackedScene *p)
 {

@@ -15,17 +15,12 @@
 #include "../../isa/isa.h"
 #include "../../sim/core.h"
 #include "../support/files.h"
+#include "../support/rng.h"
 
 /* Deterministic operand choices: the same words every run. */
-static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
+static uint64_t rng_state = TEST_RNG_SEED;
 
-static uint32_t rng_next(void)
-{
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return (uint32_t)(rng_state >> 16);
-}
+static uint32_t rng_next(void) { return test_rng_u32(&rng_state); }
 
 static int n_reg_operands(const IsaFormatInfo *f)
 {

@@ -15,6 +15,7 @@
 #include "../../sim/machine/interconnect.h"
 #include "../../sim/machine/raybuf.h"
 #include "../../sim/timing.h"
+#include "../support/rng.h"
 
 /* The definition, by brute force: distinct lines, and the most of them in one bank. */
 static int reference(const uint32_t *addr, int n, int line_bytes, int banks, int *distinct)
@@ -41,14 +42,8 @@ static int reference(const uint32_t *addr, int n, int line_bytes, int banks, int
     return worst;
 }
 
-static uint64_t rng = 0x9e3779b97f4a7c15ull;
-static uint32_t next_u32(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (uint32_t)(rng >> 16);
-}
+static uint64_t rng = TEST_RNG_SEED;
+static uint32_t next_u32(void) { return test_rng_u32(&rng); }
 
 /* One address vector of n lanes of the given kind. */
 static void make_vector(uint32_t *a, int n, int kind, int line_bytes, int banks)
