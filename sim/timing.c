@@ -16,9 +16,13 @@
  *   3. issue: one busy cycle, plus extra issue cycles the access itself needs (bank conflicts,
  *      alignment, scratchpad and scene-cache ports), each charged to its cause;
  *   4. completion: results become ready after the unit's latency (events), units get busy.
+ * A block of instructions that use no memory unit, whose start state has been seen before, is not
+ * worked through again: its stored outcome is applied at its end ("memoized blocks" below;
+ * docs/model.md).
  */
 #include "timing.h"
 
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -61,9 +65,52 @@ typedef struct TmDesc {
     uint8_t nregs, ndst;
     uint32_t lat;                            /* the unit class's result latency */
     uint32_t issue;                          /* its issue interval when > 1 (else 0: never held) */
+    uint8_t plain;                           /* times the same way every time it runs (no
+                                                memory unit, fixed result time, not a halt): can
+                                                be part of a memoized block */
     uint8_t regs[2 * ISA_MAX_OPERANDS + 1];  /* sources, exec mask, destinations */
     uint8_t dsts[ISA_MAX_OPERANDS];
+    struct MemoWays *memo;                   /* blocks starting here (kept across runs, each
+                                                entry stamped with its run); NULL until one */
 } TmDesc;
+
+/* ---- memoized blocks (declarations; the code is after the hook's parts) ----------------------
+ * A block is a run of plain instructions in one stage and statistics generation, up to a taken
+ * branch or MEMO_LEN instructions. Its timing is a function of the state at its start: the
+ * ready cycles (relative to the start) and causes of the registers it reads or writes before it
+ * writes them (its live-ins) and the pending events (relative times, kinds, units), which also
+ * stand for the bubble, the units' issue intervals and the partition unit (each is pending
+ * exactly while its event is). The first time a start state is seen the block is timed as usual
+ * and its outcome stored; when it recurs, the outcome is applied at the block's end and the
+ * records in between are only checked against the stored path (docs/performance.md). */
+enum { MEMO_LEN = 16, MEMO_REGS = 40, MEMO_EVENTS = 6, MEMO_WAYS = 4 };
+
+typedef struct MemoEv { uint32_t rel; uint16_t arg; uint8_t kind, cause; } MemoEv;
+typedef struct MemoReg { uint32_t rel; uint8_t reg, cause; } MemoReg;
+
+typedef struct MemoEntry {
+    uint32_t run;                   /* the run it was stored in (0: empty) */
+    uint8_t len, nlive, nwrite, nev_in, nev_out, taken_last, nunits;
+    uint32_t pc[MEMO_LEN];          /* the path */
+    MemoReg live[MEMO_REGS];        /* key: live-ins at the start (rel 0: landed, cause 0) */
+    MemoEv ev_in[MEMO_EVENTS];      /* key: pending events, sorted */
+    uint32_t end_rel;               /* outcome: the next issue slot after the block */
+    uint32_t hz_rel;                /* the latest result it wrote */
+    MemoReg write[MEMO_REGS];       /* registers it wrote: last ready cycle and cause */
+    MemoEv ev_out[MEMO_EVENTS];     /* events it left pending after end_rel */
+    uint8_t ncharge;                /* stall causes it charged, with their cycles */
+    uint8_t ch_cause[TM_CAUSE_COUNT];
+    uint32_t ch_cycles[TM_CAUSE_COUNT];
+    uint16_t issues[2];             /* scalar, vector */
+    uint8_t unit[MEMO_LEN], unit_n[MEMO_LEN];
+} MemoEntry;
+
+typedef struct MemoWays {
+    MemoEntry e[MEMO_WAYS];
+    uint8_t next;                   /* the way the next store replaces */
+} MemoWays;
+
+enum { MM_NONE, MM_RECORD, MM_REPLAY };
 
 struct Timing {
     EvQueue q;
@@ -79,6 +126,21 @@ struct Timing {
     uint32_t desc_cap;
     uint32_t run;                  /* runs since timing_new, from 1 (TmDesc.run) */
     TmDesc spare;                  /* describe() when the table cannot grow */
+    /* Memoized blocks (see MemoEntry): off when memo_off. */
+    int memo_off;
+    uint64_t memo_replays, memo_stores; /* blocks replayed whole, blocks stored */
+    int mmode;                     /* MM_NONE, MM_RECORD (timing a block as usual, noting its
+                                      outcome) or MM_REPLAY (following a stored block) */
+    uint64_t m_t0;                 /* the block's start cycle */
+    uint8_t m_stage, m_gen;
+    uint32_t m_i;                  /* replay: records matched so far */
+    MemoEntry *m_e;                /* replay: the stored block */
+    TmDesc *m_d0;                  /* the block's first instruction (its MemoWays) */
+    MemoEntry m_rec;               /* record: the block being noted */
+    int m_ok;                      /* record: it still fits an entry */
+    uint64_t m_written[2], m_seen[2]; /* record: registers written, live-ins noted */
+    uint64_t m_stalls0[TM_CAUSE_COUNT];
+    uint64_t m_hz;
     /* Issue cycles by stage, statistics generation and vector flag: one count per instruction;
      * timing_stats() folds them into TimingStats' busy counters and the cycles per stage and
      * generation (busy + stalls). */
@@ -128,6 +190,8 @@ void timing_free(Timing *t)
     if (!t)
         return;
     evq_free(&t->q);
+    for (uint32_t i = 0; i < t->desc_cap; i++)
+        free(t->desc[i].memo);
     free(t->desc);
     mem_free(&t->mem);
     rb_free(&t->rb);
@@ -144,7 +208,10 @@ void timing_reset(Timing *t)
     xbar_reset(&t->xbar);
     mem_reset(&t->mem);
     t->halted = 0;
+    t->mmode = MM_NONE;
     if (++t->run == 0) { /* wrapped: no entry may look current */
+        for (uint32_t i = 0; i < t->desc_cap; i++)
+            free(t->desc[i].memo);
         if (t->desc)
             memset(t->desc, 0, sizeof *t->desc * t->desc_cap);
         t->run = 1;
@@ -213,10 +280,14 @@ static void internal_error(Timing *t, const char *msg)
 
 /* ---- events ------------------------------------------------------------------------------- */
 
+static void memo_pushed(Timing *t, uint64_t time, int kind, int arg, int cause);
+
 static void push(Timing *t, uint64_t time, int kind, int arg, uint32_t tag, int cause)
 {
     if (evq_push(&t->q, time, (uint8_t)kind, (uint16_t)arg, tag, (uint8_t)cause))
         internal_error(t, "out of memory for events");
+    if (t->mmode == MM_RECORD)
+        memo_pushed(t, time, kind, arg, cause);
 }
 
 /* Apply every event due by cycle `at`. */
@@ -332,6 +403,7 @@ static void describe_fill(Timing *t, TmDesc *d, const CoreRecord *rec)
              oi->unit == ISA_U_SCENE || oi->unit == ISA_U_FB;
     d->special = oi->unit == ISA_U_AGU || oi->unit == ISA_U_RBUF || oi->unit == ISA_U_SPAD ||
                  oi->unit == ISA_U_PART;
+    d->plain = !d->mem && !d->special && !d->is_halt;
     d->lat = (uint32_t)t->simd.p.lat[oi->unit];
     d->issue = t->simd.p.issue[oi->unit] > 1 ? (uint32_t)t->simd.p.issue[oi->unit] : 0;
     int ndst;
@@ -544,15 +616,9 @@ static __attribute__((noinline)) void issue_units_complete(Timing *t, const TmDe
     complete(t, d, rec, is.at, end, ready, is.res_cause);
 }
 
-void timing_hook(void *ctx, const CoreRecord *rec)
+/* One instruction, timed as it runs. */
+static inline void time_one(Timing *t, const TmDesc *d, const CoreRecord *rec)
 {
-    Timing *t = ctx;
-    if (__builtin_expect(t->halted, 0)) { /* a halted core is not run again before timing_reset */
-        internal_error(t, "instruction after halt");
-        return;
-    }
-    const TmDesc *d = describe(t, rec);
-
     uint64_t at = t->now;
     drain(t, at);
     int cause = hazard(t, d, rec, at);
@@ -567,8 +633,317 @@ void timing_hook(void *ctx, const CoreRecord *rec)
     complete(t, d, rec, at, at + 1, at + d->lat, TM_DATA_DEPENDENCY);
 }
 
+/* ---- memoized blocks ---------------------------------------------------------------------- */
+
+static inline int bit_get(const uint64_t *b, int r) { return (int)(b[r >> 6] >> (r & 63) & 1u); }
+static inline void bit_set(uint64_t *b, int r) { b[r >> 6] |= 1ull << (r & 63); }
+
+/* The pending events relative to t0, sorted (the heap's order depends on its history): their
+ * count, or -1 if more than MEMO_EVENTS. */
+static int memo_events(const Timing *t, uint64_t t0, MemoEv *ev)
+{
+    if (t->q.n > MEMO_EVENTS)
+        return -1;
+    int n = 0;
+    for (size_t i = 0; i < t->q.n; i++) {
+        const EvEvent *e = &t->q.h[i];
+        MemoEv v = {(uint32_t)(e->time - t0), e->arg, e->kind, 0};
+        if (e->time - t0 > UINT32_MAX)
+            return -1;
+        int k = n++;
+        while (k > 0 && (ev[k - 1].rel > v.rel || (ev[k - 1].rel == v.rel && (ev[k - 1].kind > v.kind ||
+                                                   (ev[k - 1].kind == v.kind && ev[k - 1].arg > v.arg))))) {
+            ev[k] = ev[k - 1];
+            k--;
+        }
+        ev[k] = v;
+    }
+    return n;
+}
+
+/* A register's state relative to t0, as a key holds it. */
+static inline MemoReg memo_reg(const Timing *t, int r, uint64_t t0)
+{
+    uint64_t rd = t->simd.ready[r];
+    if (rd <= t0)
+        return (MemoReg){0, (uint8_t)r, 0};
+    return (MemoReg){(uint32_t)(rd - t0), (uint8_t)r, t->simd.rcause[r]};
+}
+
+/* Whether the stored block e starts from the state of now (rec: its first record). */
+static int memo_match(const Timing *t, const MemoEntry *e, const CoreRecord *rec, const MemoEv *ev, int nev)
+{
+    if (e->run != t->run || e->nev_in != nev)
+        return 0;
+    if (rec->taken != (e->len == 1 ? e->taken_last : 0))
+        return 0;
+    for (int i = 0; i < nev; i++)
+        if (e->ev_in[i].rel != ev[i].rel || e->ev_in[i].kind != ev[i].kind || e->ev_in[i].arg != ev[i].arg)
+            return 0;
+    for (int i = 0; i < e->nlive; i++) {
+        MemoReg m = memo_reg(t, e->live[i].reg, t->now);
+        if (m.rel != e->live[i].rel || m.cause != e->live[i].cause)
+            return 0;
+    }
+    return 1;
+}
+
+/* The outcome of the stored block e, applied at once (the block's records have all come). */
+static void memo_apply(Timing *t, const MemoEntry *e)
+{
+    const uint64_t t0 = t->m_t0, end = t0 + e->end_rel;
+    const int stage = t->m_stage, gen = t->m_gen;
+    drain(t, end); /* what the next record's drain would apply; the events left come after */
+    t->now = end;
+    for (int i = 0; i < e->ncharge; i++)
+        charge(t, e->ch_cause[i], e->ch_cycles[i], stage, gen);
+    t->issues[stage][gen][0] += e->issues[0];
+    t->issues[stage][gen][1] += e->issues[1];
+    for (int i = 0; i < e->nunits; i++)
+        t->st.unit_uses[e->unit[i]] += e->unit_n[i];
+    for (int i = 0; i < e->nwrite; i++) {
+        t->simd.ready[e->write[i].reg] = t0 + e->write[i].rel;
+        t->simd.rcause[e->write[i].reg] = e->write[i].cause;
+    }
+    if (t0 + e->hz_rel > t->simd.horizon)
+        t->simd.horizon = t0 + e->hz_rel;
+    for (int i = 0; i < e->nev_out; i++) {
+        const MemoEv *v = &e->ev_out[i];
+        if (v->kind == EV_UNIT)
+            t->simd.unit_pending[v->arg] = 1;
+        else if (v->kind == EV_FETCH)
+            t->simd.fetch_pending = 1;
+        if (evq_push(&t->q, t0 + v->rel, v->kind, v->arg, 0, v->cause))
+            internal_error(t, "out of memory for events");
+    }
+    t->mmode = MM_NONE;
+    t->memo_replays++;
+}
+
+/* A replay whose path the core left after m_i records: those records are timed one by one from
+ * the block's start state, which nothing has changed yet. */
+static void memo_unwind(Timing *t)
+{
+    const MemoEntry *e = t->m_e;
+    t->mmode = MM_NONE;
+    for (uint32_t i = 0; i < t->m_i; i++) {
+        CoreRecord r;
+        memset(&r, 0, offsetof(CoreRecord, addr));
+        r.pc = e->pc[i];
+        r.next_pc = e->pc[i + 1];
+        r.stage = t->m_stage;
+        r.gen = t->m_gen;
+        r.mem = CORE_MEM_COUNT;
+        time_one(t, &t->desc[r.pc], &r); /* described in this run: the entry's run is this one */
+    }
+}
+
+/* Starts a block at the plain instruction d (its first record rec): a replay when its start
+ * state is stored (1: the record is accounted for), else a recording (0: time it as usual). */
+static int memo_begin(Timing *t, TmDesc *d, const CoreRecord *rec)
+{
+    drain(t, t->now);
+    MemoEv ev[MEMO_EVENTS];
+    int nev = memo_events(t, t->now, ev);
+    if (nev < 0 || d == &t->spare)
+        return 0;
+    t->m_t0 = t->now;
+    t->m_stage = rec->stage;
+    t->m_gen = rec->gen;
+    t->m_d0 = d;
+    if (d->memo)
+        for (int w = 0; w < MEMO_WAYS; w++) {
+            MemoEntry *e = &d->memo->e[w];
+            if (memo_match(t, e, rec, ev, nev)) {
+                t->m_e = e;
+                t->m_i = 1;
+                t->mmode = MM_REPLAY;
+                if (e->len == 1)
+                    memo_apply(t, e);
+                return 1;
+            }
+        }
+    MemoEntry *m = &t->m_rec;
+    m->len = m->nlive = m->nwrite = m->nev_out = 0;
+    m->nev_in = (uint8_t)nev;
+    memcpy(m->ev_in, ev, sizeof *ev * (size_t)nev);
+    t->m_ok = 1;
+    t->m_written[0] = t->m_written[1] = t->m_seen[0] = t->m_seen[1] = 0;
+    memcpy(t->m_stalls0, t->st.stalls, sizeof t->m_stalls0);
+    t->m_hz = 0;
+    t->mmode = MM_RECORD;
+    return 0;
+}
+
+/* Recording, before the instruction d is timed: its registers not yet written in the block are
+ * live-ins, at their start state (nothing in the block has changed them). */
+static void memo_pre(Timing *t, const TmDesc *d)
+{
+    MemoEntry *m = &t->m_rec;
+    if (d == &t->spare) /* not in the table: the block cannot be kept */
+        t->m_ok = 0;
+    for (int i = 0; i < d->nregs; i++) {
+        int r = d->regs[i];
+        if (bit_get(t->m_written, r) || bit_get(t->m_seen, r))
+            continue;
+        bit_set(t->m_seen, r);
+        if (m->nlive == MEMO_REGS) {
+            t->m_ok = 0;
+            continue;
+        }
+        m->live[m->nlive++] = memo_reg(t, r, t->m_t0);
+    }
+}
+
+static void memo_pushed(Timing *t, uint64_t time, int kind, int arg, int cause)
+{
+    MemoEntry *m = &t->m_rec;
+    if (m->nev_out == MEMO_EVENTS || time - t->m_t0 > UINT32_MAX) {
+        t->m_ok = 0;
+        return;
+    }
+    m->ev_out[m->nev_out++] = (MemoEv){(uint32_t)(time - t->m_t0), (uint16_t)arg, (uint8_t)kind, (uint8_t)cause};
+}
+
+/* The recorded block's end: its outcome into the first instruction's ways. */
+static void memo_store(Timing *t)
+{
+    MemoEntry *m = &t->m_rec;
+    t->mmode = MM_NONE;
+    if (!t->m_ok || !m->len || t->err[0] || t->now - t->m_t0 > UINT32_MAX)
+        return;
+    m->end_rel = (uint32_t)(t->now - t->m_t0);
+    uint64_t stalls = 0;
+    m->ncharge = 0;
+    for (int c = 0; c < TM_CAUSE_COUNT; c++) {
+        uint64_t v = t->st.stalls[c] - t->m_stalls0[c];
+        if (v > UINT32_MAX)
+            return;
+        if (v) {
+            m->ch_cause[m->ncharge] = (uint8_t)c;
+            m->ch_cycles[m->ncharge++] = (uint32_t)v;
+        }
+        stalls += v;
+    }
+    if (stalls + m->len != m->end_rel) /* every cycle of the block is an issue or a stall */
+        return;
+    m->nwrite = 0;
+    for (int r = 0; r < SIMD_NREGS; r++)
+        if (bit_get(t->m_written, r)) {
+            if (m->nwrite == MEMO_REGS)
+                return;
+            m->write[m->nwrite++] = (MemoReg){(uint32_t)(t->simd.ready[r] - t->m_t0), (uint8_t)r, t->simd.rcause[r]};
+        }
+    m->hz_rel = t->m_hz > t->m_t0 ? (uint32_t)(t->m_hz - t->m_t0) : 0;
+    int k = 0; /* only the events still pending after the block's end are left for later */
+    for (int i = 0; i < m->nev_out; i++)
+        if (m->ev_out[i].rel > m->end_rel)
+            m->ev_out[k++] = m->ev_out[i];
+    m->nev_out = (uint8_t)k;
+    m->issues[0] = m->issues[1] = 0;
+    m->nunits = 0;
+    for (int i = 0; i < m->len; i++) {
+        const TmDesc *d = &t->desc[m->pc[i]];
+        m->issues[d->vec]++;
+        int j = 0;
+        while (j < m->nunits && m->unit[j] != d->unit)
+            j++;
+        if (j == m->nunits) {
+            m->unit[j] = d->unit;
+            m->unit_n[j] = 0;
+            m->nunits++;
+        }
+        m->unit_n[j]++;
+    }
+    m->run = t->run;
+    TmDesc *d0 = t->m_d0;
+    if (!d0->memo && !(d0->memo = calloc(1, sizeof *d0->memo)))
+        return; /* no memory: the block is just not kept */
+    d0->memo->e[d0->memo->next] = *m;
+    t->memo_stores++;
+    d0->memo->next = (uint8_t)((d0->memo->next + 1) % MEMO_WAYS);
+}
+
+/* Recording, after the instruction d was timed: its writes, its place in the path; a taken
+ * branch or a full path ends the block. */
+static void memo_post(Timing *t, const TmDesc *d, const CoreRecord *rec)
+{
+    MemoEntry *m = &t->m_rec;
+    for (int i = 0; i < d->ndst; i++) {
+        bit_set(t->m_written, d->dsts[i]);
+        if (t->simd.ready[d->dsts[i]] > t->m_hz)
+            t->m_hz = t->simd.ready[d->dsts[i]];
+    }
+    m->pc[m->len++] = rec->pc;
+    m->taken_last = rec->taken;
+    if (rec->taken || m->len == MEMO_LEN)
+        memo_store(t);
+}
+
+/* Every record but the next one of a replayed block (timing_hook). */
+static __attribute__((noinline)) void hook_any(Timing *t, const CoreRecord *rec)
+{
+    if (__builtin_expect(t->halted, 0)) { /* a halted core is not run again before timing_reset */
+        internal_error(t, "instruction after halt");
+        return;
+    }
+    if (t->mmode == MM_REPLAY)
+        memo_unwind(t); /* the core left the stored path: time what came as usual, then this */
+    TmDesc *d = (TmDesc *)describe(t, rec);
+    if (t->mmode == MM_RECORD) {
+        if (d->plain && rec->stage == t->m_stage && rec->gen == t->m_gen) {
+            memo_pre(t, d);
+            time_one(t, d, rec);
+            memo_post(t, d, rec);
+            return;
+        }
+        memo_store(t); /* the block ended before this instruction */
+    }
+    if (d->plain && !t->memo_off) {
+        if (memo_begin(t, d, rec))
+            return;
+        if (t->mmode == MM_RECORD) {
+            memo_pre(t, d);
+            time_one(t, d, rec);
+            memo_post(t, d, rec);
+            return;
+        }
+    }
+    time_one(t, d, rec);
+}
+
+void timing_hook(void *ctx, const CoreRecord *rec)
+{
+    Timing *t = ctx;
+    if (t->mmode == MM_REPLAY) { /* the next record of a stored block: only checked */
+        const MemoEntry *e = t->m_e;
+        const uint32_t i = t->m_i;
+        if (__builtin_expect(rec->pc == e->pc[i] && rec->stage == t->m_stage && rec->gen == t->m_gen &&
+                             rec->taken == (i + 1 == e->len ? e->taken_last : 0), 1)) {
+            if (++t->m_i == e->len)
+                memo_apply(t, e);
+            return;
+        }
+    }
+    hook_any(t, rec);
+}
+
+void timing_set_memo(Timing *t, int on)
+{
+    t->memo_off = !on;
+}
+
+void timing_memo_counts(const Timing *t, uint64_t *replays, uint64_t *stores)
+{
+    *replays = t->memo_replays;
+    *stores = t->memo_stores;
+}
+
 void timing_end(Timing *t)
 {
+    if (t->mmode == MM_REPLAY) /* stopped inside a replayed block: time what came */
+        memo_unwind(t);
+    t->mmode = MM_NONE;
     if (!t->halted) {
         t->st.cycles += t->now;
         t->st.runs++;

@@ -10,7 +10,10 @@
  * multiplexer interconnect, its latency and the ports the data path, AGUs and partition unit
  * share (interconnect.h); the partition unit (partition.h); the scratchpad ports (spad.h); scene
  * memory with an optional cache (scenemem.h). sim/timing.c keeps the event loop, the stall
- * accounting and the dispatch to the units by the ISA table's UNIT and FLAGS columns.
+ * accounting and the dispatch to the units by the ISA table's UNIT and FLAGS columns, and a memo
+ * of blocks of instructions that use no memory unit: a block whose start state recurs gets its
+ * stored outcome instead of being timed again, with the same result (docs/model.md, "Host
+ * speed: memoized blocks").
  * Must not: compute any architectural value or change what the program does (the functional
  * core does); results are identical with and without timing.
  *
@@ -99,6 +102,12 @@ void timing_free(Timing *t);
 void timing_reset(Timing *t);
 /* The CoreHook: one executed instruction. */
 void timing_hook(void *ctx, const CoreRecord *rec);
+/* Memoized blocks on (the default) or off: the same results either way (tests/unit/test_timing.c
+ * compares them); off only to check that. */
+void timing_set_memo(Timing *t, int on);
+/* Blocks replayed from the memo and blocks stored in it, since timing_new (host statistics, not
+ * the machine's). */
+void timing_memo_counts(const Timing *t, uint64_t *replays, uint64_t *stores);
 /* After core_run: a run that stopped without halt (trap, limit) counts the cycles so far. */
 void timing_end(Timing *t);
 const TimingStats *timing_stats(const Timing *t);

@@ -19,6 +19,7 @@
 #include "../../sim/event.h"
 #include "../../sim/machine/scenemem.h"
 #include "../../sim/timing.h"
+#include "../support/asm_fixture.h"
 
 /* A timing figure by its expect key, or -1 for an unknown key. */
 static long long figure(const TimingStats *s, const char *key)
@@ -280,5 +281,114 @@ Test(timing, a_model_reused_for_another_program_times_it_as_a_fresh_one)
         cr_expect_gt(fresh.cycles, 0u, "%s", p->file);
         cr_expect(memcmp(&fresh, &reused, sizeof fresh) == 0, "%s after %s: cycles %llu, fresh %llu", p->file,
                   prev->file, (unsigned long long)reused.cycles, (unsigned long long)fresh.cycles);
+    }
+}
+
+/* prog timed on a fresh model with the memo of blocks on or off, stopped by an instruction limit
+ * (0: run to its halt); the blocks it replayed. */
+/* (src: assembly text to time instead of p's file) */
+static TimingStats run_memo_src(const BenchProg *p, const char *src, int memo, uint64_t limit, uint64_t *replays)
+{
+    CfgMachine cfg;
+    cfg_defaults(&cfg);
+    CoreParams cp;
+    cfg_core_params(&cfg, &cp);
+    TimingParams tp;
+    timing_params(&cfg, &tp);
+    char err[512];
+    Timing *t = timing_new(&tp, err, sizeof err);
+    cr_assert(t, "%s", err);
+    timing_set_memo(t, memo);
+    AsmDefine def = {p->define, p->value};
+    AsmOptions opt = {&def, p->define ? 1 : 0, NULL, 0, NULL};
+    AsmObject obj;
+    if (src)
+        ta_assemble_ok(src, NULL, &obj);
+    else
+        cr_assert(asm_assemble_file(p->file, &opt, &obj) == 0, "%s does not assemble", p->file);
+    Core *c = core_new(&cp, &obj, err, sizeof err);
+    cr_assert(c, "%s: %s", p->file, err);
+    core_set_hook(c, timing_hook, t);
+    CoreExit ex = core_run(c, limit ? limit : 1000000);
+    cr_assert(ex == CORE_EXIT_HALT || (limit && ex == CORE_EXIT_LIMIT), "%s: %s", p->file, core_trap_message(c));
+    timing_end(t);
+    cr_assert_null(timing_error(t), "%s: %s", p->file, timing_error(t));
+    TimingStats s = *timing_stats(t);
+    uint64_t stores;
+    timing_memo_counts(t, replays, &stores);
+    timing_free(t);
+    core_free(c);
+    asm_object_free(&obj);
+    return s;
+}
+
+static TimingStats run_memo(const BenchProg *p, int memo, uint64_t limit, uint64_t *replays)
+{
+    return run_memo_src(p, NULL, memo, limit, replays);
+}
+
+/* A loop that exercises what a memoized block meets: plain vector and scalar instructions with
+ * dependency chains, a unit with an issue interval, a scene load and a ray-buffer gather
+ * between blocks, stage and statistics-generation changes inside the loop, a taken branch. */
+static const char memo_loop[] =
+    "        li      r1, 150\n"
+    "        li      r2, 4096\n"
+    "        vli     v1, 0x3f800000\n"
+    "        viota   v5\n"
+    "loop:   stage   1\n"
+    "        vfadd   v2, v1, v1\n"
+    "        vfmul   v3, v2, v1\n"
+    "        vrcp    v4, v3\n"
+    "        vrcp    v6, v1\n"
+    "        ld      r3, r2, 0\n"
+    "        add     r4, r3, r1\n"
+    "        vfadd   v1, v1, v3\n"
+    "        stage   2\n"
+    "        andi    r6, r1, 3\n"
+    "        sgen    r6\n"
+    "        rgat    v7, v5, r0, 0\n"
+    "        vfmin   v8, v7, v4\n"
+    "        addi    r1, r1, -1\n"
+    "        bne     r1, r0, loop\n"
+    "        halt\n";
+
+Test(timing, memoized_blocks_give_the_same_figures_as_timing_each_instruction)
+{
+    /* Every counter with the memo on equals the one with it off: for whole runs, and for runs
+     * stopped by an instruction limit at every point of their first few hundred instructions
+     * and then at intervals, so that runs end inside recorded and inside replayed blocks
+     * (timing_end times a replayed block's records that came before the stop). */
+    static const BenchProg progs[] = {{"kernels/bench/chains.s", "CLASS", 3}, {"kernels/bench/chains.s", "CLASS", 0},
+                                      {"kernels/bench/branch.s", NULL, 0},   {"kernels/bench/contention.s", "PATTERN", 1},
+                                      {"kernels/bench/partition.s", "N8", 0}, {"kernels/bench/scene.s", "PATTERN", 0},
+                                      {"kernels/bench/gather_banks.s", "PATTERN", 1}, {"kernels/bench/spad.s", "OFF", 32}};
+    uint64_t replayed_any = 0;
+    for (size_t i = 0; i < sizeof progs / sizeof progs[0]; i++) {
+        const BenchProg *p = &progs[i];
+        uint64_t r_on, r_off;
+        TimingStats on = run_memo(p, 1, 0, &r_on), off = run_memo(p, 0, 0, &r_off);
+        cr_assert_eq(r_off, 0u, "%s: the memo replayed blocks while off", p->file);
+        cr_expect(memcmp(&on, &off, sizeof on) == 0, "%s %s=%lld: cycles %llu with the memo, %llu without", p->file,
+                  p->define ? p->define : "", p->value, (unsigned long long)on.cycles, (unsigned long long)off.cycles);
+        replayed_any += r_on;
+        const uint64_t n = on.busy; /* one issue cycle per instruction */
+        for (uint64_t limit = 1; limit < n; limit += limit < 300 ? 1 : 97) {
+            TimingStats a = run_memo(p, 1, limit, &r_on), b = run_memo(p, 0, limit, &r_off);
+            cr_expect(memcmp(&a, &b, sizeof a) == 0, "%s stopped after %llu instructions: cycles %llu with the memo, %llu without",
+                      p->file, (unsigned long long)limit, (unsigned long long)a.cycles, (unsigned long long)b.cycles);
+        }
+    }
+    (void)replayed_any; /* the micro-benchmarks are straight lines: they check recording */
+    BenchProg loop = {"memo_loop.s", NULL, 0};
+    uint64_t r_on, r_off;
+    TimingStats on = run_memo_src(&loop, memo_loop, 1, 0, &r_on), off = run_memo_src(&loop, memo_loop, 0, 0, &r_off);
+    cr_expect(memcmp(&on, &off, sizeof on) == 0, "the loop: cycles %llu with the memo, %llu without",
+              (unsigned long long)on.cycles, (unsigned long long)off.cycles);
+    cr_expect_gt(r_on, 300u, "the loop's blocks recur: %llu replayed", (unsigned long long)r_on);
+    cr_expect_gt(on.stalls[TM_FU_BUSY] + on.stalls[TM_DATA_DEPENDENCY], 0u, "the loop stalls");
+    for (uint64_t limit = 1; limit < on.busy; limit += limit < 400 ? 1 : 13) {
+        TimingStats a = run_memo_src(&loop, memo_loop, 1, limit, &r_on), b = run_memo_src(&loop, memo_loop, 0, limit, &r_off);
+        cr_expect(memcmp(&a, &b, sizeof a) == 0, "the loop stopped after %llu instructions: cycles %llu with the memo, %llu without",
+                  (unsigned long long)limit, (unsigned long long)a.cycles, (unsigned long long)b.cycles);
     }
 }
