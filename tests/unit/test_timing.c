@@ -227,24 +227,41 @@ typedef struct BenchProg {
 
 /* prog's stats on a fresh model, or, with `after`, on a model that ran `after` first
  * (timing_reset between, as a worker does for each pass). */
-static TimingStats run_on(const BenchProg *prog, const BenchProg *after)
+/* A timing model of the default machine, and its core parameters in cp. */
+static Timing *default_timing(CoreParams *cp)
 {
     CfgMachine cfg;
     cfg_defaults(&cfg);
-    CoreParams cp;
-    cfg_core_params(&cfg, &cp);
+    cfg_core_params(&cfg, cp);
     TimingParams tp;
     timing_params(&cfg, &tp);
     char err[512];
     Timing *t = timing_new(&tp, err, sizeof err);
     cr_assert(t, "%s", err);
+    return t;
+}
+
+/* p's file assembled with its define, or src (assembly text) when not NULL. */
+static void assemble_prog(const BenchProg *p, const char *src, AsmObject *obj)
+{
+    AsmDefine def = {p->define, p->value};
+    AsmOptions opt = {&def, p->define ? 1 : 0, NULL, 0, NULL};
+    if (src)
+        ta_assemble_ok(src, NULL, obj);
+    else
+        cr_assert(asm_assemble_file(p->file, &opt, obj) == 0, "%s does not assemble", p->file);
+}
+
+static TimingStats run_on(const BenchProg *prog, const BenchProg *after)
+{
+    CoreParams cp;
+    Timing *t = default_timing(&cp);
+    char err[512];
     TimingStats before = {0};
     for (int k = after ? 0 : 1; k < 2; k++) {
         const BenchProg *p = k == 0 ? after : prog;
-        AsmDefine def = {p->define, p->value};
-        AsmOptions opt = {&def, p->define ? 1 : 0, NULL, 0, NULL};
         AsmObject obj;
-        cr_assert(asm_assemble_file(p->file, &opt, &obj) == 0, "%s does not assemble", p->file);
+        assemble_prog(p, NULL, &obj);
         Core *c = core_new(&cp, &obj, err, sizeof err);
         cr_assert(c, "%s: %s", p->file, err);
         timing_reset(t);
@@ -284,28 +301,16 @@ Test(timing, a_model_reused_for_another_program_times_it_as_a_fresh_one)
     }
 }
 
-/* prog timed on a fresh model with the memo of blocks on or off, stopped by an instruction limit
- * (0: run to its halt); the blocks it replayed. */
-/* (src: assembly text to time instead of p's file) */
+/* prog (or src, assembly text, when not NULL) timed on a fresh model with the memo of blocks on
+ * or off, stopped by an instruction limit (0: run to its halt); the blocks it replayed. */
 static TimingStats run_memo_src(const BenchProg *p, const char *src, int memo, uint64_t limit, uint64_t *replays)
 {
-    CfgMachine cfg;
-    cfg_defaults(&cfg);
     CoreParams cp;
-    cfg_core_params(&cfg, &cp);
-    TimingParams tp;
-    timing_params(&cfg, &tp);
+    Timing *t = default_timing(&cp);
     char err[512];
-    Timing *t = timing_new(&tp, err, sizeof err);
-    cr_assert(t, "%s", err);
     timing_set_memo(t, memo);
-    AsmDefine def = {p->define, p->value};
-    AsmOptions opt = {&def, p->define ? 1 : 0, NULL, 0, NULL};
     AsmObject obj;
-    if (src)
-        ta_assemble_ok(src, NULL, &obj);
-    else
-        cr_assert(asm_assemble_file(p->file, &opt, &obj) == 0, "%s does not assemble", p->file);
+    assemble_prog(p, src, &obj);
     Core *c = core_new(&cp, &obj, err, sizeof err);
     cr_assert(c, "%s: %s", p->file, err);
     core_set_hook(c, timing_hook, t);
