@@ -68,6 +68,8 @@ typedef struct TmDesc {
     uint8_t plain;                           /* times the same way every time it runs (no
                                                 memory unit, fixed result time, not a halt): can
                                                 be part of a memoized block */
+    uint8_t short_block;                     /* a block starting here was shorter than MEMO_MIN
+                                                in this run: it is timed as usual, not looked up */
     uint8_t regs[2 * ISA_MAX_OPERANDS + 1];  /* sources, exec mask, destinations */
     uint8_t dsts[ISA_MAX_OPERANDS];
     struct MemoWays *memo;                   /* blocks starting here (kept across runs, each
@@ -84,6 +86,9 @@ typedef struct TmDesc {
  * and its outcome stored; when it recurs, the outcome is applied at the block's end and the
  * records in between are only checked against the stored path (docs/performance.md). */
 enum { MEMO_LEN = 16, MEMO_REGS = 40, MEMO_EVENTS = 6, MEMO_WAYS = 4 };
+/* Blocks shorter than this cost more to look up and replay than to time (callgrind): a start
+ * that gave one is timed as usual for the rest of the run. */
+enum { MEMO_MIN = 2 };
 
 typedef struct MemoEv { uint32_t rel; uint16_t arg; uint8_t kind, cause; } MemoEv;
 typedef struct MemoReg { uint32_t rel; uint8_t reg, cause; } MemoReg;
@@ -404,6 +409,7 @@ static void describe_fill(Timing *t, TmDesc *d, const CoreRecord *rec)
     d->special = oi->unit == ISA_U_AGU || oi->unit == ISA_U_RBUF || oi->unit == ISA_U_SPAD ||
                  oi->unit == ISA_U_PART;
     d->plain = !d->mem && !d->special && !d->is_halt;
+    d->short_block = 0;
     d->lat = (uint32_t)t->simd.p.lat[oi->unit];
     d->issue = t->simd.p.issue[oi->unit] > 1 ? (uint32_t)t->simd.p.issue[oi->unit] : 0;
     int ndst;
@@ -810,7 +816,11 @@ static void memo_store(Timing *t)
 {
     MemoEntry *m = &t->m_rec;
     t->mmode = MM_NONE;
-    if (!t->m_ok || !m->len || t->err[0] || t->now - t->m_t0 > UINT32_MAX)
+    if (m->len < MEMO_MIN) {
+        t->m_d0->short_block = 1;
+        return;
+    }
+    if (!t->m_ok || t->err[0] || t->now - t->m_t0 > UINT32_MAX)
         return;
     m->end_rel = (uint32_t)(t->now - t->m_t0);
     uint64_t stalls = 0;
@@ -899,7 +909,7 @@ static __attribute__((noinline)) void hook_any(Timing *t, const CoreRecord *rec)
         }
         memo_store(t); /* the block ended before this instruction */
     }
-    if (d->plain && !t->memo_off) {
+    if (d->plain && !d->short_block && !t->memo_off) {
         if (memo_begin(t, d, rec))
             return;
         if (t->mmode == MM_RECORD) {
