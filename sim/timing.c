@@ -140,7 +140,8 @@ struct Timing {
     uint8_t m_stage, m_gen;
     uint32_t m_i;                  /* replay: records matched so far */
     MemoEntry *m_e;                /* replay: the stored block */
-    TmDesc *m_d0;                  /* the block's first instruction (its MemoWays) */
+    uint32_t m_pc0;                /* the block's first instruction (its MemoWays): a pc, not a
+                                      pointer, since the table may grow during the block */
     MemoEntry m_rec;               /* record: the block being noted */
     int m_ok;                      /* record: it still fits an entry */
     uint64_t m_written[2], m_seen[2]; /* record: registers written, live-ins noted */
@@ -756,7 +757,7 @@ static int memo_begin(Timing *t, TmDesc *d, const CoreRecord *rec)
     t->m_t0 = t->now;
     t->m_stage = rec->stage;
     t->m_gen = rec->gen;
-    t->m_d0 = d;
+    t->m_pc0 = rec->pc; /* d is in the table (not the spare), so desc[pc] stays its entry */
     if (d->memo)
         for (int w = 0; w < MEMO_WAYS; w++) {
             MemoEntry *e = &d->memo->e[w];
@@ -817,7 +818,7 @@ static void memo_store(Timing *t)
     MemoEntry *m = &t->m_rec;
     t->mmode = MM_NONE;
     if (m->len < MEMO_MIN) {
-        t->m_d0->short_block = 1;
+        t->desc[t->m_pc0].short_block = 1;
         return;
     }
     if (!t->m_ok || t->err[0] || t->now - t->m_t0 > UINT32_MAX)
@@ -866,7 +867,7 @@ static void memo_store(Timing *t)
         m->unit_n[j]++;
     }
     m->run = t->run;
-    TmDesc *d0 = t->m_d0;
+    TmDesc *d0 = &t->desc[t->m_pc0];
     if (!d0->memo && !(d0->memo = calloc(1, sizeof *d0->memo)))
         return; /* no memory: the block is just not kept */
     d0->memo->e[d0->memo->next] = *m;
