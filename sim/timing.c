@@ -669,11 +669,15 @@ static int memo_events(const Timing *t, uint64_t t0, MemoEv *ev)
 }
 
 /* A register's state relative to t0, as a key holds it. */
+enum { MEMO_FAR = 255 }; /* the cause of a register landing too far ahead to key (never stored) */
+
 static inline MemoReg memo_reg(const Timing *t, int r, uint64_t t0)
 {
     uint64_t rd = t->simd.ready[r];
     if (rd <= t0)
         return (MemoReg){0, (uint8_t)r, 0};
+    if (rd - t0 > UINT32_MAX) /* a key holds 32 bits: such a state matches nothing stored */
+        return (MemoReg){UINT32_MAX, (uint8_t)r, MEMO_FAR};
     return (MemoReg){(uint32_t)(rd - t0), (uint8_t)r, t->simd.rcause[r]};
 }
 
@@ -798,7 +802,9 @@ static void memo_pre(Timing *t, const TmDesc *d)
             t->m_ok = 0;
             continue;
         }
-        m->live[m->nlive++] = memo_reg(t, r, t->m_t0);
+        m->live[m->nlive] = memo_reg(t, r, t->m_t0);
+        if (m->live[m->nlive++].cause == MEMO_FAR)
+            t->m_ok = 0;
     }
 }
 
