@@ -724,8 +724,7 @@ static void memo_apply(Timing *t, const MemoEntry *e)
             t->simd.unit_pending[v->arg] = 1;
         else if (v->kind == EV_FETCH)
             t->simd.fetch_pending = 1;
-        if (evq_push(&t->q, t0 + v->rel, v->kind, v->arg, 0, v->cause))
-            internal_error(t, "out of memory for events");
+        push(t, t0 + v->rel, v->kind, v->arg, 0, v->cause);
     }
     t->mmode = MM_NONE;
     t->memo_replays++;
@@ -897,6 +896,14 @@ static void memo_post(Timing *t, const TmDesc *d, const CoreRecord *rec)
         memo_store(t);
 }
 
+/* Recording: the instruction timed as usual, its live-ins noted before and its writes after. */
+static void memo_time_noted(Timing *t, const TmDesc *d, const CoreRecord *rec)
+{
+    memo_pre(t, d);
+    time_one(t, d, rec);
+    memo_post(t, d, rec);
+}
+
 /* Every record but the next one of a replayed block (timing_hook). */
 static __attribute__((noinline)) void hook_any(Timing *t, const CoreRecord *rec)
 {
@@ -909,9 +916,7 @@ static __attribute__((noinline)) void hook_any(Timing *t, const CoreRecord *rec)
     TmDesc *d = (TmDesc *)describe(t, rec);
     if (t->mmode == MM_RECORD) {
         if (d->plain && rec->stage == t->m_stage && rec->gen == t->m_gen) {
-            memo_pre(t, d);
-            time_one(t, d, rec);
-            memo_post(t, d, rec);
+            memo_time_noted(t, d, rec);
             return;
         }
         memo_store(t); /* the block ended before this instruction */
@@ -920,9 +925,7 @@ static __attribute__((noinline)) void hook_any(Timing *t, const CoreRecord *rec)
         if (memo_begin(t, d, rec))
             return;
         if (t->mmode == MM_RECORD) {
-            memo_pre(t, d);
-            time_one(t, d, rec);
-            memo_post(t, d, rec);
+            memo_time_noted(t, d, rec);
             return;
         }
     }
