@@ -946,7 +946,7 @@ int ref_render(const PackedScene *p, const RefParams *rp, float *rgb, RefStats *
             goto out;
         }
     Launch launch = {ws};
-    TileLaunch tl = {ntiles, rp->threads, NULL, launch_tile, NULL, &launch, rp->progress, rp->progress_ctx};
+    TileLaunch tl = {ntiles, rp->threads, NULL, launch_tile, NULL, &launch, rp->progress, rp->progress_ctx, 0};
     tiles_run(&tl);
     /* Mean over samples. */
     float inv = 1.0f / (float)c.spp;

@@ -9,6 +9,13 @@ typedef struct Pool {
     const TileLaunch *l;
     atomic_uint next, done;
     atomic_int failed;
+    /* chained launches (TileLaunch.chain), under lock: each chain's next tile (as a count of its
+     * tiles handed out) and whether one of its tiles is running; a thread that finds no chain
+     * free sleeps on cond, woken by each finished tile and by a failure */
+    uint32_t *taken;
+    uint8_t *busy;
+    pthread_mutex_t lock;
+    pthread_cond_t cond;
 } Pool;
 
 typedef struct Thread {
@@ -24,25 +31,92 @@ int tiles_threads(int threads, uint32_t ntiles)
     return n;
 }
 
+/* A failure: every thread stops after its current tile, and none waits on a tile that will not
+ * run. */
+static void pool_fail(Pool *pool)
+{
+    atomic_store(&pool->failed, 1);
+    if (pool->taken) {
+        pthread_mutex_lock(&pool->lock);
+        pthread_cond_broadcast(&pool->cond);
+        pthread_mutex_unlock(&pool->lock);
+    }
+}
+
+/* Chained: the next tile to run into *t: of the chains with no tile running, the one whose next
+ * tile comes first (so passes go out in pass order while the tiles before them are free), after a
+ * wait while every chain with tiles left has one running. 0; 1 when every tile is handed out; -1
+ * after a failure. */
+static int pool_take(Pool *pool, uint32_t *t)
+{
+    const uint32_t k = pool->l->chain, n = pool->l->ntiles;
+    int rc = 1;
+    pthread_mutex_lock(&pool->lock);
+    for (;;) {
+        if (atomic_load(&pool->failed)) {
+            rc = -1;
+            break;
+        }
+        uint32_t best = UINT32_MAX;
+        int left = 0;
+        for (uint32_t c = 0; c < k && c < n; c++) {
+            uint64_t next = c + (uint64_t)pool->taken[c] * k;
+            if (next >= n)
+                continue;
+            left = 1;
+            if (!pool->busy[c] && next < best)
+                best = (uint32_t)next;
+        }
+        if (best != UINT32_MAX) {
+            pool->busy[best % k] = 1;
+            pool->taken[best % k]++;
+            *t = best;
+            rc = 0;
+            break;
+        }
+        if (!left)
+            break;
+        pthread_cond_wait(&pool->cond, &pool->lock);
+    }
+    pthread_mutex_unlock(&pool->lock);
+    return rc;
+}
+
+static void pool_finished(Pool *pool, uint32_t t)
+{
+    pthread_mutex_lock(&pool->lock);
+    pool->busy[t % pool->l->chain] = 0;
+    pthread_cond_broadcast(&pool->cond);
+    pthread_mutex_unlock(&pool->lock);
+}
+
 static void *thread_main(void *arg)
 {
     Thread *th = arg;
     Pool *pool = th->pool;
     const TileLaunch *l = pool->l;
     if (l->begin && l->begin(l->ctx, th->index) != 0) {
-        atomic_store(&pool->failed, 1);
+        pool_fail(pool);
         if (l->end)
             l->end(l->ctx, th->index);
         return NULL;
     }
     while (!atomic_load(&pool->failed)) {
-        uint32_t t = atomic_fetch_add(&pool->next, 1u);
-        if (t >= l->ntiles)
-            break;
+        uint32_t t;
+        if (pool->taken) {
+            if (pool_take(pool, &t) != 0)
+                break;
+        } else {
+            t = atomic_fetch_add(&pool->next, 1u);
+            if (t >= l->ntiles)
+                break;
+        }
         if (l->tile(l->ctx, th->index, t) != 0) {
-            atomic_store(&pool->failed, 1);
+            pool_fail(pool);
             break;
         }
+        if (pool->taken)
+            pool_finished(pool, t);
         uint32_t done = atomic_fetch_add(&pool->done, 1u) + 1u;
         if (l->progress)
             l->progress(l->progress_ctx, done, l->ntiles);
@@ -59,7 +133,25 @@ uint32_t tiles_run(const TileLaunch *l)
     atomic_init(&pool.next, 0u);
     atomic_init(&pool.done, 0u);
     atomic_init(&pool.failed, 0);
+    pool.taken = NULL;
+    pool.busy = NULL;
     int n = tiles_threads(l->threads, l->ntiles);
+    if (l->chain && n > 1) { /* (one thread alone takes the tiles in order: each after the one it continues) */
+        pool.taken = calloc(l->chain, sizeof *pool.taken);
+        pool.busy = calloc(l->chain, 1);
+        int locked = pool.taken && pool.busy && pthread_mutex_init(&pool.lock, NULL) == 0;
+        if (locked && pthread_cond_init(&pool.cond, NULL) != 0) {
+            pthread_mutex_destroy(&pool.lock);
+            locked = 0;
+        }
+        if (!locked) { /* no memory: the calling thread runs every tile */
+            free(pool.taken);
+            free(pool.busy);
+            pool.taken = NULL;
+            pool.busy = NULL;
+            n = 1;
+        }
+    }
     Thread local[8], *ths = n <= 8 ? local : malloc((size_t)n * sizeof *ths);
     pthread_t *ids = n > 1 ? malloc((size_t)n * sizeof *ids) : NULL;
     if (!ths || (n > 1 && !ids))
@@ -78,5 +170,11 @@ uint32_t tiles_run(const TileLaunch *l)
     free(ids);
     if (ths != local)
         free(ths);
+    if (pool.taken) {
+        pthread_cond_destroy(&pool.cond);
+        pthread_mutex_destroy(&pool.lock);
+        free(pool.taken);
+        free(pool.busy);
+    }
     return atomic_load(&pool.done);
 }

@@ -3,7 +3,8 @@
  * sampled and trace.
  *
  * Owns: the threads, the order tiles are handed out (a shared counter: the next free tile goes to
- * the next idle thread), stopping every thread after a failure, progress calls. Must not: know
+ * the next idle thread), the waits of a tile on the one it continues (TileLaunch.chain), stopping
+ * every thread after a failure, progress calls. Must not: know
  * what a tile is or hold results: per-thread state lives in the caller's workers, and results
  * never depend on which thread ran which tile or on the thread count (each tile is computed
  * from its own inputs alone; the caller sums per-thread counters in worker order).
@@ -28,6 +29,12 @@ typedef struct TileLaunch {
     /* After each finished tile, from the thread that finished it (may be NULL). */
     void (*progress)(void *ctx, uint32_t tiles_done, uint32_t tiles_total);
     void *progress_ctx;
+    /* 0: the tiles are independent. k > 0: tile t >= k continues tile t - k (a frame's passes,
+     * tile t being pass t / k of tile t % k): each chain t % k runs one tile at a time in order,
+     * a tile starting only after the one it continues finished, on whichever thread takes it
+     * (the caller hands state over from one to the next); an idle thread takes the first tile,
+     * in index order, of a chain with no tile running, and waits while there is none. */
+    uint32_t chain;
 } TileLaunch;
 
 /* The threads a launch runs: threads clamped to 1 .. ntiles, and at least 1 (the calling
