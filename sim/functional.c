@@ -36,6 +36,10 @@ typedef struct Job {
     FuncTile *tiles;
     uint32_t spp;
     const uint32_t *units;     /* sampled mode: the round's (tile, pass) units, NULL for whole tiles */
+    int passes;                /* func_render: the launch's items are (tile, pass) units in pass
+                                  order, each pass after the tile's one before (run_tile_pass) */
+    uint32_t *passes_done;     /* ... and each tile's passes finished */
+    atomic_uint tiles_done;    /* ... and the tiles with every pass finished */
     FuncUnit *unit_out;        /* ... and their figures */
     struct Worker *workers;    /* one per host thread (sim/run/tiles.h) */
     int nworkers;
@@ -340,6 +344,61 @@ static int run_tile(Worker *w, Core *c, uint32_t t, FuncStats *st)
     return 0;
 }
 
+/* The pixels of the tile ft between the framebuffer's first w x h pixels and the frame's rgb
+ * (to_fb: into the framebuffer). */
+static void tile_pixels(Job *j, Core *c, const FuncTile *ft, int to_fb)
+{
+    uint32_t size;
+    uint8_t *fb = core_mem(c, CORE_MEM_FB, &size);
+    for (uint32_t y = 0; y < ft->h; y++) {
+        float *px = &j->rgb[3 * ((size_t)(ft->y0 + y) * j->width + ft->x0)];
+        uint8_t *row = fb + (size_t)12 * y * ft->w;
+        if (to_fb)
+            memcpy(row, px, (size_t)12 * ft->w);
+        else
+            memcpy(px, row, (size_t)12 * ft->w);
+    }
+}
+
+/* Item i of a whole frame (Job.passes): pass i / ntiles of tile i % ntiles. The launcher starts it
+ * after the tile's pass before (TileLaunch.chain), maybe on another thread: that pass left the
+ * framebuffer in the frame's pixels, which go back into this core's framebuffer first, so the
+ * kernel adds to the same bytes as when one core runs every pass of the tile (run_tile). */
+static int run_tile_pass(Worker *w, Core *c, uint32_t i, FuncStats *st)
+{
+    Job *j = w->job;
+    const uint32_t t = i % j->ntiles, pass = i / j->ntiles;
+    FuncTile *ft = &j->tiles[t];
+    if (pass == 0) {
+        tile_place(j, t, ft);
+        ft->rays = 0;
+    }
+    pass_launch(j, c, ft, pass == 0);
+    if (pass > 0)
+        tile_pixels(j, c, ft, 1);
+    uint64_t before = core_instructions(c), lanes_before[ISA_STAGE_COUNT];
+    for (int k = 0; k < ISA_STAGE_COUNT; k++)
+        lanes_before[k] = core_stats(c)->active_lanes[k];
+    FuncUnit fu = {0};
+    int rc = run_pass(w, c, ft, pass, &fu);
+    if (w->tc.tm)
+        tile_add_timed(ft, &fu);
+    if (rc)
+        return -1;
+    ft->rays += counters_add(j, c, st);
+    tile_pixels(j, c, ft, 0);
+    ft->instructions += core_instructions(c) - before;
+    for (int k = 0; k < ISA_STAGE_COUNT; k++)
+        ft->active_lanes[k] += core_stats(c)->active_lanes[k] - lanes_before[k];
+    j->passes_done[t] = pass + 1;
+    if (pass + 1 == j->spp) {
+        uint32_t done = atomic_fetch_add(&j->tiles_done, 1u) + 1u;
+        if (j->fp->progress)
+            j->fp->progress(j->fp->progress_ctx, done, j->ntiles);
+    }
+    return 0;
+}
+
 /* Sampled mode: the i-th unit of the round alone, launched as every pass is (a pass reads nothing
  * an earlier pass left but the framebuffer it adds to, so its instructions and cycles are those it
  * has in the whole tile). */
@@ -401,7 +460,9 @@ static int worker_tile(void *ctx, int index, uint32_t t)
 {
     Job *j = ctx;
     Worker *w = &j->workers[index];
-    return j->units ? run_unit(w, w->tc.core, t, &w->st) : run_tile(w, w->tc.core, t, &w->st);
+    if (j->units)
+        return run_unit(w, w->tc.core, t, &w->st);
+    return j->passes ? run_tile_pass(w, w->tc.core, t, &w->st) : run_tile(w, w->tc.core, t, &w->st);
 }
 
 /* Each worker's core and timing counters into its stats, and its core closed. */
@@ -574,7 +635,7 @@ int func_units(FuncSession *s, const uint32_t *units, uint32_t n, FuncUnit *out,
     job->units = units;
     job->unit_out = out;
     TileLaunch launch = {n, job->nworkers, worker_begin, worker_tile, NULL, job, job->fp->progress,
-                         job->fp->progress_ctx};
+                         job->fp->progress_ctx, 0};
     tiles_run(&launch);
     job->units = NULL;
     job->unit_out = NULL;
@@ -641,9 +702,36 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
         return -1;
     Job *job = &s->job;
     job->rgb = rgb;
-    TileLaunch launch = {job->ntiles, job->nworkers, worker_begin, worker_tile, NULL, job, fp->progress,
-                         fp->progress_ctx};
-    uint32_t done = tiles_run(&launch);
+    /* A frame's items are its (tile, pass) units, so that the threads share the work more evenly
+     * than by whole tiles; a tile's passes still run one after the other, each adding to the
+     * framebuffer the one before left (run_tile_pass). Without an image (rgb NULL) or a pass
+     * table, whole tiles. */
+    uint32_t done;
+    job->passes_done = rgb && !fp->batch ? calloc(job->ntiles ? job->ntiles : 1, sizeof *job->passes_done) : NULL;
+    if (job->passes_done) {
+        job->passes = 1;
+        atomic_init(&job->tiles_done, 0u);
+        TileLaunch launch = {job->ntiles * job->spp, job->nworkers, worker_begin, worker_tile, NULL, job, NULL, NULL,
+                             job->ntiles};
+        tiles_run(&launch);
+        done = 0;
+        for (uint32_t t = 0; t < job->ntiles; t++) {
+            if (job->passes_done[t] == job->spp) {
+                done++;
+            } else if (job->passes_done[t]) { /* unfinished: black, as a tile never started */
+                for (uint32_t y = 0; y < job->tiles[t].h; y++)
+                    memset(&rgb[3 * ((size_t)(job->tiles[t].y0 + y) * job->width + job->tiles[t].x0)], 0,
+                           (size_t)12 * job->tiles[t].w);
+            }
+        }
+        job->passes = 0;
+        free(job->passes_done);
+        job->passes_done = NULL;
+    } else {
+        TileLaunch launch = {job->ntiles, job->nworkers, worker_begin, worker_tile, NULL, job, fp->progress,
+                             fp->progress_ctx, 0};
+        done = tiles_run(&launch);
+    }
     float inv = 1.0f / (float)job->spp;
     for (size_t i = 0; rgb && i < 3 * (size_t)job->width * job->height; i++)
         rgb[i] = rgb[i] * inv;

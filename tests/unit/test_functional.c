@@ -274,6 +274,93 @@ Test(functional, machines_too_small_for_the_kernel_are_refused_by_key)
     scene_free(&s);
 }
 
+/* A frame's (tile, pass) units (sim/functional.c, run_tile_pass): tests/unit/pass_trap.s adds 1.0
+ * per pass to the first N floats of its tile's framebuffer, so after the division by spp those
+ * pixels hold exactly 1.0 when every pass of the tile ran once and handed the framebuffer on, on
+ * whichever threads; the rest of the frame stays 0. Tiles are 32 x 32 (M = 1024), N = 16. */
+static void pass_trap_frame(int w, int h, int spp, int threads, float **rgb, FuncStats *st, int *rc, char *err,
+                            size_t errlen)
+{
+    Scene s;
+    PackedScene p;
+    load_packed("scenes/cornell/scene.ini", w, h, spp, &s, &p);
+    CfgMachine cfg;
+    cfg_defaults(&cfg);
+    cfg.stream_rays = 1024;
+    *rgb = calloc(3 * (size_t)w * h, sizeof(float));
+    cr_assert_not_null(*rgb);
+    FuncParams fp = {.cfg = &cfg, .kernel_path = "tests/unit/pass_trap.s", .needs = s.needs, .seed = 1,
+                     .threads = threads};
+    *rc = func_render(&p, &fp, *rgb, st, err, errlen);
+    pack_free(&p);
+    scene_free(&s);
+}
+
+/* Whether the 32 x 32 tile at (x0, y0) of rgb (width w) is what N = 16 lanes leave: its first 16
+ * floats `first`, every other float 0. */
+static int tile_is(const float *rgb, int w, int x0, int y0, float first)
+{
+    for (int y = 0; y < 32; y++)
+        for (int x = 0; x < 3 * 32; x++) {
+            float v = rgb[3 * ((size_t)(y0 + y) * w + x0) + x];
+            if (v != (y == 0 && x < 16 ? first : 0.0f))
+                return 0;
+        }
+    return 1;
+}
+
+Test(functional, every_pass_of_every_tile_runs_once_in_order_on_any_thread_count)
+{
+    for (int threads = 1; threads <= 4; threads++) {
+        float *rgb;
+        FuncStats st;
+        int rc;
+        char err[4096];
+        pass_trap_frame(32, 128, 5, threads, &rgb, &st, &rc, err, sizeof err); /* 4 tiles, no x0 = 32 */
+        cr_assert_eq(rc, 0, "%d threads: %s", threads, err);
+        cr_expect_eq(st.ntiles, 4u);
+        for (int t = 0; t < 4; t++)
+            cr_expect(tile_is(rgb, 32, 0, 32 * t, 1.0f), "%d threads: tile %d did not get each of 5 passes once",
+                      threads, t);
+        uint64_t sum = 0; /* the same instructions in every pass of every tile: counted once each */
+        for (uint32_t t = 0; t < st.ntiles; t++) {
+            cr_expect_eq(st.tiles[t].instructions, st.tiles[0].instructions, "%d threads: tile %u", threads, t);
+            sum += st.tiles[t].instructions;
+        }
+        cr_expect_eq(sum, st.instructions);
+        cr_expect_eq(st.tiles[0].instructions % 5u, 0u);
+        free(rgb);
+        func_stats_free(&st);
+    }
+}
+
+Test(functional, a_pass_that_fails_leaves_its_tile_black_and_keeps_finished_tiles)
+{
+    for (int threads = 1; threads <= 3; threads++) {
+        float *rgb;
+        FuncStats st;
+        int rc;
+        char err[4096];
+        pass_trap_frame(96, 32, 2, threads, &rgb, &st, &rc, err, sizeof err); /* 3 tiles; (32, 0) traps in pass 1 */
+        cr_expect_eq(rc, -2, "%d threads: rc %d (%s)", threads, rc, err);
+        cr_expect(strstr(err, "tile at (32, 0), pass 1") != NULL, "%s", err);
+        cr_expect(tile_is(rgb, 96, 32, 0, 0.0f), "%d threads: the failed tile is not black", threads);
+        uint32_t finished = 0;
+        for (int x0 = 0; x0 < 96; x0 += 64) {
+            int done = tile_is(rgb, 96, x0, 0, 1.0f);
+            cr_expect(done || tile_is(rgb, 96, x0, 0, 0.0f), "%d threads: tile at x0 = %d is neither finished nor black",
+                      threads, x0);
+            finished += (uint32_t)done;
+        }
+        cr_expect_eq(st.tiles_done, finished, "%d threads: %u tiles done, %u finished in the image", threads,
+                     st.tiles_done, finished);
+        if (threads == 1) /* passes go out in pass order: tile 0's second pass ran before tile 1's */
+            cr_expect_eq(finished, 1u);
+        free(rgb);
+        func_stats_free(&st);
+    }
+}
+
 Test(functional, a_missing_kernel_is_an_error_naming_it)
 {
     Scene s;
