@@ -310,38 +310,37 @@ static uint64_t counters_add(Job *j, Core *c, FuncStats *st)
     return (uint64_t)spad_u32(c, a->st_camera) + spad_u32(c, a->st_indirect) + spad_u32(c, a->st_shadow);
 }
 
-/* Every pass of tile t, one kernel run each; the framebuffer carries over from pass to pass (and
- * nothing else), and the tile's pixels go to the image. */
-static int run_tile(Worker *w, Core *c, uint32_t t, FuncStats *st)
+/* Pass `pass` of the tile ft (placed) on core c: its kernel run, with its timed figures, rays,
+ * instructions and active lanes added to ft's. 0, or -1 after fail(). */
+static int tile_pass(Worker *w, Core *c, FuncTile *ft, uint32_t pass, FuncStats *st)
 {
     Job *j = w->job;
-    if (j->fp->batch)
-        return trace_batch(w, c, t, st);
-    FuncTile *ft = &j->tiles[t];
-    tile_place(j, t, ft);
     uint64_t before = core_instructions(c), lanes_before[ISA_STAGE_COUNT];
     for (int k = 0; k < ISA_STAGE_COUNT; k++)
         lanes_before[k] = core_stats(c)->active_lanes[k];
-    ft->rays = 0;
-    for (uint32_t pass = 0; pass < j->spp; pass++) {
-        pass_launch(j, c, ft, pass == 0);
-        FuncUnit fu = {0};
-        int rc = run_pass(w, c, ft, pass, &fu);
-        if (w->tc.tm)
-            tile_add_timed(ft, &fu);
-        if (rc)
-            return -1;
-        ft->rays += counters_add(j, c, st);
-    }
-    uint32_t size;
-    const uint8_t *fb = core_mem(c, CORE_MEM_FB, &size);
-    for (uint32_t y = 0; y < ft->h; y++)
-        memcpy(&j->rgb[3 * ((size_t)(ft->y0 + y) * j->width + ft->x0)], fb + (size_t)12 * y * ft->w,
-               (size_t)12 * ft->w);
-    ft->instructions = core_instructions(c) - before;
+    pass_launch(j, c, ft, pass == 0);
+    FuncUnit fu = {0};
+    int rc = run_pass(w, c, ft, pass, &fu);
+    if (w->tc.tm)
+        tile_add_timed(ft, &fu);
+    if (rc)
+        return -1;
+    ft->rays += counters_add(j, c, st);
+    ft->instructions += core_instructions(c) - before;
     for (int k = 0; k < ISA_STAGE_COUNT; k++)
-        ft->active_lanes[k] = core_stats(c)->active_lanes[k] - lanes_before[k];
+        ft->active_lanes[k] += core_stats(c)->active_lanes[k] - lanes_before[k];
     return 0;
+}
+
+/* Tile t placed, its counts zeroed (before its first pass). */
+static FuncTile *tile_start(Job *j, uint32_t t)
+{
+    FuncTile *ft = &j->tiles[t];
+    tile_place(j, t, ft);
+    ft->rays = 0;
+    ft->instructions = 0;
+    memset(ft->active_lanes, 0, sizeof ft->active_lanes);
+    return ft;
 }
 
 /* The pixels of the tile ft between the framebuffer's first w x h pixels and the frame's rgb
@@ -360,6 +359,21 @@ static void tile_pixels(Job *j, Core *c, const FuncTile *ft, int to_fb)
     }
 }
 
+/* Every pass of tile t, one kernel run each; the framebuffer carries over from pass to pass (and
+ * nothing else), and the tile's pixels go to the image. */
+static int run_tile(Worker *w, Core *c, uint32_t t, FuncStats *st)
+{
+    Job *j = w->job;
+    if (j->fp->batch)
+        return trace_batch(w, c, t, st);
+    FuncTile *ft = tile_start(j, t);
+    for (uint32_t pass = 0; pass < j->spp; pass++)
+        if (tile_pass(w, c, ft, pass, st))
+            return -1;
+    tile_pixels(j, c, ft, 0);
+    return 0;
+}
+
 /* Item i of a whole frame (Job.passes): pass i / ntiles of tile i % ntiles. The launcher starts it
  * after the tile's pass before (TileLaunch.chain), maybe on another thread: that pass left the
  * framebuffer in the frame's pixels, which go back into this core's framebuffer first, so the
@@ -368,28 +382,12 @@ static int run_tile_pass(Worker *w, Core *c, uint32_t i, FuncStats *st)
 {
     Job *j = w->job;
     const uint32_t t = i % j->ntiles, pass = i / j->ntiles;
-    FuncTile *ft = &j->tiles[t];
-    if (pass == 0) {
-        tile_place(j, t, ft);
-        ft->rays = 0;
-    }
-    pass_launch(j, c, ft, pass == 0);
+    FuncTile *ft = pass ? &j->tiles[t] : tile_start(j, t);
     if (pass > 0)
         tile_pixels(j, c, ft, 1);
-    uint64_t before = core_instructions(c), lanes_before[ISA_STAGE_COUNT];
-    for (int k = 0; k < ISA_STAGE_COUNT; k++)
-        lanes_before[k] = core_stats(c)->active_lanes[k];
-    FuncUnit fu = {0};
-    int rc = run_pass(w, c, ft, pass, &fu);
-    if (w->tc.tm)
-        tile_add_timed(ft, &fu);
-    if (rc)
+    if (tile_pass(w, c, ft, pass, st))
         return -1;
-    ft->rays += counters_add(j, c, st);
     tile_pixels(j, c, ft, 0);
-    ft->instructions += core_instructions(c) - before;
-    for (int k = 0; k < ISA_STAGE_COUNT; k++)
-        ft->active_lanes[k] += core_stats(c)->active_lanes[k] - lanes_before[k];
     j->passes_done[t] = pass + 1;
     if (pass + 1 == j->spp) {
         uint32_t done = atomic_fetch_add(&j->tiles_done, 1u) + 1u;
