@@ -612,7 +612,7 @@ int func_open(const PackedScene *p, const FuncParams *fp, FuncSession **out, cha
     return 0;
 }
 
-uint32_t func_units_total(const FuncSession *s) { return s->job.ntiles * s->job.spp; }
+uint64_t func_units_total(const FuncSession *s) { return (uint64_t)s->job.ntiles * s->job.spp; }
 
 /* A failed launch's message and return (-2 when the kernel failed, -1 otherwise). */
 static int job_failure(Job *job, char *err, size_t errlen)
@@ -624,10 +624,10 @@ static int job_failure(Job *job, char *err, size_t errlen)
 int func_units(FuncSession *s, const uint32_t *units, uint32_t n, FuncUnit *out, char *err, size_t errlen)
 {
     Job *job = &s->job;
-    uint32_t total = func_units_total(s);
+    uint64_t total = func_units_total(s);
     for (uint32_t i = 0; i < n; i++)
         if (units[i] >= total) {
-            snprintf(err, errlen, "unit %u: the frame has %u (tile, pass) units", units[i], total);
+            snprintf(err, errlen, "unit %u: the frame has %llu (tile, pass) units", units[i], (unsigned long long)total);
             return -1;
         }
     job->units = units;
@@ -702,10 +702,11 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
     job->rgb = rgb;
     /* A frame's items are its (tile, pass) units, so that the threads share the work more evenly
      * than by whole tiles; a tile's passes still run one after the other, each adding to the
-     * framebuffer the one before left (run_tile_pass). Without an image (rgb NULL) or a pass
-     * table, whole tiles. */
+     * framebuffer the one before left (run_tile_pass). Without an image (rgb NULL), a pass table,
+     * or with more units than a launch counts (2^32), whole tiles. */
     uint32_t done;
-    job->passes_done = rgb && !fp->batch ? calloc(job->ntiles ? job->ntiles : 1, sizeof *job->passes_done) : NULL;
+    const int by_pass = rgb && !fp->batch && (uint64_t)job->ntiles * job->spp <= UINT32_MAX;
+    job->passes_done = by_pass ? calloc(job->ntiles ? job->ntiles : 1, sizeof *job->passes_done) : NULL;
     if (job->passes_done) {
         job->passes = 1;
         atomic_init(&job->tiles_done, 0u);

@@ -113,7 +113,7 @@ typedef struct FuncSession FuncSession;
 int func_open(const PackedScene *p, const FuncParams *fp, FuncSession **out, char *err, size_t errlen);
 int func_units(FuncSession *s, const uint32_t *units, uint32_t n, FuncUnit *out, char *err, size_t errlen);
 /* The frame's units: tiles x spp. */
-uint32_t func_units_total(const FuncSession *s);
+uint64_t func_units_total(const FuncSession *s);
 int func_close(FuncSession *s, FuncStats *st, char *err, size_t errlen);
 
 /* `sfsim trace` through the kernel: fp->batch and fp->hits must be set. Same returns. */

@@ -162,6 +162,22 @@ static double *tile_estimates(const SampleEstimate *e, const double *x, const Me
     return tc;
 }
 
+/* Sampled mode numbers a frame's (tile, pass) units in 32 bits: 0, or -1 with fs closed and a
+ * message when the frame has more. */
+static int units_countable(FuncSession *fs, char *err, size_t errlen)
+{
+    if (func_units_total(fs) <= UINT32_MAX)
+        return 0;
+    snprintf(err, errlen, "sampled mode: the frame has %llu (tile, pass) units, more than the %llu it can count; "
+             "lower render.spp or the image size", (unsigned long long)func_units_total(fs),
+             (unsigned long long)UINT32_MAX);
+    FuncStats st;
+    char ignored[256];
+    func_close(fs, &st, ignored, sizeof ignored);
+    func_stats_free(&st);
+    return -1;
+}
+
 int sampled_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg, const FuncParams *fp,
                   RunFrame *fr, char *err, size_t errlen)
 {
@@ -171,7 +187,9 @@ int sampled_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg
     FuncSession *fs = NULL;
     if (func_open(&sc->p, fp, &fs, err, errlen) != 0)
         return -1;
-    uint32_t N = func_units_total(fs), ntiles = N / spp;
+    if (units_countable(fs, err, errlen) != 0)
+        return -1;
+    uint32_t N = (uint32_t)func_units_total(fs), ntiles = N / spp;
     RefUnitStats *units = calloc(N, sizeof *units);
     double *x = malloc((size_t)N * AUX_K * sizeof *x), *ys = malloc((size_t)N * sizeof *ys);
     Measured m = {.fs = fs, .units = calloc(N, sizeof(FuncUnit)), .instructions = malloc((size_t)N * sizeof(double)),
@@ -251,7 +269,9 @@ int sampled_population(const RunScene *sc, const RunSpec *spec, SampledPopulatio
     FuncSession *fs;
     if (func_open(&sc->p, &fp, &fs, err, errlen) != 0)
         return -1;
-    pop->N = func_units_total(fs);
+    if (units_countable(fs, err, errlen) != 0)
+        return -1;
+    pop->N = (uint32_t)func_units_total(fs);
     pop->spp = (uint32_t)sc->s.render.spp;
     pop->ntiles = pop->N / pop->spp;
     size_t N = pop->N;

@@ -694,3 +694,23 @@ Test(sampled_frame, interval_covers_the_detailed_run, .init = frame_setup, .fini
     free(order);
     free(ys);
 }
+
+/* A frame with more (tile, pass) units than sampled mode numbers (32 bits) is an error that says
+ * so, not a count that wraps: 16384 x 16384 at 2^20 spp in tiles of 32 x 32 is 2^38 units. */
+Test(sampled_frame, more_units_than_it_can_count_is_an_error)
+{
+    char err[4096];
+    CfgMachine cfg;
+    cfg_defaults(&cfg);
+    cfg.stream_rays = 1024;
+    RunSize z = {16384, 16384, 1 << 20, -1};
+    RunScene sc;
+    cr_assert_eq(run_scene_open(&sc, "scenes/cornell/scene.ini", &z, &cfg, RUN_SAMPLED, NULL, err, sizeof err), 0, "%s",
+                 err);
+    RunSpec spec = {.mode = RUN_SAMPLED, .cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .seed = 1, .threads = 1,
+                    .sample_seed = 1};
+    SampledPopulation p;
+    cr_expect_neq(sampled_population(&sc, &spec, &p, err, sizeof err), 0);
+    cr_expect(strstr(err, "274877906944 (tile, pass) units") != NULL, "%s", err);
+    run_scene_close(&sc);
+}
