@@ -36,9 +36,9 @@ typedef struct Job {
     FuncTile *tiles;
     uint32_t spp;
     const uint32_t *units;     /* sampled mode: the round's (tile, pass) units, NULL for whole tiles */
-    int passes;                /* func_render: the launch's items are (tile, pass) units in pass
-                                  order, each pass after the tile's one before (run_tile_pass) */
-    uint32_t *passes_done;     /* ... and each tile's passes finished */
+    uint32_t *passes_done;     /* func_render, when not NULL: the launch's items are (tile, pass)
+                                  units in pass order, each pass after the tile's one before
+                                  (run_tile_pass); each tile's passes finished */
     atomic_uint tiles_done;    /* ... and the tiles with every pass finished */
     FuncUnit *unit_out;        /* ... and their figures */
     struct Worker *workers;    /* one per host thread (sim/run/tiles.h) */
@@ -343,6 +343,12 @@ static FuncTile *tile_start(Job *j, uint32_t t)
     return ft;
 }
 
+/* Row y of the tile ft in the frame's rgb (ft->w pixels of 12 bytes). */
+static float *tile_row(const Job *j, const FuncTile *ft, uint32_t y)
+{
+    return &j->rgb[3 * ((size_t)(ft->y0 + y) * j->width + ft->x0)];
+}
+
 /* The pixels of the tile ft between the framebuffer's first w x h pixels and the frame's rgb
  * (to_fb: into the framebuffer). */
 static void tile_pixels(Job *j, Core *c, const FuncTile *ft, int to_fb)
@@ -350,7 +356,7 @@ static void tile_pixels(Job *j, Core *c, const FuncTile *ft, int to_fb)
     uint32_t size;
     uint8_t *fb = core_mem(c, CORE_MEM_FB, &size);
     for (uint32_t y = 0; y < ft->h; y++) {
-        float *px = &j->rgb[3 * ((size_t)(ft->y0 + y) * j->width + ft->x0)];
+        float *px = tile_row(j, ft, y);
         uint8_t *row = fb + (size_t)12 * y * ft->w;
         if (to_fb)
             memcpy(row, px, (size_t)12 * ft->w);
@@ -374,7 +380,7 @@ static int run_tile(Worker *w, Core *c, uint32_t t, FuncStats *st)
     return 0;
 }
 
-/* Item i of a whole frame (Job.passes): pass i / ntiles of tile i % ntiles. The launcher starts it
+/* Item i of a whole frame (Job.passes_done): pass i / ntiles of tile i % ntiles. The launcher starts it
  * after the tile's pass before (TileLaunch.chain), maybe on another thread: that pass left the
  * framebuffer in the frame's pixels, which go back into this core's framebuffer first, so the
  * kernel adds to the same bytes as when one core runs every pass of the tile (run_tile). */
@@ -460,7 +466,7 @@ static int worker_tile(void *ctx, int index, uint32_t t)
     Worker *w = &j->workers[index];
     if (j->units)
         return run_unit(w, w->tc.core, t, &w->st);
-    return j->passes ? run_tile_pass(w, w->tc.core, t, &w->st) : run_tile(w, w->tc.core, t, &w->st);
+    return j->passes_done ? run_tile_pass(w, w->tc.core, t, &w->st) : run_tile(w, w->tc.core, t, &w->st);
 }
 
 /* Each worker's core and timing counters into its stats, and its core closed. */
@@ -708,7 +714,6 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
     const int by_pass = rgb && !fp->batch && (uint64_t)job->ntiles * job->spp <= UINT32_MAX;
     job->passes_done = by_pass ? calloc(job->ntiles ? job->ntiles : 1, sizeof *job->passes_done) : NULL;
     if (job->passes_done) {
-        job->passes = 1;
         atomic_init(&job->tiles_done, 0u);
         TileLaunch launch = {job->ntiles * job->spp, job->nworkers, worker_begin, worker_tile, NULL, job, NULL, NULL,
                              job->ntiles};
@@ -719,11 +724,9 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
                 done++;
             } else if (job->passes_done[t]) { /* unfinished: black, as a tile never started */
                 for (uint32_t y = 0; y < job->tiles[t].h; y++)
-                    memset(&rgb[3 * ((size_t)(job->tiles[t].y0 + y) * job->width + job->tiles[t].x0)], 0,
-                           (size_t)12 * job->tiles[t].w);
+                    memset(tile_row(job, &job->tiles[t], y), 0, (size_t)12 * job->tiles[t].w);
             }
         }
-        job->passes = 0;
         free(job->passes_done);
         job->passes_done = NULL;
     } else {

@@ -9,11 +9,12 @@ typedef struct Pool {
     const TileLaunch *l;
     atomic_uint next, done;
     atomic_int failed;
-    /* chained launches (TileLaunch.chain), under lock: each chain's next tile (as a count of its
-     * tiles handed out) and whether one of its tiles is running; a thread that finds no chain
-     * free sleeps on cond, woken by each finished tile and by a failure */
-    uint32_t *taken;
-    uint8_t *busy;
+    /* chained launches (TileLaunch.chain), under lock: the next tile of each chain with no tile
+     * running, in a binary min-heap (at most chain entries), and the tiles running; a thread that
+     * finds the heap empty while tiles run sleeps on cond, woken by each finished tile and by a
+     * failure */
+    uint32_t *heap;
+    uint32_t nheap, running;
     pthread_mutex_t lock;
     pthread_cond_t cond;
 } Pool;
@@ -36,7 +37,7 @@ int tiles_threads(int threads, uint32_t ntiles)
 static void pool_fail(Pool *pool)
 {
     atomic_store(&pool->failed, 1);
-    if (pool->taken) {
+    if (pool->heap) {
         pthread_mutex_lock(&pool->lock);
         pthread_cond_broadcast(&pool->cond);
         pthread_mutex_unlock(&pool->lock);
@@ -45,47 +46,54 @@ static void pool_fail(Pool *pool)
 
 /* Chained: the next tile to run into *t: of the chains with no tile running, the one whose next
  * tile comes first (so passes go out in pass order while the tiles before them are free), after a
- * wait while every chain with tiles left has one running. 0; 1 when every tile is handed out; -1
- * after a failure. */
+ * wait while the heap is empty and tiles run. 0; 1 when every tile is handed out; -1 after a
+ * failure. */
 static int pool_take(Pool *pool, uint32_t *t)
 {
-    const uint32_t k = pool->l->chain, n = pool->l->ntiles;
-    int rc = 1;
+    int rc;
     pthread_mutex_lock(&pool->lock);
     for (;;) {
         if (atomic_load(&pool->failed)) {
             rc = -1;
             break;
         }
-        uint32_t best = UINT32_MAX;
-        int left = 0;
-        for (uint32_t c = 0; c < k && c < n; c++) {
-            uint64_t next = c + (uint64_t)pool->taken[c] * k;
-            if (next >= n)
-                continue;
-            left = 1;
-            if (!pool->busy[c] && next < best)
-                best = (uint32_t)next;
-        }
-        if (best != UINT32_MAX) {
-            pool->busy[best % k] = 1;
-            pool->taken[best % k]++;
-            *t = best;
+        if (pool->nheap) { /* the root out, the last entry sifted down from the root */
+            uint32_t *h = pool->heap, n = --pool->nheap, last = h[n], i = 0;
+            *t = h[0];
+            for (uint32_t c; (c = 2 * i + 1) < n; i = c) {
+                if (c + 1 < n && h[c + 1] < h[c])
+                    c++;
+                if (last <= h[c])
+                    break;
+                h[i] = h[c];
+            }
+            h[i] = last;
+            pool->running++;
             rc = 0;
             break;
         }
-        if (!left)
+        if (!pool->running) { /* nothing queued and nothing that could queue more */
+            rc = 1;
             break;
+        }
         pthread_cond_wait(&pool->cond, &pool->lock);
     }
     pthread_mutex_unlock(&pool->lock);
     return rc;
 }
 
+/* Chained: tile t finished; the tile that continues it, if any, joins the heap. */
 static void pool_finished(Pool *pool, uint32_t t)
 {
+    const uint32_t k = pool->l->chain;
     pthread_mutex_lock(&pool->lock);
-    pool->busy[t % pool->l->chain] = 0;
+    pool->running--;
+    if ((uint64_t)t + k < pool->l->ntiles) { /* sifted up from the end */
+        uint32_t *h = pool->heap, i = pool->nheap++, v = t + k;
+        for (; i && h[(i - 1) / 2] > v; i = (i - 1) / 2)
+            h[i] = h[(i - 1) / 2];
+        h[i] = v;
+    }
     pthread_cond_broadcast(&pool->cond);
     pthread_mutex_unlock(&pool->lock);
 }
@@ -103,7 +111,7 @@ static void *thread_main(void *arg)
     }
     while (!atomic_load(&pool->failed)) {
         uint32_t t;
-        if (pool->taken) {
+        if (pool->heap) {
             if (pool_take(pool, &t) != 0)
                 break;
         } else {
@@ -115,7 +123,7 @@ static void *thread_main(void *arg)
             pool_fail(pool);
             break;
         }
-        if (pool->taken)
+        if (pool->heap)
             pool_finished(pool, t);
         uint32_t done = atomic_fetch_add(&pool->done, 1u) + 1u;
         if (l->progress)
@@ -133,23 +141,24 @@ uint32_t tiles_run(const TileLaunch *l)
     atomic_init(&pool.next, 0u);
     atomic_init(&pool.done, 0u);
     atomic_init(&pool.failed, 0);
-    pool.taken = NULL;
-    pool.busy = NULL;
+    pool.heap = NULL;
     int n = tiles_threads(l->threads, l->ntiles);
     if (l->chain && n > 1) { /* (one thread alone takes the tiles in order: each after the one it continues) */
-        pool.taken = calloc(l->chain, sizeof *pool.taken);
-        pool.busy = calloc(l->chain, 1);
-        int locked = pool.taken && pool.busy && pthread_mutex_init(&pool.lock, NULL) == 0;
+        pool.nheap = l->chain < l->ntiles ? l->chain : l->ntiles;
+        pool.running = 0;
+        pool.heap = malloc((size_t)pool.nheap * sizeof *pool.heap);
+        int locked = pool.heap && pthread_mutex_init(&pool.lock, NULL) == 0;
         if (locked && pthread_cond_init(&pool.cond, NULL) != 0) {
             pthread_mutex_destroy(&pool.lock);
             locked = 0;
         }
         if (!locked) { /* no memory: the calling thread runs every tile */
-            free(pool.taken);
-            free(pool.busy);
-            pool.taken = NULL;
-            pool.busy = NULL;
+            free(pool.heap);
+            pool.heap = NULL;
             n = 1;
+        } else {
+            for (uint32_t i = 0; i < pool.nheap; i++) /* each chain's first tile: ascending, a heap */
+                pool.heap[i] = i;
         }
     }
     Thread local[8], *ths = n <= 8 ? local : malloc((size_t)n * sizeof *ths);
@@ -170,11 +179,10 @@ uint32_t tiles_run(const TileLaunch *l)
     free(ids);
     if (ths != local)
         free(ths);
-    if (pool.taken) {
+    if (pool.heap) {
         pthread_cond_destroy(&pool.cond);
         pthread_mutex_destroy(&pool.lock);
-        free(pool.taken);
-        free(pool.busy);
+        free(pool.heap);
     }
     return atomic_load(&pool.done);
 }
