@@ -1,5 +1,6 @@
 /* tests/unit/test_raybuf.c -- the ray-buffer bank model (sim/machine/raybuf.c) against a plain
- * reference, and the interconnect's port search (sim/machine/interconnect.c) in its corner cases.
+ * reference, and the interconnect's port search (sim/machine/interconnect.c) in its corner cases
+ * and, for the data path, against its definition by brute force over random states.
  *
  * rb_access has a fast path for the common access (lines that never go down, over fewer lines
  * than banks) beside the general count; both must give what the definition gives: the cycles are
@@ -137,4 +138,59 @@ Test(raybuf, interconnect_port_search_waits_only_when_every_port_is_taken)
     xbar_init(&x, &p);
     cr_assert_eq(xbar_transfer(&x, XBAR_AGU, 0, 3, 0, &st), 0u);
     cr_assert_eq(xbar_transfer(&x, XBAR_DP, 1, 1, 1, &st), 3u);
+}
+
+/* The data path's transfer by definition: the first cycle s >= from at which, over every cycle of
+ * [s, s + max(len, 1)), fewer than `ports` of the partition unit's and the AGUs' transfers are
+ * running. */
+static uint64_t dp_reference(const Xbar *x, uint64_t from, uint64_t len)
+{
+    const uint64_t span = len ? len : 1;
+    for (uint64_t s = from;; s++) {
+        int ok = 1;
+        for (uint64_t c = s; c < s + span && ok; c++) {
+            int used = x->part.s <= c && c < x->part.e;
+            for (int i = 0; i < x->agu_n; i++)
+                used += x->agu[i].s <= c && c < x->agu[i].e;
+            ok = used < x->p.ports;
+        }
+        if (ok)
+            return s;
+    }
+}
+
+Test(raybuf, interconnect_data_path_transfer_matches_the_definition)
+{
+    /* Random states of the other users' transfers (the data path's fast path when fewer than
+     * `ports` of them run at `from`, the search otherwise), 1-3 ports. */
+    int fast = 0, waited = 0;
+    for (int trial = 0; trial < 20000; trial++) {
+        XbarParams p = {.latency = 1, .ports = 1 + (int)(test_rng_u32(&rng) % 3)};
+        Xbar x;
+        xbar_init(&x, &p);
+        const uint64_t from = 100;
+        uint64_t s0 = from - 5 + test_rng_u32(&rng) % 12;
+        x.part = (XbarIvl){s0, s0 + test_rng_u32(&rng) % 8};
+        x.agu_n = (int)(test_rng_u32(&rng) % 5);
+        for (int i = 0; i < x.agu_n; i++) {
+            uint64_t s = from - 5 + test_rng_u32(&rng) % 12;
+            x.agu[i] = (XbarIvl){s, s + test_rng_u32(&rng) % 6};
+        }
+        const uint64_t len = test_rng_u32(&rng) % 5;
+        const uint64_t want = dp_reference(&x, from, len);
+        TimingStats st;
+        memset(&st, 0, sizeof st);
+        const uint64_t got = xbar_transfer(&x, XBAR_DP, from, len, from, &st);
+        cr_assert_eq(got, want, "trial %d: ports %d, part [%llu, %llu), %d AGU transfers, len %llu: %llu, want %llu",
+                     trial, p.ports, (unsigned long long)x.part.s, (unsigned long long)x.part.e, x.agu_n,
+                     (unsigned long long)len, (unsigned long long)got, (unsigned long long)want);
+        cr_assert_eq(x.dp.s, got);
+        cr_assert_eq(x.dp.e, got + len);
+        cr_assert_eq(st.icn_transfers, 1u);
+        if (got == from)
+            fast++;
+        else
+            waited++;
+    }
+    cr_assert(fast > 1000 && waited > 1000, "%d without a wait, %d waited", fast, waited);
 }
