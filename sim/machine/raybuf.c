@@ -73,7 +73,8 @@ static inline int rb_ascending_lines(const RayBufs *rb, const uint32_t *addr, in
     return (int)changes + 1;
 }
 
-/* Any access: each distinct line is found through its own bank's list of the lines seen so far
+/* Any access, any bank count (rb_access_bits below takes the usual power-of-two counts up to 64):
+ * each distinct line is found through its own bank's list of the lines seen so far
  * (usually empty or one long), so an access costs about one probe per lane rather than one per
  * pair of lines; the counts are those of the distinct lines, in any order. */
 static int rb_access_any(RayBufs *rb, const uint32_t *addr, int naddr, TimingStats *st)
@@ -118,11 +119,57 @@ static int rb_access_any(RayBufs *rb, const uint32_t *addr, int naddr, TimingSta
     return worst;
 }
 
+/* Any access with a power-of-two count of at most 64 banks (the default 32): the banks holding a
+ * line so far are bits of one word, each with its first line and its count in small arrays read
+ * only where the bit is set (no clearing per access). A second, different line in a bank (a
+ * conflict) is looked up among the access's few other such lines. The same counts as
+ * rb_access_any. */
+static int rb_access_bits(const RayBufs *rb, const uint32_t *addr, int naddr, TimingStats *st)
+{
+    uint32_t first[64], more_line[ISA_MAX_LANES];
+    uint8_t cnt[64];
+    const uint32_t bmask = (uint32_t)rb->p.banks - 1u;
+    uint64_t used = 0;
+    int k = 0, worst = 1, nmore = 0;
+    uint32_t prev = 0;
+    for (int i = 0; i < naddr; i++) {
+        const uint32_t line = addr[i] >> rb->shift;
+        if (i && line == prev) /* the lane before's line: neighbouring IDs */
+            continue;
+        prev = line;
+        const uint32_t b = line & bmask;
+        const uint64_t bit = 1ull << b;
+        if (!(used & bit)) {
+            used |= bit;
+            first[b] = line;
+            cnt[b] = 1;
+            k++;
+            continue;
+        }
+        if (first[b] == line)
+            continue;
+        int seen = 0;
+        for (int j = 0; j < nmore; j++)
+            seen |= more_line[j] == line; /* (the same line: the same bank) */
+        if (seen)
+            continue;
+        more_line[nmore++] = line;
+        k++;
+        if (++cnt[b] > worst)
+            worst = cnt[b];
+    }
+    st->rb_accesses++;
+    st->rb_lines += (uint64_t)k;
+    st->rb_conflicted += worst > 1;
+    return worst;
+}
+
 int rb_access(RayBufs *rb, const uint32_t *addr, int naddr, TimingStats *st)
 {
     const int k = rb_ascending_lines(rb, addr, naddr);
     if (!k)
-        return rb_access_any(rb, addr, naddr, st);
+        return rb->p.banks <= 64 && (rb->p.banks & (rb->p.banks - 1)) == 0 ? rb_access_bits(rb, addr, naddr, st)
+                                                                         : rb_access_any(rb, addr, naddr, st);
     st->rb_accesses++;
     st->rb_lines += (uint64_t)k;
     return 1;

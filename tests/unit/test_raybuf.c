@@ -72,16 +72,20 @@ static void make_vector(uint32_t *a, int n, int kind, int line_bytes, int banks)
         if (n > 1)
             a[n - 1] = base > 0 ? base - 4u : 0;
         break;
-    default: /* lanes a whole bank cycle apart: every line in one bank */
+    case 4: /* lanes a whole bank cycle apart: every line in one bank */
         for (int i = 0; i < n; i++)
             a[i] = base + (uint32_t)(i * banks * line_bytes) * (next_u32() % 2u);
+        break;
+    default: /* three lines of one bank in random order: a conflicting line met again */
+        for (int i = 0; i < n; i++)
+            a[i] = base + (next_u32() % 3u) * (uint32_t)(banks * line_bytes) + 4u * (next_u32() % 16u);
         break;
     }
 }
 
 Test(raybuf, access_counts_match_the_definition_on_every_path)
 {
-    const int bank_counts[] = {32, 16, 24, 1};
+    const int bank_counts[] = {32, 16, 64, 24, 1};
     for (size_t bi = 0; bi < sizeof bank_counts / sizeof *bank_counts; bi++) {
         RbParams p = {.banks = bank_counts[bi], .line = 64, .access = 2, .align_cycles = 1};
         RayBufs rb;
@@ -92,17 +96,17 @@ Test(raybuf, access_counts_match_the_definition_on_every_path)
             if (iter % 3 == 0)
                 n = 16;
             uint32_t a[ISA_MAX_LANES];
-            make_vector(a, n, iter % 5, p.line, p.banks);
+            make_vector(a, n, iter % 6, p.line, p.banks);
             int distinct;
             int want = reference(a, n, p.line, p.banks, &distinct);
             TimingStats st;
             memset(&st, 0, sizeof st);
             int got = rb_access(&rb, a, n, &st);
             cr_assert_eq(got, want, "banks %d, kind %d, n %d: %d cycles, the definition gives %d", p.banks,
-                         iter % 5, n, got, want);
+                         iter % 6, n, got, want);
             cr_assert_eq(st.rb_accesses, 1u);
             cr_assert_eq(st.rb_lines, (uint64_t)distinct, "banks %d, kind %d, n %d: %llu lines, want %d",
-                         p.banks, iter % 5, n, (unsigned long long)st.rb_lines, distinct);
+                         p.banks, iter % 6, n, (unsigned long long)st.rb_lines, distinct);
             cr_assert_eq(st.rb_conflicted, (uint64_t)(want > 1));
             fast_seen += want == 1 && distinct > 1;
             conflict_seen += want > 1;
