@@ -624,7 +624,7 @@ static __attribute__((noinline)) void issue_units_complete(Timing *t, const TmDe
 }
 
 /* One instruction, timed as it runs. */
-static inline void time_one(Timing *t, const TmDesc *d, const CoreRecord *rec)
+static inline __attribute__((always_inline)) void time_one(Timing *t, const TmDesc *d, const CoreRecord *rec)
 {
     uint64_t at = t->now;
     drain(t, at);
@@ -750,7 +750,7 @@ static void memo_unwind(Timing *t)
 
 /* Starts a block at the plain instruction d (its first record rec): a replay when its start
  * state is stored (1: the record is accounted for), else a recording (0: time it as usual). */
-static int memo_begin(Timing *t, TmDesc *d, const CoreRecord *rec)
+static __attribute__((noinline)) int memo_begin(Timing *t, TmDesc *d, const CoreRecord *rec)
 {
     drain(t, t->now);
     MemoEv ev[MEMO_EVENTS];
@@ -818,7 +818,7 @@ static void memo_pushed(Timing *t, uint64_t time, int kind, int arg, int cause)
 }
 
 /* The recorded block's end: its outcome into the first instruction's ways. */
-static void memo_store(Timing *t)
+static __attribute__((noinline)) void memo_store(Timing *t)
 {
     MemoEntry *m = &t->m_rec;
     t->mmode = MM_NONE;
@@ -897,7 +897,7 @@ static void memo_post(Timing *t, const TmDesc *d, const CoreRecord *rec)
 }
 
 /* Recording: the instruction timed as usual, its live-ins noted before and its writes after. */
-static void memo_time_noted(Timing *t, const TmDesc *d, const CoreRecord *rec)
+static __attribute__((noinline)) void memo_time_noted(Timing *t, const TmDesc *d, const CoreRecord *rec)
 {
     memo_pre(t, d);
     time_one(t, d, rec);
