@@ -691,10 +691,18 @@ static int memo_match(const Timing *t, const MemoEntry *e, const CoreRecord *rec
     for (int i = 0; i < nev; i++)
         if (e->ev_in[i].rel != ev[i].rel || e->ev_in[i].kind != ev[i].kind || e->ev_in[i].arg != ev[i].arg)
             return 0;
+    /* memo_reg's value compared in place: a landed register is stored as {0, 0}; one in flight
+     * must land as far ahead (a distance beyond 32 bits matches no stored rel) with its cause. */
+    const uint64_t now = t->now;
     for (int i = 0; i < e->nlive; i++) {
-        MemoReg m = memo_reg(t, e->live[i].reg, t->now);
-        if (m.rel != e->live[i].rel || m.cause != e->live[i].cause)
+        const MemoReg *m = &e->live[i];
+        const uint64_t rd = t->simd.ready[m->reg];
+        if (rd <= now) {
+            if (m->rel | m->cause)
+                return 0;
+        } else if (rd - now != m->rel || t->simd.rcause[m->reg] != m->cause) {
             return 0;
+        }
     }
     return 1;
 }
