@@ -93,10 +93,11 @@ enum { MEMO_MIN = 2 };
 typedef struct MemoEv { uint32_t rel; uint16_t arg; uint8_t kind, cause; } MemoEv;
 typedef struct MemoReg { uint32_t rel; uint8_t reg, cause; } MemoReg;
 
+/* A block's path is its first pc (the MemoWays it is stored under) and the len - 1 pcs after it in
+ * order: only its last instruction may take a branch. */
 typedef struct MemoEntry {
     uint32_t run;                   /* the run it was stored in (0: empty) */
     uint8_t len, nlive, nwrite, nev_in, nev_out, taken_last, nunits;
-    uint32_t pc[MEMO_LEN];          /* the path */
     MemoReg live[MEMO_REGS];        /* key: live-ins at the start (rel 0: landed, cause 0) */
     MemoEv ev_in[MEMO_EVENTS];      /* key: pending events, sorted */
     uint32_t end_rel;               /* outcome: the next issue slot after the block */
@@ -742,13 +743,12 @@ static void memo_apply(Timing *t, const MemoEntry *e)
  * the block's start state, which nothing has changed yet. */
 static void memo_unwind(Timing *t)
 {
-    const MemoEntry *e = t->m_e;
     t->mmode = MM_NONE;
     for (uint32_t i = 0; i < t->m_i; i++) {
         CoreRecord r;
         memset(&r, 0, offsetof(CoreRecord, addr));
-        r.pc = e->pc[i];
-        r.next_pc = e->pc[i + 1];
+        r.pc = t->m_pc0 + i;
+        r.next_pc = r.pc + 1;
         r.stage = t->m_stage;
         r.gen = t->m_gen;
         r.mem = CORE_MEM_COUNT;
@@ -867,7 +867,7 @@ static __attribute__((noinline)) void memo_store(Timing *t)
     m->issues[0] = m->issues[1] = 0;
     m->nunits = 0;
     for (int i = 0; i < m->len; i++) {
-        const TmDesc *d = &t->desc[m->pc[i]];
+        const TmDesc *d = &t->desc[t->m_pc0 + (uint32_t)i];
         m->issues[d->vec]++;
         int j = 0;
         while (j < m->nunits && m->unit[j] != d->unit)
@@ -898,7 +898,9 @@ static void memo_post(Timing *t, const TmDesc *d, const CoreRecord *rec)
         if (t->simd.ready[d->dsts[i]] > t->m_hz)
             t->m_hz = t->simd.ready[d->dsts[i]];
     }
-    m->pc[m->len++] = rec->pc;
+    if (rec->pc != t->m_pc0 + m->len) /* not the next pc (cannot happen: a block ends at a taken branch) */
+        t->m_ok = 0;
+    m->len++;
     m->taken_last = rec->taken;
     if (rec->taken || m->len == MEMO_LEN)
         memo_store(t);
@@ -946,7 +948,7 @@ void timing_hook(void *ctx, const CoreRecord *rec)
     if (t->mmode == MM_REPLAY) { /* the next record of a stored block: only checked */
         const MemoEntry *e = t->m_e;
         const uint32_t i = t->m_i;
-        if (__builtin_expect(rec->pc == e->pc[i] && rec->stage == t->m_stage && rec->gen == t->m_gen &&
+        if (__builtin_expect(rec->pc == t->m_pc0 + i && rec->stage == t->m_stage && rec->gen == t->m_gen &&
                              rec->taken == (i + 1 == e->len ? e->taken_last : 0), 1)) {
             if (++t->m_i == e->len)
                 memo_apply(t, e);
