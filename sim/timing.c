@@ -139,7 +139,9 @@ struct Timing {
                                       outcome) or MM_REPLAY (following a stored block) */
     uint64_t m_t0;                 /* the block's start cycle */
     uint8_t m_stage, m_gen;
-    uint32_t m_i;                  /* replay: records matched so far */
+    uint32_t m_next;               /* replay: the pc of the next record on the path (the records
+                                      matched so far: m_next - m_pc0) */
+    uint32_t m_last;               /* replay: the pc of the block's last record */
     MemoEntry *m_e;                /* replay: the stored block */
     uint32_t m_pc0;                /* the block's first instruction (its MemoWays): a pc, not a
                                       pointer, since the table may grow during the block */
@@ -739,12 +741,12 @@ static void memo_apply(Timing *t, const MemoEntry *e)
     t->memo_replays++;
 }
 
-/* A replay whose path the core left after m_i records: those records are timed one by one from
+/* A replay whose path the core left after m_next - m_pc0 records: those are timed one by one from
  * the block's start state, which nothing has changed yet. */
 static void memo_unwind(Timing *t)
 {
     t->mmode = MM_NONE;
-    for (uint32_t i = 0; i < t->m_i; i++) {
+    for (uint32_t i = 0; i < t->m_next - t->m_pc0; i++) {
         CoreRecord r;
         memset(&r, 0, offsetof(CoreRecord, addr));
         r.pc = t->m_pc0 + i;
@@ -774,7 +776,8 @@ static __attribute__((noinline)) int memo_begin(Timing *t, TmDesc *d, const Core
             MemoEntry *e = &d->memo->e[w];
             if (memo_match(t, e, rec, ev, nev)) {
                 t->m_e = e;
-                t->m_i = 1;
+                t->m_next = rec->pc + 1;
+                t->m_last = rec->pc + e->len - 1u;
                 t->mmode = MM_REPLAY;
                 if (e->len == 1)
                     memo_apply(t, e);
@@ -946,13 +949,17 @@ void timing_hook(void *ctx, const CoreRecord *rec)
 {
     Timing *t = ctx;
     if (t->mmode == MM_REPLAY) { /* the next record of a stored block: only checked */
-        const MemoEntry *e = t->m_e;
-        const uint32_t i = t->m_i;
-        if (__builtin_expect(rec->pc == t->m_pc0 + i && rec->stage == t->m_stage && rec->gen == t->m_gen &&
-                             rec->taken == (i + 1 == e->len ? e->taken_last : 0), 1)) {
-            if (++t->m_i == e->len)
-                memo_apply(t, e);
-            return;
+        if (__builtin_expect(rec->pc == t->m_next && rec->stage == t->m_stage && rec->gen == t->m_gen, 1)) {
+            if (rec->pc != t->m_last) { /* inside the block: no branch taken */
+                if (__builtin_expect(!rec->taken, 1)) {
+                    t->m_next++;
+                    return;
+                }
+            } else if (rec->taken == t->m_e->taken_last) {
+                t->m_next++;
+                memo_apply(t, t->m_e);
+                return;
+            }
         }
     }
     hook_any(t, rec);
