@@ -47,6 +47,11 @@ const char *const tm_cause_descs[TM_CAUSE_COUNT] = {
  * waiting instruction needs (wait_hazards). */
 enum { EV_UNIT, EV_FETCH, EV_PART };
 
+/* The memory instructions that are most of a kernel's, by the ISA table's UNIT and FLAGS, each
+ * timed on a straight path of its own (issue_units_complete); the others (AGU, partition unit,
+ * a ray-buffer scalar access, a halt) take the general path. */
+enum { TK_OTHER, TK_RB_GATHER, TK_RB_SCATTER, TK_SPAD_LOAD, TK_SPAD_STORE, TK_SCENE };
+
 /* What the timing core needs of one program instruction, worked out the first time the
  * instruction runs in a run and kept by its pc (describe()): its ISA table row's unit and flags as
  * the few facts the hook branches on, its unit class's latency and issue interval, and its
@@ -68,6 +73,8 @@ typedef struct TmDesc {
     uint8_t plain;                           /* times the same way every time it runs (no
                                                 memory unit, fixed result time, not a halt): can
                                                 be part of a memoized block */
+    uint8_t kind;                            /* TK_*: the memory instructions issue_units_complete
+                                                times on a path of their own */
     uint8_t short_block;                     /* a block starting here was shorter than MEMO_MIN
                                                 in this run: it is timed as usual, not looked up */
     uint8_t regs[2 * ISA_MAX_OPERANDS + 1];  /* sources, exec mask, destinations */
@@ -413,6 +420,11 @@ static void describe_fill(Timing *t, TmDesc *d, const CoreRecord *rec)
     d->special = oi->unit == ISA_U_AGU || oi->unit == ISA_U_RBUF || oi->unit == ISA_U_SPAD ||
                  oi->unit == ISA_U_PART;
     d->plain = !d->mem && !d->special && !d->is_halt;
+    const int wr = (oi->flags & ISA_FL_WRITE) != 0;
+    d->kind = oi->unit == ISA_U_RBUF && (oi->flags & ISA_FL_VEC) ? (wr ? TK_RB_SCATTER : TK_RB_GATHER)
+              : oi->unit == ISA_U_SPAD                          ? (wr ? TK_SPAD_STORE : TK_SPAD_LOAD)
+              : oi->unit == ISA_U_SCENE || oi->unit == ISA_U_FB ? TK_SCENE
+                                                                : TK_OTHER;
     d->short_block = 0;
     d->lat = (uint32_t)t->simd.p.lat[oi->unit];
     d->issue = t->simd.p.issue[oi->unit] > 1 ? (uint32_t)t->simd.p.issue[oi->unit] : 0;
@@ -474,7 +486,6 @@ static inline const TmDesc *describe(Timing *t, const CoreRecord *rec)
 typedef struct Issue {
     uint64_t at;       /* the cycle it issues in */
     uint64_t ext;      /* extra issue cycles its access needs, after at */
-    uint64_t ready;    /* scene and framebuffer accesses: when the last line is there (0: none) */
     int res_cause;     /* what a wait for its result is charged to */
 } Issue;
 
@@ -516,26 +527,8 @@ static void issue_units(Timing *t, const IsaOpInfo *oi, const CoreRecord *rec, I
         }
         extra(t, is, TM_ALIGNMENT, rb_align_cycles(&t->rb, rec->base), rec);
         break;
-    case ISA_U_RBUF:
-        if (fl & ISA_FL_VEC) { /* a gather or scatter: its bank cycles on one interconnect port */
-            int c = rb_access(&t->rb, rec->addr, rec->naddr, &t->st);
-            dp_transfer(t, is, (uint64_t)c, rec);
-            extra(t, is, TM_BANK_CONFLICT, (uint64_t)c - 1, rec);
-        }
-        break;
-    case ISA_U_SPAD:
-        extra(t, is, TM_SCRATCHPAD, spad_access(&t->spad, rec->addr, rec->naddr, &t->st) - 1, rec);
-        break;
-    case ISA_U_SCENE:
-    case ISA_U_FB: {
-        uint64_t c = mem_issue(&t->mem, fl, rec->addr, rec->naddr, is->at + is->ext, &is->ready, &t->st);
-        if (is->ready == UINT64_MAX)
-            internal_error(t, "out of memory for the scene cache");
-        extra(t, is, TM_SCENE_MEMORY, c - 1, rec);
-        is->res_cause = TM_SCENE_MEMORY;
-        break;
-    }
-    default:
+    default: /* ray-buffer gathers and scatters, scratchpad, scene memory and framebuffer: their own
+                paths in issue_units_complete (a ray-buffer scalar access has no unit cost) */
         break;
     }
 }
@@ -549,10 +542,6 @@ static uint64_t result_time(Timing *t, const IsaOpInfo *oi, const CoreRecord *re
 {
     const uint32_t fl = oi->flags;
     switch (oi->unit) {
-    case ISA_U_RBUF:
-        if ((fl & ISA_FL_VEC) && !(fl & ISA_FL_WRITE)) /* a gather */
-            return rb_gather_ready(&t->rb, &t->xbar, last);
-        break;
     case ISA_U_AGU:
         if (isa_id_fetch(fl) || isa_id_append(fl)) /* IDs and stream pointer by the next slot */
             return end;
@@ -560,10 +549,6 @@ static uint64_t result_time(Timing *t, const IsaOpInfo *oi, const CoreRecord *re
             return rb_scalar_ready(&t->rb, last);
         if (!(fl & ISA_FL_IDM)) /* ralloc: an AGU result, not memory data */
             is->res_cause = TM_ADDRESS_FETCH;
-        break;
-    case ISA_U_SPAD:
-        if (!(fl & ISA_FL_WRITE))
-            return spad_load_ready(&t->spad, last);
         break;
     case ISA_U_PART:
         if (fl & ISA_FL_IDM) { /* part: the unit runs on beside the data path */
@@ -578,7 +563,7 @@ static uint64_t result_time(Timing *t, const IsaOpInfo *oi, const CoreRecord *re
     default:
         break;
     }
-    return is->ready ? is->ready : simd_result_ready(&t->simd, oi->unit, is->at);
+    return simd_result_ready(&t->simd, oi->unit, is->at);
 }
 
 /* ---- one instruction ---------------------------------------------------------------------- */
@@ -610,19 +595,65 @@ static inline void complete(Timing *t, const TmDesc *d, const CoreRecord *rec, u
 }
 
 /* Issue and completion of an instruction that uses a memory unit, or whose result time is not its
- * class's latency (result_time()), free of hazards from cycle at. */
+ * class's latency (result_time()), free of hazards from cycle at. The usual kinds go straight
+ * (the same steps as issue_units and result_time take for them); the rest take those. */
 static __attribute__((noinline)) void issue_units_complete(Timing *t, const TmDesc *d, const CoreRecord *rec,
                                                            uint64_t at)
 {
+    const int stage = rec->stage, gen = rec->gen;
+    uint64_t ext = 0; /* extra issue cycles after at */
+    switch (d->kind) {
+    case TK_RB_GATHER:
+    case TK_RB_SCATTER: /* its bank cycles on one interconnect port */
+        if (rec->naddr) {
+            const int c = rb_access(&t->rb, rec->addr, rec->naddr, &t->st);
+            const uint64_t s = xbar_transfer(&t->xbar, XBAR_DP, at, (uint64_t)c, t->now, &t->st);
+            charge(t, TM_INTERCONNECT, s - at, stage, gen);
+            at = s;
+            ext = (uint64_t)c - 1;
+            charge(t, TM_BANK_CONFLICT, ext, stage, gen);
+        }
+        count_issue(t, d, stage, gen);
+        complete(t, d, rec, at, at + ext + 1,
+                 d->kind == TK_RB_GATHER ? rb_gather_ready(&t->rb, &t->xbar, at + ext) : at + d->lat,
+                 TM_DATA_DEPENDENCY);
+        return;
+    case TK_SPAD_LOAD:
+    case TK_SPAD_STORE:
+        if (rec->naddr) {
+            ext = spad_access(&t->spad, rec->addr, rec->naddr, &t->st) - 1;
+            charge(t, TM_SCRATCHPAD, ext, stage, gen);
+        }
+        count_issue(t, d, stage, gen);
+        complete(t, d, rec, at, at + ext + 1,
+                 d->kind == TK_SPAD_LOAD ? spad_load_ready(&t->spad, at + ext) : at + d->lat, TM_DATA_DEPENDENCY);
+        return;
+    case TK_SCENE:
+        if (rec->naddr) {
+            uint64_t ready = 0;
+            ext = mem_issue(&t->mem, isa_ops[d->op].flags, rec->addr, rec->naddr, at, &ready, &t->st) - 1;
+            if (ready == UINT64_MAX)
+                internal_error(t, "out of memory for the scene cache");
+            charge(t, TM_SCENE_MEMORY, ext, stage, gen);
+            count_issue(t, d, stage, gen);
+            complete(t, d, rec, at, at + ext + 1, ready ? ready : at + d->lat, TM_SCENE_MEMORY);
+            return;
+        }
+        count_issue(t, d, stage, gen);
+        complete(t, d, rec, at, at + 1, at + d->lat, TM_DATA_DEPENDENCY);
+        return;
+    default:
+        break;
+    }
     const IsaOpInfo *oi = &isa_ops[d->op];
-    Issue is = {at, 0, 0, TM_DATA_DEPENDENCY};
+    Issue is = {at, 0, TM_DATA_DEPENDENCY};
     if (d->mem && rec->naddr)
         issue_units(t, oi, rec, &is);
     count_issue(t, d, rec->stage, rec->gen);
     const uint64_t last = is.at + is.ext; /* the instruction's last issue cycle */
     const uint64_t end = last + 1;        /* the next instruction's earliest issue cycle */
     const uint64_t ready = d->special ? result_time(t, oi, rec, &is, last, end)
-                                      : is.ready ? is.ready : is.at + d->lat;
+                                      : is.at + d->lat;
     complete(t, d, rec, is.at, end, ready, is.res_cause);
 }
 
