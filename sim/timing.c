@@ -105,6 +105,7 @@ typedef struct MemoReg { uint32_t rel; uint8_t reg, cause; } MemoReg;
 typedef struct MemoEntry {
     uint32_t run;                   /* the run it was stored in (0: empty) */
     uint8_t len, nlive, nwrite, nev_in, nev_out, taken_last, nunits;
+    uint8_t nlanded;                /* live[0..nlanded): landed at the start; the rest in flight */
     MemoReg live[MEMO_REGS];        /* key: live-ins at the start (rel 0: landed, cause 0) */
     MemoEv ev_in[MEMO_EVENTS];      /* key: pending events, sorted */
     uint32_t end_rel;               /* outcome: the next issue slot after the block */
@@ -725,18 +726,19 @@ static int memo_match(const Timing *t, const MemoEntry *e, const CoreRecord *rec
     for (int i = 0; i < nev; i++)
         if (e->ev_in[i].rel != ev[i].rel || e->ev_in[i].kind != ev[i].kind || e->ev_in[i].arg != ev[i].arg)
             return 0;
-    /* memo_reg's value compared in place: a landed register is stored as {0, 0}; one in flight
-     * must land as far ahead (a distance beyond 32 bits matches no stored rel) with its cause. */
+    /* memo_reg's value compared in place. The live-ins that had landed come first: when nothing is
+     * in flight (the scoreboard's horizon is past) they have landed now too. One in flight must
+     * land as far ahead (a distance beyond 32 bits matches no stored rel) with its cause. */
     const uint64_t now = t->now;
-    for (int i = 0; i < e->nlive; i++) {
+    if (t->simd.horizon > now)
+        for (int i = 0; i < e->nlanded; i++)
+            if (t->simd.ready[e->live[i].reg] > now)
+                return 0;
+    for (int i = e->nlanded; i < e->nlive; i++) {
         const MemoReg *m = &e->live[i];
         const uint64_t rd = t->simd.ready[m->reg];
-        if (rd <= now) {
-            if (m->rel | m->cause)
-                return 0;
-        } else if (rd - now != m->rel || t->simd.rcause[m->reg] != m->cause) {
+        if (rd <= now || rd - now != m->rel || t->simd.rcause[m->reg] != m->cause)
             return 0;
-        }
     }
     return 1;
 }
@@ -893,6 +895,16 @@ static __attribute__((noinline)) void memo_store(Timing *t)
             m->write[m->nwrite++] = (MemoReg){(uint32_t)(t->simd.ready[r] - t->m_t0), (uint8_t)r, t->simd.rcause[r]};
         }
     m->hz_rel = t->m_hz > t->m_t0 ? (uint32_t)(t->m_hz - t->m_t0) : 0;
+    MemoReg fly[MEMO_REGS]; /* the live-ins landed at the start first (memo_match) */
+    int nfly = 0, nl = 0;
+    for (int i = 0; i < m->nlive; i++) {
+        if (m->live[i].rel == 0)
+            m->live[nl++] = m->live[i];
+        else
+            fly[nfly++] = m->live[i];
+    }
+    memcpy(m->live + nl, fly, sizeof *fly * (size_t)nfly);
+    m->nlanded = (uint8_t)nl;
     int k = 0; /* only the events still pending after the block's end are left for later */
     for (int i = 0; i < m->nev_out; i++)
         if (m->ev_out[i].rel > m->end_rel)
