@@ -124,16 +124,10 @@ uint64_t mem_access(SceneMem *m, int space, uint32_t addr, uint64_t t, int write
     return m->ready[k];
 }
 
-uint64_t mem_issue(SceneMem *m, uint32_t flags, const uint32_t *addr, int naddr, uint64_t at, uint64_t *ready,
-                   TimingStats *st)
+/* mem_issue of more than one lane: each distinct line is one access. */
+static __attribute__((noinline)) uint64_t mem_issue_lanes(SceneMem *m, int space, int write, const uint32_t *addr,
+                                                          int naddr, uint64_t at, uint64_t *ready, TimingStats *st)
 {
-    const int space = (flags & ISA_FL_FB) ? 1 : 0, write = (flags & ISA_FL_WRITE) != 0;
-    if (naddr == 1) { /* a scalar access: one line, no search for distinct lines */
-        const uint32_t a = (uint32_t)((mem_line(m, space, addr[0]) << m->line_shift) & 0xffffffffu);
-        *ready = mem_access(m, space, a, at, write);
-        st->scene_instr++;
-        return 1;
-    }
     uint64_t lines[ISA_MAX_LANES], d[ISA_MAX_LANES];
     for (int i = 0; i < naddr; i++)
         lines[i] = mem_line(m, space, addr[i]);
@@ -153,4 +147,16 @@ uint64_t mem_issue(SceneMem *m, uint32_t flags, const uint32_t *addr, int naddr,
     }
     st->scene_instr++;
     return ((uint64_t)k + (uint64_t)m->p.ports - 1) / (uint64_t)m->p.ports;
+}
+
+uint64_t mem_issue(SceneMem *m, uint32_t flags, const uint32_t *addr, int naddr, uint64_t at, uint64_t *ready,
+                   TimingStats *st)
+{
+    const int space = (flags & ISA_FL_FB) ? 1 : 0, write = (flags & ISA_FL_WRITE) != 0;
+    if (naddr != 1)
+        return mem_issue_lanes(m, space, write, addr, naddr, at, ready, st);
+    /* a scalar access: one line, no search for distinct lines */
+    *ready = mem_access(m, space, addr[0], at, write);
+    st->scene_instr++;
+    return 1;
 }
