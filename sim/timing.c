@@ -498,11 +498,11 @@ static inline void extra(Timing *t, Issue *is, int cause, uint64_t cycles, const
 
 /* A data-path transfer of len cycles over the interconnect, asked for at is->at: the wait for a
  * port is charged to interconnect, and the instruction issues when it has one. */
-static void dp_transfer(Timing *t, Issue *is, uint64_t len, const CoreRecord *rec)
+static inline uint64_t dp_transfer(Timing *t, uint64_t at, uint64_t len, int stage, int gen)
 {
-    uint64_t s = xbar_transfer(&t->xbar, XBAR_DP, is->at, len, t->now, &t->st);
-    charge(t, TM_INTERCONNECT, s - is->at, rec->stage, rec->gen);
-    is->at = s;
+    uint64_t s = xbar_transfer(&t->xbar, XBAR_DP, at, len, t->now, &t->st);
+    charge(t, TM_INTERCONNECT, s - at, stage, gen);
+    return s;
 }
 
 /* The waits and extra issue cycles of the memory units, by the ISA table's UNIT and FLAGS. */
@@ -522,7 +522,7 @@ static void issue_units(Timing *t, const IsaOpInfo *oi, const CoreRecord *rec, I
             charge(t, TM_ADDRESS_FETCH, w.fetch, rec->stage, rec->gen);
             is->at = s;
         } else if (isa_id_append(fl)) { /* sapp: one cycle on an interconnect port */
-            dp_transfer(t, is, 1, rec);
+            is->at = dp_transfer(t, is->at, 1, rec->stage, rec->gen);
         } else {
             break;
         }
@@ -608,9 +608,7 @@ static __attribute__((noinline)) void issue_units_complete(Timing *t, const TmDe
     case TK_RB_SCATTER: /* its bank cycles on one interconnect port */
         if (rec->naddr) {
             const int c = rb_access(&t->rb, rec->addr, rec->naddr, &t->st);
-            const uint64_t s = xbar_transfer(&t->xbar, XBAR_DP, at, (uint64_t)c, t->now, &t->st);
-            charge(t, TM_INTERCONNECT, s - at, stage, gen);
-            at = s;
+            at = dp_transfer(t, at, (uint64_t)c, stage, gen);
             ext = (uint64_t)c - 1;
             charge(t, TM_BANK_CONFLICT, ext, stage, gen);
         }
@@ -629,20 +627,20 @@ static __attribute__((noinline)) void issue_units_complete(Timing *t, const TmDe
         complete(t, d, rec, at, at + ext + 1,
                  d->kind == TK_SPAD_LOAD ? spad_load_ready(&t->spad, at + ext) : at + d->lat, TM_DATA_DEPENDENCY);
         return;
-    case TK_SCENE:
+    case TK_SCENE: {
+        uint64_t ready = 0;
+        int cause = TM_DATA_DEPENDENCY;
         if (rec->naddr) {
-            uint64_t ready = 0;
             ext = mem_issue(&t->mem, isa_ops[d->op].flags, rec->addr, rec->naddr, at, &ready, &t->st) - 1;
             if (ready == UINT64_MAX)
                 internal_error(t, "out of memory for the scene cache");
             charge(t, TM_SCENE_MEMORY, ext, stage, gen);
-            count_issue(t, d, stage, gen);
-            complete(t, d, rec, at, at + ext + 1, ready ? ready : at + d->lat, TM_SCENE_MEMORY);
-            return;
+            cause = TM_SCENE_MEMORY;
         }
         count_issue(t, d, stage, gen);
-        complete(t, d, rec, at, at + 1, at + d->lat, TM_DATA_DEPENDENCY);
+        complete(t, d, rec, at, at + ext + 1, ready ? ready : at + d->lat, cause);
         return;
+    }
     default:
         break;
     }
@@ -650,7 +648,7 @@ static __attribute__((noinline)) void issue_units_complete(Timing *t, const TmDe
     Issue is = {at, 0, TM_DATA_DEPENDENCY};
     if (d->mem && rec->naddr)
         issue_units(t, oi, rec, &is);
-    count_issue(t, d, rec->stage, rec->gen);
+    count_issue(t, d, stage, gen);
     const uint64_t last = is.at + is.ext; /* the instruction's last issue cycle */
     const uint64_t end = last + 1;        /* the next instruction's earliest issue cycle */
     const uint64_t ready = d->special ? result_time(t, oi, rec, &is, last, end)

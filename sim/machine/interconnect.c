@@ -34,6 +34,18 @@ void xbar_reset(Xbar *x)
 
 /* The first cycle s >= from at which a transfer of len cycles finds a free port in each of its
  * cycles, given the other users' transfers. */
+/* The other users' transfers still running at or after from. */
+static inline int running(const Xbar *x, uint64_t from, XbarUser user)
+{
+    int n = user != XBAR_PART && x->part.e > from;
+    if (user != XBAR_AGU)
+        for (int i = 0; i < x->agu_n; i++)
+            n += x->agu[i].e > from;
+    return n + (user != XBAR_DP && x->dp.e > from);
+}
+
+/* The first cycle from `from` with a port free for len cycles, when fewer ports than running()
+ * transfers are free at from (xbar_transfer tests that first, without building a list). */
 static uint64_t earliest(const Xbar *x, uint64_t from, uint64_t len, XbarUser user)
 {
     XbarIvl iv[XBAR_AGU_MAX + 2];
@@ -46,8 +58,6 @@ static uint64_t earliest(const Xbar *x, uint64_t from, uint64_t len, XbarUser us
                 iv[n++] = x->agu[i];
     if (user != XBAR_DP && x->dp.e > from)
         iv[n++] = x->dp;
-    if (n < x->p.ports) /* fewer transfers than ports at or after from: a port is free at from */
-        return from;
     uint64_t s = from;
     for (;;) {
         /* The most ports taken at any cycle of [s, s + len): check s and every start inside. */
@@ -89,18 +99,8 @@ static void hold_agu(Xbar *x, uint64_t s, uint64_t e, uint64_t now)
 
 uint64_t xbar_transfer(Xbar *x, XbarUser user, uint64_t from, uint64_t len, uint64_t now, TimingStats *st)
 {
-    if (user == XBAR_DP) { /* the common case, earliest()'s first test without its list: the
-                              other users' transfers still running at from, fewer than ports */
-        int n = x->part.e > from;
-        for (int i = 0; i < x->agu_n; i++)
-            n += x->agu[i].e > from;
-        if (n < x->p.ports) {
-            x->dp = (XbarIvl){from, from + len};
-            st->icn_transfers++;
-            return from;
-        }
-    }
-    const uint64_t s = earliest(x, from, len ? len : 1, user);
+    /* fewer transfers running than ports (nearly always): a port is free at from */
+    const uint64_t s = running(x, from, user) < x->p.ports ? from : earliest(x, from, len ? len : 1, user);
     switch (user) {
     case XBAR_DP:
         x->dp = (XbarIvl){s, s + len};

@@ -26,15 +26,13 @@ void spad_init(Spad *s, const SpadParams *p)
 
 uint64_t spad_access(const Spad *s, const uint32_t *addr, int naddr, TimingStats *st)
 {
-    if (naddr == 1) { /* a scalar access (spld, spst): one line */
-        st->spad_accesses++;
-        st->spad_lines++;
-        return (1u + (uint64_t)s->p.ports - 1) / (uint64_t)s->p.ports;
+    int k = 1; /* a scalar access (spld, spst): one line, no search */
+    if (naddr > 1) {
+        uint64_t lines[ISA_MAX_LANES], d[ISA_MAX_LANES];
+        for (int i = 0; i < naddr; i++)
+            lines[i] = addr[i] >> s->shift;
+        k = lines_distinct(lines, naddr, d);
     }
-    uint64_t lines[ISA_MAX_LANES], d[ISA_MAX_LANES];
-    for (int i = 0; i < naddr; i++)
-        lines[i] = addr[i] >> s->shift;
-    int k = lines_distinct(lines, naddr, d);
     st->spad_accesses++;
     st->spad_lines += (uint64_t)k;
     return ((uint64_t)k + (uint64_t)s->p.ports - 1) / (uint64_t)s->p.ports;
