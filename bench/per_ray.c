@@ -20,9 +20,13 @@
  * against Embree's high-quality build on one thread, best of REPS; and the start-to-exit wall time
  * of `bin/sfsim run` of a 32 x 32, 1 spp Cornell frame (best of 5), when bin/sfsim is built.
  *
- * usage: per_ray [SIDE [REPS]] [-- SCENE ...]   (default 256 3; run from the repository root)
+ * usage: per_ray [--save-rays DIR] [SIDE [REPS]] [-- SCENE ...]   (default 256 3; run from the
+ * repository root). --save-rays writes each batch as DIR/SCENE-KIND.rays (the binary ray format of
+ * docs/trace.md), so that one engine can be profiled alone on the same rays:
+ * `bin/sfsim trace -s SCENE --rays DIR/conference-diffuse.rays --mode detailed -j 1 -o hits`.
  * Not a test: numbers depend on the host. docs/performance.md quotes runs.
  */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -30,6 +34,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "../sim/raybatch.h"
 #include "../sim/reference.h"
 #include "../sim/run/accel.h"
 #include "../sim/run/run.h"
@@ -370,7 +375,46 @@ static void scene_label(const char *path, char *label, size_t len)
     }
 }
 
-static int scene_run(const char *path, uint32_t side, int reps)
+/* DIR/LABEL-KIND.rays in the binary format of docs/trace.md, whole or not at all. */
+static int save_rays(const char *dir, const char *label, const Batch *bt)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s-%s.rays", dir, label, bt->kind);
+    FILE *f = fopen(path, "wb");
+    if (!f) {
+        fprintf(stderr, "per_ray: %s: cannot create: %s\n", path, strerror(errno));
+        return -1;
+    }
+    unsigned char head[16] = {0};
+    memcpy(head, RAYBATCH_MAGIC, 8);
+    uint32_t count = bt->b.count;
+    for (int k = 0; k < 4; k++)
+        head[8 + k] = (unsigned char)(count >> (8 * k));
+    int ok = fwrite(head, 1, sizeof head, f) == sizeof head;
+    for (uint32_t i = 0; ok && i < count; i++) {
+        const BatchRay *r = &bt->b.rays[i];
+        float v[7] = {r->org[0], r->org[1], r->org[2], r->dir[0], r->dir[1], r->dir[2], r->tmax};
+        unsigned char rec[32];
+        for (int k = 0; k < 7; k++) {
+            uint32_t w;
+            memcpy(&w, &v[k], 4);
+            for (int b = 0; b < 4; b++)
+                rec[4 * k + b] = (unsigned char)(w >> (8 * b));
+        }
+        for (int b = 0; b < 4; b++)
+            rec[28 + b] = (unsigned char)(r->query >> (8 * b));
+        ok = fwrite(rec, 1, sizeof rec, f) == sizeof rec;
+    }
+    if (fclose(f) != 0 || !ok) {
+        fprintf(stderr, "per_ray: %s: write failed\n", path);
+        remove(path);
+        return -1;
+    }
+    printf("per_ray: wrote %s (%u rays)\n", path, count);
+    return 0;
+}
+
+static int scene_run(const char *path, uint32_t side, int reps, const char *save_dir)
 {
     char err[65536];
     RunScene sc;
@@ -404,6 +448,9 @@ static int scene_run(const char *path, uint32_t side, int reps)
         goto out;
     }
     make_secondary(&sc, &bt[0], hits, &bt[1], &bt[2]);
+    for (int k = 0; save_dir && k < 3; k++)
+        if (save_rays(save_dir, label, &bt[k]) != 0)
+            goto out;
     rc = 0;
     for (int k = 0; k < 3; k++) {
         Timing tm;
@@ -477,6 +524,11 @@ int main(int argc, char **argv)
                                            "scenes/sponza-dabrovic/scene.ini"};
     uint32_t side = 256;
     int reps = 3, a = 1;
+    const char *save_dir = NULL;
+    if (a + 1 < argc && !strcmp(argv[a], "--save-rays")) {
+        save_dir = argv[a + 1];
+        a += 2;
+    }
     if (a < argc && strcmp(argv[a], "--"))
         side = (uint32_t)strtoul(argv[a++], NULL, 10);
     if (a < argc && strcmp(argv[a], "--"))
@@ -489,7 +541,7 @@ int main(int argc, char **argv)
         a = argc;
     }
     if (a != argc || side < 1 || side > 4096 || reps < 1 || reps > 100 || n < 1) {
-        fprintf(stderr, "usage: per_ray [SIDE [REPS]] [-- SCENE ...]   (SIDE 1..4096, default 256; REPS 1..100, "
+        fprintf(stderr, "usage: per_ray [--save-rays DIR] [SIDE [REPS]] [-- SCENE ...]   (SIDE 1..4096, default 256; REPS 1..100, "
                         "default 3)\n");
         return 2;
     }
@@ -503,7 +555,7 @@ int main(int argc, char **argv)
         int ok = bench_scene_ok("per_ray", list[i], &skipped);
         if (ok < 0)
             return 1;
-        if (ok && scene_run(list[i], side, reps) != 0)
+        if (ok && scene_run(list[i], side, reps, save_dir) != 0)
             rc = 1;
     }
     startup_time();
