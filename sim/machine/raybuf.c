@@ -47,7 +47,8 @@ void rb_free(RayBufs *rb)
  * are banks. Lines in such a window fall in distinct banks, so no bank serves two and the access
  * takes one cycle; its distinct lines are where the line changes from one lane to the next. The
  * scan is branch-free, and a whole vector of N = 16 lanes is one block the compiler vectorizes.
- * Returns the distinct lines, or 0 when the access is not of that kind (then rb_access_any). */
+ * Returns the distinct lines, or 0 when the access is not of that kind (then rb_access_bits or
+ * rb_access_any). */
 static inline int rb_ascending_lines(const RayBufs *rb, const uint32_t *addr, int naddr)
 {
     const int s = rb->shift;
@@ -76,8 +77,9 @@ static inline int rb_ascending_lines(const RayBufs *rb, const uint32_t *addr, in
 /* Any access, any bank count (rb_access_bits below takes the usual power-of-two counts up to 64):
  * each distinct line is found through its own bank's list of the lines seen so far
  * (usually empty or one long), so an access costs about one probe per lane rather than one per
- * pair of lines; the counts are those of the distinct lines, in any order. */
-static int rb_access_any(RayBufs *rb, const uint32_t *addr, int naddr, TimingStats *st)
+ * pair of lines; the counts are those of the distinct lines, in any order. Returns the most lines
+ * of one bank; *lines: the distinct lines. */
+static int rb_access_any(RayBufs *rb, const uint32_t *addr, int naddr, int *lines)
 {
     uint32_t line_of[ISA_MAX_LANES];
     int8_t next[ISA_MAX_LANES];
@@ -113,9 +115,7 @@ static int rb_access_any(RayBufs *rb, const uint32_t *addr, int naddr, TimingSta
         if (++rb->bank_cnt[b] > worst)
             worst = rb->bank_cnt[b];
     }
-    st->rb_accesses++;
-    st->rb_lines += (uint64_t)k;
-    st->rb_conflicted += worst > 1;
+    *lines = k;
     return worst;
 }
 
@@ -124,7 +124,7 @@ static int rb_access_any(RayBufs *rb, const uint32_t *addr, int naddr, TimingSta
  * only where the bit is set (no clearing per access). A second, different line in a bank (a
  * conflict) is looked up among the access's few other such lines. The same counts as
  * rb_access_any. */
-static int rb_access_bits(const RayBufs *rb, const uint32_t *addr, int naddr, TimingStats *st)
+static int rb_access_bits(const RayBufs *rb, const uint32_t *addr, int naddr, int *lines)
 {
     uint32_t first[64], more_line[ISA_MAX_LANES];
     uint8_t cnt[64];
@@ -158,19 +158,58 @@ static int rb_access_bits(const RayBufs *rb, const uint32_t *addr, int naddr, Ti
         if (++cnt[b] > worst)
             worst = cnt[b];
     }
-    st->rb_accesses++;
-    st->rb_lines += (uint64_t)k;
-    st->rb_conflicted += worst > 1;
+    *lines = k;
     return worst;
+}
+
+/* Whether addr[0..naddr) is the last access's lanes moved by one whole number of lines (see
+ * RayBufs.last_addr; the caller checks the bank count is a power of two). The lanes are compared
+ * in one branch-free pass the compiler vectorizes. */
+static inline int rb_same_as_last(const RayBufs *rb, const uint32_t *addr, int naddr)
+{
+    if (naddr != rb->last_n)
+        return 0;
+    const uint32_t d = addr[0] - rb->last_addr[0];
+    if (d & (uint32_t)(rb->p.line - 1))
+        return 0;
+    uint32_t diff = 0;
+    if (naddr == 16) { /* N = 16: a constant count, one vector block */
+        for (int i = 0; i < 16; i++)
+            diff |= (addr[i] - rb->last_addr[i]) ^ d;
+    } else {
+        for (int i = 0; i < naddr; i++)
+            diff |= (addr[i] - rb->last_addr[i]) ^ d;
+    }
+    return diff == 0;
+}
+
+static inline void rb_note_last(RayBufs *rb, const uint32_t *addr, int naddr)
+{
+    if (naddr == 16)
+        memcpy(rb->last_addr, addr, 16 * sizeof *addr);
+    else
+        memcpy(rb->last_addr, addr, sizeof *addr * (size_t)naddr);
+    rb->last_n = naddr;
 }
 
 int rb_access(RayBufs *rb, const uint32_t *addr, int naddr, TimingStats *st)
 {
-    const int k = rb_ascending_lines(rb, addr, naddr);
-    if (!k)
-        return rb->p.banks <= 64 && (rb->p.banks & (rb->p.banks - 1)) == 0 ? rb_access_bits(rb, addr, naddr, st)
-                                                                         : rb_access_any(rb, addr, naddr, st);
+    const int pow2 = (rb->p.banks & (rb->p.banks - 1)) == 0;
+    int cycles, lines;
+    if (pow2 && rb_same_as_last(rb, addr, naddr)) {
+        cycles = rb->last_cycles;
+        lines = rb->last_lines;
+    } else {
+        lines = rb_ascending_lines(rb, addr, naddr);
+        cycles = lines                         ? 1
+                 : pow2 && rb->p.banks <= 64 ? rb_access_bits(rb, addr, naddr, &lines)
+                                             : rb_access_any(rb, addr, naddr, &lines);
+        rb->last_cycles = cycles;
+        rb->last_lines = lines;
+    }
+    rb_note_last(rb, addr, naddr);
     st->rb_accesses++;
-    st->rb_lines += (uint64_t)k;
-    return 1;
+    st->rb_lines += (uint64_t)lines;
+    st->rb_conflicted += cycles > 1;
+    return cycles;
 }

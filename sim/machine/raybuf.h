@@ -36,6 +36,14 @@ typedef struct RayBufs {
     uint16_t *bank_cnt;        /* lines per bank in the current access, valid where stamped */
     int8_t *bank_head;         /* the bank's first line in the access's list, valid where stamped */
     uint32_t *bank_stamp, stamp;
+    /* The last access (rb_access): its lanes' addresses and its counts. An access is a function of
+     * its addresses alone, and one whose lanes are the last one's moved by the same whole number of
+     * lines (the next field of the same rays: the fields are arrays of line-aligned size) names
+     * lines that map one to one onto the last one's, in banks that map one to one too (a power-of-
+     * two bank count), so it has the same counts. */
+    uint32_t last_addr[ISA_MAX_LANES];
+    int last_n;                /* its lanes (0: none yet) */
+    int last_cycles, last_lines;
 } RayBufs;
 
 /* 0, or -1 when out of memory (then rb_free). */

@@ -119,6 +119,60 @@ Test(raybuf, access_counts_match_the_definition_on_every_path)
     }
 }
 
+/* rb_access keeps its last access's counts for an access whose lanes are the last one's moved by
+ * one whole number of lines (the next field of the same rays). Each access here is the one before
+ * moved by whole lines (also across the top of the address space), by part of a line, or with one
+ * lane changed, after accesses of every kind; every answer must still be the definition's. */
+Test(raybuf, an_access_moved_by_whole_lines_keeps_the_counts_and_no_other_does)
+{
+    const int bank_counts[] = {32, 64, 16, 24};
+    for (size_t bi = 0; bi < sizeof bank_counts / sizeof *bank_counts; bi++) {
+        RbParams p = {.banks = bank_counts[bi], .line = 64, .access = 2, .align_cycles = 1};
+        RayBufs rb;
+        cr_assert_eq(rb_init(&rb, &p), 0);
+        uint32_t a[ISA_MAX_LANES];
+        int n = 16, conflicts = 0;
+        for (int iter = 0; iter < 6000; iter++) {
+            const int step = iter % 8;
+            if (step == 0) { /* a fresh vector of any kind and length */
+                n = iter % 3 ? 16 : 1 + (int)(next_u32() % ISA_MAX_LANES);
+                make_vector(a, n, (iter / 8) % 6, p.line, p.banks);
+            } else if (step == 4) { /* to just below the top of the address space, then across it */
+                uint32_t lo = a[0];
+                for (int i = 1; i < n; i++)
+                    lo = a[i] < lo ? a[i] : lo;
+                const uint32_t d = (0u - (uint32_t)(p.line * (1 + (int)(next_u32() % 4u)))) - (lo & ~63u);
+                for (int i = 0; i < n; i++)
+                    a[i] += d;
+            } else if (step == 6) { /* part of a line */
+                const uint32_t d = 4u * (1u + next_u32() % 15u);
+                for (int i = 0; i < n; i++)
+                    a[i] += d;
+            } else if (step == 7) { /* one lane to another line */
+                a[next_u32() % (uint32_t)n] += (uint32_t)p.line * (1u + next_u32() % 40u);
+            } else { /* whole lines, a field further on (or back) */
+                const uint32_t d = (uint32_t)p.line * (next_u32() % 600u) - (uint32_t)p.line * 300u;
+                for (int i = 0; i < n; i++)
+                    a[i] += d;
+            }
+            int distinct;
+            const int want = reference(a, n, p.line, p.banks, &distinct);
+            TimingStats st;
+            memset(&st, 0, sizeof st);
+            const int got = rb_access(&rb, a, n, &st);
+            cr_assert_eq(got, want, "banks %d, step %d, n %d: %d cycles, the definition gives %d", p.banks, step, n,
+                         got, want);
+            cr_assert_eq(st.rb_lines, (uint64_t)distinct, "banks %d, step %d, n %d: %llu lines, want %d", p.banks,
+                         step, n, (unsigned long long)st.rb_lines, distinct);
+            cr_assert_eq(st.rb_accesses, 1u);
+            cr_assert_eq(st.rb_conflicted, (uint64_t)(want > 1));
+            conflicts += want > 1;
+        }
+        cr_assert(conflicts > 200, "banks %d: only %d conflicting accesses", p.banks, conflicts);
+        rb_free(&rb);
+    }
+}
+
 Test(raybuf, interconnect_port_search_waits_only_when_every_port_is_taken)
 {
     XbarParams p = {.latency = 1, .ports = 2};
