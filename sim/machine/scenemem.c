@@ -58,6 +58,7 @@ void mem_reset(SceneMem *m)
     }
     m->stamp = 0;
     m->bus_free = 0;
+    m->last_way = 0;
 }
 
 static int instantiate(SceneMem *m)
@@ -84,6 +85,8 @@ static uint64_t bus_fill(SceneMem *m, uint64_t t)
     return s + (uint64_t)m->p.latency + (uint64_t)m->xfer;
 }
 
+static uint64_t mem_miss(SceneMem *m, uint64_t line, size_t set, uint64_t t, int write);
+
 uint64_t mem_access(SceneMem *m, int space, uint32_t addr, uint64_t t, int write)
 {
     m->st.accesses++;
@@ -94,18 +97,35 @@ uint64_t mem_access(SceneMem *m, int space, uint32_t addr, uint64_t t, int write
     if (!m->instantiated && instantiate(m))
         return UINT64_MAX;
     uint64_t line = mem_line(m, space, addr);
-    size_t set = (size_t)(m->set_mask ? line & m->set_mask : line % (uint64_t)m->sets), w = (size_t)m->p.ways;
-    uint64_t *tag = m->tag + set * w;
     m->stamp++;
-    for (size_t i = 0; i < w; i++)
-        if (tag[i] == line + 1) {
-            size_t k = set * w + i;
-            m->st.hits++;
-            m->lru[k] = m->stamp;
-            m->dirty[k] |= (uint8_t)(write != 0);
-            uint64_t r = t + (uint64_t)m->p.hit_latency;
-            return r > m->ready[k] ? r : m->ready[k];
-        }
+    /* The way the last hit or fill used first: a kernel reads a node's words one after another,
+     * so it usually still holds this line (a line is in at most one way, so that is the hit the
+     * search would find). */
+    size_t k = m->last_way;
+    if (m->tag[k] != line + 1) {
+        const size_t set = (size_t)(m->set_mask ? line & m->set_mask : line % (uint64_t)m->sets);
+        const size_t w = (size_t)m->p.ways;
+        const uint64_t *tag = m->tag + set * w;
+        size_t i = 0;
+        while (i < w && tag[i] != line + 1)
+            i++;
+        if (i == w)
+            return mem_miss(m, line, set, t, write);
+        k = set * w + i;
+        m->last_way = k;
+    }
+    m->st.hits++;
+    m->lru[k] = m->stamp;
+    m->dirty[k] |= (uint8_t)(write != 0);
+    const uint64_t r = t + (uint64_t)m->p.hit_latency;
+    return r > m->ready[k] ? r : m->ready[k];
+}
+
+/* A miss of line (in set) at cycle t: the least recently used way takes it. */
+static uint64_t mem_miss(SceneMem *m, uint64_t line, size_t set, uint64_t t, int write)
+{
+    const size_t w = (size_t)m->p.ways;
+    uint64_t *tag = m->tag + set * w;
     m->st.misses++;
     size_t victim = 0;
     for (size_t i = 1; i < w; i++)
@@ -121,6 +141,7 @@ uint64_t mem_access(SceneMem *m, int space, uint32_t addr, uint64_t t, int write
     m->lru[k] = m->stamp;
     m->dirty[k] = (uint8_t)(write != 0);
     m->ready[k] = bus_fill(m, t);
+    m->last_way = k;
     return m->ready[k];
 }
 

@@ -19,6 +19,7 @@
 #ifndef SFSIM_MACHINE_SCENEMEM_H
 #define SFSIM_MACHINE_SCENEMEM_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "../config.h"
@@ -47,6 +48,7 @@ typedef struct SceneMem {
     uint64_t *lru;                /* last-use stamp per way */
     uint8_t *dirty;
     uint64_t stamp, bus_free;
+    size_t last_way;              /* the way of the last hit or fill (tag index), tried first */
     int instantiated;
     SceneMemStats st;
 } SceneMem;

@@ -20,6 +20,7 @@
 #include "../../sim/machine/scenemem.h"
 #include "../../sim/timing.h"
 #include "../support/asm_fixture.h"
+#include "../support/rng.h"
 
 /* A timing figure by its expect key, or -1 for an unknown key. */
 static long long figure(const TimingStats *s, const char *key)
@@ -208,6 +209,96 @@ Test(timing, scene_cache_lru_and_bus)
     mem_reset(&m);
     cr_expect_eq(mem_access(&m, 0, 0, 0, 0), 14, "reset leaves a cold cache");
     mem_free(&m);
+}
+
+/* A plain set-associative LRU cache with the same bus and latencies as docs/model.md gives them
+ * ("Scene memory"): the reference for the cache's shortcuts (the way of the last hit tried first). */
+typedef struct RefCache {
+    int sets, ways;
+    uint64_t tag[64][8], ready[64][8], used[64][8], clock, bus_free;
+    uint8_t dirty[64][8];
+    uint64_t hits, misses, writebacks;
+} RefCache;
+
+static uint64_t ref_cache_access(RefCache *c, const SceneMemParams *p, int space, uint32_t addr, uint64_t t,
+                                 int write)
+{
+    const uint64_t line = ((uint64_t)space << 32 | addr) / (uint64_t)p->line_bytes;
+    const int set = (int)(line % (uint64_t)c->sets), xfer = (p->line_bytes + p->bytes_per_cycle - 1) / p->bytes_per_cycle;
+    c->clock++;
+    for (int w = 0; w < c->ways; w++)
+        if (c->tag[set][w] == line + 1) {
+            c->hits++;
+            c->used[set][w] = c->clock;
+            c->dirty[set][w] |= (uint8_t)(write != 0);
+            const uint64_t r = t + (uint64_t)p->hit_latency;
+            return r > c->ready[set][w] ? r : c->ready[set][w];
+        }
+    c->misses++;
+    int v = 0;
+    for (int w = 1; w < c->ways; w++)
+        if (c->used[set][w] < c->used[set][v])
+            v = w;
+    if (c->tag[set][v] && c->dirty[set][v]) {
+        c->writebacks++;
+        c->bus_free = (t > c->bus_free ? t : c->bus_free) + (uint64_t)xfer;
+    }
+    const uint64_t s = t > c->bus_free ? t : c->bus_free;
+    c->bus_free = s + (uint64_t)xfer;
+    c->tag[set][v] = line + 1;
+    c->used[set][v] = c->clock;
+    c->dirty[set][v] = (uint8_t)(write != 0);
+    c->ready[set][v] = s + (uint64_t)p->latency + (uint64_t)xfer;
+    return c->ready[set][v];
+}
+
+Test(timing, scene_cache_matches_a_plain_lru_cache_on_random_accesses)
+{
+    /* Runs of words of one line (a node read word by word), lines of one set in turn, other lines,
+     * the framebuffer and writes, at 1, 2 and 4 ways and power-of-two and other set counts. */
+    static const int shapes[][2] = {{16, 4}, {3, 4}, {8, 2}, {5, 1}, {64, 1}};
+    uint64_t seed = TEST_RNG_SEED;
+    for (size_t k = 0; k < sizeof shapes / sizeof *shapes; k++) {
+        const int sets = shapes[k][0], ways = shapes[k][1];
+        SceneMemParams p = {10, 16, 64, 2, sets * ways * 64, ways, 1};
+        SceneMem m;
+        mem_init(&m, &p);
+        static RefCache ref;
+        memset(&ref, 0, sizeof ref);
+        ref.sets = sets;
+        ref.ways = ways;
+        uint32_t addr = 0;
+        uint64_t t = 0;
+        for (int i = 0; i < 40000; i++) {
+            const uint32_t r = test_rng_u32(&seed) % 16u;
+            if (r < 8) /* the next word of the same line */
+                addr = (addr & ~63u) | ((addr + 4u) & 63u);
+            else if (r < 12) /* another line of the same set */
+                addr += 64u * (uint32_t)sets * (1u + test_rng_u32(&seed) % (uint32_t)(ways + 1));
+            else /* anywhere in 64 KB */
+                addr = 4u * (test_rng_u32(&seed) % 16384u);
+            const int space = test_rng_u32(&seed) % 16u == 0, write = test_rng_u32(&seed) % 8u == 0;
+            t += test_rng_u32(&seed) % 6u;
+            const uint64_t got = mem_access(&m, space, addr, t, write);
+            const uint64_t want = ref_cache_access(&ref, &p, space, addr, t, write);
+            cr_assert_eq(got, want, "%d sets x %d ways, access %d (address %u, space %d): ready %llu, want %llu", sets,
+                         ways, i, addr, space, (unsigned long long)got, (unsigned long long)want);
+            if (i == 20000) { /* a reset leaves both cold */
+                mem_reset(&m);
+                memset(ref.tag, 0, sizeof ref.tag);
+                memset(ref.used, 0, sizeof ref.used);
+                memset(ref.ready, 0, sizeof ref.ready);
+                memset(ref.dirty, 0, sizeof ref.dirty);
+                ref.clock = ref.bus_free = 0;
+            }
+        }
+        cr_expect_eq(m.st.hits, ref.hits, "%d sets x %d ways", sets, ways);
+        cr_expect_eq(m.st.misses, ref.misses, "%d sets x %d ways", sets, ways);
+        cr_expect_eq(m.st.writebacks, ref.writebacks, "%d sets x %d ways", sets, ways);
+        cr_expect(ref.hits > 10000 && ref.misses > 1000, "%d sets x %d ways: %llu hits, %llu misses", sets, ways,
+                  (unsigned long long)ref.hits, (unsigned long long)ref.misses);
+        mem_free(&m);
+    }
 }
 
 Test(timing, every_cause_has_a_key_and_a_description)
