@@ -724,20 +724,22 @@ static int memo_match(const Timing *t, const MemoEntry *e, const CoreRecord *rec
     for (int i = 0; i < nev; i++)
         if (e->ev_in[i].rel != ev[i].rel || e->ev_in[i].kind != ev[i].kind || e->ev_in[i].arg != ev[i].arg)
             return 0;
-    /* memo_reg's value compared in place. The live-ins that had landed come first: when nothing is
-     * in flight (the scoreboard's horizon is past) they have landed now too. One in flight must
-     * land as far ahead (a distance beyond 32 bits matches no stored rel) with its cause. */
+    /* memo_reg's value compared in place. A live-in that was in flight must land as far ahead (a
+     * distance beyond 32 bits matches no stored rel) with its cause: the few of those tell the
+     * ways apart, so they are checked first. The ones that had landed (stored first) must have
+     * landed now too, which holds for all of them when nothing is in flight (the scoreboard's
+     * horizon is past). */
     const uint64_t now = t->now;
-    if (t->simd.horizon > now)
-        for (int i = 0; i < e->nlanded; i++)
-            if (t->simd.ready[e->live[i].reg] > now)
-                return 0;
     for (int i = e->nlanded; i < e->nlive; i++) {
         const MemoReg *m = &e->live[i];
         const uint64_t rd = t->simd.ready[m->reg];
         if (rd <= now || rd - now != m->rel || t->simd.rcause[m->reg] != m->cause)
             return 0;
     }
+    if (t->simd.horizon > now)
+        for (int i = 0; i < e->nlanded; i++)
+            if (t->simd.ready[e->live[i].reg] > now)
+                return 0;
     return 1;
 }
 
