@@ -14,6 +14,14 @@ WARN    := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wmissing-prototyp
 PORTABLE ?=
 ARCH    := $(if $(PORTABLE),,-march=native) -ffp-contract=off
 CFLAGS  := -std=c11 $(OPT) $(ARCH) -g $(WARN) -D_GNU_SOURCE $(EXTRA_CFLAGS)
+# Link-time optimization: the objects carry the compiler's intermediate code beside their machine
+# code (-ffat-lto-objects), and bin/sfsim and the benches link with -flto, so the timing core's
+# calls into the units (sim/machine/) inline across files (docs/performance.md); the tests and
+# tools link the machine code as usual. `make LTO=0` turns it off; results are the same either way.
+LTO     ?= 1
+LTO_OBJ  := $(if $(filter 1,$(LTO)),-flto=auto -ffat-lto-objects)
+LTO_LINK := $(if $(filter 1,$(LTO)),-flto=auto)
+AR      := $(if $(filter 1,$(LTO)),gcc-ar,$(AR))
 CXXWARN := -Wall -Wextra -Werror
 CXXFLAGS := -std=c++17 $(OPT) $(ARCH) -g $(CXXWARN) $(EXTRA_CXXFLAGS)
 # C++ appears only inside the shims that wrap C++ libraries (ARCHITECTURE.md Sec. 2).
@@ -37,10 +45,10 @@ EMBREE  := -lembree3
 
 BUILD   ?= build
 BIN     ?= bin
-# Objects depend on the flags they were compiled with: switching PORTABLE (or OPT) rebuilds.
+# Objects depend on the flags they were compiled with: switching PORTABLE, LTO (or OPT) rebuilds.
 FLAGS_STAMP := $(BUILD)/.flags
-$(shell mkdir -p $(BUILD) && (echo '$(CC) $(CFLAGS) | $(CXX) $(CXXFLAGS)' | cmp -s - $(FLAGS_STAMP) || \
-        echo '$(CC) $(CFLAGS) | $(CXX) $(CXXFLAGS)' > $(FLAGS_STAMP)))
+$(shell mkdir -p $(BUILD) && (echo '$(CC) $(CFLAGS) $(LTO_OBJ) | $(CXX) $(CXXFLAGS)' | cmp -s - $(FLAGS_STAMP) || \
+        echo '$(CC) $(CFLAGS) $(LTO_OBJ) | $(CXX) $(CXXFLAGS)' > $(FLAGS_STAMP)))
 SAN     := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 
 # Library sources: everything but the programs' main files.
@@ -132,7 +140,7 @@ $(BUILD)/obj/sim/img_write.o $(BUILD)/obj/sim/heatmap.o $(BUILD)/asan/sim/img_wr
 
 $(BUILD)/obj/%.o: %.c $(FLAGS_STAMP)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -MMD -MP -c $< -o $@
+	$(CC) $(CFLAGS) $(LTO_OBJ) -MMD -MP -c $< -o $@
 
 $(BUILD)/asan/%.o: %.c $(FLAGS_STAMP)
 	@mkdir -p $(dir $@)
@@ -182,7 +190,7 @@ $(BIN)/sfasm: $(BUILD)/obj/asm/main_sfasm.o $(BUILD)/libsfasm.a
 # Its image library is built with it (order-only: not linked; sim/imglib.c loads it).
 $(BIN)/sfsim: $(BUILD)/obj/sim/main.o $(BUILD)/libsfsim.a | $(IMGLIB)
 	@mkdir -p $(BIN)
-	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS)
+	$(CC) $(CFLAGS) $(LTO_LINK) $^ -o $@ $(INIH) $(LDLIBS)
 
 # ---- tools and docs -------------------------------------------------------------------------
 $(BUILD)/gen_isadoc: tools/gen_isadoc.c $(BUILD)/libsfasm.a
@@ -327,27 +335,27 @@ fuzz-run: fuzz
 # ---- benchmarks -----------------------------------------------------------------------------
 $(BUILD)/bench/core_speed: bench/core_speed.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
+	$(CC) $(CFLAGS) $(LTO_LINK) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
 
 $(BUILD)/bench/embree_xcheck: bench/embree_xcheck.c tests/support/xcheck.c tests/support/shared.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $^ -o $@ $(EMBREE) $(INIH) $(LDLIBS) $(OIIO)
+	$(CC) $(CFLAGS) $(LTO_LINK) $^ -o $@ $(EMBREE) $(INIH) $(LDLIBS) $(OIIO)
 
 $(BUILD)/bench/per_ray: bench/per_ray.c tests/support/xcheck.c tests/support/shared.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $^ -o $@ $(EMBREE) $(INIH) $(LDLIBS) $(OIIO)
+	$(CC) $(CFLAGS) $(LTO_LINK) $^ -o $@ $(EMBREE) $(INIH) $(LDLIBS) $(OIIO)
 
 $(BUILD)/bench/functional_speed: bench/functional_speed.c tests/support/shared.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
+	$(CC) $(CFLAGS) $(LTO_LINK) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
 
 $(BUILD)/bench/detailed_speed: bench/detailed_speed.c tests/support/shared.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
+	$(CC) $(CFLAGS) $(LTO_LINK) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
 
 $(BUILD)/bench/speed_vs_error: bench/speed_vs_error.c tests/support/shared.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
+	$(CC) $(CFLAGS) $(LTO_LINK) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
 
 $(BUILD)/validation: tools/validation.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
