@@ -551,6 +551,27 @@ static inline void rec_addr(Core *c, int hooked, CoreMem m, uint32_t a)
     }
 }
 
+/* The record's addresses of a gather or scatter whose lanes all passed the check: base + 4 * ID
+ * for each exec-mask lane, lowest first (what rec_addr per lane gives, in one pass; all N lanes,
+ * the usual case, in a loop the compiler vectorizes). */
+static inline void rec_lanes(Core *c, CoreMem m, uint32_t base, const VReg *B, uint64_t E, int n)
+{
+    if (!E)
+        return;
+    uint32_t *a = c->rec.addr;
+    int k = 0;
+    if (E == c->all) {
+        for (int l = 0; l < n; l++)
+            a[l] = base + 4u * B->u[l];
+        k = n;
+    } else {
+        for (uint64_t e = E; e; e &= e - 1)
+            a[k++] = base + 4u * B->u[__builtin_ctzll(e)];
+    }
+    c->rec.naddr = (uint8_t)k;
+    c->rec.mem = (uint8_t)m;
+}
+
 /* ---- the partition unit ---------------------------------------------------------------------- */
 
 static int do_part(Core *c, const IsaInstr *in, int hooked)
@@ -965,14 +986,14 @@ static ALWAYS_INLINE int exec_rbuf(Core *c, Exec *x, IsaOp op)
                 for (uint64_t e = E; e; e &= e - 1) {
                     const int l = __builtin_ctzll(e);
                     memcpy(mem + 4u * B->u[l], &A->u[l], 4);
-                    rec_addr(c, x->hooked, m, base + 4u * B->u[l]);
                 }
             else
                 for (uint64_t e = E; e; e &= e - 1) {
                     const int l = __builtin_ctzll(e);
                     memcpy(&A->u[l], mem + 4u * B->u[l], 4);
-                    rec_addr(c, x->hooked, m, base + 4u * B->u[l]);
                 }
+            if (x->hooked)
+                rec_lanes(c, m, base, B, E, n);
             break;
         }
         for (uint64_t e = E; e; e &= e - 1) { /* the exec-mask lanes, lowest first */
