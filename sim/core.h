@@ -16,6 +16,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "../asm/object.h"
 #include "../isa/isa.h"
@@ -51,13 +52,14 @@ typedef struct CoreStats {
 
 /* Per-instruction record for the timing model (produced only when a hook is set). */
 typedef struct CoreRecord {
-    uint32_t pc, next_pc;
-    const IsaInstr *in;
+    uint32_t pc;
     uint8_t stage;          /* IsaStage at execution */
+    uint8_t gen;            /* statistics generation (sgen) at execution */
     uint8_t taken;          /* branch taken */
     uint8_t mem;            /* CoreMem touched (physical buffer for ray buffers), or CORE_MEM_COUNT */
+    uint32_t next_pc;
     uint8_t naddr;          /* number of valid entries in addr (lanes that accessed memory) */
-    uint8_t gen;            /* statistics generation (sgen) at execution */
+    const IsaInstr *in;
     uint32_t count;         /* part: stream length in IDs; pmask: bits queued after it; sfetch: IDs
                                left in the stream before it (rd - rc) / 4; else 0 */
     uint32_t base;          /* sfetch: stream pointer rc before it; sapp: ra before it; part: rb */
@@ -67,6 +69,22 @@ typedef struct CoreRecord {
 } CoreRecord;
 
 typedef void (*CoreHook)(void *ctx, const CoreRecord *rec);
+
+/* A record's pc, stage, generation and taken flag as one number: the pc in the low 32 bits, then
+ * the stage, the generation and the flag a byte each (the timing model compares them at once; the
+ * fields sit side by side in this order, so a compiler can read them in one load). */
+static inline uint64_t core_record_where(const CoreRecord *r)
+{
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+    _Static_assert(offsetof(CoreRecord, stage) == 4 && offsetof(CoreRecord, gen) == 5 &&
+                       offsetof(CoreRecord, taken) == 6, "core_record_where reads the fields in one load");
+    uint64_t w;
+    memcpy(&w, r, sizeof w);
+    return w & 0x00ffffffffffffffull; /* not mem, the byte after taken */
+#else
+    return (uint64_t)r->pc | (uint64_t)r->stage << 32 | (uint64_t)r->gen << 40 | (uint64_t)r->taken << 48;
+#endif
+}
 
 typedef struct Core Core;
 

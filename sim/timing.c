@@ -147,8 +147,9 @@ struct Timing {
                                       outcome) or MM_REPLAY (following a stored block) */
     uint64_t m_t0;                 /* the block's start cycle */
     uint8_t m_stage, m_gen;
-    uint32_t m_next;               /* replay: the pc of the next record on the path (the records
-                                      matched so far: m_next - m_pc0) */
+    uint64_t m_where;              /* replay: the next record on the path as core_record_where()
+                                      gives it with no branch taken: its pc (the records matched
+                                      so far: that pc - m_pc0), the block's stage and generation */
     uint32_t m_last;               /* replay: the pc of the block's last record */
     MemoEntry *m_e;                /* replay: the stored block */
     uint32_t m_pc0;                /* the block's first instruction (its MemoWays): a pc, not a
@@ -774,12 +775,12 @@ static void memo_apply(Timing *t, const MemoEntry *e)
     t->memo_replays++;
 }
 
-/* A replay whose path the core left after m_next - m_pc0 records: those are timed one by one from
+/* A replay whose path the core left after (pc of m_where) - m_pc0 records: those are timed one by one from
  * the block's start state, which nothing has changed yet. */
 static void memo_unwind(Timing *t)
 {
     t->mmode = MM_NONE;
-    for (uint32_t i = 0; i < t->m_next - t->m_pc0; i++) {
+    for (uint32_t i = 0; i < (uint32_t)t->m_where - t->m_pc0; i++) {
         CoreRecord r;
         memset(&r, 0, offsetof(CoreRecord, addr));
         r.pc = t->m_pc0 + i;
@@ -809,7 +810,7 @@ static __attribute__((noinline)) int memo_begin(Timing *t, TmDesc *d, const Core
             MemoEntry *e = &d->memo->e[w];
             if (memo_match(t, e, rec, ev, nev)) {
                 t->m_e = e;
-                t->m_next = rec->pc + 1;
+                t->m_where = core_record_where(rec) + 1; /* the next pc; not taken (memo_match) */
                 t->m_last = rec->pc + e->len - 1u;
                 t->mmode = MM_REPLAY;
                 if (e->len == 1)
@@ -992,17 +993,16 @@ void timing_hook(void *ctx, const CoreRecord *rec)
 {
     Timing *t = ctx;
     if (t->mmode == MM_REPLAY) { /* the next record of a stored block: only checked */
-        if (__builtin_expect(rec->pc == t->m_next && rec->stage == t->m_stage && rec->gen == t->m_gen, 1)) {
-            if (rec->pc != t->m_last) { /* inside the block: no branch taken */
-                if (__builtin_expect(!rec->taken, 1)) {
-                    t->m_next++;
-                    return;
-                }
-            } else if (rec->taken == t->m_e->taken_last) {
-                t->m_next++;
-                memo_apply(t, t->m_e);
+        const uint64_t w = core_record_where(rec); /* pc, stage, generation, taken */
+        if (rec->pc != t->m_last) { /* inside the block: the next pc, no branch taken */
+            if (__builtin_expect(w == t->m_where, 1)) {
+                t->m_where++;
                 return;
             }
+        } else if (w == (t->m_where | (uint64_t)t->m_e->taken_last << 48)) {
+            t->m_where++;
+            memo_apply(t, t->m_e);
+            return;
         }
     }
     hook_any(t, rec);
