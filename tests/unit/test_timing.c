@@ -448,6 +448,54 @@ static const char memo_loop[] =
     "        bne     r1, r0, loop\n"
     "        halt\n";
 
+/* Loops whose blocks recur with another path: an sgen inside a block that keeps the generation
+ * on the first passes (so the block stored spans it) and changes it every 32 passes after, and a
+ * branch inside a block taken on some passes and not on others, so that a replay meets, at the
+ * next pc, a record that runs in another generation or took a branch, and must leave the stored
+ * block there. */
+static const char memo_paths[] =
+    "        li      r1, 200\n"
+    "        vli     v1, 0x3f800000\n"
+    "gens:   vfadd   v2, v1, v1\n"
+    "        andi    r6, r1, 32\n"
+    "        sgen    r6\n"
+    "        vfmul   v3, v2, v1\n"
+    "        vfadd   v1, v1, v3\n"
+    "        addi    r1, r1, -1\n"
+    "        bne     r1, r0, gens\n"
+    "        li      r1, 200\n"
+    "loop:   vfadd   v2, v1, v1\n"
+    "        andi    r6, r1, 2\n"
+    "        sgen    r6\n"
+    "        vfmul   v3, v2, v1\n"
+    "        vfadd   v1, v1, v3\n"
+    "        andi    r7, r1, 4\n"
+    "        beq     r7, r0, skip\n"
+    "        vfadd   v4, v3, v2\n"
+    "        vfmul   v4, v4, v1\n"
+    "skip:   vfmin   v5, v4, v3\n"
+    "        vfadd   v6, v5, v1\n"
+    "        addi    r1, r1, -1\n"
+    "        bne     r1, r0, loop\n"
+    "        halt\n";
+
+Test(timing, memoized_blocks_leave_a_stored_path_at_a_taken_branch_or_another_generation)
+{
+    BenchProg prog = {"memo_paths.s", NULL, 0};
+    uint64_t r_on, r_off;
+    TimingStats on = run_memo_src(&prog, memo_paths, 1, 0, &r_on), off = run_memo_src(&prog, memo_paths, 0, 0, &r_off);
+    cr_expect(memcmp(&on, &off, sizeof on) == 0, "cycles %llu with the memo, %llu without", (unsigned long long)on.cycles,
+              (unsigned long long)off.cycles);
+    cr_expect_gt(r_on, 100u, "the blocks recur: %llu replayed", (unsigned long long)r_on);
+    cr_expect_gt(on.gen_busy[32], 0u, "the loop runs in generation 32 too");
+    cr_expect_gt(on.gen_busy[2], 0u, "and in generation 2");
+    for (uint64_t limit = 1; limit < on.busy; limit += limit < 200 ? 1 : 11) {
+        TimingStats a = run_memo_src(&prog, memo_paths, 1, limit, &r_on), b = run_memo_src(&prog, memo_paths, 0, limit, &r_off);
+        cr_expect(memcmp(&a, &b, sizeof a) == 0, "stopped after %llu instructions: cycles %llu with the memo, %llu without",
+                  (unsigned long long)limit, (unsigned long long)a.cycles, (unsigned long long)b.cycles);
+    }
+}
+
 Test(timing, memoized_blocks_give_the_same_figures_as_timing_each_instruction)
 {
     /* Every counter with the memo on equals the one with it off: for whole runs, and for runs
