@@ -32,8 +32,6 @@ void xbar_reset(Xbar *x)
     x->part.s = x->part.e = 0;
 }
 
-/* The first cycle s >= from at which a transfer of len cycles finds a free port in each of its
- * cycles, given the other users' transfers. */
 /* The other users' transfers still running at or after from. */
 static inline int running(const Xbar *x, uint64_t from, XbarUser user)
 {
@@ -44,8 +42,9 @@ static inline int running(const Xbar *x, uint64_t from, XbarUser user)
     return n + (user != XBAR_DP && x->dp.e > from);
 }
 
-/* The first cycle from `from` with a port free for len cycles, when fewer ports than running()
- * transfers are free at from (xbar_transfer tests that first, without building a list). */
+/* The first cycle s >= from at which a transfer of len cycles finds a free port in each of its
+ * cycles, given the other users' transfers; called when running() finds every port taken at from
+ * (xbar_transfer tests that first, without building a list). */
 static uint64_t earliest(const Xbar *x, uint64_t from, uint64_t len, XbarUser user)
 {
     XbarIvl iv[XBAR_AGU_MAX + 2];

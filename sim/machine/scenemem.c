@@ -85,7 +85,29 @@ static uint64_t bus_fill(SceneMem *m, uint64_t t)
     return s + (uint64_t)m->p.latency + (uint64_t)m->xfer;
 }
 
-static uint64_t mem_miss(SceneMem *m, uint64_t line, size_t set, uint64_t t, int write);
+/* A miss of line (in set) at cycle t: the least recently used way takes it. */
+static uint64_t mem_miss(SceneMem *m, uint64_t line, size_t set, uint64_t t, int write)
+{
+    const size_t w = (size_t)m->p.ways;
+    uint64_t *tag = m->tag + set * w;
+    m->st.misses++;
+    size_t victim = 0;
+    for (size_t i = 1; i < w; i++)
+        if (m->lru[set * w + i] < m->lru[set * w + victim])
+            victim = i;
+    size_t k = set * w + victim;
+    if (tag[victim] && m->dirty[k]) { /* write the victim back: bus time, nobody waits */
+        m->st.writebacks++;
+        m->bus_free = (t > m->bus_free ? t : m->bus_free) + (uint64_t)m->xfer;
+        m->st.bus_bytes += (uint64_t)m->p.line_bytes;
+    }
+    tag[victim] = line + 1;
+    m->lru[k] = m->stamp;
+    m->dirty[k] = (uint8_t)(write != 0);
+    m->ready[k] = bus_fill(m, t);
+    m->last_way = k;
+    return m->ready[k];
+}
 
 uint64_t mem_access(SceneMem *m, int space, uint32_t addr, uint64_t t, int write)
 {
@@ -119,30 +141,6 @@ uint64_t mem_access(SceneMem *m, int space, uint32_t addr, uint64_t t, int write
     m->dirty[k] |= (uint8_t)(write != 0);
     const uint64_t r = t + (uint64_t)m->p.hit_latency;
     return r > m->ready[k] ? r : m->ready[k];
-}
-
-/* A miss of line (in set) at cycle t: the least recently used way takes it. */
-static uint64_t mem_miss(SceneMem *m, uint64_t line, size_t set, uint64_t t, int write)
-{
-    const size_t w = (size_t)m->p.ways;
-    uint64_t *tag = m->tag + set * w;
-    m->st.misses++;
-    size_t victim = 0;
-    for (size_t i = 1; i < w; i++)
-        if (m->lru[set * w + i] < m->lru[set * w + victim])
-            victim = i;
-    size_t k = set * w + victim;
-    if (tag[victim] && m->dirty[k]) { /* write the victim back: bus time, nobody waits */
-        m->st.writebacks++;
-        m->bus_free = (t > m->bus_free ? t : m->bus_free) + (uint64_t)m->xfer;
-        m->st.bus_bytes += (uint64_t)m->p.line_bytes;
-    }
-    tag[victim] = line + 1;
-    m->lru[k] = m->stamp;
-    m->dirty[k] = (uint8_t)(write != 0);
-    m->ready[k] = bus_fill(m, t);
-    m->last_way = k;
-    return m->ready[k];
 }
 
 /* mem_issue of more than one lane: each distinct line is one access. */
