@@ -57,6 +57,7 @@ struct Core {
     uint32_t pc;
     uint8_t stage;
     uint8_t gen;                  /* statistics generation (sgen) */
+    uint64_t rec_hi;              /* core_record_word(0, stage, gen), kept by count_select_row */
     int cur_rb;                   /* physical buffer (0/1) that is RBc */
     uint8_t *mem[CORE_MEM_COUNT];
     uint32_t size[CORE_MEM_COUNT];
@@ -75,6 +76,8 @@ struct Core {
     uint64_t total;
     CoreHook hook;
     void *hook_ctx;
+    CoreFollow *follow;           /* the hook's, or &no_follow */
+    CoreFollow no_follow;         /* where = CORE_FOLLOW_NONE */
     CoreRecord rec;
     char trap[1024];
 };
@@ -86,6 +89,7 @@ static void count_select_row(Core *c)
 {
     uint32_t r = (uint32_t)c->stage * CORE_GENERATIONS + c->gen;
     c->row = c->counts + (size_t)r * COUNT_COLS;
+    c->rec_hi = core_record_word(0, c->stage, c->gen);
     c->touched[r / 64] |= 1ull << (r % 64);
 }
 
@@ -256,6 +260,8 @@ Core *core_new(const CoreParams *p, const AsmObject *obj, char *err, size_t errl
         return NULL;
     }
     Core *c = calloc(1, sizeof *c);
+    if (c)
+        core_set_follow(c, NULL);
     if (!c) {
         snprintf(err, errlen, "out of memory");
         return NULL;
@@ -527,19 +533,13 @@ static inline uint64_t bits_of_bytes8(const uint8_t *b)
 #define SETF(i, x) (c->r[i] = u_of(x))
 #define IMM (in->imm)
 
-static void record_reset(CoreRecord *rec, uint32_t pc, const IsaInstr *in, uint8_t stage, uint8_t gen,
-                         uint64_t exec)
+static void record_reset(CoreRecord *rec, uint64_t where, const IsaInstr *in, uint64_t exec)
 {
-    rec->pc = pc;
+    core_record_start(rec, where);
     rec->in = in;
-    rec->stage = stage;
-    rec->gen = gen;
-    rec->base = 0;
-    rec->taken = 0;
-    rec->mem = CORE_MEM_COUNT;
-    rec->naddr = 0;
-    rec->count = 0;
     rec->exec = exec;
+    /* naddr, count and base are 0 here: only the memory families set them, and the run loop puts
+     * them back to 0 after such an instruction's hook (and at its start). */
 }
 
 static inline void rec_addr(Core *c, int hooked, CoreMem m, uint32_t a)
@@ -548,6 +548,16 @@ static inline void rec_addr(Core *c, int hooked, CoreMem m, uint32_t a)
         c->rec.mem = (uint8_t)m;
         if (c->rec.naddr < ISA_MAX_LANES)
             c->rec.addr[c->rec.naddr++] = a;
+    }
+}
+
+/* A lane loop's addresses: each lane's written at addr[k++] as the loop goes (k a local, so the
+ * lanes do not wait on each other through naddr in memory), then the count and memory once. */
+static inline void rec_addrs_done(Core *c, int hooked, CoreMem m, int k)
+{
+    if (hooked && k) {
+        c->rec.naddr = (uint8_t)k;
+        c->rec.mem = (uint8_t)m;
     }
 }
 
@@ -895,9 +905,12 @@ static ALWAYS_INLINE int exec_stream(Core *c, Exec *x, IsaOp op)
             return -trap(c, "bad stream: end 0x%08x beyond ID-stream memory (size %u)", e, c->size[CORE_MEM_IDM]);
         uint32_t avail = (e - b) / 4, k = avail < (uint32_t)n ? avail : (uint32_t)n;
         VReg *A = &c->v[in->a];
-        for (uint32_t l = 0; l < k; l++) {
+        for (uint32_t l = 0; l < k; l++)
             A->u[l] = rd32(c, CORE_MEM_IDM, b + 4 * l);
-            rec_addr(c, x->hooked, CORE_MEM_IDM, b + 4 * l);
+        if (x->hooked) {
+            for (uint32_t l = 0; l < k; l++)
+                c->rec.addr[l] = b + 4 * l;
+            rec_addrs_done(c, 1, CORE_MEM_IDM, (int)k);
         }
         if (k > 0)
             for (uint32_t l = k; l < (uint32_t)n; l++)
@@ -934,13 +947,16 @@ static ALWAYS_INLINE int exec_stream(Core *c, Exec *x, IsaOp op)
         if (x->hooked)
             c->rec.base = p;
         const VReg *B = &c->v[in->b];
+        int k = 0;
         for (uint64_t e_ = E; e_; e_ &= e_ - 1) { /* the exec-mask lanes, lowest first */
             const int l = __builtin_ctzll(e_);
             MEMCHK(CORE_MEM_IDM, p, "append");
             wr32(c, CORE_MEM_IDM, p, B->u[l]);
-            rec_addr(c, x->hooked, CORE_MEM_IDM, p);
+            if (x->hooked)
+                c->rec.addr[k++] = p;
             p += 4;
         }
+        rec_addrs_done(c, x->hooked, CORE_MEM_IDM, k);
         SR(in->a) = p;
         break;
     }
@@ -996,6 +1012,7 @@ static ALWAYS_INLINE int exec_rbuf(Core *c, Exec *x, IsaOp op)
                 rec_lanes(c, m, base, B, E, n);
             break;
         }
+        int k = 0;
         for (uint64_t e = E; e; e &= e - 1) { /* the exec-mask lanes, lowest first */
             const int l = __builtin_ctzll(e);
             /* In 64 bits, so a huge ray ID cannot wrap around onto a valid address. */
@@ -1009,8 +1026,10 @@ static ALWAYS_INLINE int exec_rbuf(Core *c, Exec *x, IsaOp op)
                 wr32(c, m, a, A->u[l]);
             else
                 A->u[l] = rd32(c, m, a);
-            rec_addr(c, x->hooked, m, a);
+            if (x->hooked)
+                c->rec.addr[k++] = a;
         }
+        rec_addrs_done(c, x->hooked, m, k);
         break;
     }
     case ISA_OP_RSWAP: c->cur_rb ^= 1; break;
@@ -1062,6 +1081,7 @@ static ALWAYS_INLINE int exec_memory(Core *c, Exec *x, IsaOp op)
         int store = op == ISA_OP_VSPST;
         uint32_t base = SR(in->b) + IMM;
         VReg *A = &c->v[in->a];
+        int k = 0;
         for (uint64_t e_ = E; e_; e_ &= e_ - 1) { /* the exec-mask lanes, lowest first */
             const int l = __builtin_ctzll(e_);
             uint32_t a = base + 4u * (uint32_t)l;
@@ -1070,8 +1090,10 @@ static ALWAYS_INLINE int exec_memory(Core *c, Exec *x, IsaOp op)
                 wr32(c, CORE_MEM_SPAD, a, A->u[l]);
             else
                 A->u[l] = rd32(c, CORE_MEM_SPAD, a);
-            rec_addr(c, x->hooked, CORE_MEM_SPAD, a);
+            if (x->hooked)
+                c->rec.addr[k++] = a;
         }
+        rec_addrs_done(c, x->hooked, CORE_MEM_SPAD, k);
         break;
     }
     case ISA_OP_LD: {
@@ -1101,24 +1123,30 @@ static ALWAYS_INLINE int exec_memory(Core *c, Exec *x, IsaOp op)
     case ISA_OP_LDG: {
         VReg *A = &c->v[in->a];
         const VReg *B = &c->v[in->b];
+        int k = 0;
         for (uint64_t e_ = E; e_; e_ &= e_ - 1) { /* the exec-mask lanes, lowest first */
             const int l = __builtin_ctzll(e_);
             uint32_t a = B->u[l] + IMM;
             MEMCHK(CORE_MEM_SCENE, a, "gather");
             A->u[l] = rd32(c, CORE_MEM_SCENE, a);
-            rec_addr(c, x->hooked, CORE_MEM_SCENE, a);
+            if (x->hooked)
+                c->rec.addr[k++] = a;
         }
+        rec_addrs_done(c, x->hooked, CORE_MEM_SCENE, k);
         break;
     }
     case ISA_OP_FBADD: {
         const VReg *A = &c->v[in->a], *B = &c->v[in->b];
+        int k = 0;
         for (uint64_t e_ = E; e_; e_ &= e_ - 1) { /* the exec-mask lanes, lowest first */
             const int l = __builtin_ctzll(e_);
             uint32_t a = B->u[l] + IMM;
             MEMCHK(CORE_MEM_FB, a, "scatter-add");
             wr32(c, CORE_MEM_FB, a, u_of(f_of(rd32(c, CORE_MEM_FB, a)) + A->f[l]));
-            rec_addr(c, x->hooked, CORE_MEM_FB, a);
+            if (x->hooked)
+                c->rec.addr[k++] = a;
         }
+        rec_addrs_done(c, x->hooked, CORE_MEM_FB, k);
         break;
     }
     default: return no_semantics(c, op, "the memory family");
@@ -1186,6 +1214,13 @@ void core_set_hook(Core *c, CoreHook hook, void *ctx)
 {
     c->hook = hook;
     c->hook_ctx = ctx;
+    core_set_follow(c, NULL);
+}
+
+void core_set_follow(Core *c, CoreFollow *f)
+{
+    c->no_follow.where = CORE_FOLLOW_NONE;
+    c->follow = f ? f : &c->no_follow;
 }
 
 int core_lanes(const Core *c) { return c->n; }

@@ -86,6 +86,42 @@ static inline uint64_t core_record_where(const CoreRecord *r)
 #endif
 }
 
+/* core_record_where()'s number for a record of pc, stage and generation with no branch taken. */
+static inline uint64_t core_record_word(uint32_t pc, uint8_t stage, uint8_t gen)
+{
+    return (uint64_t)pc | (uint64_t)stage << 32 | (uint64_t)gen << 40;
+}
+
+/* Sets a new record's pc, stage and generation (w: core_record_word), taken flag 0 and no memory
+ * touched, in one store on a little-endian host: a load of the same eight bytes then comes
+ * straight from that store (separate byte stores make the host wait for them to reach the cache
+ * before such a load). */
+static inline void core_record_start(CoreRecord *r, uint64_t w)
+{
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+    _Static_assert(offsetof(CoreRecord, mem) == 7, "core_record_start writes the fields in one store");
+    w |= (uint64_t)CORE_MEM_COUNT << 56;
+    memcpy(r, &w, sizeof w);
+#else
+    r->pc = (uint32_t)w;
+    r->stage = (uint8_t)(w >> 32);
+    r->gen = (uint8_t)(w >> 40);
+    r->taken = 0;
+    r->mem = CORE_MEM_COUNT;
+#endif
+}
+
+/* A run of records the hook has said it only needs counted (the timing model replaying a stored
+ * block: docs/performance.md, "Records a replay only counts"). While the next record's
+ * core_record_where() is `where` and its pc is not `last`, the core adds one to `where` instead of
+ * calling the hook; any other record goes to the hook as usual. The hook's owner keeps the struct
+ * and sets where to CORE_FOLLOW_NONE when no such run is open. */
+typedef struct CoreFollow {
+    uint64_t where;
+    uint32_t last;
+} CoreFollow;
+#define CORE_FOLLOW_NONE UINT64_MAX /* matches no record: core_record_where's top byte is 0 */
+
 typedef struct Core Core;
 
 /* Build a core for obj (decoded once here; an undecodable word fails). Memories are zeroed,
@@ -123,6 +159,8 @@ CoreExit core_run_slice(Core *c, uint64_t max_instr, uint64_t limit);
 const char *core_trap_message(const Core *c);
 
 void core_set_hook(Core *c, CoreHook hook, void *ctx);
+/* The hook's CoreFollow (see there), or NULL for none; core_set_hook clears it. */
+void core_set_follow(Core *c, CoreFollow *f);
 
 /* State access (for tests, the CLI and the renderer). */
 int core_lanes(const Core *c);

@@ -34,7 +34,7 @@ static __attribute__((noinline)) CoreExit CORE_LOOP_NAME(Core *c, uint64_t max_i
     uint64_t left = max_instr ? max_instr : UINT64_MAX;
     const Dec *dc;
     const IsaInstr *in;
-    uint64_t E, *row;
+    uint64_t E, *row, where = 0; /* where: the record's core_record_word, hooked */
     Exec x;
     int r;
 
@@ -46,12 +46,19 @@ static __attribute__((noinline)) CoreExit CORE_LOOP_NAME(Core *c, uint64_t max_i
         in = &dc->in;                                                                           \
         E = c->m[dc->emask] & c->all;                                                           \
         x = (Exec){.in = in, .E = E, .n = n, .next = c->pc + 1, .lanes = E, .hooked = hooked};  \
-        if (hooked)                                                                             \
-            record_reset(&c->rec, c->pc, in, c->stage, c->gen, E);                              \
+        if (hooked) {                                                                           \
+            where = c->pc | c->rec_hi;                                                          \
+            record_reset(&c->rec, where, in, E);                                                \
+        }                                                                                       \
         row = c->row; /* counted in the stage and generation before the instruction */          \
         goto *disp[in->op];                                                                     \
     } while (0)
 
+    if (hooked) { /* record_reset leaves these to the memory families (a trap may have left them set) */
+        c->rec.naddr = 0;
+        c->rec.count = 0;
+        c->rec.base = 0;
+    }
     CORE_NEXT();
 #define ISA_OP(name, code, mnem, fmt, acc, unit, cat, flags, desc)                              \
     op_##name:                                                                                  \
@@ -63,8 +70,20 @@ static __attribute__((noinline)) CoreExit CORE_LOOP_NAME(Core *c, uint64_t max_i
             row[ISA_OP_COUNT] += (uint64_t)popcount64(x.lanes);                                 \
         c->total++;                                                                             \
         if (hooked) {                                                                           \
-            c->rec.next_pc = x.halt ? c->pc : x.next;                                           \
-            c->hook(c->hook_ctx, &c->rec);                                                      \
+            CoreFollow *f_ = c->follow;                                                         \
+            if ((where | (uint64_t)c->rec.taken << 48) == f_->where && (uint32_t)where != f_->last) { \
+                f_->where++;                                                                    \
+            } else {                                                                            \
+                c->rec.next_pc = x.halt ? c->pc : x.next;                                       \
+                c->hook(c->hook_ctx, &c->rec);                                                  \
+            }                                                                                   \
+            if (ISA_U_##unit == ISA_U_AGU || ISA_U_##unit == ISA_U_RBUF ||                      \
+                ISA_U_##unit == ISA_U_PART || ISA_U_##unit == ISA_U_SPAD ||                     \
+                ISA_U_##unit == ISA_U_SCENE || ISA_U_##unit == ISA_U_FB) {                      \
+                c->rec.naddr = 0; /* what record_reset leaves to the memory families */         \
+                c->rec.count = 0;                                                               \
+                c->rec.base = 0;                                                                \
+            }                                                                                   \
         }                                                                                       \
         if (x.halt)                                                                             \
             return CORE_EXIT_HALT;                                                              \

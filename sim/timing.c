@@ -147,10 +147,12 @@ struct Timing {
                                       outcome) or MM_REPLAY (following a stored block) */
     uint64_t m_t0;                 /* the block's start cycle */
     uint8_t m_stage, m_gen;
-    uint64_t m_where;              /* replay: the next record on the path as core_record_where()
-                                      gives it with no branch taken: its pc (the records matched
-                                      so far: that pc - m_pc0), the block's stage and generation */
-    uint32_t m_last;               /* replay: the pc of the block's last record */
+    CoreFollow follow;             /* replay (else where = CORE_FOLLOW_NONE): where, the next
+                                      record on the path as core_record_where() gives it with no
+                                      branch taken: its pc (the records matched so far: that pc -
+                                      m_pc0), the block's stage and generation; last, the pc of the
+                                      block's last record. A core given it (timing_follow) counts
+                                      the records inside the block itself */
     MemoEntry *m_e;                /* replay: the stored block */
     uint32_t m_pc0;                /* the block's first instruction (its MemoWays): a pc, not a
                                       pointer, since the table may grow during the block */
@@ -227,6 +229,7 @@ void timing_reset(Timing *t)
     mem_reset(&t->mem);
     t->halted = 0;
     t->mmode = MM_NONE;
+    t->follow.where = CORE_FOLLOW_NONE;
     if (++t->run == 0) { /* wrapped: no entry may look current */
         for (uint32_t i = 0; i < t->desc_cap; i++)
             free(t->desc[i].memo);
@@ -772,6 +775,7 @@ static void memo_apply(Timing *t, const MemoEntry *e)
         push(t, t0 + v->rel, v->kind, v->arg, 0, v->cause);
     }
     t->mmode = MM_NONE;
+    t->follow.where = CORE_FOLLOW_NONE;
     t->memo_replays++;
 }
 
@@ -779,8 +783,10 @@ static void memo_apply(Timing *t, const MemoEntry *e)
  * the block's start state, which nothing has changed yet. */
 static void memo_unwind(Timing *t)
 {
+    const uint32_t n = (uint32_t)t->follow.where - t->m_pc0;
     t->mmode = MM_NONE;
-    for (uint32_t i = 0; i < (uint32_t)t->m_where - t->m_pc0; i++) {
+    t->follow.where = CORE_FOLLOW_NONE;
+    for (uint32_t i = 0; i < n; i++) {
         CoreRecord r;
         memset(&r, 0, offsetof(CoreRecord, addr));
         r.pc = t->m_pc0 + i;
@@ -810,8 +816,8 @@ static __attribute__((noinline)) int memo_begin(Timing *t, TmDesc *d, const Core
             MemoEntry *e = &d->memo->e[w];
             if (memo_match(t, e, rec, ev, nev)) {
                 t->m_e = e;
-                t->m_where = core_record_where(rec) + 1; /* the next pc; not taken (memo_match) */
-                t->m_last = rec->pc + e->len - 1u;
+                t->follow.where = core_record_where(rec) + 1; /* the next pc; not taken (memo_match) */
+                t->follow.last = rec->pc + e->len - 1u;
                 t->mmode = MM_REPLAY;
                 if (e->len == 1)
                     memo_apply(t, e);
@@ -994,19 +1000,21 @@ void timing_hook(void *ctx, const CoreRecord *rec)
     Timing *t = ctx;
     if (t->mmode == MM_REPLAY) { /* the next record of a stored block: only checked */
         const uint64_t w = core_record_where(rec); /* pc, stage, generation, taken */
-        if (rec->pc != t->m_last) { /* inside the block: the next pc, no branch taken */
-            if (__builtin_expect(w == t->m_where, 1)) {
-                t->m_where++;
+        if (rec->pc != t->follow.last) { /* inside the block: the next pc, no branch taken */
+            if (__builtin_expect(w == t->follow.where, 1)) {
+                t->follow.where++;
                 return;
             }
-        } else if (w == (t->m_where | (uint64_t)t->m_e->taken_last << 48)) {
-            t->m_where++;
+        } else if (w == (t->follow.where | (uint64_t)t->m_e->taken_last << 48)) {
+            t->follow.where++;
             memo_apply(t, t->m_e);
             return;
         }
     }
     hook_any(t, rec);
 }
+
+CoreFollow *timing_follow(Timing *t) { return &t->follow; }
 
 void timing_set_memo(Timing *t, int on)
 {
@@ -1024,6 +1032,7 @@ void timing_end(Timing *t)
     if (t->mmode == MM_REPLAY) /* stopped inside a replayed block: time what came */
         memo_unwind(t);
     t->mmode = MM_NONE;
+    t->follow.where = CORE_FOLLOW_NONE;
     if (!t->halted) {
         t->st.cycles += t->now;
         t->st.runs++;

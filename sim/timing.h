@@ -102,6 +102,9 @@ void timing_free(Timing *t);
 void timing_reset(Timing *t);
 /* The CoreHook: one executed instruction. */
 void timing_hook(void *ctx, const CoreRecord *rec);
+/* Where a core hooked to t counts the records of a replayed block without calling the hook
+ * (core_set_follow(core, timing_follow(t)) after core_set_hook): the same results, fewer calls. */
+CoreFollow *timing_follow(Timing *t);
 /* Memoized blocks on (the default) or off: the same results either way (tests/unit/test_timing.c
  * compares them); off only to check that. */
 void timing_set_memo(Timing *t, int on);

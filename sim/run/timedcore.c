@@ -21,6 +21,7 @@ int timedcore_open(TimedCore *tc, const CfgMachine *cfg, const AsmObject *obj, i
             return -2;
         }
         core_set_hook(tc->core, timing_hook, tc->tm);
+        core_set_follow(tc->core, timing_follow(tc->tm));
     }
     return 0;
 }

@@ -392,19 +392,34 @@ Test(timing, a_model_reused_for_another_program_times_it_as_a_fresh_one)
     }
 }
 
-/* prog (or src, assembly text, when not NULL) timed on a fresh model with the memo of blocks on
- * or off, stopped by an instruction limit (0: run to its halt); the blocks it replayed. */
+/* How a run_memo run times blocks: the memo off; on, with every record going to the hook; on,
+ * with the core counting a replayed block's records itself (timing_follow, as sfsim runs it). */
+enum { MEMO_OFF, MEMO_HOOK, MEMO_FOLLOW };
+
+static uint64_t hook_calls; /* records the last run_memo run's hook was given */
+
+static void counting_hook(void *ctx, const CoreRecord *rec)
+{
+    hook_calls++;
+    timing_hook(ctx, rec);
+}
+
+/* prog (or src, assembly text, when not NULL) timed on a fresh model with the memo of blocks as
+ * memo says, stopped by an instruction limit (0: run to its halt); the blocks it replayed. */
 static TimingStats run_memo_src(const BenchProg *p, const char *src, int memo, uint64_t limit, uint64_t *replays)
 {
     CoreParams cp;
     Timing *t = default_timing(&cp);
     char err[512];
-    timing_set_memo(t, memo);
+    timing_set_memo(t, memo != MEMO_OFF);
     AsmObject obj;
     assemble_prog(p, src, &obj);
     Core *c = core_new(&cp, &obj, err, sizeof err);
     cr_assert(c, "%s: %s", p->file, err);
-    core_set_hook(c, timing_hook, t);
+    hook_calls = 0;
+    core_set_hook(c, counting_hook, t);
+    if (memo == MEMO_FOLLOW)
+        core_set_follow(c, timing_follow(t));
     CoreExit ex = core_run(c, limit ? limit : 1000000);
     cr_assert(ex == CORE_EXIT_HALT || (limit && ex == CORE_EXIT_LIMIT), "%s: %s", p->file, core_trap_message(c));
     timing_end(t);
@@ -483,16 +498,27 @@ Test(timing, memoized_blocks_leave_a_stored_path_at_a_taken_branch_or_another_ge
 {
     BenchProg prog = {"memo_paths.s", NULL, 0};
     uint64_t r_on, r_off;
-    TimingStats on = run_memo_src(&prog, memo_paths, 1, 0, &r_on), off = run_memo_src(&prog, memo_paths, 0, 0, &r_off);
-    cr_expect(memcmp(&on, &off, sizeof on) == 0, "cycles %llu with the memo, %llu without", (unsigned long long)on.cycles,
-              (unsigned long long)off.cycles);
-    cr_expect_gt(r_on, 100u, "the blocks recur: %llu replayed", (unsigned long long)r_on);
-    cr_expect_gt(on.gen_busy[32], 0u, "the loop runs in generation 32 too");
-    cr_expect_gt(on.gen_busy[2], 0u, "and in generation 2");
-    for (uint64_t limit = 1; limit < on.busy; limit += limit < 200 ? 1 : 11) {
-        TimingStats a = run_memo_src(&prog, memo_paths, 1, limit, &r_on), b = run_memo_src(&prog, memo_paths, 0, limit, &r_off);
-        cr_expect(memcmp(&a, &b, sizeof a) == 0, "stopped after %llu instructions: cycles %llu with the memo, %llu without",
-                  (unsigned long long)limit, (unsigned long long)a.cycles, (unsigned long long)b.cycles);
+    TimingStats off = run_memo_src(&prog, memo_paths, MEMO_OFF, 0, &r_off);
+    cr_expect_eq(hook_calls, off.busy, "without the memo every record goes to the hook");
+    for (int memo = MEMO_HOOK; memo <= MEMO_FOLLOW; memo++) {
+        TimingStats on = run_memo_src(&prog, memo_paths, memo, 0, &r_on);
+        cr_expect(memcmp(&on, &off, sizeof on) == 0, "memo mode %d: cycles %llu with the memo, %llu without", memo,
+                  (unsigned long long)on.cycles, (unsigned long long)off.cycles);
+        cr_expect_gt(r_on, 100u, "the blocks recur: %llu replayed", (unsigned long long)r_on);
+        cr_expect_gt(on.gen_busy[32], 0u, "the loop runs in generation 32 too");
+        cr_expect_gt(on.gen_busy[2], 0u, "and in generation 2");
+        if (memo == MEMO_FOLLOW) /* the records inside replayed blocks were counted by the core */
+            cr_expect_lt(hook_calls + r_on, off.busy, "the core following: %llu hook calls for %llu records",
+                         (unsigned long long)hook_calls, (unsigned long long)off.busy);
+        else
+            cr_expect_eq(hook_calls, off.busy);
+        for (uint64_t limit = 1; limit < on.busy; limit += limit < 200 ? 1 : 11) {
+            TimingStats a = run_memo_src(&prog, memo_paths, memo, limit, &r_on),
+                        b = run_memo_src(&prog, memo_paths, MEMO_OFF, limit, &r_off);
+            cr_expect(memcmp(&a, &b, sizeof a) == 0,
+                      "memo mode %d, stopped after %llu instructions: cycles %llu with the memo, %llu without", memo,
+                      (unsigned long long)limit, (unsigned long long)a.cycles, (unsigned long long)b.cycles);
+        }
     }
 }
 
@@ -510,14 +536,14 @@ Test(timing, memoized_blocks_give_the_same_figures_as_timing_each_instruction)
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; i++) {
         const BenchProg *p = &progs[i];
         uint64_t r_on, r_off;
-        TimingStats on = run_memo(p, 1, 0, &r_on), off = run_memo(p, 0, 0, &r_off);
+        TimingStats on = run_memo(p, MEMO_FOLLOW, 0, &r_on), off = run_memo(p, MEMO_OFF, 0, &r_off);
         cr_assert_eq(r_off, 0u, "%s: the memo replayed blocks while off", p->file);
         cr_expect(memcmp(&on, &off, sizeof on) == 0, "%s %s=%lld: cycles %llu with the memo, %llu without", p->file,
                   p->define ? p->define : "", p->value, (unsigned long long)on.cycles, (unsigned long long)off.cycles);
         replayed_any += r_on;
         const uint64_t n = on.busy; /* one issue cycle per instruction */
         for (uint64_t limit = 1; limit < n; limit += limit < 300 ? 1 : 97) {
-            TimingStats a = run_memo(p, 1, limit, &r_on), b = run_memo(p, 0, limit, &r_off);
+            TimingStats a = run_memo(p, MEMO_FOLLOW, limit, &r_on), b = run_memo(p, MEMO_OFF, limit, &r_off);
             cr_expect(memcmp(&a, &b, sizeof a) == 0, "%s stopped after %llu instructions: cycles %llu with the memo, %llu without",
                       p->file, (unsigned long long)limit, (unsigned long long)a.cycles, (unsigned long long)b.cycles);
         }
@@ -525,14 +551,19 @@ Test(timing, memoized_blocks_give_the_same_figures_as_timing_each_instruction)
     (void)replayed_any; /* the micro-benchmarks are straight lines: they check recording */
     BenchProg loop = {"memo_loop.s", NULL, 0};
     uint64_t r_on, r_off;
-    TimingStats on = run_memo_src(&loop, memo_loop, 1, 0, &r_on), off = run_memo_src(&loop, memo_loop, 0, 0, &r_off);
-    cr_expect(memcmp(&on, &off, sizeof on) == 0, "the loop: cycles %llu with the memo, %llu without",
-              (unsigned long long)on.cycles, (unsigned long long)off.cycles);
-    cr_expect_gt(r_on, 300u, "the loop's blocks recur: %llu replayed", (unsigned long long)r_on);
-    cr_expect_gt(on.stalls[TM_FU_BUSY] + on.stalls[TM_DATA_DEPENDENCY], 0u, "the loop stalls");
-    for (uint64_t limit = 1; limit < on.busy; limit += limit < 400 ? 1 : 13) {
-        TimingStats a = run_memo_src(&loop, memo_loop, 1, limit, &r_on), b = run_memo_src(&loop, memo_loop, 0, limit, &r_off);
-        cr_expect(memcmp(&a, &b, sizeof a) == 0, "the loop stopped after %llu instructions: cycles %llu with the memo, %llu without",
-                  (unsigned long long)limit, (unsigned long long)a.cycles, (unsigned long long)b.cycles);
+    TimingStats off = run_memo_src(&loop, memo_loop, MEMO_OFF, 0, &r_off);
+    for (int memo = MEMO_HOOK; memo <= MEMO_FOLLOW; memo++) {
+        TimingStats on = run_memo_src(&loop, memo_loop, memo, 0, &r_on);
+        cr_expect(memcmp(&on, &off, sizeof on) == 0, "the loop, memo mode %d: cycles %llu with the memo, %llu without",
+                  memo, (unsigned long long)on.cycles, (unsigned long long)off.cycles);
+        cr_expect_gt(r_on, 300u, "the loop's blocks recur: %llu replayed", (unsigned long long)r_on);
+        cr_expect_gt(on.stalls[TM_FU_BUSY] + on.stalls[TM_DATA_DEPENDENCY], 0u, "the loop stalls");
+        for (uint64_t limit = 1; limit < on.busy; limit += limit < 400 ? 1 : 13) {
+            TimingStats a = run_memo_src(&loop, memo_loop, memo, limit, &r_on),
+                        b = run_memo_src(&loop, memo_loop, MEMO_OFF, limit, &r_off);
+            cr_expect(memcmp(&a, &b, sizeof a) == 0,
+                      "the loop, memo mode %d, stopped after %llu instructions: cycles %llu with the memo, %llu without",
+                      memo, (unsigned long long)limit, (unsigned long long)a.cycles, (unsigned long long)b.cycles);
+        }
     }
 }
