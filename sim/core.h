@@ -70,37 +70,39 @@ typedef struct CoreRecord {
 
 typedef void (*CoreHook)(void *ctx, const CoreRecord *rec);
 
-/* A record's pc, stage, generation and taken flag as one number: the pc in the low 32 bits, then
- * the stage, the generation and the flag a byte each (the timing model compares them at once; the
- * fields sit side by side in this order, so a compiler can read them in one load). */
+/* A record's pc, stage, generation, taken flag and memory as one number: the pc in the low 32
+ * bits, then the stage, the generation, the flag and the memory a byte each (the timing model
+ * compares them at once; the fields sit side by side in this order, so a compiler can read them
+ * in one load). */
 static inline uint64_t core_record_where(const CoreRecord *r)
 {
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
     _Static_assert(offsetof(CoreRecord, stage) == 4 && offsetof(CoreRecord, gen) == 5 &&
-                       offsetof(CoreRecord, taken) == 6, "core_record_where reads the fields in one load");
+                       offsetof(CoreRecord, taken) == 6 && offsetof(CoreRecord, mem) == 7,
+                   "core_record_where reads the fields in one load");
     uint64_t w;
     memcpy(&w, r, sizeof w);
-    return w & 0x00ffffffffffffffull; /* not mem, the byte after taken */
+    return w;
 #else
-    return (uint64_t)r->pc | (uint64_t)r->stage << 32 | (uint64_t)r->gen << 40 | (uint64_t)r->taken << 48;
+    return (uint64_t)r->pc | (uint64_t)r->stage << 32 | (uint64_t)r->gen << 40 | (uint64_t)r->taken << 48 |
+           (uint64_t)r->mem << 56;
 #endif
 }
 
-/* core_record_where()'s number for a record of pc, stage and generation with no branch taken. */
+/* core_record_where()'s number for a record of pc, stage and generation with no branch taken and
+ * no memory touched (CORE_MEM_COUNT). */
 static inline uint64_t core_record_word(uint32_t pc, uint8_t stage, uint8_t gen)
 {
-    return (uint64_t)pc | (uint64_t)stage << 32 | (uint64_t)gen << 40;
+    return (uint64_t)pc | (uint64_t)stage << 32 | (uint64_t)gen << 40 | (uint64_t)CORE_MEM_COUNT << 56;
 }
 
-/* Sets a new record's pc, stage and generation (w: core_record_word), taken flag 0 and no memory
- * touched, in one store on a little-endian host: a load of the same eight bytes then comes
- * straight from that store (separate byte stores make the host wait for them to reach the cache
- * before such a load). */
+/* Sets a new record's pc, stage, generation, taken flag (0) and memory (none) to w, a
+ * core_record_word, in one store on a little-endian host: a load of the same eight bytes then
+ * comes straight from that store (separate byte stores make the host wait for them to reach the
+ * cache before such a load). */
 static inline void core_record_start(CoreRecord *r, uint64_t w)
 {
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
-    _Static_assert(offsetof(CoreRecord, mem) == 7, "core_record_start writes the fields in one store");
-    w |= (uint64_t)CORE_MEM_COUNT << 56;
     memcpy(r, &w, sizeof w);
 #else
     r->pc = (uint32_t)w;
@@ -120,7 +122,7 @@ typedef struct CoreFollow {
     uint64_t where;
     uint32_t last;
 } CoreFollow;
-#define CORE_FOLLOW_NONE UINT64_MAX /* matches no record: core_record_where's top byte is 0 */
+#define CORE_FOLLOW_NONE UINT64_MAX /* matches no record: core_record_where's top byte is <= CORE_MEM_COUNT */
 
 typedef struct Core Core;
 

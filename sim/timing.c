@@ -149,8 +149,9 @@ struct Timing {
     uint8_t m_stage, m_gen;
     CoreFollow follow;             /* replay (else where = CORE_FOLLOW_NONE): where, the next
                                       record on the path as core_record_where() gives it with no
-                                      branch taken: its pc (the records matched so far: that pc -
-                                      m_pc0), the block's stage and generation; last, the pc of the
+                                      branch taken and no memory touched: its pc (the records
+                                      matched so far: that pc - m_pc0), the block's stage and
+                                      generation; last, the pc of the
                                       block's last record. A core given it (timing_follow) counts
                                       the records inside the block itself */
     MemoEntry *m_e;                /* replay: the stored block */
@@ -1015,7 +1016,7 @@ void timing_hook(void *ctx, const CoreRecord *rec)
 {
     Timing *t = ctx;
     if (t->mmode == MM_REPLAY) { /* the next record of a stored block: only checked */
-        const uint64_t w = core_record_where(rec); /* pc, stage, generation, taken */
+        const uint64_t w = core_record_where(rec); /* pc, stage, generation, taken, memory */
         if (rec->pc != t->follow.last) { /* inside the block: the next pc, no branch taken */
             if (__builtin_expect(w == t->follow.where, 1)) {
                 t->follow.where++;
