@@ -260,12 +260,11 @@ Core *core_new(const CoreParams *p, const AsmObject *obj, char *err, size_t errl
         return NULL;
     }
     Core *c = calloc(1, sizeof *c);
-    if (c)
-        core_set_follow(c, NULL);
     if (!c) {
         snprintf(err, errlen, "out of memory");
         return NULL;
     }
+    core_set_follow(c, NULL);
     c->n = p->lanes;
     c->all = p->lanes == 64 ? ~0ull : (1ull << p->lanes) - 1;
     c->obj = obj;

@@ -151,9 +151,9 @@ struct Timing {
                                       record on the path as core_record_where() gives it with no
                                       branch taken and no memory touched: its pc (the records
                                       matched so far: that pc - m_pc0), the block's stage and
-                                      generation; last, the pc of the
-                                      block's last record. A core given it (timing_follow) counts
-                                      the records inside the block itself */
+                                      generation; last, the pc of the block's last record. A core
+                                      given it (timing_follow) counts the records inside the block
+                                      itself */
     MemoEntry *m_e;                /* replay: the stored block */
     uint32_t m_pc0;                /* the block's first instruction (its MemoWays): a pc, not a
                                       pointer, since the table may grow during the block */
