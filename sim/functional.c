@@ -98,8 +98,7 @@ static void timing_begin(Worker *w, Core *c, TimingStats *before)
 {
     if (!w->tc.tm)
         return;
-    core_set_hook(c, timing_hook, w->tc.tm);
-    core_set_follow(c, timing_follow(w->tc.tm));
+    timing_attach(w->tc.tm, c);
     timing_reset(w->tc.tm);
     *before = *timing_stats(w->tc.tm);
 }

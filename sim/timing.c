@@ -219,6 +219,13 @@ void timing_free(Timing *t)
     free(t);
 }
 
+/* No block being recorded or replayed; a following core (timing_follow) counts no record. */
+static void memo_none(Timing *t)
+{
+    t->mmode = MM_NONE;
+    t->follow.where = CORE_FOLLOW_NONE;
+}
+
 void timing_reset(Timing *t)
 {
     evq_clear(&t->q);
@@ -229,8 +236,7 @@ void timing_reset(Timing *t)
     xbar_reset(&t->xbar);
     mem_reset(&t->mem);
     t->halted = 0;
-    t->mmode = MM_NONE;
-    t->follow.where = CORE_FOLLOW_NONE;
+    memo_none(t);
     if (++t->run == 0) { /* wrapped: no entry may look current */
         for (uint32_t i = 0; i < t->desc_cap; i++)
             free(t->desc[i].memo);
@@ -791,8 +797,7 @@ static void memo_apply(Timing *t, const MemoEntry *e)
             t->simd.fetch_pending = 1;
         push(t, t0 + v->rel, v->kind, v->arg, 0, v->cause);
     }
-    t->mmode = MM_NONE;
-    t->follow.where = CORE_FOLLOW_NONE;
+    memo_none(t);
     t->memo_replays++;
 }
 
@@ -801,8 +806,7 @@ static void memo_apply(Timing *t, const MemoEntry *e)
 static void memo_unwind(Timing *t)
 {
     const uint32_t n = (uint32_t)t->follow.where - t->m_pc0;
-    t->mmode = MM_NONE;
-    t->follow.where = CORE_FOLLOW_NONE;
+    memo_none(t);
     for (uint32_t i = 0; i < n; i++) {
         CoreRecord r;
         memset(&r, 0, offsetof(CoreRecord, addr));
@@ -889,7 +893,7 @@ static void memo_pushed(Timing *t, uint64_t time, int kind, int arg, int cause)
 static __attribute__((noinline)) void memo_store(Timing *t)
 {
     MemoEntry *m = &t->m_rec;
-    t->mmode = MM_NONE;
+    memo_none(t);
     if (m->len < MEMO_MIN) {
         t->desc[t->m_pc0].short_block = 1;
         return;
@@ -1033,6 +1037,12 @@ void timing_hook(void *ctx, const CoreRecord *rec)
 
 CoreFollow *timing_follow(Timing *t) { return &t->follow; }
 
+void timing_attach(Timing *t, Core *c)
+{
+    core_set_hook(c, timing_hook, t);
+    core_set_follow(c, timing_follow(t));
+}
+
 void timing_set_memo(Timing *t, int on)
 {
     t->memo_off = !on;
@@ -1048,8 +1058,7 @@ void timing_end(Timing *t)
 {
     if (t->mmode == MM_REPLAY) /* stopped inside a replayed block: time what came */
         memo_unwind(t);
-    t->mmode = MM_NONE;
-    t->follow.where = CORE_FOLLOW_NONE;
+    memo_none(t);
     if (!t->halted) {
         t->st.cycles += t->now;
         t->st.runs++;

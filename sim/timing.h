@@ -1,7 +1,7 @@
 /* sim/timing.h -- the cycle-accurate timing model of the stream-filtering machine (detailed mode).
  *
- * Owns: time. It consumes the functional core's CoreRecord stream (core_set_hook(core,
- * timing_hook, t)) and schedules each instruction's issue and completion, and each unit's work,
+ * Owns: time. It consumes the functional core's CoreRecord stream (timing_attach(t, core)) and
+ * schedules each instruction's issue and completion, and each unit's work,
  * as events on a time-ordered queue (sim/event.h); time jumps from event to event. The units,
  * one file each under sim/machine/ (Gribble & Ramani 2008, Sec. 3.3): the in-order single-issue
  * SIMD execution unit with per-class latency and issue interval and a register scoreboard
@@ -102,8 +102,11 @@ void timing_free(Timing *t);
 void timing_reset(Timing *t);
 /* The CoreHook: one executed instruction. */
 void timing_hook(void *ctx, const CoreRecord *rec);
-/* Where a core hooked to t counts the records of a replayed block without calling the hook
- * (core_set_follow(core, timing_follow(t)) after core_set_hook): the same results, fewer calls. */
+/* Hooks c to t: timing_hook, and t's CoreFollow, so that c counts the records of a replayed block
+ * itself instead of calling the hook for each (the same results with fewer calls; a core given
+ * only the hook, core_set_hook(c, timing_hook, t), gives t every record). */
+void timing_attach(Timing *t, Core *c);
+/* t's CoreFollow, for a core whose hook calls timing_hook (core_set_follow after core_set_hook). */
 CoreFollow *timing_follow(Timing *t);
 /* Memoized blocks on (the default) or off: the same results either way (tests/unit/test_timing.c
  * compares them); off only to check that. */

@@ -20,8 +20,7 @@ int timedcore_open(TimedCore *tc, const CfgMachine *cfg, const AsmObject *obj, i
             tc->core = NULL;
             return -2;
         }
-        core_set_hook(tc->core, timing_hook, tc->tm);
-        core_set_follow(tc->core, timing_follow(tc->tm));
+        timing_attach(tc->tm, tc->core);
     }
     return 0;
 }

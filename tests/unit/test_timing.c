@@ -418,7 +418,7 @@ static TimingStats run_memo_src(const BenchProg *p, const char *src, int memo, u
     cr_assert(c, "%s: %s", p->file, err);
     hook_calls = 0;
     core_set_hook(c, counting_hook, t);
-    if (memo == MEMO_FOLLOW)
+    if (memo == MEMO_FOLLOW) /* what timing_attach sets, with the counting hook */
         core_set_follow(c, timing_follow(t));
     CoreExit ex = core_run(c, limit ? limit : 1000000);
     cr_assert(ex == CORE_EXIT_HALT || (limit && ex == CORE_EXIT_LIMIT), "%s: %s", p->file, core_trap_message(c));
