@@ -1037,12 +1037,6 @@ void timing_hook(void *ctx, const CoreRecord *rec)
 
 CoreFollow *timing_follow(Timing *t) { return &t->follow; }
 
-void timing_attach(Timing *t, Core *c)
-{
-    core_set_hook(c, timing_hook, t);
-    core_set_follow(c, timing_follow(t));
-}
-
 void timing_set_memo(Timing *t, int on)
 {
     t->memo_off = !on;

@@ -102,12 +102,17 @@ void timing_free(Timing *t);
 void timing_reset(Timing *t);
 /* The CoreHook: one executed instruction. */
 void timing_hook(void *ctx, const CoreRecord *rec);
-/* Hooks c to t: timing_hook, and t's CoreFollow, so that c counts the records of a replayed block
- * itself instead of calling the hook for each (the same results with fewer calls; a core given
- * only the hook, core_set_hook(c, timing_hook, t), gives t every record). */
-void timing_attach(Timing *t, Core *c);
 /* t's CoreFollow, for a core whose hook calls timing_hook (core_set_follow after core_set_hook). */
 CoreFollow *timing_follow(Timing *t);
+/* Hooks c to t: timing_hook, and t's CoreFollow, so that c counts the records of a replayed block
+ * itself instead of calling the hook for each (the same results with fewer calls; a core given
+ * only the hook, core_set_hook(c, timing_hook, t), gives t every record). Inline here, so that
+ * the timing model itself calls nothing of the core's (tests/fuzz links it without one). */
+static inline void timing_attach(Timing *t, Core *c)
+{
+    core_set_hook(c, timing_hook, t);
+    core_set_follow(c, timing_follow(t));
+}
 /* Memoized blocks on (the default) or off: the same results either way (tests/unit/test_timing.c
  * compares them); off only to check that. */
 void timing_set_memo(Timing *t, int on);
