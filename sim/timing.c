@@ -77,6 +77,8 @@ typedef struct TmDesc {
                                                 times on a path of their own */
     uint8_t short_block;                     /* a block starting here was shorter than MEMO_MIN
                                                 in this run: it is timed as usual, not looked up */
+    uint8_t spad;                            /* a scalar scratchpad access: plain, counted by
+                                                spad_count_scalar() */
     uint8_t regs[2 * ISA_MAX_OPERANDS + 1];  /* sources, exec mask, destinations */
     uint8_t dsts[ISA_MAX_OPERANDS];
     struct MemoWays *memo;                   /* blocks starting here (kept across runs, each
@@ -116,6 +118,7 @@ typedef struct MemoEntry {
     uint8_t ch_cause[TM_CAUSE_COUNT];
     uint32_t ch_cycles[TM_CAUSE_COUNT];
     uint16_t issues[2];             /* scalar, vector */
+    uint16_t nspad;                 /* scalar scratchpad accesses (TmDesc.spad) */
     uint8_t unit[MEMO_LEN], unit_n[MEMO_LEN];
 } MemoEntry;
 
@@ -298,6 +301,8 @@ static inline void count_issue(Timing *t, const TmDesc *d, int stage, int gen)
 {
     t->issues[stage][gen][d->vec]++;
     t->st.unit_uses[d->unit]++;
+    if (__builtin_expect(d->spad, 0))
+        spad_count_scalar(&t->st.spad_accesses, &t->st.spad_lines, 1);
 }
 
 static void internal_error(Timing *t, const char *msg)
@@ -427,18 +432,24 @@ static void describe_fill(Timing *t, TmDesc *d, const CoreRecord *rec)
     d->unit = (uint8_t)oi->unit;
     d->is_halt = (oi->flags & ISA_FL_END) != 0;
     d->vec = (oi->flags & ISA_FL_VEC) != 0;
-    d->mem = oi->unit == ISA_U_AGU || oi->unit == ISA_U_RBUF || oi->unit == ISA_U_SPAD ||
-             oi->unit == ISA_U_SCENE || oi->unit == ISA_U_FB;
-    d->special = oi->unit == ISA_U_AGU || oi->unit == ISA_U_RBUF || oi->unit == ISA_U_SPAD ||
-                 oi->unit == ISA_U_PART;
-    d->plain = !d->mem && !d->special && !d->is_halt;
     const int wr = (oi->flags & ISA_FL_WRITE) != 0;
+    /* A scalar scratchpad access (spld, spst) touches one line: one issue cycle at any port count,
+     * a load's data spad.latency after it (spad.h), whatever the address; the partition unit's
+     * pmask and pclr have their class's latency. Both time as plain instructions (a scalar access
+     * is counted by d->spad). */
+    d->spad = oi->unit == ISA_U_SPAD && !d->vec;
+    const int part_data = oi->unit == ISA_U_PART && (oi->flags & ISA_FL_IDM);
+    d->mem = oi->unit == ISA_U_AGU || oi->unit == ISA_U_RBUF || (oi->unit == ISA_U_SPAD && !d->spad) ||
+             oi->unit == ISA_U_SCENE || oi->unit == ISA_U_FB;
+    d->special = oi->unit == ISA_U_AGU || oi->unit == ISA_U_RBUF || (oi->unit == ISA_U_SPAD && !d->spad) ||
+                 part_data;
+    d->plain = !d->mem && !d->special && !d->is_halt;
     d->kind = oi->unit == ISA_U_RBUF && (oi->flags & ISA_FL_VEC) ? (wr ? TK_RB_SCATTER : TK_RB_GATHER)
               : oi->unit == ISA_U_SPAD                          ? (wr ? TK_SPAD_STORE : TK_SPAD_LOAD)
               : oi->unit == ISA_U_SCENE || oi->unit == ISA_U_FB ? TK_SCENE
                                                                 : TK_OTHER;
     d->short_block = 0;
-    d->lat = (uint32_t)t->simd.p.lat[oi->unit];
+    d->lat = d->spad && !wr ? (uint32_t)(spad_load_ready(&t->spad, 0)) : (uint32_t)t->simd.p.lat[oi->unit];
     d->issue = t->simd.p.issue[oi->unit] > 1 ? (uint32_t)t->simd.p.issue[oi->unit] : 0;
     int ndst;
     int n = simd_operands(&t->simd, rec->in, d->regs, d->dsts, &ndst);
@@ -783,6 +794,8 @@ static void memo_apply(Timing *t, const MemoEntry *e)
     t->issues[stage][gen][1] += e->issues[1];
     for (int i = 0; i < e->nunits; i++)
         t->st.unit_uses[e->unit[i]] += e->unit_n[i];
+    if (e->nspad)
+        spad_count_scalar(&t->st.spad_accesses, &t->st.spad_lines, e->nspad);
     for (int i = 0; i < e->nwrite; i++) {
         t->simd.ready[e->write[i].reg] = t0 + e->write[i].rel;
         t->simd.rcause[e->write[i].reg] = e->write[i].cause;
@@ -837,7 +850,7 @@ static __attribute__((noinline)) int memo_begin(Timing *t, TmDesc *d, const Core
             MemoEntry *e = &d->memo->e[w];
             if (memo_match(t, e, rec, ev, nev)) {
                 t->m_e = e;
-                t->follow.where = core_record_where(rec) + 1; /* the next pc; not taken (memo_match) */
+                t->follow.where = core_record_word(rec->pc + 1, rec->stage, rec->gen); /* not taken (memo_match) */
                 t->follow.last = rec->pc + e->len - 1u;
                 t->mmode = MM_REPLAY;
                 if (e->len == 1)
@@ -939,10 +952,12 @@ static __attribute__((noinline)) void memo_store(Timing *t)
             m->ev_out[k++] = m->ev_out[i];
     m->nev_out = (uint8_t)k;
     m->issues[0] = m->issues[1] = 0;
+    m->nspad = 0;
     m->nunits = 0;
     for (int i = 0; i < m->len; i++) {
         const TmDesc *d = &t->desc[t->m_pc0 + (uint32_t)i];
         m->issues[d->vec]++;
+        m->nspad += d->spad;
         int j = 0;
         while (j < m->nunits && m->unit[j] != d->unit)
             j++;
@@ -1016,11 +1031,19 @@ static __attribute__((noinline)) void hook_any(Timing *t, const CoreRecord *rec)
     time_one(t, d, rec);
 }
 
+/* core_record_where() of a record as the follow holds it: with the memory byte of no memory
+ * (CORE_MEM_COUNT) whatever the record says. A block's instructions are named by their pcs, so a
+ * scalar scratchpad access in it (plain, TmDesc.spad) has the same where as the follow's. */
+static inline uint64_t where_plain(const CoreRecord *rec)
+{
+    return (core_record_where(rec) & ~(0xFFull << 56)) | (uint64_t)CORE_MEM_COUNT << 56;
+}
+
 void timing_hook(void *ctx, const CoreRecord *rec)
 {
     Timing *t = ctx;
     if (t->mmode == MM_REPLAY) { /* the next record of a stored block: only checked */
-        const uint64_t w = core_record_where(rec); /* pc, stage, generation, taken, memory */
+        const uint64_t w = where_plain(rec); /* pc, stage, generation, taken */
         if (rec->pc != t->follow.last) { /* inside the block: the next pc, no branch taken */
             if (__builtin_expect(w == t->follow.where, 1)) {
                 t->follow.where++;

@@ -42,4 +42,13 @@ static inline uint64_t spad_load_ready(const Spad *s, uint64_t last)
     return last + (uint64_t)s->p.latency;
 }
 
+/* n scalar accesses (spld, spst: one word each) counted. One word is one line, so such an access
+ * takes one issue cycle at any port count and a load's data are ready spad.latency after it,
+ * whatever its address: the timing core times it as a plain instruction and counts it here. */
+static inline void spad_count_scalar(uint64_t *accesses, uint64_t *lines, uint64_t n)
+{
+    *accesses += n;
+    *lines += n;
+}
+
 #endif
