@@ -125,6 +125,7 @@ typedef struct MemoEntry {
 typedef struct MemoWays {
     MemoEntry e[MEMO_WAYS];
     uint8_t next;                   /* the way the next store replaces */
+    uint8_t hit;                    /* the way the last lookup found: tried first */
 } MemoWays;
 
 enum { MM_NONE, MM_RECORD, MM_REPLAY };
@@ -146,6 +147,7 @@ struct Timing {
     /* Memoized blocks (see MemoEntry): off when memo_off. */
     int memo_off;
     uint64_t memo_replays, memo_stores; /* blocks replayed whole, blocks stored */
+    uint64_t memo_retimed;         /* records of a replay timed again (memo_unwind, memo_diverged) */
     int mmode;                     /* MM_NONE, MM_RECORD (timing a block as usual, noting its
                                       outcome) or MM_REPLAY (following a stored block) */
     uint64_t m_t0;                 /* the block's start cycle */
@@ -718,7 +720,7 @@ static inline void bit_set(uint64_t *b, int r) { b[r >> 6] |= 1ull << (r & 63); 
 
 /* The pending events relative to t0, sorted (the heap's order depends on its history): their
  * count, or -1 if more than MEMO_EVENTS. */
-static int memo_events(const Timing *t, uint64_t t0, MemoEv *ev)
+static inline __attribute__((always_inline)) int memo_events(const Timing *t, uint64_t t0, MemoEv *ev)
 {
     if (t->q.n > MEMO_EVENTS)
         return -1;
@@ -752,12 +754,10 @@ static inline MemoReg memo_reg(const Timing *t, int r, uint64_t t0)
     return (MemoReg){(uint32_t)(rd - t0), (uint8_t)r, t->simd.rcause[r]};
 }
 
-/* Whether the stored block e starts from the state of now (rec: its first record). */
-static int memo_match(const Timing *t, const MemoEntry *e, const CoreRecord *rec, const MemoEv *ev, int nev)
+/* Whether the stored block e starts from the state of now ... */
+static inline __attribute__((always_inline)) int memo_state_match(const Timing *t, const MemoEntry *e, const MemoEv *ev, int nev)
 {
     if (e->run != t->run || e->nev_in != nev)
-        return 0;
-    if (rec->taken != (e->len == 1 ? e->taken_last : 0))
         return 0;
     for (int i = 0; i < nev; i++)
         if (e->ev_in[i].rel != ev[i].rel || e->ev_in[i].kind != ev[i].kind || e->ev_in[i].arg != ev[i].arg)
@@ -779,6 +779,15 @@ static int memo_match(const Timing *t, const MemoEntry *e, const CoreRecord *rec
             if (t->simd.ready[e->live[i].reg] > now)
                 return 0;
     return 1;
+}
+
+/* ... and whose first record is rec (a block of one instruction ends at its branch taken or not;
+ * a longer block's first record took none). */
+static inline int memo_match(const Timing *t, const MemoEntry *e, const CoreRecord *rec, const MemoEv *ev, int nev)
+{
+    if (rec->taken != (e->len == 1 ? e->taken_last : 0))
+        return 0;
+    return memo_state_match(t, e, ev, nev);
 }
 
 /* The outcome of the stored block e, applied at once (the block's records have all come). */
@@ -820,6 +829,7 @@ static void memo_unwind(Timing *t)
 {
     const uint32_t n = (uint32_t)t->follow.where - t->m_pc0;
     memo_none(t);
+    t->memo_retimed += n;
     for (uint32_t i = 0; i < n; i++) {
         CoreRecord r;
         memset(&r, 0, offsetof(CoreRecord, addr));
@@ -830,6 +840,21 @@ static void memo_unwind(Timing *t)
         r.mem = CORE_MEM_COUNT;
         time_one(t, &t->desc[r.pc], &r); /* described in this run: the entry's run is this one */
     }
+}
+
+/* A recording of the block whose start (m_t0, m_pc0, m_stage, m_gen) is now, with the pending
+ * events ev. */
+static void memo_record_start(Timing *t, const MemoEv *ev, int nev)
+{
+    MemoEntry *m = &t->m_rec;
+    m->len = m->nlive = m->nwrite = m->nev_out = 0;
+    m->nev_in = (uint8_t)nev;
+    memcpy(m->ev_in, ev, sizeof *ev * (size_t)nev);
+    t->m_ok = 1;
+    t->m_written[0] = t->m_written[1] = t->m_seen[0] = t->m_seen[1] = 0;
+    memcpy(t->m_stalls0, t->st.stalls, sizeof t->m_stalls0);
+    t->m_hz = 0;
+    t->mmode = MM_RECORD;
 }
 
 /* Starts a block at the plain instruction d (its first record rec): a replay when its start
@@ -846,9 +871,11 @@ static __attribute__((noinline)) int memo_begin(Timing *t, TmDesc *d, const Core
     t->m_gen = rec->gen;
     t->m_pc0 = rec->pc; /* d is in the table (not the spare), so desc[pc] stays its entry */
     if (d->memo)
-        for (int w = 0; w < MEMO_WAYS; w++) {
+        for (int k = 0; k < MEMO_WAYS; k++) {
+            const int w = (d->memo->hit + k) % MEMO_WAYS; /* the last way found first: starts recur */
             MemoEntry *e = &d->memo->e[w];
             if (memo_match(t, e, rec, ev, nev)) {
+                d->memo->hit = (uint8_t)w;
                 t->m_e = e;
                 t->follow.where = core_record_word(rec->pc + 1, rec->stage, rec->gen); /* not taken (memo_match) */
                 t->follow.last = rec->pc + e->len - 1u;
@@ -858,15 +885,7 @@ static __attribute__((noinline)) int memo_begin(Timing *t, TmDesc *d, const Core
                 return 1;
             }
         }
-    MemoEntry *m = &t->m_rec;
-    m->len = m->nlive = m->nwrite = m->nev_out = 0;
-    m->nev_in = (uint8_t)nev;
-    memcpy(m->ev_in, ev, sizeof *ev * (size_t)nev);
-    t->m_ok = 1;
-    t->m_written[0] = t->m_written[1] = t->m_seen[0] = t->m_seen[1] = 0;
-    memcpy(t->m_stalls0, t->st.stalls, sizeof t->m_stalls0);
-    t->m_hz = 0;
-    t->mmode = MM_RECORD;
+    memo_record_start(t, ev, nev);
     return 0;
 }
 
@@ -1003,6 +1022,54 @@ static __attribute__((noinline)) void memo_time_noted(Timing *t, const TmDesc *d
     memo_post(t, d, rec);
 }
 
+/* A replay met rec, a record its stored path does not have (a branch taken where it was not, or
+ * not where it was, or another stage or generation), after (pc of follow.where) - m_pc0 records
+ * that matched. Nothing has changed the start state yet. If another way stored from the same
+ * start state has the path so far and rec next, the replay goes on with it (1: rec accounted
+ * for). Else (0) the records so far are timed one by one from the start state while a recording
+ * notes them, so the path taken is stored as another way of the same start (rec then goes on as
+ * the recording's next record, or ends it); a block that would end before MEMO_MIN records is
+ * timed without one (memo_unwind). */
+static __attribute__((noinline)) int memo_diverged(Timing *t, const CoreRecord *rec)
+{
+    const uint32_t k = (uint32_t)t->follow.where - t->m_pc0; /* rec's place on a path */
+    MemoEv ev[MEMO_EVENTS];
+    const int nev = memo_events(t, t->now, ev); /* as at the start: nothing changed */
+    MemoWays *mw = t->desc[t->m_pc0].memo;      /* a replay's ways exist */
+    const int same = rec->pc == t->m_pc0 + k && rec->stage == t->m_stage && rec->gen == t->m_gen;
+    if (same)
+        for (int w = 0; w < MEMO_WAYS; w++) {
+            MemoEntry *e = &mw->e[w];
+            if (e == t->m_e || e->len <= k || rec->taken != (k + 1u == e->len ? e->taken_last : 0) ||
+                !memo_state_match(t, e, ev, nev))
+                continue;
+            t->m_e = e;
+            t->follow.where = core_record_word(rec->pc + 1, rec->stage, rec->gen);
+            t->follow.last = t->m_pc0 + e->len - 1u;
+            if (k + 1u == e->len)
+                memo_apply(t, e);
+            return 1;
+        }
+    if (nev < 0 || (!same && k < MEMO_MIN)) { /* too short a block to keep (memo_store) */
+        memo_unwind(t);
+        return 0;
+    }
+    memo_none(t);
+    memo_record_start(t, ev, nev);
+    t->memo_retimed += k;
+    for (uint32_t i = 0; i < k; i++) {
+        CoreRecord r;
+        memset(&r, 0, offsetof(CoreRecord, addr));
+        r.pc = t->m_pc0 + i;
+        r.next_pc = r.pc + 1;
+        r.stage = t->m_stage;
+        r.gen = t->m_gen;
+        r.mem = CORE_MEM_COUNT;
+        memo_time_noted(t, &t->desc[r.pc], &r); /* described in this run: the entry's run is this one */
+    }
+    return 0;
+}
+
 /* Every record but the next one of a replayed block (timing_hook). */
 static __attribute__((noinline)) void hook_any(Timing *t, const CoreRecord *rec)
 {
@@ -1010,8 +1077,8 @@ static __attribute__((noinline)) void hook_any(Timing *t, const CoreRecord *rec)
         internal_error(t, "instruction after halt");
         return;
     }
-    if (t->mmode == MM_REPLAY)
-        memo_unwind(t); /* the core left the stored path: time what came as usual, then this */
+    if (t->mmode == MM_REPLAY && memo_diverged(t, rec)) /* the core left the stored path */
+        return;
     TmDesc *d = (TmDesc *)describe(t, rec);
     if (t->mmode == MM_RECORD) {
         if (d->plain && rec->stage == t->m_stage && rec->gen == t->m_gen) {
@@ -1065,10 +1132,11 @@ void timing_set_memo(Timing *t, int on)
     t->memo_off = !on;
 }
 
-void timing_memo_counts(const Timing *t, uint64_t *replays, uint64_t *stores)
+void timing_memo_counts(const Timing *t, uint64_t *replays, uint64_t *stores, uint64_t *retimed)
 {
     *replays = t->memo_replays;
     *stores = t->memo_stores;
+    *retimed = t->memo_retimed;
 }
 
 void timing_end(Timing *t)

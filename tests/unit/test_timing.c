@@ -396,7 +396,8 @@ Test(timing, a_model_reused_for_another_program_times_it_as_a_fresh_one)
  * with the core counting a replayed block's records itself (timing_follow, as sfsim runs it). */
 enum { MEMO_OFF, MEMO_HOOK, MEMO_FOLLOW };
 
-static uint64_t hook_calls; /* records the last run_memo run's hook was given */
+static uint64_t hook_calls;   /* records the last run_memo run's hook was given */
+static uint64_t memo_retimed; /* and the records it timed again (timing_memo_counts) */
 
 static void counting_hook(void *ctx, const CoreRecord *rec)
 {
@@ -426,7 +427,7 @@ static TimingStats run_memo_src(const BenchProg *p, const char *src, int memo, u
     cr_assert_null(timing_error(t), "%s: %s", p->file, timing_error(t));
     TimingStats s = *timing_stats(t);
     uint64_t stores;
-    timing_memo_counts(t, replays, &stores);
+    timing_memo_counts(t, replays, &stores, &memo_retimed);
     timing_free(t);
     core_free(c);
     asm_object_free(&obj);
@@ -473,7 +474,7 @@ static const char memo_loop[] =
  * on the first passes (so the block stored spans it) and changes it every 32 passes after, and a
  * branch inside a block taken on some passes and not on others, so that a replay meets, at the
  * next pc, a record that runs in another generation or took a branch, and must leave the stored
- * block there. */
+ * path there (for another way of the same start state, or timing from the start). */
 static const char memo_paths[] =
     "        li      r1, 200\n"
     "        vli     v1, 0x3f800000\n"
@@ -513,6 +514,11 @@ Test(timing, memoized_blocks_leave_a_stored_path_at_a_taken_branch_or_another_ge
         cr_expect_gt(r_on, 100u, "the blocks recur: %llu replayed", (unsigned long long)r_on);
         cr_expect_gt(on.gen_busy[32], 0u, "the loop runs in generation 32 too");
         cr_expect_gt(on.gen_busy[2], 0u, "and in generation 2");
+        /* each path taken from a start state is stored as a way of it the first time, and a
+         * replay that meets the other path goes on with that way: only the records before
+         * those first divergences are timed again, not some on every pass (about 600) */
+        cr_expect_lt(memo_retimed * 10, on.busy, "%llu records timed again of %llu", (unsigned long long)memo_retimed,
+                     (unsigned long long)on.busy);
         if (memo == MEMO_FOLLOW) /* the records inside replayed blocks were counted by the core */
             cr_expect_lt(hook_calls + r_on, off.busy, "the core following: %llu hook calls for %llu records",
                          (unsigned long long)hook_calls, (unsigned long long)off.busy);
