@@ -147,7 +147,7 @@ struct Timing {
     /* Memoized blocks (see MemoEntry): off when memo_off. */
     int memo_off;
     uint64_t memo_replays, memo_stores; /* blocks replayed whole, blocks stored */
-    uint64_t memo_retimed;         /* records of a replay timed again (memo_unwind, memo_diverged) */
+    uint64_t memo_retimed;         /* records of a replay timed again (memo_retime) */
     int mmode;                     /* MM_NONE, MM_RECORD (timing a block as usual, noting its
                                       outcome) or MM_REPLAY (following a stored block) */
     uint64_t m_t0;                 /* the block's start cycle */
@@ -823,12 +823,18 @@ static void memo_apply(Timing *t, const MemoEntry *e)
     t->memo_replays++;
 }
 
-/* A replay whose path the core left after (pc of m_where) - m_pc0 records: those are timed one by one from
- * the block's start state, which nothing has changed yet. */
-static void memo_unwind(Timing *t)
+static void memo_record_start(Timing *t, const MemoEv *ev, int nev);
+static void memo_time_noted(Timing *t, const TmDesc *d, const CoreRecord *rec);
+
+/* A replay the core left, or stopped in, after (pc of follow.where) - m_pc0 records: those are
+ * timed one by one from the block's start state, which nothing has changed yet; with record,
+ * while a recording with the start's pending events ev notes them. */
+static void memo_retime(Timing *t, int record, const MemoEv *ev, int nev)
 {
     const uint32_t n = (uint32_t)t->follow.where - t->m_pc0;
     memo_none(t);
+    if (record)
+        memo_record_start(t, ev, nev);
     t->memo_retimed += n;
     for (uint32_t i = 0; i < n; i++) {
         CoreRecord r;
@@ -838,7 +844,11 @@ static void memo_unwind(Timing *t)
         r.stage = t->m_stage;
         r.gen = t->m_gen;
         r.mem = CORE_MEM_COUNT;
-        time_one(t, &t->desc[r.pc], &r); /* described in this run: the entry's run is this one */
+        const TmDesc *d = &t->desc[r.pc]; /* described in this run: the entry's run is this one */
+        if (record)
+            memo_time_noted(t, d, &r);
+        else
+            time_one(t, d, &r);
     }
 }
 
@@ -1029,7 +1039,8 @@ static __attribute__((noinline)) void memo_time_noted(Timing *t, const TmDesc *d
  * for). Else (0) the records so far are timed one by one from the start state while a recording
  * notes them, so the path taken is stored as another way of the same start (rec then goes on as
  * the recording's next record, or ends it); a block that would end before MEMO_MIN records is
- * timed without one (memo_unwind). */
+ * timed without one. A way that ended just before rec, with no branch taken, is applied, and
+ * rec comes after it (0). */
 static __attribute__((noinline)) int memo_diverged(Timing *t, const CoreRecord *rec)
 {
     const uint32_t k = (uint32_t)t->follow.where - t->m_pc0; /* rec's place on a path */
@@ -1037,36 +1048,25 @@ static __attribute__((noinline)) int memo_diverged(Timing *t, const CoreRecord *
     const int nev = memo_events(t, t->now, ev); /* as at the start: nothing changed */
     MemoWays *mw = t->desc[t->m_pc0].memo;      /* a replay's ways exist */
     const int same = rec->pc == t->m_pc0 + k && rec->stage == t->m_stage && rec->gen == t->m_gen;
-    if (same)
-        for (int w = 0; w < MEMO_WAYS; w++) {
-            MemoEntry *e = &mw->e[w];
-            if (e == t->m_e || e->len <= k || rec->taken != (k + 1u == e->len ? e->taken_last : 0) ||
-                !memo_state_match(t, e, ev, nev))
-                continue;
-            t->m_e = e;
-            t->follow.where = core_record_word(rec->pc + 1, rec->stage, rec->gen);
-            t->follow.last = t->m_pc0 + e->len - 1u;
-            if (k + 1u == e->len)
-                memo_apply(t, e);
-            return 1;
+    for (int w = 0; w < MEMO_WAYS; w++) {
+        MemoEntry *e = &mw->e[w];
+        if (e == t->m_e || e->len < k || (e->len == k ? e->taken_last : !same) || !memo_state_match(t, e, ev, nev))
+            continue;
+        if (e->len == k) { /* it ended before rec (another generation, say), no branch taken */
+            memo_apply(t, e);
+            return 0;     /* rec comes after it */
         }
-    if (nev < 0 || (!same && k < MEMO_MIN)) { /* too short a block to keep (memo_store) */
-        memo_unwind(t);
-        return 0;
+        if (rec->taken != (k + 1u == e->len ? e->taken_last : 0))
+            continue;
+        t->m_e = e;
+        t->follow.where = core_record_word(rec->pc + 1, rec->stage, rec->gen);
+        t->follow.last = t->m_pc0 + e->len - 1u;
+        if (k + 1u == e->len)
+            memo_apply(t, e);
+        return 1;
     }
-    memo_none(t);
-    memo_record_start(t, ev, nev);
-    t->memo_retimed += k;
-    for (uint32_t i = 0; i < k; i++) {
-        CoreRecord r;
-        memset(&r, 0, offsetof(CoreRecord, addr));
-        r.pc = t->m_pc0 + i;
-        r.next_pc = r.pc + 1;
-        r.stage = t->m_stage;
-        r.gen = t->m_gen;
-        r.mem = CORE_MEM_COUNT;
-        memo_time_noted(t, &t->desc[r.pc], &r); /* described in this run: the entry's run is this one */
-    }
+    /* timed again, and noted unless the block would end before MEMO_MIN records (memo_store) */
+    memo_retime(t, nev >= 0 && (same || k >= MEMO_MIN), ev, nev);
     return 0;
 }
 
@@ -1142,7 +1142,7 @@ void timing_memo_counts(const Timing *t, uint64_t *replays, uint64_t *stores, ui
 void timing_end(Timing *t)
 {
     if (t->mmode == MM_REPLAY) /* stopped inside a replayed block: time what came */
-        memo_unwind(t);
+        memo_retime(t, 0, NULL, 0);
     memo_none(t);
     if (!t->halted) {
         t->st.cycles += t->now;
