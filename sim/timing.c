@@ -774,11 +774,12 @@ static inline __attribute__((always_inline)) int memo_state_match(const Timing *
         if (rd <= now || rd - now != m->rel || t->simd.rcause[m->reg] != m->cause)
             return 0;
     }
-    if (t->simd.horizon > now)
-        for (int i = 0; i < e->nlanded; i++)
-            if (t->simd.ready[e->live[i].reg] > now)
-                return 0;
-    return 1;
+    if (t->simd.horizon <= now)
+        return 1;
+    int late = 0; /* one test at the end: which one is late does not matter */
+    for (int i = 0; i < e->nlanded; i++)
+        late |= t->simd.ready[e->live[i].reg] > now;
+    return !late;
 }
 
 /* ... and whose first record is rec (a block of one instruction ends at its branch taken or not;
