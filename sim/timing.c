@@ -16,9 +16,9 @@
  *   3. issue: one busy cycle, plus extra issue cycles the access itself needs (bank conflicts,
  *      alignment, scratchpad and scene-cache ports), each charged to its cause;
  *   4. completion: results become ready after the unit's latency (events), units get busy.
- * A block of instructions that use no memory unit, whose start state has been seen before, is not
- * worked through again: its stored outcome is applied at its end ("memoized blocks" below;
- * docs/model.md).
+ * A block of instructions that time the same whatever their data (no memory unit but a scalar
+ * scratchpad access), whose start state has been seen before, is not worked through again: its
+ * stored outcome is applied at its end ("memoized blocks" below; docs/model.md).
  */
 #include "timing.h"
 

@@ -11,9 +11,9 @@
  * share (interconnect.h); the partition unit (partition.h); the scratchpad ports (spad.h); scene
  * memory with an optional cache (scenemem.h). sim/timing.c keeps the event loop, the stall
  * accounting and the dispatch to the units by the ISA table's UNIT and FLAGS columns, and a memo
- * of blocks of instructions that use no memory unit: a block whose start state recurs gets its
- * stored outcome instead of being timed again, with the same result (docs/model.md, "Host
- * speed: memoized blocks").
+ * of blocks of instructions that time the same whatever their data (no memory unit but a scalar
+ * scratchpad access): a block whose start state recurs gets its stored outcome instead of being
+ * timed again, with the same result (docs/model.md, "Host speed: memoized blocks").
  * Must not: compute any architectural value or change what the program does (the functional
  * core does); results are identical with and without timing.
  *
