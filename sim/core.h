@@ -70,10 +70,12 @@ typedef struct CoreRecord {
 
 typedef void (*CoreHook)(void *ctx, const CoreRecord *rec);
 
-/* A record's pc, stage, generation, taken flag and memory as one number: the pc in the low 32
- * bits, then the stage, the generation, the flag and the memory a byte each (the timing model
- * compares them at once; the fields sit side by side in this order, so a compiler can read them
- * in one load). */
+/* A record's pc, stage, generation and taken flag as one number: the pc in the low 32 bits, then
+ * the stage, the generation and the flag a byte each, and in the top byte CORE_MEM_COUNT whatever
+ * memory the record touched (a program's instruction is named by its pc; the run loop keeps this
+ * number, core_record_word's, from the record's start). The timing model compares it at once; the
+ * fields sit side by side in this order, with the memory after them, so a compiler can read them
+ * in one load. */
 static inline uint64_t core_record_where(const CoreRecord *r)
 {
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
@@ -82,10 +84,10 @@ static inline uint64_t core_record_where(const CoreRecord *r)
                    "core_record_where reads the fields in one load");
     uint64_t w;
     memcpy(&w, r, sizeof w);
-    return w;
+    return (w & 0x00ffffffffffffffull) | (uint64_t)CORE_MEM_COUNT << 56;
 #else
     return (uint64_t)r->pc | (uint64_t)r->stage << 32 | (uint64_t)r->gen << 40 | (uint64_t)r->taken << 48 |
-           (uint64_t)r->mem << 56;
+           (uint64_t)CORE_MEM_COUNT << 56;
 #endif
 }
 
@@ -122,7 +124,7 @@ typedef struct CoreFollow {
     uint64_t where;
     uint32_t last;
 } CoreFollow;
-#define CORE_FOLLOW_NONE UINT64_MAX /* matches no record: core_record_where's top byte is <= CORE_MEM_COUNT */
+#define CORE_FOLLOW_NONE UINT64_MAX /* matches no record: core_record_where's top byte is CORE_MEM_COUNT */
 
 typedef struct Core Core;
 

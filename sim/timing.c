@@ -146,15 +146,14 @@ struct Timing {
     TmDesc spare;                  /* describe() when the table cannot grow */
     /* Memoized blocks (see MemoEntry): off when memo_off. */
     int memo_off;
-    uint64_t memo_replays, memo_stores; /* blocks replayed whole, blocks stored */
-    uint64_t memo_retimed;         /* records of a replay timed again (memo_retime) */
+    TimingMemoCounts mc;           /* timing_memo_counts */
     int mmode;                     /* MM_NONE, MM_RECORD (timing a block as usual, noting its
                                       outcome) or MM_REPLAY (following a stored block) */
     uint64_t m_t0;                 /* the block's start cycle */
     uint8_t m_stage, m_gen;
     CoreFollow follow;             /* replay (else where = CORE_FOLLOW_NONE): where, the next
                                       record on the path as core_record_where() gives it with no
-                                      branch taken and no memory touched: its pc (the records
+                                      branch taken: its pc (the records
                                       matched so far: that pc - m_pc0), the block's stage and
                                       generation; last, the pc of the block's last record. A core
                                       given it (timing_follow) counts the records inside the block
@@ -440,11 +439,11 @@ static void describe_fill(Timing *t, TmDesc *d, const CoreRecord *rec)
      * pmask and pclr have their class's latency. Both time as plain instructions (a scalar access
      * is counted by d->spad). */
     d->spad = oi->unit == ISA_U_SPAD && !d->vec;
+    const int spad_vec = oi->unit == ISA_U_SPAD && d->vec;
     const int part_data = oi->unit == ISA_U_PART && (oi->flags & ISA_FL_IDM);
-    d->mem = oi->unit == ISA_U_AGU || oi->unit == ISA_U_RBUF || (oi->unit == ISA_U_SPAD && !d->spad) ||
-             oi->unit == ISA_U_SCENE || oi->unit == ISA_U_FB;
-    d->special = oi->unit == ISA_U_AGU || oi->unit == ISA_U_RBUF || (oi->unit == ISA_U_SPAD && !d->spad) ||
-                 part_data;
+    d->mem = oi->unit == ISA_U_AGU || oi->unit == ISA_U_RBUF || spad_vec || oi->unit == ISA_U_SCENE ||
+             oi->unit == ISA_U_FB;
+    d->special = oi->unit == ISA_U_AGU || oi->unit == ISA_U_RBUF || spad_vec || part_data;
     d->plain = !d->mem && !d->special && !d->is_halt;
     d->kind = oi->unit == ISA_U_RBUF && (oi->flags & ISA_FL_VEC) ? (wr ? TK_RB_SCATTER : TK_RB_GATHER)
               : oi->unit == ISA_U_SPAD                          ? (wr ? TK_SPAD_STORE : TK_SPAD_LOAD)
@@ -821,7 +820,7 @@ static void memo_apply(Timing *t, const MemoEntry *e)
         push(t, t0 + v->rel, v->kind, v->arg, 0, v->cause);
     }
     memo_none(t);
-    t->memo_replays++;
+    t->mc.replays++;
 }
 
 static void memo_record_start(Timing *t, const MemoEv *ev, int nev);
@@ -836,7 +835,7 @@ static void memo_retime(Timing *t, int record, const MemoEv *ev, int nev)
     memo_none(t);
     if (record)
         memo_record_start(t, ev, nev);
-    t->memo_retimed += n;
+    t->mc.retimed += n;
     for (uint32_t i = 0; i < n; i++) {
         CoreRecord r;
         memset(&r, 0, offsetof(CoreRecord, addr));
@@ -1003,7 +1002,7 @@ static __attribute__((noinline)) void memo_store(Timing *t)
     if (!d0->memo && !(d0->memo = calloc(1, sizeof *d0->memo)))
         return; /* no memory: the block is just not kept */
     d0->memo->e[d0->memo->next] = *m;
-    t->memo_stores++;
+    t->mc.stores++;
     d0->memo->next = (uint8_t)((d0->memo->next + 1) % MEMO_WAYS);
 }
 
@@ -1045,6 +1044,7 @@ static __attribute__((noinline)) void memo_time_noted(Timing *t, const TmDesc *d
 static __attribute__((noinline)) int memo_diverged(Timing *t, const CoreRecord *rec)
 {
     const uint32_t k = (uint32_t)t->follow.where - t->m_pc0; /* rec's place on a path */
+    t->mc.left++;
     MemoEv ev[MEMO_EVENTS];
     const int nev = memo_events(t, t->now, ev); /* as at the start: nothing changed */
     MemoWays *mw = t->desc[t->m_pc0].memo;      /* a replay's ways exist */
@@ -1099,19 +1099,11 @@ static __attribute__((noinline)) void hook_any(Timing *t, const CoreRecord *rec)
     time_one(t, d, rec);
 }
 
-/* core_record_where() of a record as the follow holds it: with the memory byte of no memory
- * (CORE_MEM_COUNT) whatever the record says. A block's instructions are named by their pcs, so a
- * scalar scratchpad access in it (plain, TmDesc.spad) has the same where as the follow's. */
-static inline uint64_t where_plain(const CoreRecord *rec)
-{
-    return (core_record_where(rec) & ~(0xFFull << 56)) | (uint64_t)CORE_MEM_COUNT << 56;
-}
-
 void timing_hook(void *ctx, const CoreRecord *rec)
 {
     Timing *t = ctx;
     if (t->mmode == MM_REPLAY) { /* the next record of a stored block: only checked */
-        const uint64_t w = where_plain(rec); /* pc, stage, generation, taken */
+        const uint64_t w = core_record_where(rec); /* pc, stage, generation, taken */
         if (rec->pc != t->follow.last) { /* inside the block: the next pc, no branch taken */
             if (__builtin_expect(w == t->follow.where, 1)) {
                 t->follow.where++;
@@ -1133,12 +1125,7 @@ void timing_set_memo(Timing *t, int on)
     t->memo_off = !on;
 }
 
-void timing_memo_counts(const Timing *t, uint64_t *replays, uint64_t *stores, uint64_t *retimed)
-{
-    *replays = t->memo_replays;
-    *stores = t->memo_stores;
-    *retimed = t->memo_retimed;
-}
+TimingMemoCounts timing_memo_counts(const Timing *t) { return t->mc; }
 
 void timing_end(Timing *t)
 {

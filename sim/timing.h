@@ -116,10 +116,14 @@ static inline void timing_attach(Timing *t, Core *c)
 /* Memoized blocks on (the default) or off: the same results either way (tests/unit/test_timing.c
  * compares them); off only to check that. */
 void timing_set_memo(Timing *t, int on);
-/* Blocks replayed from the memo, blocks stored in it, and records timed again because a replay
- * left its path and no other stored way had the path taken, since timing_new (host statistics,
- * not the machine's). */
-void timing_memo_counts(const Timing *t, uint64_t *replays, uint64_t *stores, uint64_t *retimed);
+/* What the memo did since timing_new (host statistics, not the machine's). */
+typedef struct TimingMemoCounts {
+    uint64_t replays; /* blocks replayed whole */
+    uint64_t stores;  /* blocks stored */
+    uint64_t left;    /* replays that met a record off their stored path */
+    uint64_t retimed; /* records timed again because no other stored way had the path taken */
+} TimingMemoCounts;
+TimingMemoCounts timing_memo_counts(const Timing *t);
 /* After core_run: a run that stopped without halt (trap, limit) counts the cycles so far. */
 void timing_end(Timing *t);
 const TimingStats *timing_stats(const Timing *t);
