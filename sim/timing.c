@@ -153,11 +153,10 @@ struct Timing {
     uint8_t m_stage, m_gen;
     CoreFollow follow;             /* replay (else where = CORE_FOLLOW_NONE): where, the next
                                       record on the path as core_record_where() gives it with no
-                                      branch taken: its pc (the records
-                                      matched so far: that pc - m_pc0), the block's stage and
-                                      generation; last, the pc of the block's last record. A core
-                                      given it (timing_follow) counts the records inside the block
-                                      itself */
+                                      branch taken: its pc (the records matched so far: that pc -
+                                      m_pc0), the block's stage and generation; last, the pc of
+                                      the block's last record. A core given it (timing_follow)
+                                      counts the records inside the block itself */
     MemoEntry *m_e;                /* replay: the stored block */
     uint32_t m_pc0;                /* the block's first instruction (its MemoWays): a pc, not a
                                       pointer, since the table may grow during the block */
@@ -826,6 +825,15 @@ static void memo_apply(Timing *t, const MemoEntry *e)
 static void memo_record_start(Timing *t, const MemoEv *ev, int nev);
 static void memo_time_noted(Timing *t, const TmDesc *d, const CoreRecord *rec);
 
+/* The replay goes on along the stored block e after rec, a record on its path that took no
+ * branch (or e's last): the core is given the next record's place and e's last pc. */
+static inline void memo_follow(Timing *t, MemoEntry *e, const CoreRecord *rec)
+{
+    t->m_e = e;
+    t->follow.where = core_record_word(rec->pc + 1, rec->stage, rec->gen);
+    t->follow.last = t->m_pc0 + e->len - 1u;
+}
+
 /* A replay the core left, or stopped in, after (pc of follow.where) - m_pc0 records: those are
  * timed one by one from the block's start state, which nothing has changed yet; with record,
  * while a recording with the start's pending events ev notes them. */
@@ -886,9 +894,7 @@ static __attribute__((noinline)) int memo_begin(Timing *t, TmDesc *d, const Core
             MemoEntry *e = &d->memo->e[w];
             if (memo_match(t, e, rec, ev, nev)) {
                 d->memo->hit = (uint8_t)w;
-                t->m_e = e;
-                t->follow.where = core_record_word(rec->pc + 1, rec->stage, rec->gen); /* not taken (memo_match) */
-                t->follow.last = rec->pc + e->len - 1u;
+                memo_follow(t, e, rec); /* rec took no branch unless it is e's last (memo_match) */
                 t->mmode = MM_REPLAY;
                 if (e->len == 1)
                     memo_apply(t, e);
@@ -1059,9 +1065,7 @@ static __attribute__((noinline)) int memo_diverged(Timing *t, const CoreRecord *
         }
         if (rec->taken != (k + 1u == e->len ? e->taken_last : 0))
             continue;
-        t->m_e = e;
-        t->follow.where = core_record_word(rec->pc + 1, rec->stage, rec->gen);
-        t->follow.last = t->m_pc0 + e->len - 1u;
+        memo_follow(t, e, rec);
         if (k + 1u == e->len)
             memo_apply(t, e);
         return 1;
