@@ -560,6 +560,14 @@ static inline void rec_addrs_done(Core *c, int hooked, CoreMem m, int k)
     }
 }
 
+/* a[l] = base + 4 * u[l] for the n lanes; a and u are apart (the record's addresses, a vector
+ * register), which the compiler is told so that it vectorizes the loop. */
+static inline void lane_addrs(uint32_t *restrict a, const uint32_t *restrict u, uint32_t base, int n)
+{
+    for (int l = 0; l < n; l++)
+        a[l] = base + 4u * u[l];
+}
+
 /* The record's addresses of a gather or scatter whose lanes all passed the check: base + 4 * ID
  * for each exec-mask lane, lowest first (what rec_addr per lane gives, in one pass; all N lanes,
  * the usual case, in a loop the compiler vectorizes). */
@@ -570,8 +578,7 @@ static inline void rec_lanes(Core *c, CoreMem m, uint32_t base, const VReg *B, u
     uint32_t *a = c->rec.addr;
     int k = 0;
     if (E == c->all) {
-        for (int l = 0; l < n; l++)
-            a[l] = base + 4u * B->u[l];
+        lane_addrs(a, B->u, base, n);
         k = n;
     } else {
         for (uint64_t e = E; e; e &= e - 1)

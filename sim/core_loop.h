@@ -71,7 +71,8 @@ static __attribute__((noinline)) CoreExit CORE_LOOP_NAME(Core *c, uint64_t max_i
         c->total++;                                                                             \
         if (hooked) {                                                                           \
             CoreFollow *f_ = c->follow;                                                         \
-            if ((where | (uint64_t)c->rec.taken << 48) == f_->where && (uint32_t)where != f_->last) { \
+            const uint64_t w_ = ((flags) & ISA_FL_BRANCH) ? where | (uint64_t)c->rec.taken << 48 : where; \
+            if (w_ == f_->where && (uint32_t)where != f_->last) {                               \
                 f_->where++;                                                                    \
             } else {                                                                            \
                 c->rec.next_pc = x.halt ? c->pc : x.next;                                       \
