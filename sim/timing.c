@@ -120,6 +120,12 @@ typedef struct MemoEntry {
     uint16_t issues[2];             /* scalar, vector */
     uint16_t nspad;                 /* scalar scratchpad accesses (TmDesc.spad) */
     uint8_t unit[MEMO_LEN], unit_n[MEMO_LEN];
+    /* Replays whose counts (stall charges, issue cycles, unit uses, scalar scratchpad accesses)
+     * are not in the statistics yet, all in one stage and generation: memo_fold adds them, when
+     * the block is replayed in another stage or generation, before the entry is replaced, and
+     * when the statistics are read (timing_stats). A replay then only counts itself. */
+    uint32_t lz_n;
+    uint8_t lz_stage, lz_gen;
 } MemoEntry;
 
 typedef struct MemoWays {
@@ -222,6 +228,8 @@ void timing_free(Timing *t)
     free(t);
 }
 
+static void memo_fold_all(Timing *t);
+
 /* No block being recorded or replayed; a following core (timing_follow) counts no record. */
 static void memo_none(Timing *t)
 {
@@ -241,6 +249,7 @@ void timing_reset(Timing *t)
     t->halted = 0;
     memo_none(t);
     if (++t->run == 0) { /* wrapped: no entry may look current */
+        memo_fold_all(t);
         for (uint32_t i = 0; i < t->desc_cap; i++)
             free(t->desc[i].memo);
         if (t->desc)
@@ -251,6 +260,7 @@ void timing_reset(Timing *t)
 
 const TimingStats *timing_stats(const Timing *t)
 {
+    memo_fold_all((Timing *)t); /* the replays' counts (MemoEntry.lz_n) */
     TimingStats *s = &((Timing *)t)->st;
     /* The scene-memory counters live in SceneMem; copy them in. */
     s->scene = t->mem.st;
@@ -789,21 +799,47 @@ static inline int memo_match(const Timing *t, const MemoEntry *e, const CoreReco
     return memo_state_match(t, e, ev, nev);
 }
 
-/* The outcome of the stored block e, applied at once (the block's records have all come). */
-static void memo_apply(Timing *t, const MemoEntry *e)
+/* The counts of e's replays not yet in the statistics (MemoEntry.lz_n) added to them. */
+static __attribute__((noinline)) void memo_fold(Timing *t, MemoEntry *e)
+{
+    const uint64_t n = e->lz_n;
+    const int stage = e->lz_stage, gen = e->lz_gen;
+    for (int i = 0; i < e->ncharge; i++)
+        charge(t, e->ch_cause[i], n * e->ch_cycles[i], stage, gen);
+    t->issues[stage][gen][0] += n * e->issues[0];
+    t->issues[stage][gen][1] += n * e->issues[1];
+    for (int i = 0; i < e->nunits; i++)
+        t->st.unit_uses[e->unit[i]] += n * e->unit_n[i];
+    if (e->nspad)
+        spad_count_scalar(&t->st.spad_accesses, &t->st.spad_lines, n * e->nspad);
+    e->lz_n = 0;
+}
+
+/* Every stored block's replays into the statistics (memo_fold). */
+static void memo_fold_all(Timing *t)
+{
+    for (uint32_t i = 0; i < t->desc_cap; i++)
+        if (t->desc[i].memo)
+            for (int w = 0; w < MEMO_WAYS; w++)
+                if (t->desc[i].memo->e[w].lz_n)
+                    memo_fold(t, &t->desc[i].memo->e[w]);
+}
+
+/* The outcome of the stored block e, applied at once (the block's records have all come); its
+ * counts are added later (MemoEntry.lz_n). */
+static void memo_apply(Timing *t, MemoEntry *e)
 {
     const uint64_t t0 = t->m_t0, end = t0 + e->end_rel;
     const int stage = t->m_stage, gen = t->m_gen;
     drain(t, end); /* what the next record's drain would apply; the events left come after */
     t->now = end;
-    for (int i = 0; i < e->ncharge; i++)
-        charge(t, e->ch_cause[i], e->ch_cycles[i], stage, gen);
-    t->issues[stage][gen][0] += e->issues[0];
-    t->issues[stage][gen][1] += e->issues[1];
-    for (int i = 0; i < e->nunits; i++)
-        t->st.unit_uses[e->unit[i]] += e->unit_n[i];
-    if (e->nspad)
-        spad_count_scalar(&t->st.spad_accesses, &t->st.spad_lines, e->nspad);
+    if (__builtin_expect(e->lz_stage != stage || e->lz_gen != gen || e->lz_n == UINT32_MAX, 0)) {
+        if (e->lz_n)
+            memo_fold(t, e);
+        e->lz_stage = (uint8_t)stage;
+        e->lz_gen = (uint8_t)gen;
+    }
+    e->lz_n++;
     for (int i = 0; i < e->nwrite; i++) {
         t->simd.ready[e->write[i].reg] = t0 + e->write[i].rel;
         t->simd.rcause[e->write[i].reg] = e->write[i].cause;
@@ -1007,7 +1043,11 @@ static __attribute__((noinline)) void memo_store(Timing *t)
     TmDesc *d0 = &t->desc[t->m_pc0];
     if (!d0->memo && !(d0->memo = calloc(1, sizeof *d0->memo)))
         return; /* no memory: the block is just not kept */
-    d0->memo->e[d0->memo->next] = *m;
+    MemoEntry *old = &d0->memo->e[d0->memo->next];
+    if (old->lz_n)
+        memo_fold(t, old);
+    m->lz_n = 0;
+    *old = *m;
     t->mc.stores++;
     d0->memo->next = (uint8_t)((d0->memo->next + 1) % MEMO_WAYS);
 }
