@@ -434,6 +434,39 @@ static TimingStats run_memo_src(const BenchProg *p, const char *src, int memo, u
     return s;
 }
 
+/* src timed to its halt with the memo on and the core following, in slices of `slice`
+ * instructions with the statistics read after each (a replayed block's counts reach the
+ * statistics when they are read: MemoEntry.lz_n); the figures read after the first slice, and
+ * at the end. */
+static TimingStats run_memo_read_between(const char *src, uint64_t slice, TimingStats *first)
+{
+    CoreParams cp;
+    Timing *t = default_timing(&cp);
+    char err[512];
+    BenchProg p = {"memo_loop.s", NULL, 0};
+    AsmObject obj;
+    assemble_prog(&p, src, &obj);
+    Core *c = core_new(&cp, &obj, err, sizeof err);
+    cr_assert(c, "%s", err);
+    timing_attach(t, c);
+    CoreExit ex;
+    int n = 0;
+    while ((ex = core_run_slice(c, slice, 1000000)) == CORE_EXIT_LIMIT && n < 100000)
+        if (n++ == 0)
+            *first = *timing_stats(t);
+        else
+            (void)timing_stats(t);
+    cr_assert(ex == CORE_EXIT_HALT, "%s", core_trap_message(c));
+    cr_assert_gt(n, 0, "the run is longer than one slice of %llu", (unsigned long long)slice);
+    timing_end(t);
+    cr_assert_null(timing_error(t), "%s", timing_error(t));
+    TimingStats s = *timing_stats(t);
+    timing_free(t);
+    core_free(c);
+    asm_object_free(&obj);
+    return s;
+}
+
 static TimingStats run_memo(const BenchProg *p, int memo, uint64_t limit, uint64_t *replays)
 {
     return run_memo_src(p, NULL, memo, limit, replays);
@@ -535,6 +568,43 @@ Test(timing, memoized_blocks_leave_a_stored_path_at_a_taken_branch_or_another_ge
     }
 }
 
+/* A loop whose blocks start in more states than a start keeps ways: a scene load that misses
+ * (a new line each pass) and a delay loop of 0 to 7 passes after it, so the blocks of the delay
+ * loop and after it start with the load's result landing at many distances ahead. Ways replayed
+ * are replaced by others while their replays' counts are still to be added (MemoEntry.lz_n). */
+static const char memo_churn[] =
+    "        li      r1, 300\n"
+    "        li      r2, 0\n"
+    "        vli     v1, 0x3f800000\n"
+    "loop:   ld      r3, r2, 0\n"
+    "        addi    r2, r2, 64\n"
+    "        andi    r7, r1, 14\n"
+    "        beq     r7, r0, join\n"
+    "delay:  addi    r7, r7, -2\n"
+    "        vfadd   v2, v1, v1\n"
+    "        bne     r7, r0, delay\n"
+    "join:   add     r4, r3, r1\n"
+    "        vfadd   v2, v1, v1\n"
+    "        vfmul   v3, v2, v1\n"
+    "        add     r5, r4, r1\n"
+    "        addi    r1, r1, -1\n"
+    "        bne     r1, r0, loop\n"
+    "        halt\n";
+
+Test(timing, memoized_blocks_replaced_while_their_replays_are_uncounted_give_the_same_figures)
+{
+    BenchProg prog = {"memo_churn.s", NULL, 0};
+    uint64_t r_on, r_off;
+    TimingStats off = run_memo_src(&prog, memo_churn, MEMO_OFF, 0, &r_off);
+    TimingStats on = run_memo_src(&prog, memo_churn, MEMO_FOLLOW, 0, &r_on);
+    cr_expect(memcmp(&on, &off, sizeof on) == 0, "cycles %llu with the memo, %llu without",
+              (unsigned long long)on.cycles, (unsigned long long)off.cycles);
+    /* a handful of block starts, many more ways stored than they keep (4 each), many replayed */
+    cr_expect_gt(memo_counts.stores, 100u, "%llu ways stored", (unsigned long long)memo_counts.stores);
+    cr_expect_gt(r_on, 200u, "%llu replays", (unsigned long long)r_on);
+    cr_expect_gt(on.stalls[TM_SCENE_MEMORY], 0u, "the load misses");
+}
+
 Test(timing, memoized_blocks_give_the_same_figures_as_timing_each_instruction)
 {
     /* Every counter with the memo on equals the one with it off: for whole runs, and for runs
@@ -580,6 +650,22 @@ Test(timing, memoized_blocks_give_the_same_figures_as_timing_each_instruction)
         /* its scalar scratchpad accesses are plain instructions inside its blocks, counted when
          * a block is replayed too */
         cr_expect_eq(on.spad_accesses, 3 * 150u, "scratchpad accesses %llu", (unsigned long long)on.spad_accesses);
+        /* the statistics read between slices of the run (a replayed block's counts reach them
+         * when they are read: MemoEntry.lz_n): the same at the end; after the first slice, those
+         * of a run stopped there but for the records of a block still being replayed (at most
+         * 16, counted when it ends), not behind by the blocks replayed so far */
+        if (memo == MEMO_FOLLOW)
+            for (uint64_t slice = 37; slice < 2000; slice = slice * 3 + 1) {
+                TimingStats first = {0}, read = run_memo_read_between(memo_loop, slice, &first);
+                cr_expect(memcmp(&read, &off, sizeof read) == 0, "read every %llu instructions: cycles %llu, %llu without the memo",
+                          (unsigned long long)slice, (unsigned long long)read.cycles, (unsigned long long)off.cycles);
+                TimingStats stop = run_memo_src(&loop, memo_loop, MEMO_OFF, slice, &r_off);
+                cr_expect(first.busy <= stop.busy && stop.busy - first.busy < 16,
+                          "after %llu instructions: %llu issue cycles read, %llu in a run stopped there",
+                          (unsigned long long)slice, (unsigned long long)first.busy, (unsigned long long)stop.busy);
+                cr_expect(first.unit_uses[ISA_U_VADD] <= stop.unit_uses[ISA_U_VADD] &&
+                          stop.unit_uses[ISA_U_VADD] - first.unit_uses[ISA_U_VADD] < 16);
+            }
         for (uint64_t limit = 1; limit < on.busy; limit += limit < 400 ? 1 : 13) {
             TimingStats a = run_memo_src(&loop, memo_loop, memo, limit, &r_on),
                         b = run_memo_src(&loop, memo_loop, MEMO_OFF, limit, &r_off);
