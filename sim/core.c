@@ -73,7 +73,6 @@ struct Core {
                                      active lanes, per (stage, generation) */
     uint64_t *row;                /* the current (stage, gen)'s row */
     uint64_t touched[(COUNT_ROWS + 63) / 64]; /* rows that may hold counts not yet folded */
-    uint64_t total;
     CoreHook hook;
     void *hook_ctx;
     CoreFollow *follow;           /* the hook's, or &no_follow */
@@ -1241,7 +1240,19 @@ const CoreStats *core_stats(Core *c)
     count_fold(c);
     return &c->st;
 }
-uint64_t core_instructions(const Core *c) { return c->total; }
+/* The instructions counted in st and in the rows not yet folded into it (the run loop keeps no
+ * total of its own: one count an instruction fewer). */
+uint64_t core_instructions(const Core *c)
+{
+    uint64_t n = 0;
+    for (int s = 0; s < ISA_STAGE_COUNT; s++)
+        n += c->st.instructions[s];
+    for (uint32_t r = 0; r < COUNT_ROWS; r++)
+        if ((c->touched[r / 64] >> (r % 64)) & 1u)
+            for (int op = 0; op < ISA_OP_COUNT; op++)
+                n += c->counts[(size_t)r * COUNT_COLS + (size_t)op];
+    return n;
+}
 
 uint8_t *core_mem(Core *c, CoreMem m, uint32_t *bytes)
 {

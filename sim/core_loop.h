@@ -68,7 +68,6 @@ static __attribute__((noinline)) CoreExit CORE_LOOP_NAME(Core *c, uint64_t max_i
         row[ISA_OP_##name]++;                                                                   \
         if ((flags) & ISA_FL_VEC)                                                               \
             row[ISA_OP_COUNT] += (uint64_t)popcount64(x.lanes);                                 \
-        c->total++;                                                                             \
         if (hooked) {                                                                           \
             CoreFollow *f_ = c->follow;                                                         \
             const uint64_t w_ = ((flags) & ISA_FL_BRANCH) ? where | (uint64_t)c->rec.taken << 48 : where; \
