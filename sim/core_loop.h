@@ -77,10 +77,13 @@ static __attribute__((noinline)) CoreExit CORE_LOOP_NAME(Core *c, uint64_t max_i
                 c->rec.next_pc = x.halt ? c->pc : x.next;                                       \
                 c->hook(c->hook_ctx, &c->rec);                                                  \
             }                                                                                   \
+            /* what record_reset leaves to the memory families: the addresses, and the count and \
+             * base that only the AGU's and the partition unit's set */                          \
             if (ISA_U_##unit == ISA_U_AGU || ISA_U_##unit == ISA_U_RBUF ||                      \
                 ISA_U_##unit == ISA_U_PART || ISA_U_##unit == ISA_U_SPAD ||                     \
-                ISA_U_##unit == ISA_U_SCENE || ISA_U_##unit == ISA_U_FB) {                      \
-                c->rec.naddr = 0; /* what record_reset leaves to the memory families */         \
+                ISA_U_##unit == ISA_U_SCENE || ISA_U_##unit == ISA_U_FB)                        \
+                c->rec.naddr = 0;                                                               \
+            if (ISA_U_##unit == ISA_U_AGU || ISA_U_##unit == ISA_U_PART) {                      \
                 c->rec.count = 0;                                                               \
                 c->rec.base = 0;                                                                \
             }                                                                                   \
