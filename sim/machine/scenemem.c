@@ -138,7 +138,8 @@ uint64_t mem_access(SceneMem *m, int space, uint32_t addr, uint64_t t, int write
     }
     m->st.hits++;
     m->lru[k] = m->stamp;
-    m->dirty[k] |= (uint8_t)(write != 0);
+    if (write) /* a load leaves the line as it was */
+        m->dirty[k] = 1;
     const uint64_t r = t + (uint64_t)m->p.hit_latency;
     return r > m->ready[k] ? r : m->ready[k];
 }
