@@ -162,6 +162,37 @@ static int rb_access_bits(const RayBufs *rb, const uint32_t *addr, int naddr, in
     return worst;
 }
 
+/* rb_access_bits for N = 16 lanes, branch-free: a lane's line is new when no lower lane has it, and
+ * a bank's count is that of the new lines in it (a lane's bank is its line's, so the most over all
+ * lanes is the most over the banks). Each inner loop is one block of 16 comparisons the compiler
+ * vectorizes; the branchy scan of rb_access_bits mispredicts on the random banks of a gather. */
+static int rb_access_bits16(const RayBufs *rb, const uint32_t *addr, int *lines)
+{
+    uint32_t line[16], bank[16], fresh[16];
+    const uint32_t bmask = (uint32_t)rb->p.banks - 1u;
+    for (int i = 0; i < 16; i++) {
+        line[i] = addr[i] >> rb->shift;
+        bank[i] = line[i] & bmask;
+    }
+    int k = 0;
+    for (int i = 0; i < 16; i++) {
+        uint32_t seen = 0;
+        for (int j = 0; j < 16; j++)
+            seen |= (uint32_t)(j < i) & (uint32_t)(line[j] == line[i]);
+        fresh[i] = seen ^ 1u;
+        k += (int)fresh[i];
+    }
+    uint32_t worst = 0;
+    for (int i = 0; i < 16; i++) {
+        uint32_t cnt = 0;
+        for (int j = 0; j < 16; j++)
+            cnt += fresh[j] & (uint32_t)(bank[j] == bank[i]);
+        worst = cnt > worst ? cnt : worst;
+    }
+    *lines = k;
+    return (int)worst;
+}
+
 /* Whether addr[0..naddr) is the last access's lanes moved by one whole number of lines (see
  * RayBufs.last_addr; the caller checks the bank count is a power of two). The lanes are compared
  * in one branch-free pass the compiler vectorizes. */
@@ -202,6 +233,7 @@ int rb_access(RayBufs *rb, const uint32_t *addr, int naddr, TimingStats *st)
     } else {
         lines = rb_ascending_lines(rb, addr, naddr);
         cycles = lines                         ? 1
+                 : pow2 && naddr == 16        ? rb_access_bits16(rb, addr, &lines)
                  : pow2 && rb->p.banks <= 64 ? rb_access_bits(rb, addr, naddr, &lines)
                                              : rb_access_any(rb, addr, naddr, &lines);
         rb->last_cycles = cycles;
