@@ -601,15 +601,27 @@ static int do_part(Core *c, const IsaInstr *in, int hooked)
     uint32_t len = (e - b) / 4;
     if (c->pq_len < len || c->pq_len >= len + (uint32_t)c->n)
         return trap(c, "partition: %u mask bits queued for a stream of %u IDs", c->pq_len, len);
-    uint32_t k = 0;
-    for (uint32_t i = 0; i < len; i++)
-        if (c->pq[i])
-            c->part_tmp[k++] = rd32(c, CORE_MEM_IDM, b + 4 * i);
-    uint32_t set = k;
-    for (uint32_t i = 0; i < len; i++)
-        if (!c->pq[i])
-            c->part_tmp[k++] = rd32(c, CORE_MEM_IDM, b + 4 * i);
-    memcpy(c->mem[CORE_MEM_IDM] + b, c->part_tmp, 4 * (size_t)len);
+    /* Branch-free (the bits are the rays' data, a branch on each mispredicts): every ID is written
+     * at the next place of its side and the place moves on only if it belongs there, so a
+     * place is overwritten until an ID of its side takes it; the last write of each pass may fall
+     * one past (part_tmp holds one word more than the ID-stream memory). */
+    const uint8_t *q = c->pq;
+    const uint8_t *ids = c->mem[CORE_MEM_IDM] + b;
+    uint32_t *tmp = c->part_tmp, k = 0;
+    for (uint32_t i = 0; i < len; i++) {
+        uint32_t v;
+        memcpy(&v, ids + 4 * (size_t)i, 4);
+        tmp[k] = v;
+        k += q[i];
+    }
+    const uint32_t set = k;
+    for (uint32_t i = 0; i < len; i++) {
+        uint32_t v;
+        memcpy(&v, ids + 4 * (size_t)i, 4);
+        tmp[k] = v;
+        k += 1u - q[i];
+    }
+    memcpy(c->mem[CORE_MEM_IDM] + b, tmp, 4 * (size_t)len);
     SR(in->a) = b + 4 * set;
     c->pq_len = 0;
     if (hooked) {
