@@ -216,7 +216,7 @@ static inline int rb_same_as_last(const RayBufs *rb, const uint32_t *addr, int n
 
 static inline void rb_note_last(RayBufs *rb, const uint32_t *addr, int naddr)
 {
-    if (naddr == 16)
+    if (naddr <= 16) /* a fixed 16 (the lanes past naddr are never compared): no call to memcpy */
         memcpy(rb->last_addr, addr, 16 * sizeof *addr);
     else
         memcpy(rb->last_addr, addr, sizeof *addr * (size_t)naddr);

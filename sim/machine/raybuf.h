@@ -51,7 +51,9 @@ int rb_init(RayBufs *rb, const RbParams *p);
 void rb_free(RayBufs *rb);
 
 /* A gather or scatter of naddr lanes (naddr >= 1): the cycles the banks need, the most distinct
- * lines any one bank serves. Counts the access, its lines and whether it had a conflict. */
+ * lines any one bank serves. Counts the access, its lines and whether it had a conflict. addr
+ * holds at least 16 words however small naddr is (a CoreRecord's addr does): the access is kept
+ * for the next as 16 words in one copy, the words past naddr never compared. */
 int rb_access(RayBufs *rb, const uint32_t *addr, int naddr, struct TimingStats *st);
 
 /* Extra issue cycles of an ID vector read or appended at byte address base. */
