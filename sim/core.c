@@ -73,7 +73,8 @@ struct Core {
                                      active lanes, per (stage, generation) */
     uint64_t *row;                /* the current (stage, gen)'s row */
     uint64_t touched[(COUNT_ROWS + 63) / 64]; /* rows that may hold counts not yet folded */
-    CoreHook hook;
+    CoreHook hook;                /* core_set_hook's: non-NULL selects the hooked run loops */
+    CoreHook hook_op[ISA_OP_COUNT]; /* the hook each opcode's records go to (core_set_op_hook) */
     void *hook_ctx;
     CoreFollow *follow;           /* the hook's, or &no_follow */
     CoreFollow no_follow;         /* where = CORE_FOLLOW_NONE */
@@ -1240,8 +1241,16 @@ CoreExit core_run(Core *c, uint64_t max_instr)
 void core_set_hook(Core *c, CoreHook hook, void *ctx)
 {
     c->hook = hook;
+    for (int op = 0; op < ISA_OP_COUNT; op++)
+        c->hook_op[op] = hook;
     c->hook_ctx = ctx;
     core_set_follow(c, NULL);
+}
+
+void core_set_op_hook(Core *c, int op, CoreHook hook)
+{
+    if (c->hook && op >= 0 && op < ISA_OP_COUNT && hook)
+        c->hook_op[op] = hook;
 }
 
 void core_set_follow(Core *c, CoreFollow *f)

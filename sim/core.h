@@ -163,6 +163,11 @@ CoreExit core_run_slice(Core *c, uint64_t max_instr, uint64_t limit);
 const char *core_trap_message(const Core *c);
 
 void core_set_hook(Core *c, CoreHook hook, void *ctx);
+/* After core_set_hook: the records of opcode op go to hook instead (same ctx). A hook owner that
+ * times instructions by kind gives each opcode its kind's hook, so that the choice is made once
+ * per opcode, at the run loop's own dispatch, not by a branch in the hook on every record. No
+ * effect without a hook set, or for an op out of range or a NULL hook. */
+void core_set_op_hook(Core *c, int op, CoreHook hook);
 /* The hook's CoreFollow (see there), or NULL for none; core_set_hook clears it. */
 void core_set_follow(Core *c, CoreFollow *f);
 

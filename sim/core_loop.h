@@ -75,7 +75,7 @@ static __attribute__((noinline)) CoreExit CORE_LOOP_NAME(Core *c, uint64_t max_i
                 f_->where++;                                                                    \
             } else {                                                                            \
                 c->rec.next_pc = x.halt ? c->pc : x.next;                                       \
-                c->hook(c->hook_ctx, &c->rec);                                                  \
+                c->hook_op[ISA_OP_##name](c->hook_ctx, &c->rec);                                \
             }                                                                                   \
             /* what record_reset leaves to the memory families: the addresses, and the count and \
              * base that only the AGU's and the partition unit's set */                          \

@@ -51,6 +51,9 @@ enum { EV_UNIT, EV_FETCH, EV_PART };
  * timed on a straight path of its own (issue_units_complete); the others (AGU, partition unit,
  * a ray-buffer scalar access, a halt) take the general path. */
 enum { TK_OTHER, TK_RB_GATHER, TK_RB_SCATTER, TK_SPAD_LOAD, TK_SPAD_STORE, TK_SCENE };
+/* Kinds of hook (timing_op_hook), beside those: a plain instruction (TmDesc.plain) and a vector
+ * scratchpad access. */
+enum { TK_PLAIN = TK_SCENE + 1, TK_SPAD_VEC };
 
 /* What the timing core needs of one program instruction, worked out the first time the
  * instruction runs in a run and kept by its pc (describe()): its ISA table row's unit and flags as
@@ -434,30 +437,53 @@ static __attribute__((noinline)) uint64_t wait_hazards(Timing *t, const TmDesc *
     return at;
 }
 
-/* Works out d for the instruction at rec->pc (see TmDesc). */
-static void describe_fill(Timing *t, TmDesc *d, const CoreRecord *rec)
+/* What the timing core branches on for an opcode, from the ISA table's UNIT and FLAGS: the
+ * TmDesc fields of that name (describe_fill) and the hook the opcode's records go to
+ * (timing_op_hook), both from here. */
+typedef struct TmClass {
+    uint8_t is_halt, vec, wr, spad, mem, special, plain, kind;
+} TmClass;
+
+static TmClass tm_class(int op)
 {
-    const IsaOpInfo *oi = &isa_ops[rec->in->op];
-    d->op = (uint8_t)rec->in->op;
-    d->unit = (uint8_t)oi->unit;
-    d->is_halt = (oi->flags & ISA_FL_END) != 0;
-    d->vec = (oi->flags & ISA_FL_VEC) != 0;
-    const int wr = (oi->flags & ISA_FL_WRITE) != 0;
+    const IsaOpInfo *oi = &isa_ops[op];
+    TmClass k;
+    k.is_halt = (oi->flags & ISA_FL_END) != 0;
+    k.vec = (oi->flags & ISA_FL_VEC) != 0;
+    k.wr = (oi->flags & ISA_FL_WRITE) != 0;
     /* A scalar scratchpad access (spld, spst) touches one line: one issue cycle at any port count,
      * a load's data spad.latency after it (spad.h), whatever the address; the partition unit's
      * pmask and pclr have their class's latency. Both time as plain instructions (a scalar access
      * is counted by d->spad). */
-    d->spad = oi->unit == ISA_U_SPAD && !d->vec;
-    const int spad_vec = oi->unit == ISA_U_SPAD && d->vec;
+    k.spad = oi->unit == ISA_U_SPAD && !k.vec;
+    const int spad_vec = oi->unit == ISA_U_SPAD && k.vec;
     const int part_data = oi->unit == ISA_U_PART && (oi->flags & ISA_FL_IDM);
-    d->mem = oi->unit == ISA_U_AGU || oi->unit == ISA_U_RBUF || spad_vec || oi->unit == ISA_U_SCENE ||
-             oi->unit == ISA_U_FB;
-    d->special = oi->unit == ISA_U_AGU || oi->unit == ISA_U_RBUF || spad_vec || part_data;
-    d->plain = !d->mem && !d->special && !d->is_halt;
-    d->kind = oi->unit == ISA_U_RBUF && (oi->flags & ISA_FL_VEC) ? (wr ? TK_RB_SCATTER : TK_RB_GATHER)
-              : oi->unit == ISA_U_SPAD                          ? (wr ? TK_SPAD_STORE : TK_SPAD_LOAD)
-              : oi->unit == ISA_U_SCENE || oi->unit == ISA_U_FB ? TK_SCENE
-                                                                : TK_OTHER;
+    k.mem = oi->unit == ISA_U_AGU || oi->unit == ISA_U_RBUF || spad_vec || oi->unit == ISA_U_SCENE ||
+            oi->unit == ISA_U_FB;
+    k.special = oi->unit == ISA_U_AGU || oi->unit == ISA_U_RBUF || spad_vec || part_data;
+    k.plain = !k.mem && !k.special && !k.is_halt;
+    k.kind = oi->unit == ISA_U_RBUF && k.vec                       ? (k.wr ? TK_RB_SCATTER : TK_RB_GATHER)
+             : oi->unit == ISA_U_SPAD                              ? (k.wr ? TK_SPAD_STORE : TK_SPAD_LOAD)
+             : oi->unit == ISA_U_SCENE || oi->unit == ISA_U_FB     ? TK_SCENE
+                                                                   : TK_OTHER;
+    return k;
+}
+
+/* Works out d for the instruction at rec->pc (see TmDesc). */
+static void describe_fill(Timing *t, TmDesc *d, const CoreRecord *rec)
+{
+    const IsaOpInfo *oi = &isa_ops[rec->in->op];
+    const TmClass c = tm_class(rec->in->op);
+    d->op = (uint8_t)rec->in->op;
+    d->unit = (uint8_t)oi->unit;
+    d->is_halt = c.is_halt;
+    d->vec = c.vec;
+    const int wr = c.wr;
+    d->spad = c.spad;
+    d->mem = c.mem;
+    d->special = c.special;
+    d->plain = c.plain;
+    d->kind = c.kind;
     d->short_block = 0;
     d->lat = d->spad && !wr ? (uint32_t)(spad_load_ready(&t->spad, 0)) : (uint32_t)t->simd.p.lat[oi->unit];
     d->issue = t->simd.p.issue[oi->unit] > 1 ? (uint32_t)t->simd.p.issue[oi->unit] : 0;
@@ -704,21 +730,43 @@ static inline void issue_units_complete(Timing *t, const TmDesc *d, const CoreRe
     }
 }
 
-/* One instruction, timed as it runs. */
-static inline __attribute__((always_inline)) void time_one(Timing *t, const TmDesc *d, const CoreRecord *rec)
+/* One instruction, timed as it runs. kind: d->kind when the caller knows it as a constant
+ * (the hooks by kind: the compiler keeps only that kind's path), or -1 for any instruction. */
+static inline __attribute__((always_inline)) void time_kind(Timing *t, const TmDesc *d, const CoreRecord *rec,
+                                                            int kind)
 {
     uint64_t at = t->now;
     drain(t, at);
     int cause = hazard(t, d, rec, at);
     if (__builtin_expect(cause >= 0, 0))
         at = wait_hazards(t, d, rec, at, cause);
-    if ((d->mem && rec->naddr) || d->special) {
-        issue_units_complete(t, d, rec, at);
-        return;
+    switch (kind) {
+    case TK_PLAIN: /* neither a memory unit nor a special result time (the common case below) */
+        break;
+    case TK_RB_GATHER:
+    case TK_RB_SCATTER: issue_rb(t, d, rec, at); return; /* a ray-buffer vector access is special */
+    case TK_SPAD_VEC: issue_spad(t, d, rec, at); return; /* so is a vector scratchpad access */
+    case TK_SCENE:                                       /* a memory unit, its result time usual */
+        if (rec->naddr) {
+            issue_scene(t, d, rec, at);
+            return;
+        }
+        break;
+    default:
+        if ((d->mem && rec->naddr) || d->special) {
+            issue_units_complete(t, d, rec, at);
+            return;
+        }
+        break;
     }
     /* The common case: one issue cycle, the result after the class's latency. */
     count_issue(t, d, rec->stage, rec->gen);
     complete(t, d, rec, at, at + 1, at + d->lat, TM_DATA_DEPENDENCY);
+}
+
+static inline __attribute__((always_inline)) void time_one(Timing *t, const TmDesc *d, const CoreRecord *rec)
+{
+    time_kind(t, d, rec, -1);
 }
 
 /* ---- memoized blocks ---------------------------------------------------------------------- */
@@ -1143,23 +1191,114 @@ static __attribute__((noinline)) void hook_any(Timing *t, const CoreRecord *rec)
     time_one(t, d, rec);
 }
 
+/* The next record of a replayed block, only checked (1), or not (0). */
+static inline __attribute__((always_inline)) int hook_followed(Timing *t, const CoreRecord *rec)
+{
+    const uint64_t w = core_record_where(rec); /* pc, stage, generation, taken */
+    if (rec->pc != t->follow.last) { /* inside the block: the next pc, no branch taken */
+        if (__builtin_expect(w == t->follow.where, 1)) {
+            t->follow.where++;
+            return 1;
+        }
+    } else if (w == (t->follow.where | (uint64_t)t->m_e->taken_last << 48)) {
+        t->follow.where++;
+        memo_apply(t, t->m_e);
+        return 1;
+    }
+    return 0;
+}
+
 void timing_hook(void *ctx, const CoreRecord *rec)
 {
     Timing *t = ctx;
-    if (t->mmode == MM_REPLAY) { /* the next record of a stored block: only checked */
-        const uint64_t w = core_record_where(rec); /* pc, stage, generation, taken */
-        if (rec->pc != t->follow.last) { /* inside the block: the next pc, no branch taken */
-            if (__builtin_expect(w == t->follow.where, 1)) {
-                t->follow.where++;
-                return;
-            }
-        } else if (w == (t->follow.where | (uint64_t)t->m_e->taken_last << 48)) {
-            t->follow.where++;
-            memo_apply(t, t->m_e);
+    if (t->mmode == MM_REPLAY && hook_followed(t, rec)) /* the next record of a stored block */
+        return;
+    hook_any(t, rec);
+}
+
+/* ---- hooks by kind ------------------------------------------------------------------------
+ * timing_hook's work for the records of one kind of instruction (tm_class), which the core
+ * calls by opcode (timing_attach): the same steps with the kind a constant, so that the choice
+ * between a plain instruction's block and a memory instruction's unit is made by the core's
+ * dispatch on the opcode, not by branches on the instruction's description at every record (they
+ * followed the kernel's data; callgrind's branch model put 3 M of a diffuse batch's 15 M
+ * mispredicted branches there). */
+
+/* A plain instruction (TmDesc.plain; hook_any's steps for one). */
+static __attribute__((noinline)) void hook_plain_any(Timing *t, const CoreRecord *rec)
+{
+    if (__builtin_expect(t->halted, 0)) {
+        internal_error(t, "instruction after halt");
+        return;
+    }
+    if (t->mmode == MM_REPLAY && memo_diverged(t, rec))
+        return;
+    TmDesc *d = (TmDesc *)describe(t, rec);
+    if (t->mmode == MM_RECORD) {
+        if (rec->stage == t->m_stage && rec->gen == t->m_gen) {
+            memo_time_noted(t, d, rec);
+            return;
+        }
+        memo_store(t);
+    }
+    if (!d->short_block && !t->memo_off) {
+        if (memo_begin(t, d, rec))
+            return;
+        if (t->mmode == MM_RECORD) {
+            memo_time_noted(t, d, rec);
             return;
         }
     }
-    hook_any(t, rec);
+    time_kind(t, d, rec, TK_PLAIN);
+}
+
+static void hook_plain(void *ctx, const CoreRecord *rec)
+{
+    Timing *t = ctx;
+    if (t->mmode == MM_REPLAY && hook_followed(t, rec))
+        return;
+    hook_plain_any(t, rec);
+}
+
+/* An instruction that is not plain (hook_any's steps for one, of the kind given): it ends a
+ * replay or a recording, and is timed as it runs. */
+static inline __attribute__((always_inline)) void hook_unit(void *ctx, const CoreRecord *rec, int kind)
+{
+    Timing *t = ctx;
+    if (__builtin_expect(t->halted, 0)) {
+        internal_error(t, "instruction after halt");
+        return;
+    }
+    if (t->mmode != MM_NONE) {
+        if (t->mmode == MM_REPLAY && memo_diverged(t, rec)) /* (never 1: rec is on no block's path) */
+            return;
+        if (t->mmode == MM_RECORD)
+            memo_store(t);
+    }
+    time_kind(t, describe(t, rec), rec, kind);
+}
+
+static void hook_rb_gather(void *ctx, const CoreRecord *rec) { hook_unit(ctx, rec, TK_RB_GATHER); }
+static void hook_rb_scatter(void *ctx, const CoreRecord *rec) { hook_unit(ctx, rec, TK_RB_SCATTER); }
+static void hook_spad_vec(void *ctx, const CoreRecord *rec) { hook_unit(ctx, rec, TK_SPAD_VEC); }
+static void hook_scene(void *ctx, const CoreRecord *rec) { hook_unit(ctx, rec, TK_SCENE); }
+static void hook_other(void *ctx, const CoreRecord *rec) { hook_unit(ctx, rec, -1); }
+
+CoreHook timing_op_hook(int op)
+{
+    if (op < 0 || op >= ISA_OP_COUNT)
+        return timing_hook;
+    const TmClass c = tm_class(op);
+    if (c.plain)
+        return hook_plain;
+    switch (c.kind) {
+    case TK_RB_GATHER: return hook_rb_gather;
+    case TK_RB_SCATTER: return hook_rb_scatter;
+    case TK_SPAD_LOAD:
+    case TK_SPAD_STORE: return c.vec ? hook_spad_vec : hook_other;
+    case TK_SCENE: return hook_scene;
+    default: return hook_other;
+    }
 }
 
 CoreFollow *timing_follow(Timing *t) { return &t->follow; }

@@ -102,6 +102,9 @@ void timing_free(Timing *t);
 void timing_reset(Timing *t);
 /* The CoreHook: one executed instruction. */
 void timing_hook(void *ctx, const CoreRecord *rec);
+/* The hook for the records of opcode op: timing_hook's work specialized to the op's kind of
+ * instruction (same results; timing_attach gives each opcode its own). */
+CoreHook timing_op_hook(int op);
 /* t's CoreFollow, for a core whose hook calls timing_hook (core_set_follow after core_set_hook). */
 CoreFollow *timing_follow(Timing *t);
 /* Hooks c to t: timing_hook, and t's CoreFollow, so that c counts the records of a replayed block
@@ -111,6 +114,8 @@ CoreFollow *timing_follow(Timing *t);
 static inline void timing_attach(Timing *t, Core *c)
 {
     core_set_hook(c, timing_hook, t);
+    for (int op = 0; op < ISA_OP_COUNT; op++)
+        core_set_op_hook(c, op, timing_op_hook(op));
     core_set_follow(c, timing_follow(t));
 }
 /* Memoized blocks on (the default) or off: the same results either way (tests/unit/test_timing.c

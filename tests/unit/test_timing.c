@@ -393,8 +393,10 @@ Test(timing, a_model_reused_for_another_program_times_it_as_a_fresh_one)
 }
 
 /* How a run_memo run times blocks: the memo off; on, with every record going to the hook; on,
- * with the core counting a replayed block's records itself (timing_follow, as sfsim runs it). */
-enum { MEMO_OFF, MEMO_HOOK, MEMO_FOLLOW };
+ * with the core counting a replayed block's records itself (timing_follow); that, with each
+ * opcode's records going to its kind's hook (timing_op_hook: as sfsim runs it, timing_attach);
+ * the kinds' hooks with the memo off. */
+enum { MEMO_OFF, MEMO_HOOK, MEMO_FOLLOW, MEMO_KINDS, MEMO_KINDS_OFF };
 
 static uint64_t hook_calls;   /* records the last run_memo run's hook was given */
 static TimingMemoCounts memo_counts; /* and what its memo did */
@@ -405,6 +407,12 @@ static void counting_hook(void *ctx, const CoreRecord *rec)
     timing_hook(ctx, rec);
 }
 
+static void counting_op_hook(void *ctx, const CoreRecord *rec)
+{
+    hook_calls++;
+    timing_op_hook(rec->in->op)(ctx, rec);
+}
+
 /* prog (or src, assembly text, when not NULL) timed on a fresh model with the memo of blocks as
  * memo says, stopped by an instruction limit (0: run to its halt); the blocks it replayed. */
 static TimingStats run_memo_src(const BenchProg *p, const char *src, int memo, uint64_t limit, uint64_t *replays)
@@ -412,14 +420,14 @@ static TimingStats run_memo_src(const BenchProg *p, const char *src, int memo, u
     CoreParams cp;
     Timing *t = default_timing(&cp);
     char err[512];
-    timing_set_memo(t, memo != MEMO_OFF);
+    timing_set_memo(t, memo != MEMO_OFF && memo != MEMO_KINDS_OFF);
     AsmObject obj;
     assemble_prog(p, src, &obj);
     Core *c = core_new(&cp, &obj, err, sizeof err);
     cr_assert(c, "%s: %s", p->file, err);
     hook_calls = 0;
-    core_set_hook(c, counting_hook, t);
-    if (memo == MEMO_FOLLOW) /* what timing_attach sets, with the counting hook */
+    core_set_hook(c, memo >= MEMO_KINDS ? counting_op_hook : counting_hook, t);
+    if (memo >= MEMO_FOLLOW) /* what timing_attach sets, with a counting hook */
         core_set_follow(c, timing_follow(t));
     CoreExit ex = core_run(c, limit ? limit : 1000000);
     cr_assert(ex == CORE_EXIT_HALT || (limit && ex == CORE_EXIT_LIMIT), "%s: %s", p->file, core_trap_message(c));
@@ -540,7 +548,7 @@ Test(timing, memoized_blocks_leave_a_stored_path_at_a_taken_branch_or_another_ge
     uint64_t r_on, r_off;
     TimingStats off = run_memo_src(&prog, memo_paths, MEMO_OFF, 0, &r_off);
     cr_expect_eq(hook_calls, off.busy, "without the memo every record goes to the hook");
-    for (int memo = MEMO_HOOK; memo <= MEMO_FOLLOW; memo++) {
+    for (int memo = MEMO_HOOK; memo <= MEMO_KINDS; memo++) {
         TimingStats on = run_memo_src(&prog, memo_paths, memo, 0, &r_on);
         cr_expect(memcmp(&on, &off, sizeof on) == 0, "memo mode %d: cycles %llu with the memo, %llu without", memo,
                   (unsigned long long)on.cycles, (unsigned long long)off.cycles);
@@ -553,7 +561,7 @@ Test(timing, memoized_blocks_leave_a_stored_path_at_a_taken_branch_or_another_ge
         cr_expect_lt(memo_counts.retimed * 10, on.busy, "%llu records timed again of %llu",
                      (unsigned long long)memo_counts.retimed,
                      (unsigned long long)on.busy);
-        if (memo == MEMO_FOLLOW) /* the records inside replayed blocks were counted by the core */
+        if (memo >= MEMO_FOLLOW) /* the records inside replayed blocks were counted by the core */
             cr_expect_lt(hook_calls + r_on, off.busy, "the core following: %llu hook calls for %llu records",
                          (unsigned long long)hook_calls, (unsigned long long)off.busy);
         else
@@ -596,7 +604,7 @@ Test(timing, memoized_blocks_replaced_while_their_replays_are_uncounted_give_the
     BenchProg prog = {"memo_churn.s", NULL, 0};
     uint64_t r_on, r_off;
     TimingStats off = run_memo_src(&prog, memo_churn, MEMO_OFF, 0, &r_off);
-    TimingStats on = run_memo_src(&prog, memo_churn, MEMO_FOLLOW, 0, &r_on);
+    TimingStats on = run_memo_src(&prog, memo_churn, MEMO_KINDS, 0, &r_on);
     cr_expect(memcmp(&on, &off, sizeof on) == 0, "cycles %llu with the memo, %llu without",
               (unsigned long long)on.cycles, (unsigned long long)off.cycles);
     /* a handful of block starts, many more ways stored than they keep (4 each), many replayed */
@@ -623,10 +631,17 @@ Test(timing, memoized_blocks_give_the_same_figures_as_timing_each_instruction)
         cr_assert_eq(r_off, 0u, "%s: the memo replayed blocks while off", p->file);
         cr_expect(memcmp(&on, &off, sizeof on) == 0, "%s %s=%lld: cycles %llu with the memo, %llu without", p->file,
                   p->define ? p->define : "", p->value, (unsigned long long)on.cycles, (unsigned long long)off.cycles);
+        for (int memo = MEMO_KINDS; memo <= MEMO_KINDS_OFF; memo++) { /* the hooks by kind, memo on and off */
+            TimingStats k = run_memo(p, memo, 0, &r_on);
+            cr_expect(memcmp(&k, &off, sizeof k) == 0, "%s %s=%lld, memo mode %d: cycles %llu, %llu with timing_hook",
+                      p->file, p->define ? p->define : "", p->value, memo, (unsigned long long)k.cycles,
+                      (unsigned long long)off.cycles);
+        }
         replayed_any += r_on;
         const uint64_t n = on.busy; /* one issue cycle per instruction */
         for (uint64_t limit = 1; limit < n; limit += limit < 300 ? 1 : 97) {
-            TimingStats a = run_memo(p, MEMO_FOLLOW, limit, &r_on), b = run_memo(p, MEMO_OFF, limit, &r_off);
+            TimingStats a = run_memo(p, limit % 2 ? MEMO_KINDS : MEMO_FOLLOW, limit, &r_on),
+                        b = run_memo(p, MEMO_OFF, limit, &r_off);
             cr_expect(memcmp(&a, &b, sizeof a) == 0, "%s stopped after %llu instructions: cycles %llu with the memo, %llu without",
                       p->file, (unsigned long long)limit, (unsigned long long)a.cycles, (unsigned long long)b.cycles);
         }
@@ -635,7 +650,10 @@ Test(timing, memoized_blocks_give_the_same_figures_as_timing_each_instruction)
     BenchProg loop = {"memo_loop.s", NULL, 0};
     uint64_t r_on, r_off;
     TimingStats off = run_memo_src(&loop, memo_loop, MEMO_OFF, 0, &r_off);
-    for (int memo = MEMO_HOOK; memo <= MEMO_FOLLOW; memo++) {
+    TimingStats kinds_off = run_memo_src(&loop, memo_loop, MEMO_KINDS_OFF, 0, &r_on);
+    cr_expect(memcmp(&kinds_off, &off, sizeof off) == 0, "the loop, the hooks by kind without the memo: cycles %llu, %llu",
+              (unsigned long long)kinds_off.cycles, (unsigned long long)off.cycles);
+    for (int memo = MEMO_HOOK; memo <= MEMO_KINDS; memo++) {
         TimingStats on = run_memo_src(&loop, memo_loop, memo, 0, &r_on);
         cr_expect(memcmp(&on, &off, sizeof on) == 0, "the loop, memo mode %d: cycles %llu with the memo, %llu without",
                   memo, (unsigned long long)on.cycles, (unsigned long long)off.cycles);
