@@ -281,6 +281,45 @@ Test(core_hook, stage_and_wide_addresses)
     tc_free(&t);
 }
 
+/* The records of one opcode sent to a hook of their own: each record reaches exactly one of the
+ * two hooks, in order, and core_set_hook sends them all back to one. */
+static void log_hook_other(void *ctx, const CoreRecord *r)
+{
+    log_hook((HookLog *)ctx + 1, r);
+}
+
+Test(core_hook, a_hook_per_opcode)
+{
+    for (int again = 0; again < 2; again++) {
+        HookLog log[2];
+        memset(log, 0, sizeof log);
+        TcCore t;
+        tc_init(&t, PROG(I_ABI(ADDI, 1, 1, 1), V_A(VIOTA, 1, 0), I_ABI(ADDI, 1, 1, 1), V_ABCI(RGAT, 2, 1, 0, 0, 0),
+                         I_ABI(ADDI, 1, 1, 1), I_0(HALT)),
+                4);
+        core_set_hook(t.c, log_hook, &log[0]);
+        core_set_op_hook(t.c, ISA_OP_ADDI, log_hook_other);
+        core_set_op_hook(t.c, -1, log_hook_other);           /* out of range: ignored */
+        core_set_op_hook(t.c, ISA_OP_COUNT, log_hook_other);
+        core_set_op_hook(t.c, ISA_OP_RGAT, NULL);            /* NULL: ignored */
+        if (again)
+            core_set_hook(t.c, log_hook, &log[0]);            /* all back to one */
+        tc_run_halt(&t);
+        if (!again) {
+            cr_assert_eq(log[1].n, 3, "the three addi to their own hook: %d", log[1].n);
+            cr_assert_eq(log[0].n, 3, "viota, rgat and halt to the core's hook: %d", log[0].n);
+            for (int i = 0; i < 3; i++)
+                cr_expect_eq(log[1].rec[i].pc, 2u * (uint32_t)i, "addi %d at pc %u", i, log[1].rec[i].pc);
+            cr_expect_eq(log[0].rec[1].pc, 3u);
+            cr_expect_eq(log[0].rec[1].naddr, 4, "the gather's record is whole");
+        } else {
+            cr_expect_eq(log[0].n, 6);
+            cr_expect_eq(log[1].n, 0);
+        }
+        tc_free(&t);
+    }
+}
+
 /* ==== core_run: limits and determinism ================================================================ */
 
 Test(core_run, limit_is_resumable_and_zero_means_none)
