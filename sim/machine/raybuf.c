@@ -223,22 +223,27 @@ static inline void rb_note_last(RayBufs *rb, const uint32_t *addr, int naddr)
     rb->last_n = naddr;
 }
 
+/* An access that is not the last one moved (rb_same_as_last): its lines and bank cycles worked
+ * out into last_lines and last_cycles. Out of line: its 16-lane paths keep aligned vector arrays on
+ * the stack, which the usual access (the last one moved, about 90 % of a kernel's) would set up
+ * a frame for at every call. */
+static __attribute__((noinline)) void rb_access_new(RayBufs *rb, const uint32_t *addr, int naddr, int pow2)
+{
+    int lines = rb_ascending_lines(rb, addr, naddr);
+    const int cycles = lines                         ? 1
+                       : pow2 && naddr == 16        ? rb_access_bits16(rb, addr, &lines)
+                       : pow2 && rb->p.banks <= 64 ? rb_access_bits(rb, addr, naddr, &lines)
+                                                   : rb_access_any(rb, addr, naddr, &lines);
+    rb->last_cycles = cycles;
+    rb->last_lines = lines;
+}
+
 int rb_access(RayBufs *rb, const uint32_t *addr, int naddr, TimingStats *st)
 {
     const int pow2 = (rb->p.banks & (rb->p.banks - 1)) == 0;
-    int cycles, lines;
-    if (pow2 && rb_same_as_last(rb, addr, naddr)) {
-        cycles = rb->last_cycles;
-        lines = rb->last_lines;
-    } else {
-        lines = rb_ascending_lines(rb, addr, naddr);
-        cycles = lines                         ? 1
-                 : pow2 && naddr == 16        ? rb_access_bits16(rb, addr, &lines)
-                 : pow2 && rb->p.banks <= 64 ? rb_access_bits(rb, addr, naddr, &lines)
-                                             : rb_access_any(rb, addr, naddr, &lines);
-        rb->last_cycles = cycles;
-        rb->last_lines = lines;
-    }
+    if (!(pow2 && rb_same_as_last(rb, addr, naddr)))
+        rb_access_new(rb, addr, naddr, pow2);
+    const int cycles = rb->last_cycles, lines = rb->last_lines;
     rb_note_last(rb, addr, naddr);
     st->rb_accesses++;
     st->rb_lines += (uint64_t)lines;
