@@ -25,8 +25,12 @@ const char *const core_mem_names[CORE_MEM_COUNT] = {"rb0", "rb1", "idm", "spad",
 static const char *const mem_long[CORE_MEM_COUNT] = {"ray buffer 0", "ray buffer 1", "ID-stream memory",
                                                      "scratchpad", "scene memory", "framebuffer"};
 
+/* A vector register, aligned to a cache line (and so is the core: core_new): a vector instruction's
+ * lane loops read and write it in 32- or 64-byte pieces, which then never straddle a line or a
+ * page. Placed where malloc put the core, a register could cross a page boundary, and functional
+ * mode ran 15-40 % slower for it (docs/performance.md, "Where the core's registers lie"). */
 typedef union VReg {
-    uint32_t u[ISA_MAX_LANES];
+    _Alignas(64) uint32_t u[ISA_MAX_LANES];
     int32_t i[ISA_MAX_LANES];
     float f[ISA_MAX_LANES];
 } VReg;
@@ -259,7 +263,9 @@ Core *core_new(const CoreParams *p, const AsmObject *obj, char *err, size_t errl
                  obj->ndata, p->mem_bytes[CORE_MEM_SCENE], obj->nspad, p->mem_bytes[CORE_MEM_SPAD]);
         return NULL;
     }
-    Core *c = calloc(1, sizeof *c);
+    Core *c = aligned_alloc(_Alignof(Core), sizeof *c); /* (sizeof is a multiple of the alignment) */
+    if (c)
+        memset(c, 0, sizeof *c);
     if (!c) {
         snprintf(err, errlen, "out of memory");
         return NULL;

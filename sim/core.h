@@ -65,7 +65,9 @@ typedef struct CoreRecord {
     uint32_t base;          /* sfetch: stream pointer rc before it; sapp: ra before it; part: rb */
     uint64_t exec;          /* exec mask as applied (all N lanes for unmasked ops; sfetch: the
                                lanes that received an ID) */
-    uint32_t addr[ISA_MAX_LANES]; /* byte addresses, lane order (sfetch/vspld: the N words) */
+    _Alignas(64) uint32_t addr[ISA_MAX_LANES]; /* byte addresses, lane order (sfetch/vspld: the N
+                                                    words); a cache line's alignment, as the core's
+                                                    vector registers (sim/core.c) */
 } CoreRecord;
 
 typedef void (*CoreHook)(void *ctx, const CoreRecord *rec);

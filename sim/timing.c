@@ -197,7 +197,9 @@ void timing_params(const CfgMachine *c, TimingParams *p)
 
 Timing *timing_new(const TimingParams *p, char *err, size_t errlen)
 {
-    Timing *t = calloc(1, sizeof *t);
+    Timing *t = aligned_alloc(_Alignof(Timing), sizeof *t); /* (its ray buffers' last access is aligned) */
+    if (t)
+        memset(t, 0, sizeof *t);
     if (!t) {
         snprintf(err, errlen, "out of memory");
         return NULL;

@@ -41,7 +41,7 @@ typedef struct RayBufs {
      * lines (the next field of the same rays: the fields are arrays of line-aligned size) names
      * lines that map one to one onto the last one's, in banks that map one to one too (a power-of-
      * two bank count), so it has the same counts. */
-    uint32_t last_addr[ISA_MAX_LANES];
+    _Alignas(64) uint32_t last_addr[ISA_MAX_LANES]; /* (compared and copied in vector pieces) */
     int last_n;                /* its lanes (0: none yet) */
     int last_cycles, last_lines;
 } RayBufs;
