@@ -46,6 +46,11 @@ const char *const tm_cause_descs[TM_CAUSE_COUNT] = {
  * than on the heap, and time jumps to the earliest of the queue's top and the landings the
  * waiting instruction needs (wait_hazards). */
 enum { EV_UNIT, EV_FETCH, EV_PART };
+/* The bubble after a taken branch (EV_FETCH) is the commonest of these: a block that ends at a
+ * taken branch leaves it behind, and at most one is pending (nothing issues during it, so no
+ * branch is taken). It is kept as a cycle beside the queue (Timing.fetch_at, while the SIMD unit's
+ * fetch_pending), not pushed and popped; everything that reads the pending events (drain,
+ * wait_hazards, the memo's keys) takes it as the event it stands for. */
 
 /* The memory instructions that are most of a kernel's, by the ISA table's UNIT and FLAGS, each
  * timed on a straight path of its own (issue_units_complete); the others (AGU, partition unit,
@@ -142,6 +147,7 @@ enum { MM_NONE, MM_RECORD, MM_REPLAY };
 struct Timing {
     EvQueue q;
     uint64_t now;                  /* the cycle the next instruction may issue in */
+    uint64_t fetch_at;             /* while simd.fetch_pending: the cycle the bubble ends (EV_FETCH) */
     SimdUnit simd;
     RayBufs rb;
     Agus agu;
@@ -345,7 +351,6 @@ static __attribute__((noinline)) void drain_due(Timing *t, uint64_t at)
     while ((e = evq_top(&t->q)) && e->time <= at) {
         switch (e->kind) {
         case EV_UNIT: simd_unit_free(&t->simd, e->arg); break;
-        case EV_FETCH: simd_fetch_resumed(&t->simd); break;
         case EV_PART: part_done(&t->part); break;
         }
         evq_pop(&t->q);
@@ -356,6 +361,16 @@ static inline void drain(Timing *t, uint64_t at)
 {
     if (t->q.n && t->q.h[0].time <= at)
         drain_due(t, at);
+    if (t->simd.fetch_pending && t->fetch_at <= at)
+        simd_fetch_resumed(&t->simd);
+}
+
+/* A taken branch's bubble, until the cycle until (see EV_FETCH). */
+static void fetch_hold(Timing *t, uint64_t until)
+{
+    t->fetch_at = until;
+    if (t->mmode == MM_RECORD)
+        memo_pushed(t, until, EV_FETCH, 0, TM_CONTROL);
 }
 
 /* ---- 1. hazards that an event clears ------------------------------------------------------ */
@@ -425,6 +440,8 @@ static __attribute__((noinline)) uint64_t wait_hazards(Timing *t, const TmDesc *
         const EvEvent *e = evq_top(&t->q);
         if (e && e->time < next)
             next = e->time;
+        if (t->simd.fetch_pending && t->fetch_at < next)
+            next = t->fetch_at;
         if (next == UINT64_MAX || next <= at) {
             internal_error(t, "a hazard with no event to clear it");
             break;
@@ -645,7 +662,7 @@ static inline void complete(Timing *t, const TmDesc *d, const CoreRecord *rec, u
     if (__builtin_expect(rec->taken, 0)) {
         uint64_t until;
         if (simd_redirect(&t->simd, end, &until))
-            push(t, until, EV_FETCH, 0, 0, TM_CONTROL);
+            fetch_hold(t, until);
     }
     t->now = end;
     if (__builtin_expect(d->is_halt, 0)) {
@@ -780,13 +797,14 @@ static inline void bit_set(uint64_t *b, int r) { b[r >> 6] |= 1ull << (r & 63); 
  * count, or -1 if more than MEMO_EVENTS. */
 static inline __attribute__((always_inline)) int memo_events(const Timing *t, uint64_t t0, MemoEv *ev)
 {
-    if (t->q.n > MEMO_EVENTS)
+    const size_t nq = t->q.n, nf = t->simd.fetch_pending; /* the queue's, then the bubble (EV_FETCH) */
+    if (nq + nf > MEMO_EVENTS)
         return -1;
     int n = 0;
-    for (size_t i = 0; i < t->q.n; i++) {
-        const EvEvent *e = &t->q.h[i];
-        MemoEv v = {(uint32_t)(e->time - t0), e->arg, e->kind, 0};
-        if (e->time - t0 > UINT32_MAX)
+    for (size_t i = 0; i < nq + nf; i++) {
+        const uint64_t time = i < nq ? t->q.h[i].time : t->fetch_at;
+        MemoEv v = {(uint32_t)(time - t0), i < nq ? t->q.h[i].arg : 0, i < nq ? t->q.h[i].kind : (uint8_t)EV_FETCH, 0};
+        if (time - t0 > UINT32_MAX)
             return -1;
         int k = n++;
         while (k > 0 && (ev[k - 1].rel > v.rel || (ev[k - 1].rel == v.rel && (ev[k - 1].kind > v.kind ||
@@ -898,10 +916,13 @@ static void memo_apply(Timing *t, MemoEntry *e)
         t->simd.horizon = t0 + e->hz_rel;
     for (int i = 0; i < e->nev_out; i++) {
         const MemoEv *v = &e->ev_out[i];
+        if (v->kind == EV_FETCH) {
+            t->simd.fetch_pending = 1;
+            t->fetch_at = t0 + v->rel;
+            continue;
+        }
         if (v->kind == EV_UNIT)
             t->simd.unit_pending[v->arg] = 1;
-        else if (v->kind == EV_FETCH)
-            t->simd.fetch_pending = 1;
         push(t, t0 + v->rel, v->kind, v->arg, 0, v->cause);
     }
     memo_none(t);
