@@ -59,6 +59,10 @@ enum { TK_OTHER, TK_RB_GATHER, TK_RB_SCATTER, TK_SPAD_LOAD, TK_SPAD_STORE, TK_SC
 /* Kinds of hook (timing_op_hook), beside those: a plain instruction (TmDesc.plain) and a vector
  * scratchpad access. */
 enum { TK_PLAIN = TK_SCENE + 1, TK_SPAD_VEC };
+/* The instructions of the memory kinds (TK_RB_*, TK_SPAD_*, TK_SCENE) are neither branches nor
+ * halts (the ISA table: tests/unit/test_timing.c checks it), so their paths leave out the tests
+ * for a taken branch and for the end of the program (hazard_as, complete_as). */
+enum { TM_NO_FLOW = 0 };
 
 /* What the timing core needs of one program instruction, worked out the first time the
  * instruction runs in a run and kept by its pc (describe()): its ISA table row's unit and flags as
@@ -377,13 +381,13 @@ static void fetch_hold(Timing *t, uint64_t until)
 
 /* The hazards after the registers': the unit's issue interval, the partition unit, and for a
  * halt everything in flight (waiting: the cause of a register still waiting, or -1). -1 if none. */
-static inline int hazard_units(const Timing *t, const TmDesc *d, const CoreRecord *rec, int waiting)
+static inline int hazard_units(const Timing *t, const TmDesc *d, const CoreRecord *rec, int waiting, int flow)
 {
     if (t->simd.unit_pending[d->unit])
         return TM_FU_BUSY;
     if (t->part.busy && part_blocks(&t->part, &isa_ops[d->op], rec))
         return TM_PARTITION;
-    if (d->is_halt) { /* the program ends when every result in flight has landed */
+    if (flow && d->is_halt) { /* the program ends when every result in flight has landed */
         if (t->part.busy)
             return TM_PARTITION;
         return waiting;
@@ -393,15 +397,21 @@ static inline int hazard_units(const Timing *t, const TmDesc *d, const CoreRecor
 
 /* The highest-priority hazard at cycle at that an event will clear, or -1 (docs/model.md, "Stall
  * causes"): fetch after a taken branch, then the instruction's registers (sources, mask,
- * destinations), then the units (hazard_units). */
-static inline int hazard(const Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at)
+ * destinations), then the units (hazard_units). flow: 0 when the instruction is known to be no
+ * branch and no halt (a constant at the memory kinds' paths: TM_NO_FLOW), else 1. */
+static inline int hazard_as(const Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at, int flow)
 {
     if (t->simd.fetch_pending)
         return TM_CONTROL;
     int cause = simd_waiting_operand(&t->simd, d->regs, d->nregs, at);
     if (cause >= 0)
         return cause;
-    return hazard_units(t, d, rec, d->is_halt ? simd_any_waiting(&t->simd, at) : -1);
+    return hazard_units(t, d, rec, flow && d->is_halt ? simd_any_waiting(&t->simd, at) : -1, flow);
+}
+
+static inline int hazard(const Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at)
+{
+    return hazard_as(t, d, rec, at, 1);
 }
 
 /* A hazard (cause) holds at cycle at: jump from event to event while one holds; returns the first
@@ -649,8 +659,8 @@ static uint64_t result_time(Timing *t, const IsaOpInfo *oi, const CoreRecord *re
 /* The instruction d issued in cycle at and holds the issue slot until end; its results are ready
  * at ready (a wait for them charged to res_cause): the scoreboard, the unit's issue interval, a
  * taken branch's bubble, and the end of the program at a halt. */
-static inline void complete(Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at, uint64_t end,
-                            uint64_t ready, int res_cause)
+static inline void complete_as(Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at, uint64_t end,
+                               uint64_t ready, int res_cause, int flow)
 {
     for (int i = 0; i < d->ndst; i++)
         simd_result(&t->simd, d->dsts[i], ready, res_cause);
@@ -659,17 +669,23 @@ static inline void complete(Timing *t, const TmDesc *d, const CoreRecord *rec, u
         if (simd_hold_unit(&t->simd, d->unit, at, end, &until))
             push(t, until, EV_UNIT, d->unit, 0, TM_FU_BUSY);
     }
-    if (__builtin_expect(rec->taken, 0)) {
+    if (flow && __builtin_expect(rec->taken, 0)) {
         uint64_t until;
         if (simd_redirect(&t->simd, end, &until))
             fetch_hold(t, until);
     }
     t->now = end;
-    if (__builtin_expect(d->is_halt, 0)) {
+    if (flow && __builtin_expect(d->is_halt, 0)) {
         t->st.cycles += end;
         t->st.runs++;
         t->halted = 1;
     }
+}
+
+static inline void complete(Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at, uint64_t end,
+                            uint64_t ready, int res_cause)
+{
+    complete_as(t, d, rec, at, end, ready, res_cause, 1);
 }
 
 /* Issue and completion of an instruction that uses a memory unit, or whose result time is not its
@@ -689,8 +705,9 @@ static __attribute__((noinline)) void issue_rb(Timing *t, const TmDesc *d, const
         charge(t, TM_BANK_CONFLICT, ext, stage, gen);
     }
     count_issue(t, d, stage, gen);
-    complete(t, d, rec, at, at + ext + 1,
-             d->kind == TK_RB_GATHER ? rb_gather_ready(&t->rb, &t->xbar, at + ext) : at + d->lat, TM_DATA_DEPENDENCY);
+    complete_as(t, d, rec, at, at + ext + 1,
+                d->kind == TK_RB_GATHER ? rb_gather_ready(&t->rb, &t->xbar, at + ext) : at + d->lat, TM_DATA_DEPENDENCY,
+                TM_NO_FLOW);
 }
 
 static __attribute__((noinline)) void issue_spad(Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at)
@@ -702,8 +719,8 @@ static __attribute__((noinline)) void issue_spad(Timing *t, const TmDesc *d, con
         charge(t, TM_SCRATCHPAD, ext, stage, gen);
     }
     count_issue(t, d, stage, gen);
-    complete(t, d, rec, at, at + ext + 1, d->kind == TK_SPAD_LOAD ? spad_load_ready(&t->spad, at + ext) : at + d->lat,
-             TM_DATA_DEPENDENCY);
+    complete_as(t, d, rec, at, at + ext + 1, d->kind == TK_SPAD_LOAD ? spad_load_ready(&t->spad, at + ext) : at + d->lat,
+                TM_DATA_DEPENDENCY, TM_NO_FLOW);
 }
 
 static __attribute__((noinline)) void issue_scene(Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at)
@@ -719,7 +736,7 @@ static __attribute__((noinline)) void issue_scene(Timing *t, const TmDesc *d, co
         cause = TM_SCENE_MEMORY;
     }
     count_issue(t, d, stage, gen);
-    complete(t, d, rec, at, at + ext + 1, ready ? ready : at + d->lat, cause);
+    complete_as(t, d, rec, at, at + ext + 1, ready ? ready : at + d->lat, cause, TM_NO_FLOW);
 }
 
 static __attribute__((noinline)) void issue_units_other(Timing *t, const TmDesc *d, const CoreRecord *rec,
@@ -756,7 +773,8 @@ static inline __attribute__((always_inline)) void time_kind(Timing *t, const TmD
 {
     uint64_t at = t->now;
     drain(t, at);
-    int cause = hazard(t, d, rec, at);
+    const int flow = kind < 0 || kind == TK_PLAIN ? 1 : TM_NO_FLOW; /* (a plain instruction may branch) */
+    int cause = hazard_as(t, d, rec, at, flow);
     if (__builtin_expect(cause >= 0, 0))
         at = wait_hazards(t, d, rec, at, cause);
     switch (kind) {

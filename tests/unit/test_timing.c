@@ -693,3 +693,22 @@ Test(timing, memoized_blocks_give_the_same_figures_as_timing_each_instruction)
         }
     }
 }
+
+Test(timing, memory_kinds_are_neither_branches_nor_halts)
+{
+    /* sim/timing.c times ray-buffer vector accesses, scratchpad and scene-memory or framebuffer
+     * instructions on paths without the tests for a taken branch or the program's end
+     * (TM_NO_FLOW): an opcode of those units that branched or halted would be timed wrong. */
+    int seen = 0;
+    for (int op = 0; op < ISA_OP_COUNT; op++) {
+        const IsaOpInfo *oi = &isa_ops[op];
+        const int memory_kind = (oi->unit == ISA_U_RBUF && (oi->flags & ISA_FL_VEC)) || oi->unit == ISA_U_SPAD ||
+                                oi->unit == ISA_U_SCENE || oi->unit == ISA_U_FB;
+        if (!memory_kind)
+            continue;
+        seen++;
+        cr_expect_eq(oi->flags & (ISA_FL_BRANCH | ISA_FL_END), 0u, "%s: a memory kind's opcode branches or halts",
+                     oi->mnemonic);
+    }
+    cr_expect_gt(seen, 6, "the ISA table's memory opcodes: %d", seen);
+}
