@@ -120,6 +120,7 @@ typedef struct MemoEntry {
     uint32_t run;                   /* the run it was stored in (0: empty) */
     uint8_t len, nlive, nwrite, nev_in, nev_out, taken_last, nunits;
     uint8_t nlanded;                /* live[0..nlanded): landed at the start; the rest in flight */
+    uint8_t landed[MEMO_REGS];      /* live[0..nlanded)'s registers, packed for memo_state_match */
     MemoReg live[MEMO_REGS];        /* key: live-ins at the start (rel 0: landed, cause 0) */
     MemoEv ev_in[MEMO_EVENTS];      /* key: pending events, sorted */
     uint32_t end_rel;               /* outcome: the next issue slot after the block */
@@ -872,7 +873,7 @@ static inline __attribute__((always_inline)) int memo_state_match(const Timing *
         return 1;
     int late = 0; /* one test at the end: which one is late does not matter */
     for (int i = 0; i < e->nlanded; i++)
-        late |= t->simd.ready[e->live[i].reg] > now;
+        late |= t->simd.ready[e->landed[i]] > now;
     return !late;
 }
 
@@ -1106,6 +1107,8 @@ static __attribute__((noinline)) void memo_store(Timing *t)
     }
     memcpy(m->live + nl, fly, sizeof *fly * (size_t)nfly);
     m->nlanded = (uint8_t)nl;
+    for (int i = 0; i < nl; i++)
+        m->landed[i] = m->live[i].reg;
     int k = 0; /* only the events still pending after the block's end are left for later */
     for (int i = 0; i < m->nev_out; i++)
         if (m->ev_out[i].rel > m->end_rel)
