@@ -105,8 +105,22 @@ typedef struct TmDesc {
  * stand for the bubble, the units' issue intervals and the partition unit (each is pending
  * exactly while its event is). The first time a start state is seen the block is timed as usual
  * and its outcome stored; when it recurs, the outcome is applied at the block's end and the
- * records in between are only checked against the stored path (docs/performance.md). */
-enum { MEMO_LEN = 16, MEMO_REGS = 40, MEMO_EVENTS = 6, MEMO_WAYS = 4 };
+ * records in between are only checked against the stored path (docs/performance.md).
+ *
+ * Two relaxations keep one way good for more starts, each exact:
+ *  - a slack live-in: one that had landed by the first hazard check of the instruction that
+ *    first names it (rel <= that check's cycle, its slack) is only asked to have landed by then
+ *    again. Every check of it then finds it landed, as in the recording (time only grows within
+ *    a block), so nothing the block does reads its exact ready cycle or its cause; the others
+ *    (which stalled an instruction) must land exactly as far ahead, with the same cause.
+ *  - a flipped last branch: a block's last instruction taking its branch the other way than when
+ *    stored changes only the taken-branch bubble after the block's end (the same instructions
+ *    issued at the same cycles; a block ends at its last record however that branch goes), so
+ *    the replay applies the stored outcome with the bubble added or left out (memo_apply).
+ * MEMO_LEN and MEMO_WAYS: 32 and 8 against 16 and 4 took 4 % off the conference diffuse batch
+ * with both relaxations (docs/performance.md, thirteenth session); 48 or 64 instructions, or 16
+ * ways, were slower. */
+enum { MEMO_LEN = 32, MEMO_REGS = 40, MEMO_EVENTS = 6, MEMO_WAYS = 8 };
 /* Blocks shorter than this cost more to look up and replay than to time (callgrind): a start
  * that gave one is timed as usual for the rest of the run. */
 enum { MEMO_MIN = 2 };
@@ -119,8 +133,10 @@ typedef struct MemoReg { uint32_t rel; uint8_t reg, cause; } MemoReg;
 typedef struct MemoEntry {
     uint32_t run;                   /* the run it was stored in (0: empty) */
     uint8_t len, nlive, nwrite, nev_in, nev_out, taken_last, nunits;
-    uint8_t nlanded;                /* live[0..nlanded): landed at the start; the rest in flight */
+    uint8_t nlanded;                /* live[0..nlanded): slack live-ins (landed at the start, or
+                                       before the first check that reads them); the rest exact */
     uint8_t landed[MEMO_REGS];      /* live[0..nlanded)'s registers, packed for memo_state_match */
+    uint16_t slack[MEMO_REGS];      /* live[0..nlanded)'s slack: landed by t0 + slack at a match */
     MemoReg live[MEMO_REGS];        /* key: live-ins at the start (rel 0: landed, cause 0) */
     MemoEv ev_in[MEMO_EVENTS];      /* key: pending events, sorted */
     uint32_t end_rel;               /* outcome: the next issue slot after the block */
@@ -184,6 +200,7 @@ struct Timing {
     int m_ok;                      /* record: it still fits an entry */
     uint64_t m_written[2], m_seen[2]; /* record: registers written, live-ins noted */
     uint64_t m_stalls0[TM_CAUSE_COUNT];
+    uint32_t m_bound[MEMO_REGS];   /* record: each live-in's first check, relative to m_t0 */
     uint64_t m_hz;
     /* Issue cycles by stage, statistics generation and vector flag: one count per instruction;
      * timing_stats() folds them into TimingStats' busy counters and the cycles per stage and
@@ -859,9 +876,9 @@ static inline __attribute__((always_inline)) int memo_state_match(const Timing *
             return 0;
     /* memo_reg's value compared in place. A live-in that was in flight must land as far ahead (a
      * distance beyond 32 bits matches no stored rel) with its cause: the few of those tell the
-     * ways apart, so they are checked first. The ones that had landed (stored first) must have
-     * landed now too, which holds for all of them when nothing is in flight (the scoreboard's
-     * horizon is past). */
+     * ways apart, so they are checked first. The slack ones (stored first) must have landed by
+     * their slack after now, which holds for all of them when nothing is in flight (the
+     * scoreboard's horizon is past). */
     const uint64_t now = t->now;
     for (int i = e->nlanded; i < e->nlive; i++) {
         const MemoReg *m = &e->live[i];
@@ -873,7 +890,7 @@ static inline __attribute__((always_inline)) int memo_state_match(const Timing *
         return 1;
     int late = 0; /* one test at the end: which one is late does not matter */
     for (int i = 0; i < e->nlanded; i++)
-        late |= t->simd.ready[e->landed[i]] > now;
+        late |= t->simd.ready[e->landed[i]] > now + e->slack[i];
     return !late;
 }
 
@@ -913,8 +930,9 @@ static void memo_fold_all(Timing *t)
 }
 
 /* The outcome of the stored block e, applied at once (the block's records have all come); its
- * counts are added later (MemoEntry.lz_n). */
-static void memo_apply(Timing *t, MemoEntry *e)
+ * counts are added later (MemoEntry.lz_n). flip: the block's last branch went the other way than
+ * stored: the bubble after a taken branch is left out, or added as complete_as adds it. */
+static void memo_apply(Timing *t, MemoEntry *e, int flip)
 {
     const uint64_t t0 = t->m_t0, end = t0 + e->end_rel;
     const int stage = t->m_stage, gen = t->m_gen;
@@ -936,13 +954,21 @@ static void memo_apply(Timing *t, MemoEntry *e)
     for (int i = 0; i < e->nev_out; i++) {
         const MemoEv *v = &e->ev_out[i];
         if (v->kind == EV_FETCH) {
-            t->simd.fetch_pending = 1;
-            t->fetch_at = t0 + v->rel;
+            if (!flip) {
+                t->simd.fetch_pending = 1;
+                t->fetch_at = t0 + v->rel;
+            }
             continue;
         }
         if (v->kind == EV_UNIT)
             t->simd.unit_pending[v->arg] = 1;
         push(t, t0 + v->rel, v->kind, v->arg, 0, v->cause);
+    }
+    if (__builtin_expect(flip, 0)) {
+        t->mc.flipped++;
+        uint64_t until;
+        if (!e->taken_last && simd_redirect(&t->simd, end, &until))
+            t->fetch_at = until;
     }
     memo_none(t);
     t->mc.replays++;
@@ -1023,7 +1049,7 @@ static __attribute__((noinline)) int memo_begin(Timing *t, TmDesc *d, const Core
                 memo_follow(t, e, rec); /* rec took no branch unless it is e's last (memo_match) */
                 t->mmode = MM_REPLAY;
                 if (e->len == 1)
-                    memo_apply(t, e);
+                    memo_apply(t, e, 0);
                 return 1;
             }
         }
@@ -1047,6 +1073,7 @@ static void memo_pre(Timing *t, const TmDesc *d)
             t->m_ok = 0;
             continue;
         }
+        t->m_bound[m->nlive] = (uint32_t)(t->now - t->m_t0);
         m->live[m->nlive] = memo_reg(t, r, t->m_t0);
         if (m->live[m->nlive++].cause == MEMO_FAR)
             t->m_ok = 0;
@@ -1097,12 +1124,13 @@ static __attribute__((noinline)) void memo_store(Timing *t)
             m->write[m->nwrite++] = (MemoReg){(uint32_t)(t->simd.ready[r] - t->m_t0), (uint8_t)r, t->simd.rcause[r]};
         }
     m->hz_rel = t->m_hz > t->m_t0 ? (uint32_t)(t->m_hz - t->m_t0) : 0;
-    MemoReg fly[MEMO_REGS]; /* the live-ins landed at the start first (memo_match) */
+    MemoReg fly[MEMO_REGS]; /* the slack live-ins first (memo_match) */
     int nfly = 0, nl = 0;
     for (int i = 0; i < m->nlive; i++) {
-        if (m->live[i].rel == 0)
+        if (m->live[i].rel <= t->m_bound[i]) {
+            m->slack[nl] = t->m_bound[i] > UINT16_MAX ? UINT16_MAX : (uint16_t)t->m_bound[i];
             m->live[nl++] = m->live[i];
-        else
+        } else
             fly[nfly++] = m->live[i];
     }
     memcpy(m->live + nl, fly, sizeof *fly * (size_t)nfly);
@@ -1192,14 +1220,14 @@ static __attribute__((noinline)) int memo_diverged(Timing *t, const CoreRecord *
         if (e == t->m_e || e->len < k || (e->len == k ? e->taken_last : !same) || !memo_state_match(t, e, ev, nev))
             continue;
         if (e->len == k) { /* it ended before rec (another generation, say), no branch taken */
-            memo_apply(t, e);
+            memo_apply(t, e, 0);
             return 0;     /* rec comes after it */
         }
         if (rec->taken != (k + 1u == e->len ? e->taken_last : 0))
             continue;
         memo_follow(t, e, rec);
         if (k + 1u == e->len)
-            memo_apply(t, e);
+            memo_apply(t, e, 0);
         return 1;
     }
     /* timed again, and noted unless the block would end before MEMO_MIN records (memo_store) */
@@ -1235,7 +1263,8 @@ static __attribute__((noinline)) void hook_any(Timing *t, const CoreRecord *rec)
     time_one(t, d, rec);
 }
 
-/* The next record of a replayed block, only checked (1), or not (0). */
+/* The next record of a replayed block, only checked (1), or not (0). Its last record may have
+ * taken its branch either way (a flipped last branch: memo_apply). */
 static inline __attribute__((always_inline)) int hook_followed(Timing *t, const CoreRecord *rec)
 {
     const uint64_t w = core_record_where(rec); /* pc, stage, generation, taken */
@@ -1244,9 +1273,9 @@ static inline __attribute__((always_inline)) int hook_followed(Timing *t, const 
             t->follow.where++;
             return 1;
         }
-    } else if (w == (t->follow.where | (uint64_t)t->m_e->taken_last << 48)) {
+    } else if ((w & ~(0xffull << 48)) == t->follow.where) {
         t->follow.where++;
-        memo_apply(t, t->m_e);
+        memo_apply(t, t->m_e, rec->taken != t->m_e->taken_last);
         return 1;
     }
     return 0;

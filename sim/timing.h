@@ -127,6 +127,7 @@ typedef struct TimingMemoCounts {
     uint64_t stores;  /* blocks stored */
     uint64_t left;    /* replays that met a record off their stored path */
     uint64_t retimed; /* records timed again because no other stored way had the path taken */
+    uint64_t flipped; /* replays whose last branch went the other way than when stored */
 } TimingMemoCounts;
 TimingMemoCounts timing_memo_counts(const Timing *t);
 /* After core_run: a run that stopped without halt (trap, limit) counts the cycles so far. */

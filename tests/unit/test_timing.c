@@ -577,7 +577,7 @@ Test(timing, memoized_blocks_leave_a_stored_path_at_a_taken_branch_or_another_ge
 }
 
 /* A loop whose blocks start in more states than a start keeps ways: a scene load that misses
- * (a new line each pass) and a delay loop of 0 to 7 passes after it, so the blocks of the delay
+ * (a new line each pass) and a delay loop of 0 to 15 passes after it, so the blocks of the delay
  * loop and after it start with the load's result landing at many distances ahead. Ways replayed
  * are replaced by others while their replays' counts are still to be added (MemoEntry.lz_n). */
 static const char memo_churn[] =
@@ -586,7 +586,7 @@ static const char memo_churn[] =
     "        vli     v1, 0x3f800000\n"
     "loop:   ld      r3, r2, 0\n"
     "        addi    r2, r2, 64\n"
-    "        andi    r7, r1, 14\n"
+    "        andi    r7, r1, 30\n"
     "        beq     r7, r0, join\n"
     "delay:  addi    r7, r7, -2\n"
     "        vfadd   v2, v1, v1\n"
@@ -607,7 +607,7 @@ Test(timing, memoized_blocks_replaced_while_their_replays_are_uncounted_give_the
     TimingStats on = run_memo_src(&prog, memo_churn, MEMO_KINDS, 0, &r_on);
     cr_expect(memcmp(&on, &off, sizeof on) == 0, "cycles %llu with the memo, %llu without",
               (unsigned long long)on.cycles, (unsigned long long)off.cycles);
-    /* a handful of block starts, many more ways stored than they keep (4 each), many replayed */
+    /* a handful of block starts, many more ways stored than they keep (MEMO_WAYS each), many replayed */
     cr_expect_gt(memo_counts.stores, 100u, "%llu ways stored", (unsigned long long)memo_counts.stores);
     cr_expect_gt(r_on, 200u, "%llu replays", (unsigned long long)r_on);
     cr_expect_gt(on.stalls[TM_SCENE_MEMORY], 0u, "the load misses");
@@ -711,4 +711,75 @@ Test(timing, memory_kinds_are_neither_branches_nor_halts)
                      oi->mnemonic);
     }
     cr_expect_gt(seen, 6, "the ISA table's memory opcodes: %d", seen);
+}
+
+/* Random loops (a seeded generator): a scene load each pass whose stride makes it hit or miss,
+ * then branches on the pass count around runs of plain instructions of several latencies, some
+ * reading the load's result. Their blocks start with results landing at many distances, some
+ * before the instruction that first reads them (a way's slack live-ins) and some after, and end at
+ * branches that go either way from the same start (a replay whose last branch flips). Every
+ * counter with the memo on, in each of its modes, equals the one with it off. */
+static uint32_t gen_next(uint32_t *s)
+{
+    *s = *s * 1664525u + 1013904223u;
+    return *s >> 8;
+}
+
+static void gen_loop(char *out, size_t cap, uint32_t seed)
+{
+    static const char *const sops[] = {"add", "sub", "mul"}, *const vops[] = {"vfadd", "vfmul", "vfdiv"};
+    static const char *const ssrc[] = {"r1", "r3", "r4", "r5", "r6"}, *const sdst[] = {"r4", "r5", "r6"};
+    static const int strides[] = {0, 8, 64, 128};
+    uint32_t s = seed;
+    size_t n = 0;
+#define EMIT(...) (n += (size_t)snprintf(out + n, cap - n, __VA_ARGS__))
+    EMIT("        li      r1, 120\n        li      r2, 0\n        li      r4, 1\n        li      r5, 2\n"
+         "        li      r6, 3\n        vli     v1, 0x3f800000\n        vli     v2, 0x40000000\n"
+         "        vli     v3, 0x3f000000\n        vli     v4, 0x3fc00000\n");
+    EMIT("loop:   ld      r3, r2, 0\n        addi    r2, r2, %d\n", strides[gen_next(&s) % 4]);
+    const int nbr = 1 + (int)(gen_next(&s) % 4);
+    for (int b = 0; b < nbr; b++) {
+        EMIT("        andi    r7, r1, %u\n", 1u + gen_next(&s) % 7);
+        EMIT("        %s     r7, r0, j%d\n", gen_next(&s) % 2 ? "beq" : "bne", b);
+        if (gen_next(&s) % 2) /* a load after it: the block ends at the branch taken or not */
+            EMIT("        ld      r%u, r2, 4\n", 4 + gen_next(&s) % 3);
+        for (int part = 0; part < 2; part++) {
+            if (part)
+                EMIT("j%d:\n", b);
+            const int k = (int)(gen_next(&s) % 8);
+            for (int i = 0; i < k; i++) {
+                if (gen_next(&s) % 2)
+                    EMIT("        %s     %s, %s, %s\n", sops[gen_next(&s) % 3], sdst[gen_next(&s) % 3],
+                         ssrc[gen_next(&s) % 5], ssrc[gen_next(&s) % 5]);
+                else
+                    EMIT("        %s   v%u, v%u, v%u\n", vops[gen_next(&s) % 3], 3 + gen_next(&s) % 4,
+                         1 + gen_next(&s) % 6, 1 + gen_next(&s) % 6);
+            }
+        }
+    }
+    EMIT("        addi    r1, r1, -1\n        bne     r1, r0, loop\n        halt\n");
+#undef EMIT
+    cr_assert_lt(n, cap, "the generated loop fits");
+}
+
+Test(timing, memoized_blocks_of_random_loops_give_the_same_figures)
+{
+    uint64_t replays = 0, flipped = 0;
+    for (uint32_t seed = 1; seed <= 100; seed++) {
+        char src[8192];
+        gen_loop(src, sizeof src, seed);
+        BenchProg prog = {"random_loop.s", NULL, 0};
+        uint64_t r_on, r_off;
+        TimingStats off = run_memo_src(&prog, src, MEMO_OFF, 0, &r_off);
+        for (int memo = MEMO_HOOK; memo <= MEMO_KINDS; memo++) {
+            TimingStats on = run_memo_src(&prog, src, memo, 0, &r_on);
+            cr_expect(memcmp(&on, &off, sizeof on) == 0, "seed %u, memo mode %d: cycles %llu with the memo, %llu without\n%s",
+                      seed, memo, (unsigned long long)on.cycles, (unsigned long long)off.cycles, src);
+            replays += r_on;
+            flipped += memo_counts.flipped;
+        }
+    }
+    /* the loops exercise what they are for: replays, and replays whose last branch flipped */
+    cr_expect_gt(replays, 10000u, "%llu replays", (unsigned long long)replays);
+    cr_expect_gt(flipped, 100u, "%llu replays with their last branch flipped", (unsigned long long)flipped);
 }
