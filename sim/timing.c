@@ -888,8 +888,10 @@ static inline __attribute__((always_inline)) int memo_state_match(const Timing *
     }
     if (t->simd.horizon <= now)
         return 1;
+    /* stored by slack, smallest first: one whose slack reaches the horizon has landed by then */
+    const uint64_t span = t->simd.horizon - now;
     int late = 0; /* one test at the end: which one is late does not matter */
-    for (int i = 0; i < e->nlanded; i++)
+    for (int i = 0; i < e->nlanded && e->slack[i] < span; i++)
         late |= t->simd.ready[e->landed[i]] > now + e->slack[i];
     return !late;
 }
@@ -1132,6 +1134,18 @@ static __attribute__((noinline)) void memo_store(Timing *t)
             m->live[nl++] = m->live[i];
         } else
             fly[nfly++] = m->live[i];
+    }
+    for (int i = 1; i < nl; i++) { /* by slack, smallest first (memo_state_match) */
+        const MemoReg r = m->live[i];
+        const uint16_t sl = m->slack[i];
+        int j = i;
+        while (j > 0 && m->slack[j - 1] > sl) {
+            m->live[j] = m->live[j - 1];
+            m->slack[j] = m->slack[j - 1];
+            j--;
+        }
+        m->live[j] = r;
+        m->slack[j] = sl;
     }
     memcpy(m->live + nl, fly, sizeof *fly * (size_t)nfly);
     m->nlanded = (uint8_t)nl;
