@@ -1126,23 +1126,19 @@ static __attribute__((noinline)) void memo_store(Timing *t)
             m->write[m->nwrite++] = (MemoReg){(uint32_t)(t->simd.ready[r] - t->m_t0), (uint8_t)r, t->simd.rcause[r]};
         }
     m->hz_rel = t->m_hz > t->m_t0 ? (uint32_t)(t->m_hz - t->m_t0) : 0;
-    MemoReg fly[MEMO_REGS]; /* the slack live-ins first (memo_match) */
+    MemoReg fly[MEMO_REGS]; /* the slack live-ins first, smallest slack first (memo_match) */
     int nfly = 0, nl = 0;
     for (int i = 0; i < m->nlive; i++) {
-        if (m->live[i].rel <= t->m_bound[i]) {
-            m->slack[nl] = t->m_bound[i] > UINT16_MAX ? UINT16_MAX : (uint16_t)t->m_bound[i];
-            m->live[nl++] = m->live[i];
-        } else
-            fly[nfly++] = m->live[i];
-    }
-    for (int i = 1; i < nl; i++) { /* by slack, smallest first (memo_state_match) */
         const MemoReg r = m->live[i];
-        const uint16_t sl = m->slack[i];
-        int j = i;
-        while (j > 0 && m->slack[j - 1] > sl) {
+        if (r.rel > t->m_bound[i]) {
+            fly[nfly++] = r;
+            continue;
+        }
+        const uint16_t sl = t->m_bound[i] > UINT16_MAX ? UINT16_MAX : (uint16_t)t->m_bound[i];
+        int j = nl++; /* (j <= i: the slack ones so far only move up over slots already read) */
+        for (; j > 0 && m->slack[j - 1] > sl; j--) {
             m->live[j] = m->live[j - 1];
             m->slack[j] = m->slack[j - 1];
-            j--;
         }
         m->live[j] = r;
         m->slack[j] = sl;
@@ -1219,8 +1215,8 @@ static __attribute__((noinline)) void memo_time_noted(Timing *t, const TmDesc *d
  * for). Else (0) the records so far are timed one by one from the start state while a recording
  * notes them, so the path taken is stored as another way of the same start (rec then goes on as
  * the recording's next record, or ends it); a block that would end before MEMO_MIN records is
- * timed without one. A way that ended just before rec, with no branch taken, is applied, and
- * rec comes after it (0). */
+ * timed without one. A way that ended just before rec is applied, and rec comes after it (0).
+ * A way's last record may take its branch either way (a flipped last branch), as in a replay. */
 static __attribute__((noinline)) int memo_diverged(Timing *t, const CoreRecord *rec)
 {
     const uint32_t k = (uint32_t)t->follow.where - t->m_pc0; /* rec's place on a path */
@@ -1231,17 +1227,18 @@ static __attribute__((noinline)) int memo_diverged(Timing *t, const CoreRecord *
     const int same = rec->pc == t->m_pc0 + k && rec->stage == t->m_stage && rec->gen == t->m_gen;
     for (int w = 0; w < MEMO_WAYS; w++) {
         MemoEntry *e = &mw->e[w];
-        if (e == t->m_e || e->len < k || (e->len == k ? e->taken_last : !same) || !memo_state_match(t, e, ev, nev))
+        if (e == t->m_e || e->len < k || (e->len > k && !same) || !memo_state_match(t, e, ev, nev))
             continue;
-        if (e->len == k) { /* it ended before rec (another generation, say), no branch taken */
-            memo_apply(t, e, 0);
+        if (e->len == k) { /* it ended before rec (another generation, say): its last record took
+                              no branch here (a flipped last branch if it did when stored) */
+            memo_apply(t, e, e->taken_last);
             return 0;     /* rec comes after it */
         }
-        if (rec->taken != (k + 1u == e->len ? e->taken_last : 0))
+        if (k + 1u < e->len && rec->taken) /* only a way's last record may take a branch */
             continue;
         memo_follow(t, e, rec);
         if (k + 1u == e->len)
-            memo_apply(t, e, 0);
+            memo_apply(t, e, rec->taken != e->taken_last);
         return 1;
     }
     /* timed again, and noted unless the block would end before MEMO_MIN records (memo_store) */
@@ -1287,7 +1284,7 @@ static inline __attribute__((always_inline)) int hook_followed(Timing *t, const 
             t->follow.where++;
             return 1;
         }
-    } else if ((w & ~(0xffull << 48)) == t->follow.where) {
+    } else if (core_record_word(rec->pc, rec->stage, rec->gen) == t->follow.where) { /* taken or not */
         t->follow.where++;
         memo_apply(t, t->m_e, rec->taken != t->m_e->taken_last);
         return 1;
