@@ -7,6 +7,9 @@
 
 #include <stdlib.h>
 #include <string.h>
+#if defined(__AVX512CD__) && defined(__AVX512VPOPCNTDQ__)
+#include <immintrin.h>
+#endif
 
 #include "../timing.h"
 #include "lines.h"
@@ -168,6 +171,17 @@ static int rb_access_bits(const RayBufs *rb, const uint32_t *addr, int naddr, in
  * vectorizes; the branchy scan of rb_access_bits mispredicts on the random banks of a gather. */
 static int rb_access_bits16(const RayBufs *rb, const uint32_t *addr, int *lines)
 {
+#if defined(__AVX512CD__) && defined(__AVX512VPOPCNTDQ__)
+    /* The same counts from the host's conflict detection: each lane's mask of the lower lanes
+     * with its line (none: a new line) and with its bank; a new line's count of the new lines up
+     * to it in its bank, the highest over the new lines, is the busiest bank's. */
+    const __m512i line = _mm512_srl_epi32(_mm512_loadu_si512((const void *)addr), _mm_cvtsi32_si128(rb->shift));
+    const __mmask16 fresh = _mm512_cmpeq_epi32_mask(_mm512_conflict_epi32(line), _mm512_setzero_si512());
+    const __m512i bank = _mm512_and_si512(line, _mm512_set1_epi32(rb->p.banks - 1));
+    const __m512i below = _mm512_and_si512(_mm512_conflict_epi32(bank), _mm512_set1_epi32((int)fresh));
+    *lines = __builtin_popcount(fresh);
+    return (int)_mm512_mask_reduce_max_epu32(fresh, _mm512_popcnt_epi32(below)) + 1;
+#else
     uint32_t line[16], bank[16], fresh[16];
     const uint32_t bmask = (uint32_t)rb->p.banks - 1u;
     for (int i = 0; i < 16; i++) {
@@ -191,6 +205,7 @@ static int rb_access_bits16(const RayBufs *rb, const uint32_t *addr, int *lines)
     }
     *lines = k;
     return (int)worst;
+#endif
 }
 
 /* Whether addr[0..naddr) is the last access's lanes moved by one whole number of lines (see
