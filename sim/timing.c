@@ -126,6 +126,10 @@ enum { MEMO_LEN = 33, MEMO_REGS = 40, MEMO_EVENTS = 6, MEMO_WAYS = 8 };
 /* Blocks shorter than this cost more to look up and replay than to time (callgrind): a start
  * that gave one is timed as usual for the rest of the run. */
 enum { MEMO_MIN = 2 };
+/* Lookups start at the way last found from a start state with the same few bits (memo_sig), one
+ * of MEMO_PRED: on the conference diffuse batch, 98 % of replays then match the first way tried,
+ * against 87 % when the way last found at the pc was tried first (fourteenth session). */
+enum { MEMO_PRED = 8 };
 
 typedef struct MemoEv { uint32_t rel; uint16_t arg; uint8_t kind, cause; } MemoEv;
 typedef struct MemoReg { uint32_t rel; uint8_t reg, cause; } MemoReg;
@@ -167,7 +171,9 @@ typedef struct MemoEntry {
 typedef struct MemoWays {
     MemoEntry e[MEMO_WAYS];
     uint8_t next;                   /* the way the next store replaces */
-    uint8_t hit;                    /* the way the last lookup found: tried first */
+    uint8_t pred[MEMO_PRED];        /* by memo_sig of the start state: the way the last lookup
+                                       from such a state found, tried first (then the others in
+                                       turn) */
 } MemoWays;
 
 enum { MM_NONE, MM_RECORD, MM_REPLAY };
@@ -1036,6 +1042,17 @@ static void memo_record_start(Timing *t, const MemoEv *ev, int nev)
     t->mmode = MM_RECORD;
 }
 
+/* A few bits of the state at a block's start that tell a pc's stored ways apart more often than
+ * not: the distance to the scoreboard's horizon (results in flight) and the first pending event,
+ * relative to now. MemoWays.pred's index: only the order of the lookup, every way tried is still
+ * matched whole. */
+static inline unsigned memo_sig(const Timing *t, const MemoEv *ev, int nev)
+{
+    const uint64_t span = t->simd.horizon > t->now ? t->simd.horizon - t->now : 0;
+    const unsigned e = nev > 0 ? ev[0].rel * 3u + ev[0].kind : 0u;
+    return (unsigned)(span * 5u + e) % MEMO_PRED;
+}
+
 /* Starts a block at the plain instruction d (its first record rec): a replay when its start
  * state is stored (1: the record is accounted for), else a recording (0: time it as usual). */
 static __attribute__((noinline)) int memo_begin(Timing *t, TmDesc *d, const CoreRecord *rec)
@@ -1049,12 +1066,13 @@ static __attribute__((noinline)) int memo_begin(Timing *t, TmDesc *d, const Core
     t->m_stage = rec->stage;
     t->m_gen = rec->gen;
     t->m_pc0 = rec->pc; /* d is in the table (not the spare), so desc[pc] stays its entry */
-    if (d->memo)
+    if (d->memo) {
+        uint8_t *pred = &d->memo->pred[memo_sig(t, ev, nev)];
         for (int k = 0; k < MEMO_WAYS; k++) {
-            const int w = (d->memo->hit + k) % MEMO_WAYS; /* the last way found first: starts recur */
+            const int w = (*pred + k) % MEMO_WAYS;
             MemoEntry *e = &d->memo->e[w];
             if (memo_match(t, e, rec, ev, nev)) {
-                d->memo->hit = (uint8_t)w;
+                *pred = (uint8_t)w;
                 memo_follow(t, e, rec); /* rec took no branch unless it is e's last (memo_match) */
                 t->mmode = MM_REPLAY;
                 if (e->len == 1)
@@ -1062,6 +1080,7 @@ static __attribute__((noinline)) int memo_begin(Timing *t, TmDesc *d, const Core
                 return 1;
             }
         }
+    }
     memo_record_start(t, ev, nev);
     return 0;
 }
