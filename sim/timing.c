@@ -146,7 +146,8 @@ typedef struct MemoEntry {
     MemoReg live[MEMO_REGS];        /* key: live-ins at the start (rel 0: landed, cause 0) */
     MemoEv ev_in[MEMO_EVENTS];      /* key: pending events, sorted */
     uint32_t end_rel;               /* outcome: the next issue slot after the block */
-    uint32_t hz_rel;                /* the latest result it wrote */
+    uint32_t hz_rel;                /* the latest of write[] (0: none): the scoreboard's horizon
+                                       (the registers it leaves as they are had landed under it) */
     MemoReg write[MEMO_REGS];       /* registers it wrote whose results land after end_rel: last
                                        ready cycle and cause (one landed by the block's end is
                                        left as it is: a landed register's ready cycle and cause
@@ -214,7 +215,6 @@ struct Timing {
     uint64_t m_written[2], m_seen[2]; /* record: registers written, live-ins noted */
     uint64_t m_stalls0[TM_CAUSE_COUNT];
     uint32_t m_bound[MEMO_REGS];   /* record: each live-in's first check, relative to m_t0 */
-    uint64_t m_hz;
     /* Issue cycles by stage, statistics generation and vector flag: one count per instruction;
      * timing_stats() folds them into TimingStats' busy counters and the cycles per stage and
      * generation (busy + stalls). */
@@ -1038,7 +1038,6 @@ static void memo_record_start(Timing *t, const MemoEv *ev, int nev)
     t->m_ok = 1;
     t->m_written[0] = t->m_written[1] = t->m_seen[0] = t->m_seen[1] = 0;
     memcpy(t->m_stalls0, t->st.stalls, sizeof t->m_stalls0);
-    t->m_hz = 0;
     t->mmode = MM_RECORD;
 }
 
@@ -1145,13 +1144,16 @@ static __attribute__((noinline)) void memo_store(Timing *t)
     if (stalls + m->len != m->end_rel) /* every cycle of the block is an issue or a stall */
         return;
     m->nwrite = 0;
+    m->hz_rel = 0;
     for (int r = 0; r < SIMD_NREGS; r++)
         if (bit_get(t->m_written, r) && t->simd.ready[r] > t->now) { /* landing after the end */
             if (m->nwrite == MEMO_REGS)
                 return;
-            m->write[m->nwrite++] = (MemoReg){(uint32_t)(t->simd.ready[r] - t->m_t0), (uint8_t)r, t->simd.rcause[r]};
+            const uint32_t rel = (uint32_t)(t->simd.ready[r] - t->m_t0);
+            m->write[m->nwrite++] = (MemoReg){rel, (uint8_t)r, t->simd.rcause[r]};
+            if (rel > m->hz_rel)
+                m->hz_rel = rel;
         }
-    m->hz_rel = t->m_hz > t->m_t0 ? (uint32_t)(t->m_hz - t->m_t0) : 0;
     MemoReg fly[MEMO_REGS]; /* the slack live-ins first, smallest slack first (memo_match) */
     int nfly = 0, nl = 0;
     for (int i = 0; i < m->nlive; i++) {
@@ -1213,11 +1215,8 @@ static __attribute__((noinline)) void memo_store(Timing *t)
 static void memo_post(Timing *t, const TmDesc *d, const CoreRecord *rec)
 {
     MemoEntry *m = &t->m_rec;
-    for (int i = 0; i < d->ndst; i++) {
+    for (int i = 0; i < d->ndst; i++)
         bit_set(t->m_written, d->dsts[i]);
-        if (t->simd.ready[d->dsts[i]] > t->m_hz)
-            t->m_hz = t->simd.ready[d->dsts[i]];
-    }
     if (rec->pc != t->m_pc0 + m->len) /* not the next pc (cannot happen: a block ends at a taken branch) */
         t->m_ok = 0;
     m->len++;
