@@ -505,6 +505,7 @@ int pack_scene(const Scene *s, const BvhParams *bp, uint32_t base, PackedScene *
     out->size = (uint32_t)w.size;
     out->base = base;
     out->nprims = nprims;
+    out->nspheres = s->nspheres;
     out->nlights = l.nlights;
     return 0;
 }

@@ -51,6 +51,7 @@ typedef struct PackedScene {
     uint32_t base;       /* scene-memory byte address of the header */
     Bvh bvh;             /* the tree that was packed (node i = packed node i) */
     uint32_t nprims;     /* triangles + spheres */
+    uint32_t nspheres;   /* of which spheres (so a reader need not scan the primitive array) */
     uint32_t nlights;
     uint32_t kd_depth;   /* levels of the kd-tree pack_add_kd appended (root = 1); 0: none */
     PackHost *host;      /* NULL, or built on first use by its reader (atomically published); freed by pack_free */

@@ -236,11 +236,9 @@ static void scene_defines(const PackedScene *p, uint32_t needs, AsmDefine *defs,
         add_define(defs, nd, list, len, "HAS_GLOSSY", 1);
     if (kinds & (1 << SCENE_MAT_DIELECTRIC))
         add_define(defs, nd, list, len, "HAS_DIELECTRIC", 1);
-    uint32_t prims = sm_u32(p, sm_hdr(p, SM_HDR_PRIMS));
-    int spheres = 0;
-    for (uint32_t i = 0; i < p->nprims && !spheres; i++)
-        spheres = sm_u32(p, sm_rec(prims, SM_PRIM_WORDS, i, SM_PRIM_KIND)) == 1;
-    if (spheres)
+    /* From the packer's count: a scan of the primitive array for a sphere took 4 ms on a
+     * triangle-only scene of 280 K primitives, at every run. */
+    if (p->nspheres)
         add_define(defs, nd, list, len, "HAS_SPHERES", 1);
     if (sm_u32(p, sm_hdr(p, SM_HDR_NORMALS)))
         add_define(defs, nd, list, len, "HAS_NORMALS", 1);
