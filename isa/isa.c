@@ -4,7 +4,9 @@
  */
 #include "isa.h"
 
+#include <pthread.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 const IsaOpInfo isa_ops[ISA_OP_COUNT] = {
@@ -53,12 +55,39 @@ static const int16_t code_to_op1[256] = {
 
 int isa_op_from_code(uint8_t code) { return code_to_op1[code] - 1; }
 
-int isa_op_from_mnemonic(const char *mnem)
+/* isa_op_from_mnemonic's index: the opcodes in order of mnemonic (then of opcode), built once.
+ * The assembler asks at every statement and macro line; a scan of the table with strcmp was
+ * about half of assembling the path tracer, which every run does (fifteenth session,
+ * docs/performance.md). */
+static int16_t by_mnemonic[ISA_OP_COUNT];
+static pthread_once_t by_mnemonic_once = PTHREAD_ONCE_INIT;
+
+static int mnemonic_order(const void *pa, const void *pb)
+{
+    const int a = *(const int16_t *)pa, b = *(const int16_t *)pb;
+    const int c = strcmp(isa_ops[a].mnemonic, isa_ops[b].mnemonic);
+    return c ? c : (a > b) - (a < b);
+}
+
+static void by_mnemonic_build(void)
 {
     for (int i = 0; i < ISA_OP_COUNT; i++)
-        if (strcmp(isa_ops[i].mnemonic, mnem) == 0)
-            return i;
-    return -1;
+        by_mnemonic[i] = (int16_t)i;
+    qsort(by_mnemonic, ISA_OP_COUNT, sizeof by_mnemonic[0], mnemonic_order);
+}
+
+int isa_op_from_mnemonic(const char *mnem)
+{
+    pthread_once(&by_mnemonic_once, by_mnemonic_build);
+    int lo = 0, hi = ISA_OP_COUNT; /* the first entry not below mnem */
+    while (lo < hi) {
+        const int mid = lo + (hi - lo) / 2;
+        if (strcmp(isa_ops[by_mnemonic[mid]].mnemonic, mnem) < 0)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < ISA_OP_COUNT && strcmp(isa_ops[by_mnemonic[lo]].mnemonic, mnem) == 0 ? by_mnemonic[lo] : -1;
 }
 
 int isa_kind_max_reg(IsaOperandKind k)

@@ -78,6 +78,13 @@ Test(isa_table, mnemonics_are_unique_lowercase_and_lookups_agree)
     }
     cr_expect_eq(isa_op_from_mnemonic("nosuchop"), -1);
     cr_expect_eq(isa_op_from_mnemonic(""), -1);
+    /* the lookup is a search of the sorted mnemonics: names before the first, after the last, a
+     * prefix of one and one with a character more are not found */
+    cr_expect_eq(isa_op_from_mnemonic("a"), -1);
+    cr_expect_eq(isa_op_from_mnemonic("zzzzzz"), -1);
+    cr_expect_eq(isa_op_from_mnemonic("vf"), -1);
+    cr_expect_eq(isa_op_from_mnemonic("vfmulx"), -1);
+    cr_expect_eq(isa_op_from_mnemonic("ADD"), -1);
 }
 
 Test(isa_table, formats_have_distinct_fields_of_the_right_kind)
