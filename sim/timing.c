@@ -122,7 +122,20 @@ typedef struct TmDesc {
  * ways, were slower. 33, not 32: the box test's chunk loop (kernels/filters/traverse.inc) has 32
  * plain instructions after its gathers and its loop branch as the 33rd, which at 32 was left a
  * block of one, timed as usual at every chunk (fourteenth session). */
-enum { MEMO_LEN = 33, MEMO_REGS = 40, MEMO_EVENTS = 6, MEMO_WAYS = 8 };
+enum { MEMO_LEN = 40, MEMO_REGS = 40, MEMO_EVENTS = 6, MEMO_WAYS = 8 };
+/* A block that starts with a ray-buffer gather (TK_RB_GATHER) may hold more gathers of the same
+ * rays: a gather times as a function of the same start state and of its bank cycles (rb_access),
+ * provided the data path finds a port free at once from the block's start on (xbar_dp_free: no
+ * AGU or partition transfer can start inside a block, so none can take a port from it). The key
+ * holds the first gather's cycles (MemoEntry.gc[0]), compared when its record starts the block.
+ * A later gather joins only when it reads the same index, base and exec-mask registers, none
+ * written since, at an offset a whole number of lines away (the next field of the same rays), with
+ * a power-of-two bank count: it then has the first one's cycles and lines whatever the rays
+ * (rb_same_as_last's case), so a replay needs no record of it, the core counts it like a plain
+ * one, and its access is counted at the block's end (memo_apply) from the first one's lines. So
+ * the box test's chunk loop (kernels/filters/traverse.inc: seven gathers, then 33 plain
+ * instructions) is one block of 40 a chunk (fifteenth session). */
+enum { MEMO_NO_LANES = 255 }; /* MemoEntry.gc of a gather with no lanes (no access, no transfer) */
 /* Blocks shorter than this cost more to look up and replay than to time (callgrind): a start
  * that gave one is timed as usual for the rest of the run. */
 enum { MEMO_MIN = 2 };
@@ -161,6 +174,12 @@ typedef struct MemoEntry {
     uint16_t issues[2];             /* scalar, vector */
     uint16_t nspad;                 /* scalar scratchpad accesses (TmDesc.spad) */
     uint8_t unit[MEMO_LEN], unit_n[MEMO_LEN];
+    uint8_t ngath;                  /* gathers in the block (then the key asks xbar_dp_free) */
+    uint8_t nicn;                   /* of which with lanes: data-path transfers (counted late) */
+    uint8_t gc[MEMO_LEN];           /* by record, a gather's bank cycles (MEMO_NO_LANES: no lanes),
+                                       0 for a plain instruction; gc[0] is part of the key, the
+                                       others equal it */
+    uint32_t dp_s, dp_e;            /* outcome: the last gather's data-path transfer (dp_e 0: none) */
     /* Replays whose counts (stall charges, issue cycles, unit uses, scalar scratchpad accesses)
      * are not in the statistics yet, all in one stage and generation: memo_fold adds them, when
      * the block is replayed in another stage or generation, before the entry is replaced, and
@@ -212,6 +231,9 @@ struct Timing {
                                       pointer, since the table may grow during the block */
     MemoEntry m_rec;               /* record: the block being noted */
     int m_ok;                      /* record: it still fits an entry */
+    int m_xfree;                   /* record: xbar_dp_free at the block's start (a gather may join) */
+    const IsaInstr *m_g0;          /* record: the block's first record when a gather, else NULL */
+    uint32_t m_glines;             /* replay of a block with gathers: the first one's lines */
     uint64_t m_written[2], m_seen[2]; /* record: registers written, live-ins noted */
     uint64_t m_stalls0[TM_CAUSE_COUNT];
     uint32_t m_bound[MEMO_REGS];   /* record: each live-in's first check, relative to m_t0 */
@@ -725,12 +747,12 @@ static inline void complete(Timing *t, const TmDesc *d, const CoreRecord *rec, u
  * of line one by one: each saves only the registers it uses, where one function for all of them
  * saved, and aligned a stack frame for, the largest one's at every call (callgrind: about 26 host
  * instructions a call in the prologue and epilogue). The rest take issue_units_other. */
-static __attribute__((noinline)) void issue_rb(Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at)
+/* c: the bank cycles of its access (rb_access), 0 when it has no lanes. */
+static inline void issue_rb_c(Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at, int c)
 {
     const int stage = rec->stage, gen = rec->gen;
     uint64_t ext = 0; /* extra issue cycles after at */
-    if (rec->naddr) { /* its bank cycles on one interconnect port */
-        const int c = rb_access(&t->rb, rec->addr, rec->naddr, &t->st);
+    if (c) { /* its bank cycles on one interconnect port */
         at = dp_transfer(t, at, (uint64_t)c, stage, gen);
         ext = (uint64_t)c - 1;
         charge(t, TM_BANK_CONFLICT, ext, stage, gen);
@@ -739,6 +761,24 @@ static __attribute__((noinline)) void issue_rb(Timing *t, const TmDesc *d, const
     complete_as(t, d, rec, at, at + ext + 1,
                 d->kind == TK_RB_GATHER ? rb_gather_ready(&t->rb, &t->xbar, at + ext) : at + d->lat, TM_DATA_DEPENDENCY,
                 TM_NO_FLOW);
+}
+
+static __attribute__((noinline)) void issue_rb(Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at)
+{
+    issue_rb_c(t, d, rec, at, rec->naddr ? rb_access(&t->rb, rec->addr, rec->naddr, &t->st) : 0);
+}
+
+/* A gather whose access's bank cycles are known (c as issue_rb_c takes it; its access was
+ * counted when its record came): time_kind's steps for it, from a record without addresses (a
+ * gather's hazards do not read them: part_blocks only asks the ID-stream memory's). */
+static void time_gather_c(Timing *t, const TmDesc *d, const CoreRecord *rec, int c)
+{
+    uint64_t at = t->now;
+    drain(t, at);
+    int cause = hazard_as(t, d, rec, at, TM_NO_FLOW);
+    if (cause >= 0)
+        at = wait_hazards(t, d, rec, at, cause);
+    issue_rb_c(t, d, rec, at, c);
 }
 
 static __attribute__((noinline)) void issue_spad(Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at)
@@ -911,11 +951,17 @@ static inline __attribute__((always_inline)) int memo_state_match(const Timing *
 
 /* ... and whose first record is rec (a block of one instruction ends at its branch taken or not;
  * a longer block's first record took none). */
-static inline int memo_match(const Timing *t, const MemoEntry *e, const CoreRecord *rec, const MemoEv *ev, int nev)
+static inline int memo_match(const Timing *t, const MemoEntry *e, const CoreRecord *rec, const MemoEv *ev, int nev,
+                             int c0, int *xfree)
 {
-    if (rec->taken != (e->len == 1 ? e->taken_last : 0))
+    if (rec->taken != (e->len == 1 ? e->taken_last : 0) || e->gc[0] != c0 || !memo_state_match(t, e, ev, nev))
         return 0;
-    return memo_state_match(t, e, ev, nev);
+    if (e->ngath) { /* the data path free from now on (worked out once a lookup, when first asked) */
+        if (*xfree < 0)
+            *xfree = xbar_dp_free(&t->xbar, t->now);
+        return *xfree;
+    }
+    return 1;
 }
 
 /* The counts of e's replays not yet in the statistics (MemoEntry.lz_n) added to them. */
@@ -931,6 +977,7 @@ static __attribute__((noinline)) void memo_fold(Timing *t, MemoEntry *e)
         t->st.unit_uses[e->unit[i]] += n * e->unit_n[i];
     if (e->nspad)
         spad_count_scalar(&t->st.spad_accesses, &t->st.spad_lines, n * e->nspad);
+    t->st.icn_transfers += n * e->nicn;
     e->lz_n = 0;
 }
 
@@ -942,6 +989,24 @@ static void memo_fold_all(Timing *t)
             for (int w = 0; w < MEMO_WAYS; w++)
                 if (t->desc[i].memo->e[w].lz_n)
                     memo_fold(t, &t->desc[i].memo->e[w]);
+}
+
+/* The accesses of the gathers at e's records [from, to), all after its first: they had its bank
+ * cycles (gc[0]) and lines (m_glines, from its access in this replay). */
+static void memo_count_gathers(Timing *t, const MemoEntry *e, uint32_t from, uint32_t to)
+{
+    if (e->gc[0] == MEMO_NO_LANES)
+        return;
+    uint64_t n = 0;
+    if (from == 1u && to == e->len)
+        n = e->ngath - 1u;
+    else
+        for (uint32_t i = from; i < to; i++)
+            n += e->gc[i] != 0;
+    t->st.rb_accesses += n;
+    t->st.rb_lines += n * t->m_glines;
+    if (e->gc[0] > 1)
+        t->st.rb_conflicted += n;
 }
 
 /* The outcome of the stored block e, applied at once (the block's records have all come); its
@@ -966,6 +1031,10 @@ static void memo_apply(Timing *t, MemoEntry *e, int flip)
     }
     if (t0 + e->hz_rel > t->simd.horizon)
         t->simd.horizon = t0 + e->hz_rel;
+    if (__builtin_expect(e->dp_e != 0, 0)) { /* its gathers' last transfer, and the later ones' accesses */
+        t->xbar.dp = (XbarIvl){t0 + e->dp_s, t0 + e->dp_e};
+        memo_count_gathers(t, e, 1u, e->len);
+    }
     for (int i = 0; i < e->nev_out; i++) {
         const MemoEv *v = &e->ev_out[i];
         if (v->kind == EV_FETCH) {
@@ -991,6 +1060,8 @@ static void memo_apply(Timing *t, MemoEntry *e, int flip)
 
 static void memo_record_start(Timing *t, const MemoEv *ev, int nev);
 static void memo_time_noted(Timing *t, const TmDesc *d, const CoreRecord *rec);
+static void memo_pre(Timing *t, const TmDesc *d);
+static void memo_post(Timing *t, const TmDesc *d, const CoreRecord *rec, int gc);
 
 /* The replay goes on along the stored block e after rec, a record on its path that took no
  * branch (or e's last): the core is given the next record's place and e's last pc. */
@@ -1007,7 +1078,10 @@ static inline void memo_follow(Timing *t, MemoEntry *e, const CoreRecord *rec)
 static void memo_retime(Timing *t, int record, const MemoEv *ev, int nev)
 {
     const uint32_t n = (uint32_t)t->follow.where - t->m_pc0;
+    const MemoEntry *e = t->m_e; /* its gathers so far had its bank cycles */
     memo_none(t);
+    if (e->ngath > 1 && n > 1)
+        memo_count_gathers(t, e, 1u, n); /* (the first was counted as it came) */
     if (record)
         memo_record_start(t, ev, nev);
     t->mc.retimed += n;
@@ -1020,10 +1094,18 @@ static void memo_retime(Timing *t, int record, const MemoEv *ev, int nev)
         r.gen = t->m_gen;
         r.mem = CORE_MEM_COUNT;
         const TmDesc *d = &t->desc[r.pc]; /* described in this run: the entry's run is this one */
-        if (record)
+        const int g = e->gc[i];
+        if (g) {
+            if (record)
+                memo_pre(t, d);
+            time_gather_c(t, d, &r, g == MEMO_NO_LANES ? 0 : g);
+            if (record)
+                memo_post(t, d, &r, g);
+        } else if (record) {
             memo_time_noted(t, d, &r);
-        else
+        } else {
             time_one(t, d, &r);
+        }
     }
 }
 
@@ -1033,6 +1115,10 @@ static void memo_record_start(Timing *t, const MemoEv *ev, int nev)
 {
     MemoEntry *m = &t->m_rec;
     m->len = m->nlive = m->nwrite = m->nev_out = 0;
+    m->ngath = m->nicn = 0;
+    m->dp_s = m->dp_e = 0;
+    t->m_g0 = NULL;
+    t->m_xfree = xbar_dp_free(&t->xbar, t->now);
     m->nev_in = (uint8_t)nev;
     memcpy(m->ev_in, ev, sizeof *ev * (size_t)nev);
     t->m_ok = 1;
@@ -1052,9 +1138,10 @@ static inline unsigned memo_sig(const Timing *t, const MemoEv *ev, int nev)
     return (unsigned)(span * 5u + e) % MEMO_PRED;
 }
 
-/* Starts a block at the plain instruction d (its first record rec): a replay when its start
- * state is stored (1: the record is accounted for), else a recording (0: time it as usual). */
-static __attribute__((noinline)) int memo_begin(Timing *t, TmDesc *d, const CoreRecord *rec)
+/* Starts a block at the plain instruction or gather d (its first record rec; c0: a gather's bank
+ * cycles as MemoEntry.gc holds them, 0 for a plain one): a replay when its start state is stored
+ * (1: the record is accounted for), else a recording (0: time it as usual). */
+static __attribute__((noinline)) int memo_begin(Timing *t, TmDesc *d, const CoreRecord *rec, int c0)
 {
     drain(t, t->now);
     MemoEv ev[MEMO_EVENTS];
@@ -1067,11 +1154,16 @@ static __attribute__((noinline)) int memo_begin(Timing *t, TmDesc *d, const Core
     t->m_pc0 = rec->pc; /* d is in the table (not the spare), so desc[pc] stays its entry */
     if (d->memo) {
         uint8_t *pred = &d->memo->pred[memo_sig(t, ev, nev)];
+        int xfree = -1;
         for (int k = 0; k < MEMO_WAYS; k++) {
             const int w = (*pred + k) % MEMO_WAYS;
             MemoEntry *e = &d->memo->e[w];
-            if (memo_match(t, e, rec, ev, nev)) {
+            if (memo_match(t, e, rec, ev, nev, c0, &xfree)) {
                 *pred = (uint8_t)w;
+                if (c0 && c0 != MEMO_NO_LANES) { /* the first gather's access, counted as it comes */
+                    rb_count(&t->rb, &t->st);
+                    t->m_glines = (uint32_t)t->rb.last_lines;
+                }
                 memo_follow(t, e, rec); /* rec took no branch unless it is e's last (memo_match) */
                 t->mmode = MM_REPLAY;
                 if (e->len == 1)
@@ -1212,13 +1304,24 @@ static __attribute__((noinline)) void memo_store(Timing *t)
 
 /* Recording, after the instruction d was timed: its writes, its place in the path; a taken
  * branch or a full path ends the block. */
-static void memo_post(Timing *t, const TmDesc *d, const CoreRecord *rec)
+static void memo_post(Timing *t, const TmDesc *d, const CoreRecord *rec, int gc)
 {
     MemoEntry *m = &t->m_rec;
     for (int i = 0; i < d->ndst; i++)
         bit_set(t->m_written, d->dsts[i]);
     if (rec->pc != t->m_pc0 + m->len) /* not the next pc (cannot happen: a block ends at a taken branch) */
         t->m_ok = 0;
+    m->gc[m->len] = (uint8_t)gc;
+    if (gc) { /* a gather (its bank cycles gc): the key holds them */
+        if (!t->m_xfree)
+            t->m_ok = 0;
+        m->ngath++;
+        if (gc != MEMO_NO_LANES) {
+            m->nicn++;
+            m->dp_s = (uint32_t)(t->xbar.dp.s - t->m_t0);
+            m->dp_e = (uint32_t)(t->xbar.dp.e - t->m_t0);
+        }
+    }
     m->len++;
     m->taken_last = rec->taken;
     if (rec->taken || m->len == MEMO_LEN)
@@ -1230,7 +1333,8 @@ static __attribute__((noinline)) void memo_time_noted(Timing *t, const TmDesc *d
 {
     memo_pre(t, d);
     time_one(t, d, rec);
-    memo_post(t, d, rec);
+    memo_post(t, d, rec,
+              d->kind != TK_RB_GATHER ? 0 : rec->naddr ? t->rb.last_cycles : MEMO_NO_LANES); /* (rb_access's) */
 }
 
 /* A replay met rec, a record its stored path does not have (a branch taken where it was not, or
@@ -1252,7 +1356,9 @@ static __attribute__((noinline)) int memo_diverged(Timing *t, const CoreRecord *
     const int same = rec->pc == t->m_pc0 + k && rec->stage == t->m_stage && rec->gen == t->m_gen;
     for (int w = 0; w < MEMO_WAYS; w++) {
         MemoEntry *e = &mw->e[w];
-        if (e == t->m_e || e->len < k || (e->len > k && !same) || !memo_state_match(t, e, ev, nev))
+        /* (ways with gathers are left out: their bank cycles would have to agree too) */
+        if (e == t->m_e || t->m_e->ngath || e->ngath || e->len < k || (e->len > k && !same) ||
+            !memo_state_match(t, e, ev, nev))
             continue;
         if (e->len == k) { /* it ended before rec (another generation, say): its last record took
                               no branch here (a flipped last branch if it did when stored) */
@@ -1271,6 +1377,58 @@ static __attribute__((noinline)) int memo_diverged(Timing *t, const CoreRecord *
     return 0;
 }
 
+/* Whether the gather d (instruction in) may join the block being recorded, which started with the
+ * gather t->m_g0: see MEMO_LEN's note (the same opcode, index, base and exec-mask registers, none
+ * written in the block so far, an offset a whole number of lines away, banks a power of two). */
+static int memo_gather_joins(const Timing *t, const TmDesc *d, const IsaInstr *in)
+{
+    const IsaInstr *g0 = t->m_g0;
+    if (!g0 || in->op != g0->op || in->b != g0->b || in->c != g0->c || in->mask != g0->mask ||
+        (in->imm - g0->imm) % (uint32_t)t->rb.p.line != 0 || (t->rb.p.banks & (t->rb.p.banks - 1)) != 0)
+        return 0;
+    for (int i = 0; i < d->nregs - d->ndst; i++) /* its sources and exec mask (simd_operands' order) */
+        if (bit_get(t->m_written, d->regs[i]))
+            return 0;
+    return 1;
+}
+
+/* A gather's record (TK_RB_GATHER) that came to the hook: 1 when a block took it in (a replay
+ * whose next record it is: only with a hook given every record, as a following core counts a
+ * block's later gathers itself; a recording it may join; a block it starts), 0 when it is to be
+ * timed alone. A replay it is not on is timed again up to it (memo_diverged). */
+static __attribute__((noinline)) int memo_gather(Timing *t, TmDesc *d, const CoreRecord *rec)
+{
+    if (t->mmode == MM_REPLAY) {
+        MemoEntry *e = t->m_e;
+        const uint32_t k = (uint32_t)t->follow.where - t->m_pc0; /* the block's records so far */
+        if (k > 0 && k < e->len && e->gc[k] && core_record_word(rec->pc, rec->stage, rec->gen) == t->follow.where) {
+            t->follow.where++; /* (a later gather: counted with the block, memo_count_gathers) */
+            if (k + 1u == e->len)
+                memo_apply(t, e, 0);
+            return 1;
+        }
+        memo_diverged(t, rec); /* (0: no stored way has a gather next; the block was timed again) */
+    }
+    if (t->mmode == MM_RECORD) {
+        if (rec->stage == t->m_stage && rec->gen == t->m_gen && memo_gather_joins(t, d, rec->in)) {
+            memo_time_noted(t, d, rec);
+            return 1;
+        }
+        memo_store(t); /* the block ended before this gather */
+    }
+    if (d->short_block || t->memo_off || !xbar_dp_free(&t->xbar, t->now))
+        return 0;
+    const int c = rec->naddr ? rb_cycles(&t->rb, rec->addr, rec->naddr) : MEMO_NO_LANES; /* (counted below) */
+    if (memo_begin(t, d, rec, c))
+        return 1;
+    if (t->mmode == MM_RECORD) {
+        t->m_g0 = rec->in;
+        memo_time_noted(t, d, rec);
+        return 1;
+    }
+    return 0;
+}
+
 /* Every record but the next one of a replayed block (timing_hook). */
 static __attribute__((noinline)) void hook_any(Timing *t, const CoreRecord *rec)
 {
@@ -1278,9 +1436,14 @@ static __attribute__((noinline)) void hook_any(Timing *t, const CoreRecord *rec)
         internal_error(t, "instruction after halt");
         return;
     }
+    TmDesc *d = (TmDesc *)describe(t, rec);
+    if (d->kind == TK_RB_GATHER) {
+        if (!memo_gather(t, d, rec))
+            time_one(t, d, rec);
+        return;
+    }
     if (t->mmode == MM_REPLAY && memo_diverged(t, rec)) /* the core left the stored path */
         return;
-    TmDesc *d = (TmDesc *)describe(t, rec);
     if (t->mmode == MM_RECORD) {
         if (d->plain && rec->stage == t->m_stage && rec->gen == t->m_gen) {
             memo_time_noted(t, d, rec);
@@ -1289,7 +1452,7 @@ static __attribute__((noinline)) void hook_any(Timing *t, const CoreRecord *rec)
         memo_store(t); /* the block ended before this instruction */
     }
     if (d->plain && !d->short_block && !t->memo_off) {
-        if (memo_begin(t, d, rec))
+        if (memo_begin(t, d, rec, 0))
             return;
         if (t->mmode == MM_RECORD) {
             memo_time_noted(t, d, rec);
@@ -1351,7 +1514,7 @@ static __attribute__((noinline)) void hook_plain_any(Timing *t, const CoreRecord
         memo_store(t);
     }
     if (!d->short_block && !t->memo_off) {
-        if (memo_begin(t, d, rec))
+        if (memo_begin(t, d, rec, 0))
             return;
         if (t->mmode == MM_RECORD) {
             memo_time_noted(t, d, rec);
@@ -1387,7 +1550,18 @@ static inline __attribute__((always_inline)) void hook_unit(void *ctx, const Cor
     time_kind(t, describe(t, rec), rec, kind);
 }
 
-static void hook_rb_gather(void *ctx, const CoreRecord *rec) { hook_unit(ctx, rec, TK_RB_GATHER); }
+/* A gather: in a block when one takes it (memo_gather), else timed alone. */
+static void hook_rb_gather(void *ctx, const CoreRecord *rec)
+{
+    Timing *t = ctx;
+    if (__builtin_expect(t->halted, 0)) {
+        internal_error(t, "instruction after halt");
+        return;
+    }
+    TmDesc *d = (TmDesc *)describe(t, rec);
+    if (!memo_gather(t, d, rec))
+        time_kind(t, d, rec, TK_RB_GATHER);
+}
 static void hook_rb_scatter(void *ctx, const CoreRecord *rec) { hook_unit(ctx, rec, TK_RB_SCATTER); }
 static void hook_spad_vec(void *ctx, const CoreRecord *rec) { hook_unit(ctx, rec, TK_SPAD_VEC); }
 static void hook_scene(void *ctx, const CoreRecord *rec) { hook_unit(ctx, rec, TK_SCENE); }

@@ -96,6 +96,11 @@ static void hold_agu(Xbar *x, uint64_t s, uint64_t e, uint64_t now)
     x->agu[x->agu_n++] = (XbarIvl){s, e};
 }
 
+int xbar_dp_free(const Xbar *x, uint64_t t)
+{
+    return running(x, t, XBAR_DP) < x->p.ports;
+}
+
 uint64_t xbar_transfer(Xbar *x, XbarUser user, uint64_t from, uint64_t len, uint64_t now, TimingStats *st)
 {
     /* fewer transfers running than ports (nearly always): a port is free at from */

@@ -49,5 +49,9 @@ void xbar_reset(Xbar *x);
  * a free port (at least one cycle long), holds a port for [s, s + len) and returns s. Counts a
  * data-path transfer, or the cycles a unit (AGU, partition) waited for the port. */
 uint64_t xbar_transfer(Xbar *x, XbarUser user, uint64_t from, uint64_t len, uint64_t now, struct TimingStats *st);
+/* 1 when a data-path transfer asked for at any cycle from t on starts at once, as far as the
+ * reservations made so far go: fewer of the other users' transfers not ended by t than ports
+ * (fewer still at any later cycle, until another is made). */
+int xbar_dp_free(const Xbar *x, uint64_t t);
 
 #endif

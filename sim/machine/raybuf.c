@@ -253,15 +253,25 @@ static __attribute__((noinline)) void rb_access_new(RayBufs *rb, const uint32_t 
     rb->last_lines = lines;
 }
 
-int rb_access(RayBufs *rb, const uint32_t *addr, int naddr, TimingStats *st)
+int rb_cycles(RayBufs *rb, const uint32_t *addr, int naddr)
 {
     const int pow2 = (rb->p.banks & (rb->p.banks - 1)) == 0;
     if (!(pow2 && rb_same_as_last(rb, addr, naddr)))
         rb_access_new(rb, addr, naddr, pow2);
-    const int cycles = rb->last_cycles, lines = rb->last_lines;
     rb_note_last(rb, addr, naddr);
+    return rb->last_cycles;
+}
+
+void rb_count(const RayBufs *rb, TimingStats *st)
+{
     st->rb_accesses++;
-    st->rb_lines += (uint64_t)lines;
-    st->rb_conflicted += cycles > 1;
+    st->rb_lines += (uint64_t)rb->last_lines;
+    st->rb_conflicted += rb->last_cycles > 1;
+}
+
+int rb_access(RayBufs *rb, const uint32_t *addr, int naddr, TimingStats *st)
+{
+    const int cycles = rb_cycles(rb, addr, naddr);
+    rb_count(rb, st);
     return cycles;
 }

@@ -55,6 +55,11 @@ void rb_free(RayBufs *rb);
  * holds at least 16 words however small naddr is (a CoreRecord's addr does): the access is kept
  * for the next as 16 words in one copy, the words past naddr never compared. */
 int rb_access(RayBufs *rb, const uint32_t *addr, int naddr, struct TimingStats *st);
+/* rb_access in two steps: the cycles (the lines in last_lines), counting nothing; then the
+ * counts of that access (a gather a replayed block takes in: the timing model's memo compares
+ * the cycles first, and counts the access only when its replay goes on). */
+int rb_cycles(RayBufs *rb, const uint32_t *addr, int naddr);
+void rb_count(const RayBufs *rb, struct TimingStats *st);
 
 /* Extra issue cycles of an ID vector read or appended at byte address base. */
 static inline uint64_t rb_align_cycles(const RayBufs *rb, uint32_t base)
