@@ -135,7 +135,23 @@ enum { MEMO_LEN = 40, MEMO_REGS = 40, MEMO_EVENTS = 6, MEMO_WAYS = 8 };
  * one, and its access is counted at the block's end (memo_apply) from the first one's lines. So
  * the box test's chunk loop (kernels/filters/traverse.inc: seven gathers, then 33 plain
  * instructions) is one block of 40 a chunk (fifteenth session). */
+/* A block that starts with a scalar scene load (ld, ldb) that hits the cache may likewise hold
+ * more loads of the same line (the same opcode, base and exec-mask registers, none written since,
+ * an offset that stays in the first one's line: the box test's six loads of a node's bounds): the
+ * first one's hit is keyed by its place in the line and by when the line's data are there
+ * (relative to the start, 0 if by its hit latency), and nothing else touches the cache inside a
+ * block, so every later load hits the same way; the core counts them like plain records, and
+ * their accesses are counted at the block's end (mem_hits). */
 enum { MEMO_NO_LANES = 255 }; /* MemoEntry.gc of a gather with no lanes (no access, no transfer) */
+enum { MEMO_SCENE = 254 };    /* MemoEntry.gc of a scene load */
+
+/* What a block's key asks of its first record beyond the start state: a gather's bank cycles
+ * (c0, as MemoEntry.gc; 0 for a plain instruction), or for a scene load (c0 MEMO_SCENE) its
+ * address's place in its line and when its line's data are there. */
+typedef struct MemoFirst {
+    int c0;
+    uint32_t off, rel;
+} MemoFirst;
 /* Blocks shorter than this cost more to look up and replay than to time (callgrind): a start
  * that gave one is timed as usual for the rest of the run. */
 enum { MEMO_MIN = 2 };
@@ -180,6 +196,10 @@ typedef struct MemoEntry {
                                        0 for a plain instruction; gc[0] is part of the key, the
                                        others equal it */
     uint32_t dp_s, dp_e;            /* outcome: the last gather's data-path transfer (dp_e 0: none) */
+    uint8_t nscene;                 /* scene loads in the block (gc MEMO_SCENE) */
+    uint32_t sc_off, sc_rel;        /* key, a scene load first (MemoFirst): its place in its line,
+                                       when the line's data are there relative to the start (0: by
+                                       its hit latency) */
     /* Replays whose counts (stall charges, issue cycles, unit uses, scalar scratchpad accesses)
      * are not in the statistics yet, all in one stage and generation: memo_fold adds them, when
      * the block is replayed in another stage or generation, before the entry is replaced, and
@@ -234,6 +254,7 @@ struct Timing {
     int m_xfree;                   /* record: xbar_dp_free at the block's start (a gather may join) */
     const IsaInstr *m_g0;          /* record: the block's first record when a gather, else NULL */
     uint32_t m_glines;             /* replay of a block with gathers: the first one's lines */
+    size_t m_sway;                 /* replay or record of a block of scene loads: their way */
     uint64_t m_written[2], m_seen[2]; /* record: registers written, live-ins noted */
     uint64_t m_stalls0[TM_CAUSE_COUNT];
     uint32_t m_bound[MEMO_REGS];   /* record: each live-in's first check, relative to m_t0 */
@@ -781,6 +802,21 @@ static void time_gather_c(Timing *t, const TmDesc *d, const CoreRecord *rec, int
     issue_rb_c(t, d, rec, at, c);
 }
 
+/* A scalar scene load that hits the line in `way` (its access counted apart: mem_hits): time_kind's
+ * and issue_scene's steps for it, from a record without addresses (a scene load's hazards do not
+ * read them). */
+static void time_scene_hit(Timing *t, const TmDesc *d, const CoreRecord *rec, size_t way)
+{
+    uint64_t at = t->now;
+    drain(t, at);
+    int cause = hazard_as(t, d, rec, at, TM_NO_FLOW);
+    if (cause >= 0)
+        at = wait_hazards(t, d, rec, at, cause);
+    const uint64_t r = at + (uint64_t)t->mem.p.hit_latency, line = t->mem.ready[way];
+    count_issue(t, d, rec->stage, rec->gen);
+    complete_as(t, d, rec, at, at + 1, r > line ? r : line, TM_SCENE_MEMORY, TM_NO_FLOW);
+}
+
 static __attribute__((noinline)) void issue_spad(Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at)
 {
     const int stage = rec->stage, gen = rec->gen;
@@ -952,9 +988,10 @@ static inline __attribute__((always_inline)) int memo_state_match(const Timing *
 /* ... and whose first record is rec (a block of one instruction ends at its branch taken or not;
  * a longer block's first record took none). */
 static inline int memo_match(const Timing *t, const MemoEntry *e, const CoreRecord *rec, const MemoEv *ev, int nev,
-                             int c0, int *xfree)
+                             const MemoFirst *f, int *xfree)
 {
-    if (rec->taken != (e->len == 1 ? e->taken_last : 0) || e->gc[0] != c0 || !memo_state_match(t, e, ev, nev))
+    if (rec->taken != (e->len == 1 ? e->taken_last : 0) || e->gc[0] != f->c0 || e->sc_off != f->off ||
+        e->sc_rel != f->rel || !memo_state_match(t, e, ev, nev))
         return 0;
     if (e->ngath) { /* the data path free from now on (worked out once a lookup, when first asked) */
         if (*xfree < 0)
@@ -995,7 +1032,7 @@ static void memo_fold_all(Timing *t)
  * cycles (gc[0]) and lines (m_glines, from its access in this replay). */
 static void memo_count_gathers(Timing *t, const MemoEntry *e, uint32_t from, uint32_t to)
 {
-    if (e->gc[0] == MEMO_NO_LANES)
+    if (e->gc[0] == MEMO_NO_LANES || e->gc[0] == MEMO_SCENE)
         return;
     uint64_t n = 0;
     if (from == 1u && to == e->len)
@@ -1034,6 +1071,10 @@ static void memo_apply(Timing *t, MemoEntry *e, int flip)
     if (__builtin_expect(e->dp_e != 0, 0)) { /* its gathers' last transfer, and the later ones' accesses */
         t->xbar.dp = (XbarIvl){t0 + e->dp_s, t0 + e->dp_e};
         memo_count_gathers(t, e, 1u, e->len);
+    }
+    if (__builtin_expect(e->nscene > 1, 0)) { /* the later loads' hits */
+        mem_hits(&t->mem, t->m_sway, e->nscene - 1u);
+        t->st.scene_instr += e->nscene - 1u;
     }
     for (int i = 0; i < e->nev_out; i++) {
         const MemoEv *v = &e->ev_out[i];
@@ -1082,8 +1123,20 @@ static void memo_retime(Timing *t, int record, const MemoEv *ev, int nev)
     memo_none(t);
     if (e->ngath > 1 && n > 1)
         memo_count_gathers(t, e, 1u, n); /* (the first was counted as it came) */
-    if (record)
+    if (e->nscene > 1 && n > 1) { /* the later loads' hits so far (the first was counted as it came) */
+        uint64_t k = 0;
+        for (uint32_t i = 1; i < n; i++)
+            k += e->gc[i] == MEMO_SCENE;
+        if (k) {
+            mem_hits(&t->mem, t->m_sway, k);
+            t->st.scene_instr += k;
+        }
+    }
+    if (record) {
         memo_record_start(t, ev, nev);
+        t->m_rec.sc_off = e->sc_off; /* the same start: a first scene load's key */
+        t->m_rec.sc_rel = e->sc_rel;
+    }
     t->mc.retimed += n;
     for (uint32_t i = 0; i < n; i++) {
         CoreRecord r;
@@ -1095,7 +1148,13 @@ static void memo_retime(Timing *t, int record, const MemoEv *ev, int nev)
         r.mem = CORE_MEM_COUNT;
         const TmDesc *d = &t->desc[r.pc]; /* described in this run: the entry's run is this one */
         const int g = e->gc[i];
-        if (g) {
+        if (g == MEMO_SCENE) {
+            if (record)
+                memo_pre(t, d);
+            time_scene_hit(t, d, &r, t->m_sway);
+            if (record)
+                memo_post(t, d, &r, g);
+        } else if (g) {
             if (record)
                 memo_pre(t, d);
             time_gather_c(t, d, &r, g == MEMO_NO_LANES ? 0 : g);
@@ -1115,8 +1174,8 @@ static void memo_record_start(Timing *t, const MemoEv *ev, int nev)
 {
     MemoEntry *m = &t->m_rec;
     m->len = m->nlive = m->nwrite = m->nev_out = 0;
-    m->ngath = m->nicn = 0;
-    m->dp_s = m->dp_e = 0;
+    m->ngath = m->nicn = m->nscene = 0;
+    m->dp_s = m->dp_e = m->sc_off = m->sc_rel = 0;
     t->m_g0 = NULL;
     t->m_xfree = xbar_dp_free(&t->xbar, t->now);
     m->nev_in = (uint8_t)nev;
@@ -1138,10 +1197,11 @@ static inline unsigned memo_sig(const Timing *t, const MemoEv *ev, int nev)
     return (unsigned)(span * 5u + e) % MEMO_PRED;
 }
 
-/* Starts a block at the plain instruction or gather d (its first record rec; c0: a gather's bank
- * cycles as MemoEntry.gc holds them, 0 for a plain one): a replay when its start state is stored
- * (1: the record is accounted for), else a recording (0: time it as usual). */
-static __attribute__((noinline)) int memo_begin(Timing *t, TmDesc *d, const CoreRecord *rec, int c0)
+/* Starts a block at the plain instruction, gather or scene load d (its first record rec; f: what
+ * the key asks of it): a replay when its start state is stored (1: the record is accounted for
+ * but for a gather's or load's access, which the caller counts), else a recording (0: time it as
+ * usual). */
+static __attribute__((noinline)) int memo_begin(Timing *t, TmDesc *d, const CoreRecord *rec, const MemoFirst *f)
 {
     drain(t, t->now);
     MemoEv ev[MEMO_EVENTS];
@@ -1158,12 +1218,8 @@ static __attribute__((noinline)) int memo_begin(Timing *t, TmDesc *d, const Core
         for (int k = 0; k < MEMO_WAYS; k++) {
             const int w = (*pred + k) % MEMO_WAYS;
             MemoEntry *e = &d->memo->e[w];
-            if (memo_match(t, e, rec, ev, nev, c0, &xfree)) {
+            if (memo_match(t, e, rec, ev, nev, f, &xfree)) {
                 *pred = (uint8_t)w;
-                if (c0 && c0 != MEMO_NO_LANES) { /* the first gather's access, counted as it comes */
-                    rb_count(&t->rb, &t->st);
-                    t->m_glines = (uint32_t)t->rb.last_lines;
-                }
                 memo_follow(t, e, rec); /* rec took no branch unless it is e's last (memo_match) */
                 t->mmode = MM_REPLAY;
                 if (e->len == 1)
@@ -1312,7 +1368,9 @@ static void memo_post(Timing *t, const TmDesc *d, const CoreRecord *rec, int gc)
     if (rec->pc != t->m_pc0 + m->len) /* not the next pc (cannot happen: a block ends at a taken branch) */
         t->m_ok = 0;
     m->gc[m->len] = (uint8_t)gc;
-    if (gc) { /* a gather (its bank cycles gc): the key holds them */
+    if (gc == MEMO_SCENE) {
+        m->nscene++;
+    } else if (gc) { /* a gather (its bank cycles gc): the key holds them */
         if (!t->m_xfree)
             t->m_ok = 0;
         m->ngath++;
@@ -1334,7 +1392,10 @@ static __attribute__((noinline)) void memo_time_noted(Timing *t, const TmDesc *d
     memo_pre(t, d);
     time_one(t, d, rec);
     memo_post(t, d, rec,
-              d->kind != TK_RB_GATHER ? 0 : rec->naddr ? t->rb.last_cycles : MEMO_NO_LANES); /* (rb_access's) */
+              d->kind == TK_SCENE        ? MEMO_SCENE
+              : d->kind != TK_RB_GATHER ? 0
+              : rec->naddr              ? t->rb.last_cycles /* (rb_access's) */
+                                        : MEMO_NO_LANES);
 }
 
 /* A replay met rec, a record its stored path does not have (a branch taken where it was not, or
@@ -1419,10 +1480,80 @@ static __attribute__((noinline)) int memo_gather(Timing *t, TmDesc *d, const Cor
     if (d->short_block || t->memo_off || !xbar_dp_free(&t->xbar, t->now))
         return 0;
     const int c = rec->naddr ? rb_cycles(&t->rb, rec->addr, rec->naddr) : MEMO_NO_LANES; /* (counted below) */
-    if (memo_begin(t, d, rec, c))
+    if (memo_begin(t, d, rec, &(const MemoFirst){c, 0, 0})) {
+        if (c != MEMO_NO_LANES) { /* the first gather's access, counted as it comes */
+            rb_count(&t->rb, &t->st);
+            t->m_glines = (uint32_t)t->rb.last_lines;
+        }
         return 1;
+    }
     if (t->mmode == MM_RECORD) {
         t->m_g0 = rec->in;
+        memo_time_noted(t, d, rec);
+        return 1;
+    }
+    return 0;
+}
+
+/* Whether the scene load d (instruction in, address addr) may join the block being recorded, which
+ * started with the scene load t->m_g0: see MEMO_SCENE's note (the same opcode, base and
+ * exec-mask registers, none written in the block so far, its address in the first one's line). */
+static int memo_scene_joins(const Timing *t, const TmDesc *d, const IsaInstr *in)
+{
+    const IsaInstr *g0 = t->m_g0;
+    if (!g0 || t->m_rec.gc[0] != MEMO_SCENE || in->op != g0->op || in->b != g0->b || in->mask != g0->mask)
+        return 0;
+    const int64_t at = (int64_t)t->m_rec.sc_off + (int64_t)(int32_t)in->imm - (int64_t)(int32_t)g0->imm;
+    if (at < 0 || at >= (int64_t)t->mem.p.line_bytes)
+        return 0;
+    for (int i = 0; i < d->nregs - d->ndst; i++) /* its sources and exec mask (simd_operands' order) */
+        if (bit_get(t->m_written, d->regs[i]))
+            return 0;
+    return 1;
+}
+
+/* A scene-memory record (TK_SCENE) that came to the hook: as memo_gather, for the scalar loads that
+ * a block may start with or take in (MEMO_SCENE's note); 0 when it is to be timed alone. */
+static __attribute__((noinline)) int memo_scene(Timing *t, TmDesc *d, const CoreRecord *rec)
+{
+    if (t->mmode == MM_REPLAY) {
+        MemoEntry *e = t->m_e;
+        const uint32_t k = (uint32_t)t->follow.where - t->m_pc0; /* the block's records so far */
+        if (k > 0 && k < e->len && e->gc[k] == MEMO_SCENE &&
+            core_record_word(rec->pc, rec->stage, rec->gen) == t->follow.where) {
+            t->follow.where++; /* (a later load: counted with the block) */
+            if (k + 1u == e->len)
+                memo_apply(t, e, 0);
+            return 1;
+        }
+        memo_diverged(t, rec);
+    }
+    const int load = (rec->in->op == ISA_OP_LD || rec->in->op == ISA_OP_LDB) && rec->naddr == 1;
+    if (t->mmode == MM_RECORD) {
+        if (load && rec->stage == t->m_stage && rec->gen == t->m_gen && memo_scene_joins(t, d, rec->in)) {
+            memo_time_noted(t, d, rec);
+            return 1;
+        }
+        memo_store(t);
+    }
+    size_t way;
+    if (!load || d->short_block || t->memo_off || !mem_peek(&t->mem, 0, rec->addr[0], &way))
+        return 0;
+    const uint64_t line = t->mem.ready[way], hit = t->now + (uint64_t)t->mem.p.hit_latency;
+    if (line > hit && line - t->now > UINT32_MAX)
+        return 0;
+    const MemoFirst f = {MEMO_SCENE, rec->addr[0] & (uint32_t)(t->mem.p.line_bytes - 1),
+                         line > hit ? (uint32_t)(line - t->now) : 0u};
+    t->m_sway = way;
+    if (memo_begin(t, d, rec, &f)) {
+        mem_hits(&t->mem, way, 1); /* the first load's access */
+        t->st.scene_instr++;
+        return 1;
+    }
+    if (t->mmode == MM_RECORD) {
+        t->m_g0 = rec->in;
+        t->m_rec.sc_off = f.off;
+        t->m_rec.sc_rel = f.rel;
         memo_time_noted(t, d, rec);
         return 1;
     }
@@ -1437,8 +1568,8 @@ static __attribute__((noinline)) void hook_any(Timing *t, const CoreRecord *rec)
         return;
     }
     TmDesc *d = (TmDesc *)describe(t, rec);
-    if (d->kind == TK_RB_GATHER) {
-        if (!memo_gather(t, d, rec))
+    if (d->kind == TK_RB_GATHER || d->kind == TK_SCENE) {
+        if (!(d->kind == TK_RB_GATHER ? memo_gather(t, d, rec) : memo_scene(t, d, rec)))
             time_one(t, d, rec);
         return;
     }
@@ -1452,7 +1583,7 @@ static __attribute__((noinline)) void hook_any(Timing *t, const CoreRecord *rec)
         memo_store(t); /* the block ended before this instruction */
     }
     if (d->plain && !d->short_block && !t->memo_off) {
-        if (memo_begin(t, d, rec, 0))
+        if (memo_begin(t, d, rec, &(const MemoFirst){0, 0, 0}))
             return;
         if (t->mmode == MM_RECORD) {
             memo_time_noted(t, d, rec);
@@ -1514,7 +1645,7 @@ static __attribute__((noinline)) void hook_plain_any(Timing *t, const CoreRecord
         memo_store(t);
     }
     if (!d->short_block && !t->memo_off) {
-        if (memo_begin(t, d, rec, 0))
+        if (memo_begin(t, d, rec, &(const MemoFirst){0, 0, 0}))
             return;
         if (t->mmode == MM_RECORD) {
             memo_time_noted(t, d, rec);
@@ -1564,7 +1695,18 @@ static void hook_rb_gather(void *ctx, const CoreRecord *rec)
 }
 static void hook_rb_scatter(void *ctx, const CoreRecord *rec) { hook_unit(ctx, rec, TK_RB_SCATTER); }
 static void hook_spad_vec(void *ctx, const CoreRecord *rec) { hook_unit(ctx, rec, TK_SPAD_VEC); }
-static void hook_scene(void *ctx, const CoreRecord *rec) { hook_unit(ctx, rec, TK_SCENE); }
+/* A scene-memory instruction: in a block when one takes it (memo_scene), else timed alone. */
+static void hook_scene(void *ctx, const CoreRecord *rec)
+{
+    Timing *t = ctx;
+    if (__builtin_expect(t->halted, 0)) {
+        internal_error(t, "instruction after halt");
+        return;
+    }
+    TmDesc *d = (TmDesc *)describe(t, rec);
+    if (!memo_scene(t, d, rec))
+        time_kind(t, d, rec, TK_SCENE);
+}
 static void hook_other(void *ctx, const CoreRecord *rec) { hook_unit(ctx, rec, -1); }
 
 CoreHook timing_op_hook(int op)

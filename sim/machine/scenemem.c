@@ -144,6 +144,34 @@ uint64_t mem_access(SceneMem *m, int space, uint32_t addr, uint64_t t, int write
     return r > m->ready[k] ? r : m->ready[k];
 }
 
+int mem_peek(const SceneMem *m, int space, uint32_t addr, size_t *way)
+{
+    if (m->sets == 0 || !m->instantiated)
+        return 0;
+    const uint64_t line = mem_line(m, space, addr);
+    if (m->tag[m->last_way] == line + 1) {
+        *way = m->last_way;
+        return 1;
+    }
+    const size_t set = (size_t)(m->set_mask ? line & m->set_mask : line % (uint64_t)m->sets);
+    const size_t w = (size_t)m->p.ways;
+    for (size_t i = 0; i < w; i++)
+        if (m->tag[set * w + i] == line + 1) {
+            *way = set * w + i;
+            return 1;
+        }
+    return 0;
+}
+
+void mem_hits(SceneMem *m, size_t way, uint64_t n)
+{
+    m->st.accesses += n;
+    m->st.hits += n;
+    m->stamp += n;
+    m->lru[way] = m->stamp;
+    m->last_way = way;
+}
+
 /* mem_issue of more than one lane: each distinct line is one access. */
 static __attribute__((noinline)) uint64_t mem_issue_lanes(SceneMem *m, int space, int write, const uint32_t *addr,
                                                           int naddr, uint64_t at, uint64_t *ready, TimingStats *st)

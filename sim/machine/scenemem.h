@@ -61,6 +61,12 @@ void mem_reset(SceneMem *m);
  * 1 = framebuffer) at cycle t; write marks the line dirty. Returns the cycle its data are ready.
  * Returns UINT64_MAX only if the tag array cannot be allocated. */
 uint64_t mem_access(SceneMem *m, int space, uint32_t addr, uint64_t t, int write);
+/* Whether the line holding addr is in the cache, without touching anything (a lookup as
+ * mem_access's, its way in *way): 0 on a miss, with no cache, or before the first access. */
+int mem_peek(const SceneMem *m, int space, uint32_t addr, size_t *way);
+/* n loads that hit the line in `way`, one after another, with nothing between them: their counts
+ * and the line's use (mem_access's hit path n times, but for the cycles it returns). */
+void mem_hits(SceneMem *m, size_t way, uint64_t n);
 /* The line number of an address (for counting distinct lines of a gather). */
 static inline uint64_t mem_line(const SceneMem *m, int space, uint32_t addr)
 {
