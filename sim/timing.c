@@ -789,17 +789,25 @@ static __attribute__((noinline)) void issue_rb(Timing *t, const TmDesc *d, const
     issue_rb_c(t, d, rec, at, rec->naddr ? rb_access(&t->rb, rec->addr, rec->naddr, &t->st) : 0);
 }
 
+/* The first cycle from now in which the instruction d is free of hazards (the events due by then
+ * applied, the waits charged); flow as hazard_as takes it. */
+static inline __attribute__((always_inline)) uint64_t hazards_cleared(Timing *t, const TmDesc *d,
+                                                                      const CoreRecord *rec, int flow)
+{
+    uint64_t at = t->now;
+    drain(t, at);
+    int cause = hazard_as(t, d, rec, at, flow);
+    if (__builtin_expect(cause >= 0, 0))
+        at = wait_hazards(t, d, rec, at, cause);
+    return at;
+}
+
 /* A gather whose access's bank cycles are known (c as issue_rb_c takes it; its access was
  * counted when its record came): time_kind's steps for it, from a record without addresses (a
  * gather's hazards do not read them: part_blocks only asks the ID-stream memory's). */
 static void time_gather_c(Timing *t, const TmDesc *d, const CoreRecord *rec, int c)
 {
-    uint64_t at = t->now;
-    drain(t, at);
-    int cause = hazard_as(t, d, rec, at, TM_NO_FLOW);
-    if (cause >= 0)
-        at = wait_hazards(t, d, rec, at, cause);
-    issue_rb_c(t, d, rec, at, c);
+    issue_rb_c(t, d, rec, hazards_cleared(t, d, rec, TM_NO_FLOW), c);
 }
 
 /* A scalar scene load that hits the line in `way` (its access counted apart: mem_hits): time_kind's
@@ -807,11 +815,7 @@ static void time_gather_c(Timing *t, const TmDesc *d, const CoreRecord *rec, int
  * read them). */
 static void time_scene_hit(Timing *t, const TmDesc *d, const CoreRecord *rec, size_t way)
 {
-    uint64_t at = t->now;
-    drain(t, at);
-    int cause = hazard_as(t, d, rec, at, TM_NO_FLOW);
-    if (cause >= 0)
-        at = wait_hazards(t, d, rec, at, cause);
+    const uint64_t at = hazards_cleared(t, d, rec, TM_NO_FLOW);
     const uint64_t r = at + (uint64_t)t->mem.p.hit_latency, line = t->mem.ready[way];
     count_issue(t, d, rec->stage, rec->gen);
     complete_as(t, d, rec, at, at + 1, r > line ? r : line, TM_SCENE_MEMORY, TM_NO_FLOW);
@@ -878,12 +882,8 @@ static inline void issue_units_complete(Timing *t, const TmDesc *d, const CoreRe
 static inline __attribute__((always_inline)) void time_kind(Timing *t, const TmDesc *d, const CoreRecord *rec,
                                                             int kind)
 {
-    uint64_t at = t->now;
-    drain(t, at);
     const int flow = kind < 0 || kind == TK_PLAIN ? 1 : TM_NO_FLOW; /* (a plain instruction may branch) */
-    int cause = hazard_as(t, d, rec, at, flow);
-    if (__builtin_expect(cause >= 0, 0))
-        at = wait_hazards(t, d, rec, at, cause);
+    const uint64_t at = hazards_cleared(t, d, rec, flow);
     switch (kind) {
     case TK_PLAIN: /* neither a memory unit nor a special result time (the common case below) */
         break;
@@ -1438,6 +1438,34 @@ static __attribute__((noinline)) int memo_diverged(Timing *t, const CoreRecord *
     return 0;
 }
 
+/* Whether none of d's sources and exec mask (simd_operands' order) was written in the block being
+ * recorded so far. */
+static int memo_reads_unwritten(const Timing *t, const TmDesc *d)
+{
+    for (int i = 0; i < d->nregs - d->ndst; i++)
+        if (bit_get(t->m_written, d->regs[i]))
+            return 0;
+    return 1;
+}
+
+/* A gather's or scene load's record during a replay, that came to the hook (a following core
+ * counts a block's later ones itself): 1 when it is the block's next record, a later one (counted
+ * with the block at its end); else 0, after memo_diverged (no stored way has it next: the records
+ * so far were timed again). */
+static int memo_later(Timing *t, const CoreRecord *rec)
+{
+    MemoEntry *e = t->m_e;
+    const uint32_t k = (uint32_t)t->follow.where - t->m_pc0; /* the block's records so far */
+    if (k > 0 && k < e->len && e->gc[k] && core_record_word(rec->pc, rec->stage, rec->gen) == t->follow.where) {
+        t->follow.where++;
+        if (k + 1u == e->len)
+            memo_apply(t, e, 0);
+        return 1;
+    }
+    memo_diverged(t, rec);
+    return 0;
+}
+
 /* Whether the gather d (instruction in) may join the block being recorded, which started with the
  * gather t->m_g0: see MEMO_LEN's note (the same opcode, index, base and exec-mask registers, none
  * written in the block so far, an offset a whole number of lines away, banks a power of two). */
@@ -1447,29 +1475,16 @@ static int memo_gather_joins(const Timing *t, const TmDesc *d, const IsaInstr *i
     if (!g0 || in->op != g0->op || in->b != g0->b || in->c != g0->c || in->mask != g0->mask ||
         (in->imm - g0->imm) % (uint32_t)t->rb.p.line != 0 || (t->rb.p.banks & (t->rb.p.banks - 1)) != 0)
         return 0;
-    for (int i = 0; i < d->nregs - d->ndst; i++) /* its sources and exec mask (simd_operands' order) */
-        if (bit_get(t->m_written, d->regs[i]))
-            return 0;
-    return 1;
+    return memo_reads_unwritten(t, d);
 }
 
 /* A gather's record (TK_RB_GATHER) that came to the hook: 1 when a block took it in (a replay
- * whose next record it is: only with a hook given every record, as a following core counts a
- * block's later gathers itself; a recording it may join; a block it starts), 0 when it is to be
- * timed alone. A replay it is not on is timed again up to it (memo_diverged). */
+ * whose next record it is: memo_later; a recording it may join; a block it starts), 0 when it is
+ * to be timed alone. */
 static __attribute__((noinline)) int memo_gather(Timing *t, TmDesc *d, const CoreRecord *rec)
 {
-    if (t->mmode == MM_REPLAY) {
-        MemoEntry *e = t->m_e;
-        const uint32_t k = (uint32_t)t->follow.where - t->m_pc0; /* the block's records so far */
-        if (k > 0 && k < e->len && e->gc[k] && core_record_word(rec->pc, rec->stage, rec->gen) == t->follow.where) {
-            t->follow.where++; /* (a later gather: counted with the block, memo_count_gathers) */
-            if (k + 1u == e->len)
-                memo_apply(t, e, 0);
-            return 1;
-        }
-        memo_diverged(t, rec); /* (0: no stored way has a gather next; the block was timed again) */
-    }
+    if (t->mmode == MM_REPLAY && memo_later(t, rec))
+        return 1;
     if (t->mmode == MM_RECORD) {
         if (rec->stage == t->m_stage && rec->gen == t->m_gen && memo_gather_joins(t, d, rec->in)) {
             memo_time_noted(t, d, rec);
@@ -1506,28 +1521,15 @@ static int memo_scene_joins(const Timing *t, const TmDesc *d, const IsaInstr *in
     const int64_t at = (int64_t)t->m_rec.sc_off + (int64_t)(int32_t)in->imm - (int64_t)(int32_t)g0->imm;
     if (at < 0 || at >= (int64_t)t->mem.p.line_bytes)
         return 0;
-    for (int i = 0; i < d->nregs - d->ndst; i++) /* its sources and exec mask (simd_operands' order) */
-        if (bit_get(t->m_written, d->regs[i]))
-            return 0;
-    return 1;
+    return memo_reads_unwritten(t, d);
 }
 
 /* A scene-memory record (TK_SCENE) that came to the hook: as memo_gather, for the scalar loads that
  * a block may start with or take in (MEMO_SCENE's note); 0 when it is to be timed alone. */
 static __attribute__((noinline)) int memo_scene(Timing *t, TmDesc *d, const CoreRecord *rec)
 {
-    if (t->mmode == MM_REPLAY) {
-        MemoEntry *e = t->m_e;
-        const uint32_t k = (uint32_t)t->follow.where - t->m_pc0; /* the block's records so far */
-        if (k > 0 && k < e->len && e->gc[k] == MEMO_SCENE &&
-            core_record_word(rec->pc, rec->stage, rec->gen) == t->follow.where) {
-            t->follow.where++; /* (a later load: counted with the block) */
-            if (k + 1u == e->len)
-                memo_apply(t, e, 0);
-            return 1;
-        }
-        memo_diverged(t, rec);
-    }
+    if (t->mmode == MM_REPLAY && memo_later(t, rec))
+        return 1;
     const int load = (rec->in->op == ISA_OP_LD || rec->in->op == ISA_OP_LDB) && rec->naddr == 1;
     if (t->mmode == MM_RECORD) {
         if (load && rec->stage == t->m_stage && rec->gen == t->m_gen && memo_scene_joins(t, d, rec->in)) {
@@ -1681,8 +1683,9 @@ static inline __attribute__((always_inline)) void hook_unit(void *ctx, const Cor
     time_kind(t, describe(t, rec), rec, kind);
 }
 
-/* A gather: in a block when one takes it (memo_gather), else timed alone. */
-static void hook_rb_gather(void *ctx, const CoreRecord *rec)
+/* A gather or a scene-memory instruction (kind): in a block when one takes it (memo_gather,
+ * memo_scene), else timed alone. */
+static inline __attribute__((always_inline)) void hook_block_kind(void *ctx, const CoreRecord *rec, int kind)
 {
     Timing *t = ctx;
     if (__builtin_expect(t->halted, 0)) {
@@ -1690,23 +1693,14 @@ static void hook_rb_gather(void *ctx, const CoreRecord *rec)
         return;
     }
     TmDesc *d = (TmDesc *)describe(t, rec);
-    if (!memo_gather(t, d, rec))
-        time_kind(t, d, rec, TK_RB_GATHER);
+    if (!(kind == TK_RB_GATHER ? memo_gather(t, d, rec) : memo_scene(t, d, rec)))
+        time_kind(t, d, rec, kind);
 }
+
+static void hook_rb_gather(void *ctx, const CoreRecord *rec) { hook_block_kind(ctx, rec, TK_RB_GATHER); }
 static void hook_rb_scatter(void *ctx, const CoreRecord *rec) { hook_unit(ctx, rec, TK_RB_SCATTER); }
 static void hook_spad_vec(void *ctx, const CoreRecord *rec) { hook_unit(ctx, rec, TK_SPAD_VEC); }
-/* A scene-memory instruction: in a block when one takes it (memo_scene), else timed alone. */
-static void hook_scene(void *ctx, const CoreRecord *rec)
-{
-    Timing *t = ctx;
-    if (__builtin_expect(t->halted, 0)) {
-        internal_error(t, "instruction after halt");
-        return;
-    }
-    TmDesc *d = (TmDesc *)describe(t, rec);
-    if (!memo_scene(t, d, rec))
-        time_kind(t, d, rec, TK_SCENE);
-}
+static void hook_scene(void *ctx, const CoreRecord *rec) { hook_block_kind(ctx, rec, TK_SCENE); }
 static void hook_other(void *ctx, const CoreRecord *rec) { hook_unit(ctx, rec, -1); }
 
 CoreHook timing_op_hook(int op)

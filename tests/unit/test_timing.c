@@ -624,39 +624,59 @@ static const char memo_gathers[] =
     "        bne     r1, r0, loop\n"
     "        halt\n";
 
+/* src timed with the memo on in each mode that replays (every record to the hook, the core
+ * following, the kinds' hooks) gives every counter of `off` (its run with the memo off), whole and
+ * stopped at every point of its first 300 instructions and every 7th after; its blocks recur.
+ * After each whole run, check(memo) asks the test's own questions of hook_calls and the others. */
+static void expect_memo_modes_agree(const BenchProg *prog, const char *src, const TimingStats *off, void (*check)(int memo))
+{
+    uint64_t r_on, r_off;
+    for (int memo = MEMO_HOOK; memo <= MEMO_KINDS; memo++) {
+        TimingStats on = run_memo_src(prog, src, memo, 0, &r_on);
+        cr_expect(memcmp(&on, off, sizeof on) == 0,
+                  "%s, memo mode %d: cycles %llu with the memo, %llu without; ray-buffer accesses %llu, %llu, "
+                  "lines %llu, %llu; transfers %llu, %llu; scene accesses %llu, %llu, hits %llu, %llu",
+                  prog->file, memo, (unsigned long long)on.cycles, (unsigned long long)off->cycles,
+                  (unsigned long long)on.rb_accesses, (unsigned long long)off->rb_accesses,
+                  (unsigned long long)on.rb_lines, (unsigned long long)off->rb_lines,
+                  (unsigned long long)on.icn_transfers, (unsigned long long)off->icn_transfers,
+                  (unsigned long long)on.scene.accesses, (unsigned long long)off->scene.accesses,
+                  (unsigned long long)on.scene.hits, (unsigned long long)off->scene.hits);
+        cr_expect_gt(r_on, 100u, "%s: the blocks recur: %llu replayed", prog->file, (unsigned long long)r_on);
+        check(memo);
+        for (uint64_t limit = 1; limit < on.busy; limit += limit < 300 ? 1 : 7) {
+            TimingStats a = run_memo_src(prog, src, memo, limit, &r_on),
+                        b = run_memo_src(prog, src, MEMO_OFF, limit, &r_off);
+            cr_expect(memcmp(&a, &b, sizeof a) == 0,
+                      "%s, memo mode %d, stopped after %llu instructions: cycles %llu with the memo, %llu without",
+                      prog->file, memo, (unsigned long long)limit, (unsigned long long)a.cycles,
+                      (unsigned long long)b.cycles);
+        }
+    }
+}
+
+static uint64_t all_gathers; /* every rgat record of memo_gathers, the memo off */
+
+static void gathers_check(int memo)
+{
+    if (memo == MEMO_KINDS) /* later gathers of replayed blocks were counted by the core: of the
+                               ten or eleven a pass, the three that always join and the one with
+                               no lanes, on nearly every pass */
+        cr_expect_gt(all_gathers - gather_calls, 4u * 140u, "%llu of %llu gathers came to the hook",
+                     (unsigned long long)gather_calls, (unsigned long long)all_gathers);
+}
+
 Test(timing, memoized_blocks_with_gathers_give_the_same_figures)
 {
     BenchProg prog = {"memo_gathers.s", NULL, 0};
-    uint64_t r_on, r_off;
+    uint64_t r_off;
     TimingStats off = run_memo_src(&prog, memo_gathers, MEMO_OFF, 0, &r_off);
     TimingStats koff = run_memo_src(&prog, memo_gathers, MEMO_KINDS_OFF, 0, &r_off);
-    const uint64_t all_gathers = gather_calls; /* every rgat record, the memo off */
+    all_gathers = gather_calls;
     cr_expect(memcmp(&koff, &off, sizeof koff) == 0);
     cr_expect_gt(off.stalls[TM_BANK_CONFLICT], 0u, "the gathers meet bank conflicts");
     cr_expect_gt(off.rb_conflicted, 0u);
-    for (int memo = MEMO_HOOK; memo <= MEMO_KINDS; memo++) {
-        TimingStats on = run_memo_src(&prog, memo_gathers, memo, 0, &r_on);
-        cr_expect(memcmp(&on, &off, sizeof on) == 0,
-                  "memo mode %d: cycles %llu with the memo, %llu without; ray-buffer accesses %llu, %llu, lines %llu, "
-                  "%llu; transfers %llu, %llu",
-                  memo, (unsigned long long)on.cycles, (unsigned long long)off.cycles,
-                  (unsigned long long)on.rb_accesses, (unsigned long long)off.rb_accesses,
-                  (unsigned long long)on.rb_lines, (unsigned long long)off.rb_lines,
-                  (unsigned long long)on.icn_transfers, (unsigned long long)off.icn_transfers);
-        cr_expect_gt(r_on, 100u, "the blocks recur: %llu replayed", (unsigned long long)r_on);
-        if (memo == MEMO_KINDS) /* later gathers of replayed blocks were counted by the core: of the
-                                   ten or eleven a pass, the three that always join and the
-                                   one with no lanes, on nearly every pass */
-            cr_expect_gt(all_gathers - gather_calls, 4u * 140u, "%llu of %llu gathers came to the hook",
-                         (unsigned long long)gather_calls, (unsigned long long)all_gathers);
-        for (uint64_t limit = 1; limit < on.busy; limit += limit < 300 ? 1 : 7) {
-            TimingStats a = run_memo_src(&prog, memo_gathers, memo, limit, &r_on),
-                        b = run_memo_src(&prog, memo_gathers, MEMO_OFF, limit, &r_off);
-            cr_expect(memcmp(&a, &b, sizeof a) == 0,
-                      "memo mode %d, stopped after %llu instructions: cycles %llu with the memo, %llu without", memo,
-                      (unsigned long long)limit, (unsigned long long)a.cycles, (unsigned long long)b.cycles);
-        }
-    }
+    expect_memo_modes_agree(&prog, memo_gathers, &off, gathers_check);
 }
 
 /* Blocks that start with a scene load and take in later loads of the same line (the box test's
@@ -697,35 +717,26 @@ static const char memo_scene_loads[] =
     "        bne     r1, r0, loop\n"
     "        halt\n";
 
+static uint64_t all_ldb; /* every ldb record of memo_scene_loads, the memo off */
+
+static void scene_loads_check(int memo)
+{
+    if (memo == MEMO_KINDS) /* later loads of replayed blocks were counted by the core: of the nine
+                               or ten a pass, the three after the first that always join, on most
+                               passes */
+        cr_expect_gt(all_ldb - ldb_calls, 3u * 100u, "%llu of %llu ldb came to the hook",
+                     (unsigned long long)ldb_calls, (unsigned long long)all_ldb);
+}
+
 Test(timing, memoized_blocks_with_scene_loads_give_the_same_figures)
 {
     BenchProg prog = {"memo_scene_loads.s", NULL, 0};
-    uint64_t r_on, r_off;
+    uint64_t r_off;
     TimingStats off = run_memo_src(&prog, memo_scene_loads, MEMO_KINDS_OFF, 0, &r_off);
-    const uint64_t all_ldb = ldb_calls; /* every ldb record, the memo off */
+    all_ldb = ldb_calls;
     cr_expect_gt(off.scene.misses, 20u, "the nodes' first loads miss at first");
     cr_expect_gt(off.scene.hits, 1000u);
-    for (int memo = MEMO_HOOK; memo <= MEMO_KINDS; memo++) {
-        TimingStats on = run_memo_src(&prog, memo_scene_loads, memo, 0, &r_on);
-        cr_expect(memcmp(&on, &off, sizeof on) == 0,
-                  "memo mode %d: cycles %llu with the memo, %llu without; scene accesses %llu, %llu, hits %llu, %llu",
-                  memo, (unsigned long long)on.cycles, (unsigned long long)off.cycles,
-                  (unsigned long long)on.scene.accesses, (unsigned long long)off.scene.accesses,
-                  (unsigned long long)on.scene.hits, (unsigned long long)off.scene.hits);
-        cr_expect_gt(r_on, 100u, "the blocks recur: %llu replayed", (unsigned long long)r_on);
-        if (memo == MEMO_KINDS) /* later loads of replayed blocks were counted by the core: of the
-                                   nine or ten a pass, the three after the first that always join,
-                                   on most passes */
-            cr_expect_gt(all_ldb - ldb_calls, 3u * 100u, "%llu of %llu ldb came to the hook",
-                         (unsigned long long)ldb_calls, (unsigned long long)all_ldb);
-        for (uint64_t limit = 1; limit < on.busy; limit += limit < 300 ? 1 : 7) {
-            TimingStats a = run_memo_src(&prog, memo_scene_loads, memo, limit, &r_on),
-                        b = run_memo_src(&prog, memo_scene_loads, MEMO_OFF, limit, &r_off);
-            cr_expect(memcmp(&a, &b, sizeof a) == 0,
-                      "memo mode %d, stopped after %llu instructions: cycles %llu with the memo, %llu without", memo,
-                      (unsigned long long)limit, (unsigned long long)a.cycles, (unsigned long long)b.cycles);
-        }
-    }
+    expect_memo_modes_agree(&prog, memo_scene_loads, &off, scene_loads_check);
 }
 
 /* A loop whose blocks start in more states than a start keeps ways: a scene load that misses
