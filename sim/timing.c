@@ -1028,22 +1028,31 @@ static void memo_fold_all(Timing *t)
                     memo_fold(t, &t->desc[i].memo->e[w]);
 }
 
-/* The accesses of the gathers at e's records [from, to), all after its first: they had its bank
- * cycles (gc[0]) and lines (m_glines, from its access in this replay). */
-static void memo_count_gathers(Timing *t, const MemoEntry *e, uint32_t from, uint32_t to)
+/* The accesses of the gathers or scene loads at e's records [1, to), all after its first (a block
+ * holds later ones only of the kind it starts with, gc[0]): they had its outcome, a gather its bank
+ * cycles and lines (m_glines, from its access in this replay), a load its hit (way m_sway). */
+static void memo_count_later(Timing *t, const MemoEntry *e, uint32_t to)
 {
-    if (e->gc[0] == MEMO_NO_LANES || e->gc[0] == MEMO_SCENE)
+    const int g0 = e->gc[0];
+    if (!g0 || g0 == MEMO_NO_LANES)
         return;
     uint64_t n = 0;
-    if (from == 1u && to == e->len)
-        n = e->ngath - 1u;
+    if (to == e->len)
+        n = (g0 == MEMO_SCENE ? e->nscene : e->ngath) - 1u;
     else
-        for (uint32_t i = from; i < to; i++)
+        for (uint32_t i = 1; i < to; i++)
             n += e->gc[i] != 0;
-    t->st.rb_accesses += n;
-    t->st.rb_lines += n * t->m_glines;
-    if (e->gc[0] > 1)
-        t->st.rb_conflicted += n;
+    if (!n)
+        return;
+    if (g0 == MEMO_SCENE) {
+        mem_hits(&t->mem, t->m_sway, n);
+        t->st.scene_instr += n;
+    } else {
+        t->st.rb_accesses += n;
+        t->st.rb_lines += n * t->m_glines;
+        if (g0 > 1)
+            t->st.rb_conflicted += n;
+    }
 }
 
 /* The outcome of the stored block e, applied at once (the block's records have all come); its
@@ -1068,13 +1077,10 @@ static void memo_apply(Timing *t, MemoEntry *e, int flip)
     }
     if (t0 + e->hz_rel > t->simd.horizon)
         t->simd.horizon = t0 + e->hz_rel;
-    if (__builtin_expect(e->dp_e != 0, 0)) { /* its gathers' last transfer, and the later ones' accesses */
-        t->xbar.dp = (XbarIvl){t0 + e->dp_s, t0 + e->dp_e};
-        memo_count_gathers(t, e, 1u, e->len);
-    }
-    if (__builtin_expect(e->nscene > 1, 0)) { /* the later loads' hits */
-        mem_hits(&t->mem, t->m_sway, e->nscene - 1u);
-        t->st.scene_instr += e->nscene - 1u;
+    if (__builtin_expect(e->gc[0] != 0, 0)) { /* its gathers' last transfer, the later accesses */
+        if (e->dp_e)
+            t->xbar.dp = (XbarIvl){t0 + e->dp_s, t0 + e->dp_e};
+        memo_count_later(t, e, e->len);
     }
     for (int i = 0; i < e->nev_out; i++) {
         const MemoEv *v = &e->ev_out[i];
@@ -1121,17 +1127,7 @@ static void memo_retime(Timing *t, int record, const MemoEv *ev, int nev)
     const uint32_t n = (uint32_t)t->follow.where - t->m_pc0;
     const MemoEntry *e = t->m_e; /* its gathers so far had its bank cycles */
     memo_none(t);
-    if (e->ngath > 1 && n > 1)
-        memo_count_gathers(t, e, 1u, n); /* (the first was counted as it came) */
-    if (e->nscene > 1 && n > 1) { /* the later loads' hits so far (the first was counted as it came) */
-        uint64_t k = 0;
-        for (uint32_t i = 1; i < n; i++)
-            k += e->gc[i] == MEMO_SCENE;
-        if (k) {
-            mem_hits(&t->mem, t->m_sway, k);
-            t->st.scene_instr += k;
-        }
-    }
+    memo_count_later(t, e, n); /* the later accesses so far (the first was counted as it came) */
     if (record) {
         memo_record_start(t, ev, nev);
         t->m_rec.sc_off = e->sc_off; /* the same start: a first scene load's key */
