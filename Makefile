@@ -51,7 +51,14 @@ $(shell mkdir -p $(BUILD) && (echo '$(CC) $(CFLAGS) $(LTO_OBJ) | $(CXX) $(CXXFLA
         echo '$(CC) $(CFLAGS) $(LTO_OBJ) | $(CXX) $(CXXFLAGS)' > $(FLAGS_STAMP)))
 SAN     := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 
-# Library sources: everything but the programs' main files.
+# The build's version and commit (host/version.c): build/gen/version_gen.h is rewritten only when
+# scripts/version.sh prints something new (a new commit, a tree that became dirty or clean).
+$(shell mkdir -p $(BUILD)/gen && bash scripts/version.sh | cmp -s - $(BUILD)/gen/version_gen.h || \
+        bash scripts/version.sh > $(BUILD)/gen/version_gen.h)
+
+# Library sources: everything but the programs' main files. host/ (files in and out, the
+# version) serves both programs.
+HOST_SRC := $(wildcard host/*.c)
 ISA_SRC := isa/isa.c
 ASM_SRC := $(filter-out asm/main_sfasm.c,$(wildcard asm/*.c))
 SIM_SRC := $(filter-out sim/main.c,$(wildcard sim/*.c sim/*/*.c))
@@ -63,7 +70,7 @@ SCN_SRC := $(wildcard scenes/*.c)
 # instead (sim/imglib.c uses that copy).
 SHIM_SRC := sim/img.cpp
 CXX_SRC := $(filter-out $(SHIM_SRC),$(wildcard scenes/*.cpp sim/*.cpp))
-LIB_SRC := $(ISA_SRC) $(ASM_SRC) $(SIM_SRC) $(SCN_SRC)
+LIB_SRC := $(HOST_SRC) $(ISA_SRC) $(ASM_SRC) $(SIM_SRC) $(SCN_SRC)
 # An archive keeps members by file name only: two sources with one name in different folders
 # (sim/a/x.c, sim/b/x.c) would silently replace each other in libsfsim.a.
 LIB_NAMES := $(notdir $(basename $(LIB_SRC) $(CXX_SRC) $(SHIM_SRC)))
@@ -79,7 +86,7 @@ TEST_SRC := $(wildcard tests/unit/*.c) tests/support/numerics.c tests/support/sh
 IO_TEST_SRC := $(wildcard tests/io/*.c) tests/support/xcheck.c tests/support/shared.c tests/support/files.c
 LDAS    := -Wl,--as-needed
 
-ASMLIB_OBJ = $(patsubst %.c,$(BUILD)/obj/%.o,$(ISA_SRC) $(ASM_SRC))
+ASMLIB_OBJ = $(patsubst %.c,$(BUILD)/obj/%.o,$(HOST_SRC) $(ISA_SRC) $(ASM_SRC))
 LIB_OBJ  = $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/obj/%.o,$(CXX_SRC))
 ASAN_OBJ = $(patsubst %.c,$(BUILD)/asan/%.o,$(LIB_SRC)) $(patsubst %.cpp,$(BUILD)/asan/%.o,$(CXX_SRC))
 # The image library's objects: position-independent, every symbol hidden but its table.
@@ -133,6 +140,8 @@ run: deps
 
 test: deps
 	@$(MAKE) --no-print-directory test-built
+
+$(BUILD)/obj/host/version.o $(BUILD)/asan/host/version.o: CFLAGS += -I$(BUILD)/gen
 
 # Only the image writers see the image libraries' headers.
 $(BUILD)/obj/sim/img_write.o $(BUILD)/obj/sim/heatmap.o $(BUILD)/asan/sim/img_write.o $(BUILD)/asan/sim/heatmap.o: \
@@ -268,6 +277,7 @@ test-built: all $(BUILD)/tests/unit $(BUILD)/tests/io $(BUILD)/gen_cornell $(BUI
 	@bash tests/outputs/check.sh
 	@bash tests/cli/run.sh
 	@bash tests/cli/sweep.sh
+	@for t in $(sort $(wildcard tests/cli/cases/*.sh)); do bash $$t || exit 1; done
 	@SFSIM_GEN_CORNELL=$(BUILD)/gen_cornell bash tests/cli/standalone.sh
 	@$(TEST_ENV) bash tests/run_criterion.sh $(BUILD)/tests/io --jobs 2
 	@$(TEST_ENV) bash tests/run_criterion.sh $(BUILD)/tests/unit --jobs 2
@@ -295,9 +305,9 @@ test-asan: deps
 
 # ---- fuzzing (clang + libFuzzer) -------------------------------------------------------------
 FUZZ_SECONDS ?= 60
-$(BUILD)/fuzz/fuzz_asm: tests/fuzz/fuzz_asm.c $(ISA_SRC) $(ASM_SRC)
+$(BUILD)/fuzz/fuzz_asm: tests/fuzz/fuzz_asm.c $(HOST_SRC) $(ISA_SRC) $(ASM_SRC)
 	@mkdir -p $(dir $@)
-	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ -lm
+	$(CLANG) -I$(BUILD)/gen -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ -lm
 
 # The scene-loader fuzzer compiles tinygltf and stb_image into the shim (scenes/gltf_load.cpp
 # acts on SFSIM_TINYGLTF_IMPLEMENTATION) so the sanitizers see inside them (the project's

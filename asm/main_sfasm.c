@@ -12,9 +12,9 @@
 
 #include "../sim/exitcodes.h"
 #include "../sim/exithelp.h"
+#include "../host/version.h"
 #include "asm.h"
 
-#define SFASM_VERSION "1.0"
 
 typedef struct Args {
     AsmDefine *defines; int ndefines;
@@ -100,7 +100,7 @@ static int parse_args(int argc, char **argv, Args *a)
             return -1;
         }
         if (strcmp(arg, "--version") == 0) {
-            printf("sfasm %s (object format version %u)\n", SFASM_VERSION, ASM_OBJ_VERSION);
+            printf("sfasm %s (commit %s, object format version %u)\n", version_string(), version_commit(), ASM_OBJ_VERSION);
             return -1;
         }
         if (strcmp(arg, "--source") == 0) {

@@ -15,6 +15,7 @@ case "${1:-}" in
     fonts-dejavu-core
     libinih-dev libcjson-dev libcriterion-dev
     libembree-dev gnuplot-nox parallel
+    libtinyobjloader-dev libgsl-dev
   )
   ;;
 slurm)

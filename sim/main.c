@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "../asm/object.h"
+#include "../host/version.h"
 #include "config.h"
 #include "core.h"
 #include "datadir.h"
@@ -27,8 +28,6 @@
 #include "timing.h"
 #include "trace.h"
 #include "util.h"
-
-#define SFSIM_VERSION "0.1"
 
 static void usage(FILE *out)
 {
@@ -818,7 +817,7 @@ static int dispatch(int argc, char **argv)
         return EXIT_OK;
     }
     if (!strcmp(cmd, "--version")) {
-        printf("sfsim %s\n", SFSIM_VERSION);
+        printf("sfsim %s (commit %s)\n", version_string(), version_commit());
         return EXIT_OK;
     }
     if (!strcmp(cmd, "help")) {
