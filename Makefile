@@ -318,16 +318,16 @@ $(BUILD)/fuzz/gltf_%.o: scenes/gltf_%.cpp scenes/gltf_internal.hpp scenes/gltf.h
 	$(CLANG)++ -std=c++17 -g -O1 -fsanitize=fuzzer-no-link,address,undefined -isystem /usr/include/stb \
 	    -DSFSIM_TINYGLTF_IMPLEMENTATION -c $< -o $@
 
-$(BUILD)/fuzz/fuzz_scene: tests/fuzz/fuzz_scene.c scenes/scene.c scenes/scene_file.c sim/ini.c $(FUZZ_GLTF_OBJ)
+$(BUILD)/fuzz/fuzz_scene: tests/fuzz/fuzz_scene.c scenes/scene.c scenes/scene_file.c sim/ini.c host/infile.c $(FUZZ_GLTF_OBJ)
 	@mkdir -p $(dir $@)
 	$(CLANG)++ -x c -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined \
 	    $(filter %.c,$^) -x none $(filter %.o,$^) -o $@ -linih -lcjson -lm
 
-$(BUILD)/fuzz/fuzz_rays: tests/fuzz/fuzz_rays.c sim/raybatch.c sim/outfile.c sim/util.c
+$(BUILD)/fuzz/fuzz_rays: tests/fuzz/fuzz_rays.c sim/raybatch.c host/outfile.c host/infile.c sim/util.c
 	@mkdir -p $(dir $@)
 	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ -lm
 
-$(BUILD)/fuzz/fuzz_config: tests/fuzz/fuzz_config.c sim/config.c sim/ini.c sim/timing.c sim/event.c $(wildcard sim/machine/*.c) isa/isa.c
+$(BUILD)/fuzz/fuzz_config: tests/fuzz/fuzz_config.c sim/config.c sim/ini.c host/infile.c sim/timing.c sim/event.c $(wildcard sim/machine/*.c) isa/isa.c
 	@mkdir -p $(dir $@)
 	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ $(INIH) $(CJSON) -lm
 

@@ -8,6 +8,7 @@
  */
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,6 +17,7 @@
 
 #include "ctx.h"
 #include "../isa/isa.h"
+#include "../host/infile.h"
 
 /* ---- memory and diagnostics ------------------------------------------------------------------- */
 
@@ -230,39 +232,16 @@ static int add_file(Asm *a, const char *name)
     return (int)a->nfiles++;
 }
 
-/* Reads a regular file whole. Opening with O_NONBLOCK and refusing anything but a regular file
- * keeps FIFOs and devices (an include of /dev/zero) from hanging or exhausting memory. */
+/* Reads a regular file whole through the one input check (host/infile.h): FIFOs and devices (an
+ * include of /dev/zero) are refused before a byte is read; room caps the input in all. */
 static int read_source(const char *path, size_t room, char **buf, size_t *len, char *why, size_t whylen)
 {
-    int fd = open(path, O_RDONLY | O_NONBLOCK);
-    struct stat st;
-    if (fd < 0 || fstat(fd, &st) != 0) {
-        snprintf(why, whylen, "%s", strerror(errno));
-        if (fd >= 0)
-            close(fd);
+    char err[PATH_MAX + 256], what[64];
+    snprintf(what, sizeof what, "the assembler's input (%u MiB in all)", ASM_MAX_INPUT_BYTES >> 20);
+    if (infile_read(path, room, what, buf, len, err, sizeof err) != 0) {
+        snprintf(why, whylen, "%s", infile_reason(err, path));
         return -1;
     }
-    if (!S_ISREG(st.st_mode) || st.st_size > (off_t)room) {
-        if (S_ISREG(st.st_mode))
-            snprintf(why, whylen, "input exceeds %u MiB in total", ASM_MAX_INPUT_BYTES >> 20);
-        else
-            snprintf(why, whylen, "not a regular file");
-        close(fd);
-        return -1;
-    }
-    size_t cap = (size_t)st.st_size + 1, n = 0;
-    char *b = malloc(cap);
-    ssize_t r = 0;
-    while (b && n < cap && (r = read(fd, b + n, cap - n)) > 0)
-        n += (size_t)r;
-    close(fd);
-    if (!b || r < 0 || n >= cap) { /* n == cap: the file grew while we read it */
-        snprintf(why, whylen, "%s", !b ? "out of memory" : r < 0 ? strerror(errno) : "file changed while read");
-        free(b);
-        return -1;
-    }
-    *buf = b;
-    *len = n;
     return 0;
 }
 
@@ -279,20 +258,22 @@ static char *join_path(const char *dir, size_t dirlen, const char *name)
     return p;
 }
 
-static int is_regular(const char *path)
+/* A candidate for an include: anything there but a folder (as a C preprocessor skips folders). A
+ * device or a FIFO is found, and then refused by name when read (read_source). */
+static int is_candidate(const char *path)
 {
     struct stat st;
-    return stat(path, &st) == 0 && S_ISREG(st.st_mode);
+    return stat(path, &st) == 0 && !S_ISDIR(st.st_mode);
 }
 
 /* The including file's directory first, then each -I directory. */
 static char *find_include(const Asm *a, const char *name, const char *from)
 {
     if (name[0] == '/')
-        return is_regular(name) ? strdup(name) : NULL;
+        return is_candidate(name) ? strdup(name) : NULL;
     const char *slash = strrchr(from, '/');
     char *p = join_path(from, slash ? (size_t)(slash - from) : 0, name);
-    if (p && is_regular(p))
+    if (p && is_candidate(p))
         return p;
     free(p);
     for (int i = 0; i < a->opt->ninclude_dirs; i++) {
@@ -300,7 +281,7 @@ static char *find_include(const Asm *a, const char *name, const char *from)
         if (!dir)
             continue;
         p = join_path(dir, strlen(dir), name);
-        if (p && is_regular(p))
+        if (p && is_candidate(p))
             return p;
         free(p);
     }

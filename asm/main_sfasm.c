@@ -12,6 +12,7 @@
 
 #include "../sim/exitcodes.h"
 #include "../sim/exithelp.h"
+#include "../host/outfile.h"
 #include "../host/version.h"
 #include "asm.h"
 
@@ -190,6 +191,7 @@ static int assemble(const Args *a)
 int main(int argc, char **argv)
 {
     Args a = {0};
+    outfile_process_init();
     int rc = parse_args(argc, argv, &a);
     if (rc == 0)
         rc = a.disasm ? disassemble(&a) : assemble(&a);

@@ -13,6 +13,8 @@
 #include <string.h>
 
 #include "../isa/isa.h"
+#include "../host/infile.h"
+#include "../host/outfile.h"
 
 #define OBJ_HDR_BYTES  16u
 #define OBJ_SEC_BYTES  16u
@@ -201,23 +203,9 @@ int asm_object_write(const AsmObject *obj, const char *path, char *err, size_t e
     size_t len;
     if (asm_object_encode(obj, &buf, &len, err, errlen) < 0)
         return -1;
-    int rc = -1;
-    FILE *f = fopen(path, "wb");
-    if (!f) {
-        set_err(err, errlen, "%s: %s", path, strerror(errno));
-        goto out;
-    }
-    if (fwrite(buf, 1, len, f) != len) {
-        set_err(err, errlen, "%s: write failed: %s", path, strerror(errno));
-        fclose(f);
-        goto out;
-    }
-    if (fclose(f) != 0) {
-        set_err(err, errlen, "%s: %s", path, strerror(errno));
-        goto out;
-    }
-    rc = 0;
-out:
+    /* Written under a temporary name and renamed into place once whole (host/outfile.h): a full
+     * disk or a file-size limit leaves the object that was there, not a truncated one. */
+    int rc = outfile_write_file(NULL, path, buf, len, err, errlen);
     free(buf);
     return rc;
 }
@@ -491,49 +479,14 @@ int asm_object_decode(const uint8_t *buf, size_t len, const char *name, AsmObjec
     return 0;
 }
 
-/* Reads a whole file into memory. */
-static int slurp(const char *path, uint8_t **buf, size_t *len, char *err, size_t errlen)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        set_err(err, errlen, "%s: %s", path, strerror(errno));
-        return -1;
-    }
-    size_t cap = 4096, n = 0;
-    uint8_t *b = malloc(cap);
-    while (b) {
-        n += fread(b + n, 1, cap - n, f);
-        if (n < cap)
-            break;
-        uint8_t *nb = cap > SIZE_MAX / 2 ? NULL : realloc(b, cap * 2);
-        if (!nb) {
-            free(b);
-            b = NULL;
-            break;
-        }
-        b = nb;
-        cap *= 2;
-    }
-    int bad = ferror(f);
-    fclose(f);
-    if (!b || bad) {
-        free(b);
-        set_err(err, errlen, "%s: %s", path, b ? "read error" : "out of memory");
-        return -1;
-    }
-    *buf = b;
-    *len = n;
-    return 0;
-}
-
 int asm_object_read(const char *path, AsmObject *obj, char *err, size_t errlen)
 {
     memset(obj, 0, sizeof *obj);
-    uint8_t *buf;
+    char *buf;
     size_t len;
-    if (slurp(path, &buf, &len, err, errlen) < 0)
+    if (infile_read(path, ASM_OBJ_MAX_BYTES, "an object file", &buf, &len, err, errlen) != 0)
         return -1;
-    int rc = asm_object_decode(buf, len, path, obj, err, errlen);
+    int rc = asm_object_decode((const uint8_t *)buf, len, path, obj, err, errlen);
     free(buf);
     return rc;
 }

@@ -24,6 +24,9 @@
 
 #define ASM_OBJ_MAGIC   "SFO"   /* 4 bytes with the NUL */
 #define ASM_OBJ_VERSION 1u
+/* The largest object file a reader takes (host/infile.h): 4 GiB, above any program the machine
+ * can hold. */
+#define ASM_OBJ_MAX_BYTES (1ull << 32)
 
 typedef enum AsmSectionKind {
     ASM_SEC_TEXT = 1,

@@ -32,7 +32,7 @@
 
 #include <stddef.h>
 
-#include "outfile.h"
+#include "../host/outfile.h"
 
 #ifdef __cplusplus
 extern "C" {

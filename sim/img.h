@@ -14,9 +14,9 @@
 
 #include <stddef.h>
 
-#include "outfile.h"
+#include "../host/outfile.h"
 
-/* The writers below encode in memory and write through sim/outfile.c: set NULL puts the file in
+/* The writers below encode in memory and write through host/outfile.c: set NULL puts the file in
  * place at once (whole, or not at all); a set stages it until outset_commit. Errors name path:
  * a file name of another format than the writer's, a size that is not positive or too large to
  * encode, no memory, or the write itself (a full disk, an unwritable folder). */
@@ -38,7 +38,9 @@ unsigned char img_to_u8(float x);
 /* out[i] = img_to_u8(x[i]) for i < n (img_write_rgb8's conversion, vectorized). */
 void img_to_u8_n(const float *x, unsigned char *out, size_t n);
 /* Read any format OpenImageIO knows into float RGB (*rgb malloc'ed; grey is replicated, alpha
- * dropped). Values are as stored: linear for EXR, encoded 0..1 for PNG. */
+ * dropped). Values are as stored: linear for EXR, encoded 0..1 for PNG. Only a regular file of at
+ * most IMG_MAX_FILE_BYTES is opened (host/infile.h). */
+#define IMG_MAX_FILE_BYTES (16ull << 30)
 int img_read(const char *path, float **rgb, int *width, int *height, char *err, size_t errlen);
 
 typedef struct ImgCompare {

@@ -8,7 +8,7 @@
  * Owns: encoding into memory (EXR: float R, G, B, ZIP compression, scanlines, as OpenImageIO
  * wrote them; PNG: 8-bit RGB, row filter Sub, zlib level 1), the display transfer documented in
  * img.h, the 8-bit conversion. Must not: open files itself (the bytes go through
- * sim/outfile.c, which writes them whole or not at all and counts the writes for its fault
+ * host/outfile.c, which writes them whole or not at all and counts the writes for its fault
  * hook), or exit.
  */
 #include <errno.h>

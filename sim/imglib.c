@@ -16,6 +16,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "../host/infile.h"
 #include "img.h"
 
 /* Defined when the binary links the library's objects in (tests and tools: sim/imgshim.h). */
@@ -138,6 +139,9 @@ static const ImgShim *shim_for(const char *path, char *err, size_t errlen)
 int img_read(const char *path, float **rgb, int *width, int *height, char *err, size_t errlen)
 {
     *rgb = NULL;
+    /* Checked before OpenImageIO opens it: a folder, a device or a FIFO is refused by name. */
+    if (infile_check(path, IMG_MAX_FILE_BYTES, "an image file", err, errlen) != 0)
+        return -1;
     const ImgShim *t = shim_for(path, err, errlen);
     return t ? t->read(path, rgb, width, height, err, errlen) : -1;
 }

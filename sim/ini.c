@@ -20,6 +20,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "../host/infile.h"
+
 /* ---- messages -------------------------------------------------------------------------------- */
 
 static void add_message(IniFile *f, int line, char *text)
@@ -450,81 +452,9 @@ int inifile_parse(IniFile *f, const char *name, const char *text, size_t len, co
     return f->nerrors;
 }
 
-static const char *file_kind(mode_t m)
-{
-    return S_ISCHR(m) ? "a character device" : S_ISBLK(m) ? "a block device" : S_ISFIFO(m) ? "a FIFO"
-         : S_ISSOCK(m) ? "a socket" : "not a file";
-}
-
 int inifile_read(const char *path, char **text, size_t *len, char *err, size_t errlen)
 {
-    *text = NULL;
-    *len = 0;
-    /* O_NONBLOCK: opening a FIFO must not wait for a writer; fstat then refuses it. */
-    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
-    if (fd < 0) {
-        snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
-        return -1;
-    }
-    struct stat st;
-    char *buf = NULL;
-    size_t n = 0;
-    if (fstat(fd, &st) != 0) {
-        snprintf(err, errlen, "%s: cannot read: %s", path, strerror(errno));
-        goto fail;
-    }
-    if (S_ISDIR(st.st_mode)) {
-        snprintf(err, errlen, "%s: is a directory, not a regular file", path);
-        goto fail;
-    }
-    if (!S_ISREG(st.st_mode)) {
-        snprintf(err, errlen, "%s: not a regular file (%s)", path, file_kind(st.st_mode));
-        goto fail;
-    }
-    if (st.st_size > INIFILE_MAX_BYTES)
-        goto too_big;
-    /* Read to the end, not st_size bytes: the file may grow, and /proc files say 0. One byte
-     * more than the limit tells a file that is too big. */
-    size_t cap = (size_t)st.st_size + 1 < 4096 ? 4096 : (size_t)st.st_size + 1;
-    buf = malloc(cap + 1);
-    if (!buf)
-        goto oom;
-    for (;;) {
-        if (n == cap) {
-            if (cap > INIFILE_MAX_BYTES)
-                goto too_big;
-            size_t more = 2 * cap > (size_t)INIFILE_MAX_BYTES + 1 ? (size_t)INIFILE_MAX_BYTES + 1 : 2 * cap;
-            char *b = realloc(buf, more + 1);
-            if (!b)
-                goto oom;
-            buf = b;
-            cap = more;
-        }
-        ssize_t got = read(fd, buf + n, cap - n);
-        if (got < 0 && errno == EINTR)
-            continue;
-        if (got < 0) {
-            snprintf(err, errlen, "%s: cannot read: %s", path, strerror(errno));
-            goto fail;
-        }
-        if (got == 0)
-            break;
-        n += (size_t)got;
-    }
-    close(fd);
-    buf[n] = 0;
-    *text = buf;
-    *len = n;
-    return 0;
-too_big:
-    snprintf(err, errlen, "%s: larger than %d MiB, the most an INI file may hold", path, INIFILE_MAX_BYTES >> 20);
-    goto fail;
-oom:
-    snprintf(err, errlen, "%s: out of memory", path);
-fail:
-    free(buf);
-    close(fd);
-    return -1;
+    return infile_read(path, INIFILE_MAX_BYTES, "an INI file", text, len, err, errlen);
 }
 
 int inifile_load(IniFile *f, const char *path, const IniOptions *opt)

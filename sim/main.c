@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "../asm/object.h"
+#include "../host/outfile.h"
 #include "../host/version.h"
 #include "config.h"
 #include "core.h"
@@ -872,6 +873,7 @@ static int dispatch(int argc, char **argv)
 
 int main(int argc, char **argv)
 {
+    outfile_process_init();
     int rc = dispatch(argc, argv);
     /* What went to stdout (a config dump, help, registers, the summary) is an output too: a full
      * disk or closed pipe must not pass for success. */

@@ -11,7 +11,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "outfile.h"
+#include "../host/infile.h"
+#include "../host/outfile.h"
 
 void raybatch_free(RayBatch *b)
 {
@@ -206,51 +207,20 @@ int raybatch_parse(const char *name, const unsigned char *data, size_t len, RayB
     memset(out, 0, sizeof *out);
     if (len >= 8 && !memcmp(data, RAYBATCH_MAGIC, 8))
         return parse_binary(name, data, len, out, err, errlen);
-    return parse_text(name, data, len, out, err, errlen);
+    /* A UTF-8 byte-order mark (an editor's) is skipped, as the INI reader skips it. */
+    size_t bom = infile_bom(data, len);
+    return parse_text(name, data + bom, len - bom, out, err, errlen);
 }
 
 int raybatch_load(const char *path, RayBatch *out, char *err, size_t errlen)
 {
     memset(out, 0, sizeof *out);
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+    char *data;
+    size_t len;
+    /* A text file of the most rays a file may claim, at four times the binary size, is the cap. */
+    if (infile_read(path, ((uint64_t)RAYBATCH_MAX_RAYS * 32 + 16) * 4, "a ray file", &data, &len, err, errlen) != 0)
         return -1;
-    }
-    unsigned char *data = NULL;
-    size_t len = 0, cap = 0;
-    for (;;) {
-        if (len == cap) {
-            size_t nc = cap ? cap * 2 : 65536;
-            if (nc > ((size_t)RAYBATCH_MAX_RAYS * 32 + 16) * 4) {
-                snprintf(err, errlen, "%s: larger than any ray file can be", path);
-                free(data);
-                fclose(f);
-                return -1;
-            }
-            unsigned char *n = realloc(data, nc);
-            if (!n) {
-                snprintf(err, errlen, "%s: out of memory", path);
-                free(data);
-                fclose(f);
-                return -1;
-            }
-            data = n;
-            cap = nc;
-        }
-        size_t got = fread(data + len, 1, cap - len, f);
-        len += got;
-        if (got == 0)
-            break;
-    }
-    int bad = ferror(f);
-    fclose(f);
-    if (bad) {
-        snprintf(err, errlen, "%s: read error", path);
-        free(data);
-        return -1;
-    }
-    int rc = raybatch_parse(path, data, len, out, err, errlen);
+    int rc = raybatch_parse(path, (const unsigned char *)data, len, out, err, errlen);
     free(data);
     return rc;
 }
@@ -266,7 +236,7 @@ static void wr32(unsigned char *p, uint32_t v)
 int raybatch_write_hits(const char *path, const RayBatch *b, const BatchHit *hits, int binary, char *err,
                         size_t errlen)
 {
-    /* Through sim/outfile.c: every write checked, and the file in place only once whole. */
+    /* Through host/outfile.c: every write checked, and the file in place only once whole. */
     OutFile f;
     if (outfile_open(&f, path, err, errlen) != 0)
         return -1;

@@ -42,7 +42,7 @@ int raybatch_load(const char *path, RayBatch *out, char *err, size_t errlen);
 void raybatch_free(RayBatch *b);
 
 /* Write hits: text (one line per ray) or binary ("SFHITS1" format), whole or not at all
- * (sim/outfile.h). 0 or -1 with a message naming path and the reason. */
+ * (host/outfile.h). 0 or -1 with a message naming path and the reason. */
 int raybatch_write_hits(const char *path, const RayBatch *b, const BatchHit *hits, int binary, char *err,
                         size_t errlen);
 /* A ray that cannot be traced: a non-finite origin or direction, or a zero direction. */

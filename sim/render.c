@@ -5,7 +5,7 @@
  * renderer or the report's readers would need to know without reading the report.
  *
  * Outputs (docs/report.md): the folder is checked before any work and created only when there is
- * something to write; every file is staged under a temporary name (sim/outfile.c) and the set is
+ * something to write; every file is staged under a temporary name (host/outfile.c) and the set is
  * renamed into place only once all of them were written whole, so a failed run leaves no file of
  * its own under a final name and no mix with an older run's files.
  */
@@ -23,7 +23,7 @@
 #include "config.h"
 #include "heatmap.h"
 #include "img.h"
-#include "outfile.h"
+#include "../host/outfile.h"
 #include "reference.h"
 #include "report.h"
 #include "run/run.h"
@@ -207,7 +207,7 @@ static void image_figures(const float *rgb, size_t n, double *mean, long *nonfin
     *mean = n ? sum / (double)n : 0.0;
 }
 
-/* Report r's files into set, staged under temporary names (sim/outfile.h). 0, or -1 with a message. */
+/* Report r's files into set, staged under temporary names (host/outfile.h). 0, or -1 with a message. */
 static int stage_outputs(OutSet *set, const Report *r, char *err, size_t errlen)
 {
     const RenderOptions *o = r->o;

@@ -43,7 +43,7 @@ void render_default_options(RenderOptions *o);
  * kernel on functional cores, sim/functional.c). 0, or -1 with a message naming the file or
  * the setting at fault; -2 when the simulated program failed (trap, instruction limit); -3 when
  * an output could not be written (the folder checked before any work, a full disk, ...). Outputs
- * are written whole or not at all (sim/outfile.h): after a failure no file of this run is left
+ * are written whole or not at all (host/outfile.h): after a failure no file of this run is left
  * under a final name, except a kernel failure's frame.partial.exr and "failed" report.json. */
 int render_run(const RenderOptions *o, char *err, size_t errlen);
 

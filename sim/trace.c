@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "outfile.h"
+#include "../host/outfile.h"
 #include "run/run.h"
 
 int trace_run(const TraceOptions *o, TraceSummary *sum, char *err, size_t errlen)

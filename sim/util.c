@@ -15,6 +15,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "../host/infile.h"
+
 double util_now(void)
 {
     struct timespec ts;
@@ -68,32 +70,10 @@ int util_mkdir_p(const char *path, char *err, size_t errlen)
 
 char *util_file_read(const char *path, size_t *len, char *err, size_t errlen)
 {
-    FILE *f = fopen(path, "rbe");
-    if (!f) {
-        snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+    char *text;
+    if (infile_read(path, UTIL_FILE_MAX_BYTES, "a file sfsim reads back", &text, len, err, errlen) != 0)
         return NULL;
-    }
-    UtilBuf b = {0};
-    char chunk[65536];
-    size_t n;
-    while ((n = fread(chunk, 1, sizeof chunk, f)) > 0)
-        util_buf_add(&b, chunk, n);
-    int bad = ferror(f);
-    fclose(f);
-    if (bad) {
-        snprintf(err, errlen, "%s: cannot read: %s", path, strerror(errno));
-        util_buf_free(&b);
-        return NULL;
-    }
-    if (!b.s)
-        util_buf_add(&b, "", 0);
-    if (b.failed) {
-        snprintf(err, errlen, "%s: out of memory", path);
-        util_buf_free(&b);
-        return NULL;
-    }
-    *len = b.len;
-    return b.s;
+    return text;
 }
 
 /* ---- the string buffer ----------------------------------------------------------------------- */

@@ -1,5 +1,5 @@
 /* sim/util.h -- small helpers every part of sfsim shares, written once: a monotonic clock, strict
- * integer parsing, mkdir -p, reading whole files (outputs are written by sim/outfile.c), and a growable string buffer.
+ * integer parsing, mkdir -p, reading whole files (outputs are written by host/outfile.c), and a growable string buffer.
  *
  * Owns: these helpers and nothing else. Must not: print, exit or abort (each returns 0 / -1 or
  * NULL with a message in err, or records a failure the caller checks), or know about any sfsim
@@ -22,7 +22,10 @@ int util_parse_int(const char *s, long long lo, long long hi, long long *out);
  * ("P: cannot create the folder: ...", "PATH: exists and is not a folder"). */
 int util_mkdir_p(const char *path, char *err, size_t errlen);
 
-/* The whole file, NUL-terminated (malloc'ed), its length in *len; NULL with the reason in err. */
+/* The whole file, NUL-terminated (malloc'ed), its length in *len; NULL with the reason in err. A
+ * regular file of at most UTIL_FILE_MAX_BYTES only (host/infile.h): the reports and records a
+ * sweep reads back. */
+#define UTIL_FILE_MAX_BYTES (256u << 20)
 char *util_file_read(const char *path, size_t *len, char *err, size_t errlen);
 
 /* A growable NUL-terminated string; {0} is empty. When memory runs out the buffer keeps what it

@@ -324,7 +324,7 @@ static int assemble(const char *path, const AsmDefine *defs, int nd, AsmObject *
     if (dm)
         fclose(dm);
     if (nerr)
-        snprintf(err, errlen, "kernel %s does not assemble (%d errors):\n%s", path, nerr, diag ? diag : "");
+        snprintf(err, errlen, "kernel %s does not assemble (%d error%s):\n%s", path, nerr, nerr == 1 ? "" : "s", diag ? diag : "");
     free(diag);
     return nerr ? -1 : 0;
 }

@@ -8,7 +8,7 @@
  * with a CSV name, expanded by sim/stats_csv.c; nor decide a point's state (folder.c reads its
  * markers).
  */
-#include "../outfile.h"
+#include "../../host/outfile.h"
 #include "sweep_int.h"
 
 #include <math.h>

@@ -6,7 +6,7 @@
  * K` with the defining arguments, paths absolute) and the next steps it prints. Must not: run
  * anything, or write into the point folders.
  */
-#include "../outfile.h"
+#include "../../host/outfile.h"
 #include "sweep_int.h"
 
 #include "../exitcodes.h"

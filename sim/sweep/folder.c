@@ -6,7 +6,7 @@
  * failed marker's log tail. Must not: decide which points run (plan.c), start processes
  * (runner.c), or read reports (csv.c).
  */
-#include "../outfile.h"
+#include "../../host/outfile.h"
 #include "sweep_int.h"
 
 #include <dirent.h>

@@ -5,14 +5,21 @@
  * charts against the point), their .gp and .dat files, titles, axis units and colours, and
  * running gnuplot (a missing or failing gnuplot is a warning), and the figure columns they draw,
  * found by their sweep.csv names once (sweep_plot_cols). Must not: read reports (csv.c gives the
- * rows), index a figure column by a number of its own, or change the exit status of a sweep.
+ * rows), index a figure column by a number of its own, or decide the exit status of a sweep (it
+ * says how many plots could not be drawn; sweep.c decides).
+ *
+ * Whole or not at all: gnuplot draws each PNG under a temporary name (".NAME.png.tmp-PID", given to
+ * the script as the variable sfsim_png, so that the .gp file still draws NAME.png when a user runs
+ * it by hand); the PNG is renamed into place only when gnuplot exited 0 and the file ends with
+ * PNG's IEND chunk. pngcairo does not report a failed write (a full disk, a file-size limit).
  */
-#include "../outfile.h"
+#include "../../host/outfile.h"
 #include "sweep_int.h"
 
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -184,13 +191,34 @@ static int groups_make(const Plotter *p, const char *xkey, int m0, int nm, Group
     return ng;
 }
 
-/* Run gnuplot on base.gp in the plots folder; its messages go to gnuplot.log. */
+/* 1 when the file at path is a whole PNG as far as its ends tell: the signature first and the
+ * IEND chunk (length 0, type, CRC AE 42 60 82) last. */
+static int png_whole(const char *path)
+{
+    static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    static const unsigned char iend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xAE, 0x42, 0x60, 0x82};
+    unsigned char head[8], tail[12];
+    int fd = open(path, O_RDONLY | O_CLOEXEC), ok = 0;
+    struct stat st;
+    if (fd < 0)
+        return 0;
+    if (fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size >= 20 && pread(fd, head, 8, 0) == 8 &&
+        pread(fd, tail, 12, st.st_size - 12) == 12)
+        ok = !memcmp(head, sig, 8) && !memcmp(tail, iend, 12) && fsync(fd) == 0;
+    return close(fd) == 0 && ok;
+}
+
+/* Run gnuplot on base.gp in the plots folder, drawing into a temporary PNG renamed into place once
+ * whole; its messages go to gnuplot.log. */
 static void gp_run(Plotter *p, const char *base)
 {
     if (p->gnuplot_missing)
         return;
     char *script = xasprintf("%s.gp", base);
     char *logpath = xasprintf("%s/gnuplot.log", p->dir);
+    char *tmpname = xasprintf(".%s.png.tmp-%ld", base, (long)getpid());
+    char *tmp = xasprintf("%s/%s", p->dir, tmpname), *png = xasprintf("%s/%s.png", p->dir, base);
+    char *var = xasprintf("sfsim_png='%s'", tmpname); /* base has no quote (plot names are ours) */
     int logfd = open(logpath, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
     if (logfd < 0) {
         fprintf(stderr, "sfsim sweep: warning: %s: cannot create: %s; no plots\n", logpath, strerror(errno));
@@ -198,11 +226,12 @@ static void gp_run(Plotter *p, const char *base)
         goto out;
     }
     dprintf(logfd, "== gnuplot %s\n", script);
+    int made_before = p->made;
     pid_t pid = fork();
     if (pid == 0) {
         if (chdir(p->dir) != 0 || dup2(logfd, 1) < 0 || dup2(logfd, 2) < 0)
             _exit(126);
-        execlp("gnuplot", "gnuplot", script, (char *)NULL);
+        execlp("gnuplot", "gnuplot", "-e", var, script, (char *)NULL);
         _exit(127);
     }
     close(logfd);
@@ -219,14 +248,29 @@ static void gp_run(Plotter *p, const char *base)
                         "written\n");
         p->gnuplot_missing = 1;
     } else if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) {
-        fprintf(stderr, "sfsim sweep: warning: gnuplot failed on %s/%s (see %s)\n", p->dir, script, logpath);
+        fprintf(stderr, "sfsim sweep: %s: gnuplot failed on %s (see %s); the plot was not drawn\n", png, script, logpath);
+        p->gnuplot_failed++;
+    } else if (!png_whole(tmp)) {
+        fprintf(stderr, "sfsim sweep: %s: gnuplot wrote an incomplete PNG (a full disk or a file-size limit?); the plot "
+                        "was not drawn\n", png);
+        p->gnuplot_failed++;
+    } else if (rename(tmp, png) != 0) {
+        fprintf(stderr, "sfsim sweep: %s: cannot rename into place: %s; the plot was not drawn\n", png, strerror(errno));
         p->gnuplot_failed++;
     } else {
         p->made++;
     }
+    /* A plot of an earlier merge must not stand beside this CSV as if drawn from it. */
+    if (p->made == made_before)
+        unlink(png);
 out:
+    unlink(tmp); /* nothing there once renamed */
     free(script);
     free(logpath);
+    free(tmpname);
+    free(tmp);
+    free(png);
+    free(var);
 }
 
 /* Write base.gp and base.dat, then draw base.png. */
@@ -257,8 +301,8 @@ static void gp_head(const Plotter *p, UtilBuf *g, const char *base, int w, int h
 {
     util_buf_printf(g, "# Written by sfsim sweep / sfsim merge from the points of this sweep; the data is in %s.dat.\n"
                        "# Restyle and redraw: cd into this folder, then gnuplot %s.gp\n", base, base);
-    util_buf_printf(g, "set terminal pngcairo size %d,%d noenhanced font \"sans,11\"\nset output \"%s.png\"\n", w, h,
-                    base);
+    util_buf_printf(g, "set terminal pngcairo size %d,%d noenhanced font \"sans,11\"\n"
+                       "set output (exists(\"sfsim_png\") ? sfsim_png : \"%s.png\")\n", w, h, base);
     util_buf_puts(g, "set datafile missing \"NaN\"\nset grid\n");
     UtilBuf t = {0};
     util_buf_printf(&t, "%s against %s", what, against);
@@ -697,6 +741,6 @@ int sweep_plots_make(const SweepPlan *pl, const SweepRow *rows, const char *dir,
             plot_bars(&p, kind); /* (kd_nodes_point: only when some point ran on a kd-tree) */
     free(p.subtitle);
     free(pdir);
-    *failed = p.gnuplot_failed || p.gnuplot_missing;
+    *failed = p.gnuplot_failed;
     return p.made;
 }

@@ -6,7 +6,7 @@
  * while points run. Must not: decide which points run (plan.c gives the list), or read the
  * points' reports (csv.c).
  */
-#include "../outfile.h"
+#include "../../host/outfile.h"
 #include "sweep_int.h"
 
 #include <errno.h>

@@ -158,7 +158,8 @@ static int args_parse(int argc, char **argv, SweepArgs *a)
     return 0;
 }
 
-/* sweep.csv and the plots; prints what was written. -1 when the CSV could not be written. */
+/* sweep.csv and the plots; prints what was written. -1 when the CSV or a plot could not be written
+ * (a missing gnuplot is only a warning: the CSV holds every figure). */
 static int outputs_write(const SweepPlan *pl, const char *dir, const char *cmd, int *ndone, int *nfailed,
                          int *nunfinished)
 {
@@ -171,7 +172,11 @@ static int outputs_write(const SweepPlan *pl, const char *dir, const char *cmd, 
     } else {
         int pfail;
         int made = sweep_plots_make(pl, rows, dir, &pfail);
-        fprintf(stderr, "%s: wrote %s and %d plot%s in %s/plots\n", cmd, csv, made, made == 1 ? "" : "s", dir);
+        fprintf(stderr, "%s: wrote %s and %d plot%s in %s/plots", cmd, csv, made, made == 1 ? "" : "s", dir);
+        if (pfail)
+            fprintf(stderr, "; %d plot%s could not be drawn", pfail, pfail == 1 ? "" : "s");
+        fprintf(stderr, "\n");
+        rc = pfail ? -1 : 0;
     }
     free(csv);
     sweep_rows_free(rows, pl->npoints);

@@ -273,8 +273,9 @@ typedef struct SweepPlotCols {
 } SweepPlotCols;
 /* 0, or -1 with the column that is missing or out of its group's order in err. */
 int sweep_plot_cols(SweepPlotCols *cols, char *err, size_t errlen);
-/* Every plot of the sweep into DIR/plots; returns how many were drawn, *failed when gnuplot is
- * missing or failed on one. */
+/* Every plot of the sweep into DIR/plots, each PNG whole or not at all; returns how many were
+ * drawn, and in *failed how many gnuplot could not draw whole (each said on stderr; a missing
+ * gnuplot is a warning and counts none). */
 int sweep_plots_make(const SweepPlan *pl, const SweepRow *rows, const char *dir, int *failed);
 /* DIR/sweep.slurm or DIR/sweep.parallel (a->emit), and what to run next on stdout. EXIT_OK or
  * EXIT_IO (said). */

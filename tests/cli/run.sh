@@ -471,13 +471,13 @@ run "$SFSIM" trace -s scenes/cornell/scene.ini
 want_rc 2; want_err "required"
 end
 
-# ---- outputs: written whole or not at all (sim/outfile.h, docs/report.md) --------------------
+# ---- outputs: written whole or not at all (host/outfile.h, docs/report.md) --------------------
 TINY=(--set render.width=32 --set render.height=32 --set render.spp=1 -j 2 --no-progress)
 TRAP=(--mode functional --kernel "$T/trap_kernel.s" -s scenes/cornell/scene.ini --set render.width=32 --set render.height=16
       --set stream.rays=1024 --set core.simd_width=4 --set stream.mode=packet --set render.spp=1 -j 1 --no-progress)
 RUN_OUTPUTS="frame.exr frame.png report.txt report.json cost.png frame.partial.exr"
 
-# no_temporaries DIR: no temporary file of sim/outfile.c anywhere under DIR.
+# no_temporaries DIR: no temporary file of host/outfile.c anywhere under DIR.
 no_temporaries() {
     local left
     left=$(find "$1" -name '.*.tmp-*' 2>/dev/null | head -3)

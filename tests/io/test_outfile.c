@@ -1,4 +1,4 @@
-/* tests/io/test_outfile.c -- output files written whole or not at all (sim/outfile.h): every
+/* tests/io/test_outfile.c -- output files written whole or not at all (host/outfile.h): every
  * operation that can fail on a full disk made to fail in turn (the fault hook, as SQLite tests
  * its I/O), for plain files, staged sets and images; the checks before work; the folders a run
  * makes and removes again. After each failure: the error names the file and says why, the final
@@ -17,7 +17,7 @@
 
 #include "../../sim/heatmap.h"
 #include "../../sim/img.h"
-#include "../../sim/outfile.h"
+#include "../../host/outfile.h"
 
 static char dir[64];
 
@@ -39,7 +39,7 @@ static void cleanup(void)
     rm_tree(dir);
 }
 
-/* Entries of folder d that are temporary files of sim/outfile.c. */
+/* Entries of folder d that are temporary files of host/outfile.c. */
 static int temporaries(const char *d)
 {
     DIR *h = opendir(d);

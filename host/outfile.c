@@ -1,4 +1,4 @@
-/* sim/outfile.c -- output files written whole or not at all (sim/outfile.h).
+/* host/outfile.c -- output files written whole or not at all (host/outfile.h).
  *
  * Owns: temporary names, checked writes, the one close, the rename into place, the folders a run
  * creates, the checks before work, and the fault hook SFSIM_FAIL_WRITE. Must not: know file
@@ -23,7 +23,6 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "util.h"
 
 enum { OUT_BUF = 1 << 16, OUT_PATH_MAX = 4096 };
 
@@ -39,9 +38,11 @@ static void fault_init(void)
     const char *s = getenv("SFSIM_FAIL_WRITE");
     if (!s || atomic_load(&fault_overridden))
         return;
-    long long k;
     /* A test hook: anything but a positive integer leaves it off. */
-    atomic_store(&fault_at, util_parse_int(s, 1, LONG_MAX, &k) == 0 ? (long)k : 0);
+    char *end;
+    errno = 0;
+    long k = *s >= '0' && *s <= '9' ? strtol(s, &end, 10) : 0;
+    atomic_store(&fault_at, k > 0 && !errno && !*end ? k : 0);
 }
 
 /* One operation that can fail on a full disk: -1 with errno = ENOSPC if it is the one to fail. */
@@ -84,6 +85,11 @@ static int fail(char *err, size_t errlen, const char *path, const char *what, in
 {
     snprintf(err, errlen, "%s: %s: %s", path, what, strerror(e));
     return -1;
+}
+
+void outfile_process_init(void)
+{
+    signal(SIGXFSZ, SIG_IGN);
 }
 
 /* The name rename(2) must replace: a symbolic link is followed (as fopen would), so that the file

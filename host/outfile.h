@@ -1,4 +1,4 @@
-/* sim/outfile.h -- output files written whole or not at all, and failures that name the file.
+/* host/outfile.h -- output files written whole or not at all, and failures that name the file.
  *
  * Owns: how every output of `sfsim run` and `sfsim trace` reaches the disk: a temporary name in
  * the final file's folder (".NAME.tmp-PID-N"), every write(2) checked, fsync, one checked close,
@@ -41,6 +41,12 @@ typedef struct OutFile {
 typedef struct OutSet OutSet;
 
 /* Create PATH's temporary file (PATH's folder must exist). */
+/* Once, at the start of every program that writes files (sfsim, sfasm): SIGXFSZ ignored, so that a
+ * write past a file-size limit (ulimit -f) fails with EFBIG, is reported naming the file, and its
+ * temporary is removed, instead of the signal killing the process and leaving the temporary
+ * behind. Programs it starts (gnuplot, the points of a sweep) inherit the setting. */
+void outfile_process_init(void);
+
 int outfile_open(OutFile *f, const char *path, char *err, size_t errlen);
 /* Append bytes (buffered; the buffer is written when full). */
 int outfile_write(OutFile *f, const void *data, size_t n, char *err, size_t errlen);
