@@ -5,6 +5,7 @@
  * Must not: assemble or format anything itself (asm/ does).
  */
 #include <errno.h>
+#include <getopt.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -32,16 +33,23 @@ static void usage(FILE *f)
             "\n"
             "Assembles sfsim assembly into an object (.sfo), or disassembles an object to stdout.\n"
             "\n"
-            "options:\n"
-            "  -o OUT          output object (default: the input with .sfo instead of .s)\n"
-            "  -D NAME[=VAL]   define symbol NAME (VAL an integer, default 1)\n"
-            "  -I DIR          search DIR for .include files (after the including file's directory)\n"
-            "  -d FILE.sfo     disassemble FILE.sfo to stdout\n"
-            "  --source        with -d: add each instruction's file:line as a comment\n"
-            "  --help          this text\n"
-            "  --version       the version\n"
+            "options (a value as -o OUT, -oOUT, --output OUT or --output=OUT; options and the file in any\n"
+            "order; -- ends the options):\n"
+            "  -o, --output OUT           output object (default: the input with .sfo instead of .s); written\n"
+            "                             whole or not at all: a full disk keeps the object that was there\n"
+            "  -D, --define NAME[=VAL]    define symbol NAME (VAL an integer, default 1)\n"
+            "  -I, --include-dir DIR      search DIR for .include files (after the including file's directory)\n"
+            "  -d, --disassemble FILE.sfo disassemble FILE.sfo to stdout\n"
+            "  --source                   with -d: add each instruction's file:line as a comment\n"
+            "  -h, --help                 this text\n"
+            "  --version                  the version (the same as sfsim's) and the object format's\n"
             "\n"
             "At most 50 errors are printed (in source order), then how many more there were.\n"
+            "\n"
+            "examples:\n"
+            "  sfasm prog.s                                   writes prog.sfo\n"
+            "  sfasm kernels/pathtrace.s -I kernels/lib -I kernels -DRAYS=4096 -D SPAD_BYTES=65536 -o k.sfo\n"
+            "  sfasm -d k.sfo --source | less                 the disassembly, each line with its source line\n"
             "\n"
             "exit codes (shared by sfsim; sfasm returns 0, 1, 2 or 4; docs/exit-codes.md):\n");
     exithelp_print(f);
@@ -78,53 +86,56 @@ static int parse_define(Args *a, char *spec)
     return 0;
 }
 
-/* Value of an option given as "-X VALUE" or "-XVALUE"; NULL if missing. */
-static char *opt_value(int argc, char **argv, int *i)
+enum { A_SOURCE = 0x100, A_VERSION };
+static const struct option longs[] = {
+    {"output", required_argument, NULL, 'o'},      {"define", required_argument, NULL, 'D'},
+    {"include-dir", required_argument, NULL, 'I'}, {"disassemble", required_argument, NULL, 'd'},
+    {"source", no_argument, NULL, A_SOURCE},       {"help", no_argument, NULL, 'h'},
+    {"version", no_argument, NULL, A_VERSION},     {NULL, 0, NULL, 0}};
+
+/* getopt_long's (glibc) error for the argument it just looked at. */
+static int option_error(int code, int argc, char **argv)
 {
-    if (argv[*i][2] != '\0')
-        return argv[*i] + 2;
-    if (*i + 1 >= argc)
-        return NULL;
-    return argv[++*i];
+    const char *w = optind - 1 >= 1 && optind - 1 < argc ? argv[optind - 1] : "?";
+    if (code == ':')
+        return usage_error("option '%s' needs a value", w);
+    if (strncmp(w, "--", 2) != 0)
+        return usage_error("unknown option '-%c'", optopt ? optopt : '?');
+    if (optopt && strchr(w, '='))
+        return usage_error("option '%.*s' takes no value", (int)(strchr(w, '=') - w), w);
+    return usage_error("unknown or ambiguous option '%s'", w);
 }
 
+/* 0 to go on, -1 when --help or --version was printed, or EXIT_USAGE (said). */
 static int parse_args(int argc, char **argv, Args *a)
 {
     a->defines = calloc((size_t)argc, sizeof *a->defines);
     a->include_dirs = calloc((size_t)argc, sizeof *a->include_dirs);
     if (!a->defines || !a->include_dirs)
         return usage_error("out of memory");
-    for (int i = 1; i < argc; i++) {
-        char *arg = argv[i], *val;
-        if (strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0) {
-            usage(stdout);
-            return -1;
-        }
-        if (strcmp(arg, "--version") == 0) {
+    opterr = 0;
+    int code;
+    while ((code = getopt_long(argc, argv, ":o:D:I:d:h", longs, NULL)) != -1) {
+        switch (code) {
+        case 'h': usage(stdout); return -1;
+        case A_VERSION:
             printf("sfasm %s (commit %s, object format version %u)\n", version_string(), version_commit(), ASM_OBJ_VERSION);
             return -1;
-        }
-        if (strcmp(arg, "--source") == 0) {
-            a->source = 1;
-        } else if (arg[0] == '-' && (arg[1] == 'D' || arg[1] == 'I' || arg[1] == 'o' || arg[1] == 'd') &&
-                   (arg[2] == '\0' || arg[1] == 'D' || arg[1] == 'I')) {
-            if (!(val = opt_value(argc, argv, &i)))
-                return usage_error("option %s needs a value", arg);
-            if (arg[1] == 'D' && parse_define(a, val) != 0)
+        case A_SOURCE: a->source = 1; break;
+        case 'D':
+            if (parse_define(a, optarg) != 0)
                 return EXIT_USAGE;
-            if (arg[1] == 'I')
-                a->include_dirs[a->ninclude_dirs++] = val;
-            if (arg[1] == 'o')
-                a->output = val;
-            if (arg[1] == 'd')
-                a->disasm = val;
-        } else if (arg[0] == '-' && arg[1] != '\0') {
-            return usage_error("unknown option '%s'", arg);
-        } else if (a->input) {
-            return usage_error("more than one input file ('%s')", arg);
-        } else {
-            a->input = arg;
+            break;
+        case 'I': a->include_dirs[a->ninclude_dirs++] = optarg; break;
+        case 'o': a->output = optarg; break;
+        case 'd': a->disasm = optarg; break;
+        default: return option_error(code, argc, argv);
         }
+    }
+    for (int i = optind; i < argc; i++) {
+        if (a->input)
+            return usage_error("more than one input file ('%s')", argv[i]);
+        a->input = argv[i];
     }
     if (a->disasm && (a->input || a->output))
         return usage_error("-d takes only an object file");

@@ -1,9 +1,11 @@
-/* sim/main.c -- the `sfsim` command line.
+/* sim/main.c -- the `sfsim` command line: which command runs, and the commands run, trace,
+ * config and compare (exec is sim/cli/exec.c; sweep and merge sim/sweep/sweep.c).
  *
- * Owns: argument parsing, exit codes and what is printed. Must not: simulate (it calls the
- * core, the config and the renderers). Exit codes: the EXIT_* of sim/exitcodes.def, nothing
- * else; an option value out of range is bad input (EXIT_INPUT), an unknown option or a missing
- * argument a usage error (EXIT_USAGE).
+ * Owns: each command's options (a getopt_long table each, parsed by sim/cli/opts.c), the one check
+ * of how they go together, what is printed, and the exit code. Must not: simulate (it calls the
+ * config, the renderers and trace). Exit codes: the EXIT_* of sim/exitcodes.def, nothing else; an
+ * option value out of range is bad input (EXIT_INPUT), an unknown option, a missing argument or
+ * options that do not go together a usage error (EXIT_USAGE).
  */
 #include <errno.h>
 #include <math.h>
@@ -12,530 +14,146 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "../asm/object.h"
 #include "../host/outfile.h"
 #include "../host/version.h"
+#include "cli/exec.h"
+#include "cli/help.h"
+#include "cli/opts.h"
 #include "config.h"
-#include "core.h"
 #include "datadir.h"
 #include "exitcodes.h"
-#include "exithelp.h"
 #include "img.h"
 #include "imglib.h"
 #include "render.h"
-#include "run/timedcore.h"
-#include "stats.h"
+#include "run/run.h"
 #include "sweep/sweep.h"
-#include "timing.h"
 #include "trace.h"
 #include "util.h"
 
-static void usage(FILE *out)
-{
-    fprintf(out,
-            "usage: sfsim <command> [options]\n"
-            "\n"
-            "sfsim simulates a stream-filtering ray tracing processor (Gribble & Ramani 2008).\n"
-            "\n"
-            "commands:\n"
-            "  run      render a scene: --mode detailed (default: the kernel on the timed machine),\n"
-            "           functional (the kernel, no timing) or reference (the golden model)\n"
-            "  exec     run an assembled program (.sfo) on the functional core; print registers\n"
-            "           and counters\n"
-            "  config   list the machine-config keys (--dump) or write their reference (--markdown)\n"
-            "  compare  compare two images: RMSE, PSNR, largest difference, NaN/Inf counts\n"
-            "  trace    closest-hit / any-hit queries for a file of rays, through the kernel or the golden model\n"
-            "  sweep    run a scene over many machine configs in parallel (sweep files, resumable; CSV, plots)\n"
-            "  merge    build a sweep's CSV and plots from its point folders (after Slurm or GNU parallel)\n"
-            "  help     help on a command (sfsim help exec), or on the exit codes (sfsim help exit-codes)\n"
-            "\n"
-            "options everywhere: --help, --version\n"
-            "\n"
-            "exit codes (every command; docs/exit-codes.md):\n");
-    exithelp_print(out);
-    fprintf(out, "\ndocumentation: docs/README.md\n");
-}
+/* ---- config ------------------------------------------------------------------------------------ */
 
-static void usage_help(FILE *out)
-{
-    fprintf(out,
-            "usage: sfsim help [COMMAND | exit-codes]\n"
-            "\n"
-            "Prints the help of COMMAND (run, exec, config, compare, trace, sweep, merge, help), the exit\n"
-            "codes every command returns (exit-codes), or without an argument the list of commands.\n"
-            "`sfsim COMMAND --help` prints the same as `sfsim help COMMAND`.\n");
-}
-
-static void usage_exit_codes(FILE *out)
-{
-    fprintf(out,
-            "Exit codes of every sfsim and sfasm command (sim/exitcodes.def; docs/exit-codes.md):\n"
-            "\n");
-    exithelp_print(out);
-}
-
-static void usage_exec(FILE *out)
-{
-    fprintf(out,
-            "usage: sfsim exec PROG.sfo [options]\n"
-            "\n"
-            "Runs an object produced by sfasm on the functional core until halt, a trap, or the\n"
-            "instruction limit, then prints the scalar registers, the non-zero vector lanes, the\n"
-            "masks and the counters per stage (instructions, operations by category, SIMD\n"
-            "utilization = active lanes / (N x vector instructions)). With --timing the timing model\n"
-            "runs beside it and the cycles are printed too: total, busy, stalls by cause, per stage,\n"
-            "and the units' counters (docs/model.md).\n"
-            "\n"
-            "options:\n"
-            "  -c, --config FILE        machine config (default: the built-in streamray machine)\n"
-            "  --set SECTION.KEY=VALUE  override a config key (repeatable)\n"
-            "  --width N                SIMD width, same as --set core.simd_width=N\n"
-            "  --max-instructions N     instruction limit, same as --set sim.max_instructions=N\n"
-            "  --dump-mem MEM:ADDR:WORDS  print WORDS words of MEM (rb0 rb1 idm spad scene fb) from\n"
-            "                           byte address ADDR (a multiple of 4) after the run (repeatable)\n"
-            "  -t, --timing             time the run on the machine of the config (detailed mode)\n"
-            "  -q, --quiet              print only the summary line (and the timing, with --timing)\n"
-            "  --no-progress            no progress line: a run still going after 2 s otherwise says on\n"
-            "                           stderr, every 5 s, how many instructions it ran of the limit\n"
-            "\n"
-            "The --dump-mem specs are checked against the config's memory sizes before the program runs.\n"
-            "Exit codes: 0 halted, 1 bad input (config, object, --dump-mem spec), 2 usage, 3 trap or the\n"
-            "instruction limit (sfsim help exit-codes).\n");
-}
-
-static void usage_config(FILE *out)
-{
-    fprintf(out,
-            "usage: sfsim config (--dump | --markdown) [-c FILE] [--set SECTION.KEY=VALUE]...\n"
-            "\n"
-            "  --dump       every key with its value, type, default, range and help\n"
-            "  --markdown   the key reference as Markdown (docs/config.md is this output)\n");
-}
-
-static void usage_run(FILE *out)
-{
-    fprintf(out,
-            "usage: sfsim run [-s SCENE] [-o DIR] [-c CONFIG] [--mode detailed|sampled|functional|reference] [options]\n"
-            "\n"
-            "Renders SCENE (a .gltf/.glb file or a scene.ini) and writes DIR/frame.exr (linear),\n"
-            "DIR/frame.png (tone-mapped sRGB), DIR/report.json and DIR/report.txt, and in detailed\n"
-            "mode DIR/cost.png (simulated cycles per pixel, per tile). docs/report.md lists the fields.\n"
-            "\n"
-            "modes:\n"
-            "  detailed    (default) the path-tracing kernel (kernels/pathtrace.s) on the functional core\n"
-            "              with the cycle-accurate timing model of the machine in CONFIG: cycles, fps,\n"
-            "              stalls by cause, per stage, generation and tile, the units' counters\n"
-            "              (docs/model.md); the same image bits as functional mode\n"
-            "  sampled     the golden model renders the image (the same bits) and counts every (tile, pass)\n"
-            "              unit's work; a seeded random sample of the units runs on the timed kernel and the\n"
-            "              rest are skipped; cycles, instructions and fps estimated with 95%% confidence\n"
-            "              intervals (docs/sampling.md): by default until the cycles are known to +-1%%\n"
-            "  functional  the kernel executed instruction by instruction, no timing (fastest\n"
-            "              simulation): operation mix, SIMD utilization and stream lengths per stage\n"
-            "  reference   the golden model: a plain C path tracer over the packed scene memory\n"
-            "\n"
-            "options:\n"
-            "  -s, --scene FILE         scene (default: the shipped Cornell box, scenes/cornell/scene.ini\n"
-            "                           in sfsim's data folder, found beside the binary: docs/install.md)\n"
-            "  -o, --out DIR            output folder (default: out): checked before any work, made when the\n"
-            "                           outputs are written, each file whole or not at all (exit 4 if not;\n"
-            "                           docs/report.md)\n"
-            "  -c, --config FILE        machine config (stream.rays sets the tile: sqrt(M) pixels)\n"
-            "  --set SECTION.KEY=VALUE  override a config key, or render.width, render.height,\n"
-            "                           render.spp, render.max_depth, render.seed\n"
-            "  -j, --threads N          host threads (default: all cores; results do not change)\n"
-            "  --exposure X             scale before tone mapping frame.png (default 1)\n"
-            "  --no-progress            no progress bar (it is shown only on a terminal anyway)\n"
-            "  --target-error E         sampled mode: time units until the 95%% interval of the cycles is\n"
-            "                           within +-E (a fraction: 0.01 = 1%%, the default), or every unit\n"
-            "  --sample F               sampled mode: time a fixed fraction F of the units, (0, 1], instead\n"
-            "  --sample-seed S          sampled mode: which units (default 1)\n"
-            "  --no-image               sampled mode: no image; the golden model runs only a pilot pass per\n"
-            "                           tile for the units' counts (the estimate alone, fastest)\n"
-            "  --kernel FILE            kernel modes: the kernel source (default:\n"
-            "                           kernels/pathtrace.s in the data folder, or $SFSIM_KERNEL)\n");
-}
-
-/* Config from -c/--set options, collected by the commands that take them. */
-typedef struct ConfigArgs {
-    const char *path;
-    const char *sets[256];
-    int nsets;
-} ConfigArgs;
-
-static int build_config(const ConfigArgs *a, CfgMachine *cfg)
-{
-    CfgErrors errs = {0};
-    cfg_defaults(cfg);
-    if (a->path)
-        cfg_load(cfg, a->path, &errs);
-    for (int i = 0; i < a->nsets; i++)
-        cfg_set(cfg, a->sets[i], &errs);
-    if (!errs.count)
-        cfg_check(cfg, &errs);
-    if (errs.count) {
-        fprintf(stderr, "%s", errs.text);
-        fprintf(stderr, "sfsim: %d configuration error%s\n", errs.count, errs.count == 1 ? "" : "s");
-    }
-    int n = errs.count;
-    cfg_errors_free(&errs);
-    return n ? -1 : 0;
-}
-
-static int add_set(ConfigArgs *a, const char *s)
-{
-    if (a->nsets >= (int)(sizeof a->sets / sizeof a->sets[0])) {
-        fprintf(stderr, "sfsim: too many --set options (at most %zu)\n", sizeof a->sets / sizeof a->sets[0]);
-        return -1;
-    }
-    a->sets[a->nsets++] = s;
-    return 0;
-}
-
-static void print_float_of(uint32_t u, char *buf, size_t len)
-{
-    float f;
-    memcpy(&f, &u, 4);
-    snprintf(buf, len, "%.9g", (double)f);
-}
-
-/* One --dump-mem MEM:ADDR:WORDS, checked against the configured memory sizes before the program
- * runs (a typo must not cost a long run). */
-typedef struct MemDump {
-    const char *spec;
-    CoreMem mem;
-    uint32_t addr, words;
-} MemDump;
-
-/* A number of a --dump-mem spec: decimal, 0x hex or 0 octal, nothing else after it but `stop`. */
-static int dump_number(const char *s, char stop, unsigned long long *out, const char **rest)
-{
-    char *end;
-    errno = 0;
-    if (*s == '-' || *s == '+' || *s == ' ')
-        return -1;
-    unsigned long long v = strtoull(s, &end, 0);
-    if (end == s || errno || *end != stop)
-        return -1;
-    *out = v;
-    *rest = end;
-    return 0;
-}
-
-static int dump_parse(const char *spec, const CoreParams *cp, MemDump *d)
-{
-    const char *colon = strchr(spec, ':'), *rest;
-    unsigned long long addr, words;
-    if (!colon || dump_number(colon + 1, ':', &addr, &rest) || dump_number(rest + 1, '\0', &words, &rest)) {
-        fprintf(stderr, "sfsim exec: --dump-mem %s: expected MEM:ADDR:WORDS, e.g. spad:0x40:8 (sfsim help exec)\n",
-                spec);
-        return -1;
-    }
-    int m = -1;
-    for (int i = 0; i < CORE_MEM_COUNT; i++)
-        if (strlen(core_mem_names[i]) == (size_t)(colon - spec) && !strncmp(spec, core_mem_names[i], (size_t)(colon - spec)))
-            m = i;
-    if (m < 0) {
-        fprintf(stderr, "sfsim exec: --dump-mem %s: unknown memory '%.*s' (rb0 rb1 idm spad scene fb)\n", spec,
-                (int)(colon - spec), spec);
-        return -1;
-    }
-    uint64_t size = cp->mem_bytes[m];
-    if (addr % 4) {
-        fprintf(stderr, "sfsim exec: --dump-mem %s: address 0x%llx is not a multiple of 4 (words are 4 bytes)\n",
-                spec, addr);
-        return -1;
-    }
-    if (addr > size || words > (size - addr) / 4) {
-        fprintf(stderr, "sfsim exec: --dump-mem %s: %llu word%s from 0x%llx end%s beyond %s (%llu bytes in this config)\n",
-                spec, words, words == 1 ? "" : "s", addr, words == 1 ? "s" : "", core_mem_names[m],
-                (unsigned long long)size);
-        return -1;
-    }
-    *d = (MemDump){spec, (CoreMem)m, (uint32_t)addr, (uint32_t)words};
-    return 0;
-}
-
-static void dump_print(Core *c, const MemDump *d)
-{
-    uint32_t size;
-    uint8_t *mem = core_mem(c, d->mem, &size);
-    printf("%s from 0x%08x:\n", core_mem_names[d->mem], d->addr);
-    for (uint32_t i = 0; i < d->words && d->addr + 4ull * i + 4 <= size; i++) {
-        uint32_t w;
-        memcpy(&w, mem + d->addr + 4 * i, 4);
-        char f[32];
-        print_float_of(w, f, sizeof f);
-        printf("  [0x%08x] 0x%08x %11d  %s\n", d->addr + 4 * i, w, (int32_t)w, f);
-    }
-}
-
-/* Run to halt, trap or the instruction limit in slices, so that a long run can say how far it is:
- * after `after` seconds (SFSIM_PROGRESS_AFTER, default 2; 0 reports after every slice) and then
- * every 5 s, one line on stderr. stdout is the same with or without it. */
-static CoreExit run_with_progress(Core *c, uint64_t limit, int progress)
-{
-    enum { SLICE = 1 << 20 };
-    double after = 2.0;
-    const char *env = getenv("SFSIM_PROGRESS_AFTER");
-    if (env && *env) {
-        char *end;
-        double v = strtod(env, &end);
-        if (!*end && v >= 0.0 && isfinite(v))
-            after = v;
-    }
-    double t0 = util_now(), next = t0 + after;
-    uint64_t done = 0;
-    for (;;) {
-        uint64_t slice = limit - done < SLICE ? limit - done : SLICE;
-        CoreExit ex = core_run_slice(c, slice, limit);
-        done += slice;
-        if (ex != CORE_EXIT_LIMIT || done >= limit)
-            return ex;
-        double t = util_now();
-        if (progress && t >= next) {
-            uint64_t n = core_instructions(c);
-            fprintf(stderr, "sfsim exec: still running after %.0f s: %llu instructions of the limit %llu "
-                    "(sim.max_instructions; --max-instructions N sets it)\n", t - t0, (unsigned long long)n,
-                    (unsigned long long)limit);
-            next = t + (after > 0.0 ? 5.0 : 0.0);
-        }
-    }
-}
-
-static void print_state(Core *c)
-{
-    int n = core_lanes(c);
-    printf("scalar registers:\n");
-    for (int r = 0; r < ISA_NUM_SREGS; r++) {
-        uint32_t v = core_sreg(c, r);
-        if (!v)
-            continue;
-        char f[32];
-        print_float_of(v, f, sizeof f);
-        printf("  r%-2d = 0x%08x %11d  float %s\n", r, v, (int32_t)v, f);
-    }
-    printf("vector registers (lanes 0..%d; registers with every lane 0 left out):\n", n - 1);
-    for (int v = 0; v < ISA_NUM_VREGS; v++) {
-        int any = 0;
-        for (int l = 0; l < n; l++)
-            any |= core_vreg(c, v, l) != 0;
-        if (!any)
-            continue;
-        printf("  v%-2d =", v);
-        for (int l = 0; l < n; l++)
-            printf("%s%x", l ? " " : " ", core_vreg(c, v, l));
-        printf("\n");
-    }
-    printf("masks (lane 0 first):\n");
-    for (int m = 0; m < ISA_NUM_MREGS; m++) {
-        printf("  m%d = ", m);
-        uint64_t x = core_mreg(c, m);
-        for (int l = 0; l < n; l++)
-            putchar((x >> l) & 1 ? '1' : '0');
-        putchar('\n');
-    }
-    const CoreStats *st = core_stats(c);
-    printf("counters per stage:\n  %-13s %12s %12s %6s", "stage", "instructions", "vector", "util");
-    for (int k = 0; k < ISA_C_COUNT; k++)
-        printf(" %14s", isa_category_keys[k]);
-    printf("\n");
-    for (int s = 0; s < ISA_STAGE_COUNT; s++) {
-        if (!st->instructions[s])
-            continue;
-        double util = stats_utilization(st, n, s);
-        printf("  %-13s %12llu %12llu %5.1f%%", isa_stage_keys[s], (unsigned long long)st->instructions[s],
-               (unsigned long long)st->vec_instructions[s], 100.0 * util);
-        for (int k = 0; k < ISA_C_COUNT; k++)
-            printf(" %14llu", (unsigned long long)st->ops[s][k]);
-        printf("\n");
-    }
-}
-
-/* The timing of one `exec --timing` run (or a detailed trace) from the statistics registry
- * (sim/stats.def); non-zero when the model failed its own check. */
-static int print_timing(const TimingStats *s, const CfgMachine *cfg, const char *model_err)
-{
-    StatsCtx sx = {.mode = STATS_M_EXEC, .cfg = cfg, .t = s};
-    stats_print_exec(stdout, &sx);
-    char err[256];
-    if (model_err || timing_check(s, err, sizeof err)) {
-        fprintf(stderr, "sfsim exec: %s\n", model_err ? model_err : err);
-        return -1;
-    }
-    return 0;
-}
-
-static int cmd_exec(int argc, char **argv)
-{
-    ConfigArgs ca = {0};
-    const char *prog = NULL, *dumps[64];
-    int ndumps = 0, quiet = 0, timed = 0, progress = 1;
-    char setbuf[2][64];
-    for (int i = 0; i < argc; i++) {
-        const char *a = argv[i];
-        int has_next = i + 1 < argc;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            usage_exec(stdout);
-            return EXIT_OK;
-        } else if ((!strcmp(a, "-c") || !strcmp(a, "--config")) && has_next) {
-            ca.path = argv[++i];
-        } else if (!strcmp(a, "--set") && has_next) {
-            if (add_set(&ca, argv[++i]))
-                return EXIT_USAGE;
-        } else if (!strcmp(a, "--width") && has_next) {
-            snprintf(setbuf[0], sizeof setbuf[0], "core.simd_width=%s", argv[++i]);
-            if (add_set(&ca, setbuf[0]))
-                return EXIT_USAGE;
-        } else if (!strcmp(a, "--max-instructions") && has_next) {
-            snprintf(setbuf[1], sizeof setbuf[1], "sim.max_instructions=%s", argv[++i]);
-            if (add_set(&ca, setbuf[1]))
-                return EXIT_USAGE;
-        } else if (!strcmp(a, "--dump-mem") && has_next) {
-            if (ndumps >= 64) {
-                fprintf(stderr, "sfsim exec: at most 64 --dump-mem options\n");
-                return EXIT_USAGE;
-            }
-            dumps[ndumps++] = argv[++i];
-        } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
-            quiet = 1;
-        } else if (!strcmp(a, "-t") || !strcmp(a, "--timing")) {
-            timed = 1;
-        } else if (!strcmp(a, "--no-progress")) {
-            progress = 0;
-        } else if (a[0] == '-') {
-            fprintf(stderr, "sfsim exec: unknown option or missing value: %s (sfsim help exec)\n", a);
-            return EXIT_USAGE;
-        } else if (!prog) {
-            prog = a;
-        } else {
-            fprintf(stderr, "sfsim exec: more than one program: %s and %s\n", prog, a);
-            return EXIT_USAGE;
-        }
-    }
-    if (!prog) {
-        fprintf(stderr, "sfsim exec: no program given (sfsim help exec)\n");
-        return EXIT_USAGE;
-    }
-    CfgMachine cfg;
-    if (build_config(&ca, &cfg))
-        return EXIT_INPUT;
-    CoreParams cp;
-    cfg_core_params(&cfg, &cp);
-    MemDump dd[64];
-    for (int i = 0; i < ndumps; i++)
-        if (dump_parse(dumps[i], &cp, &dd[i]))
-            return EXIT_INPUT;
-    AsmObject obj;
-    char err[1024];
-    if (asm_object_read(prog, &obj, err, sizeof err) != 0) {
-        fprintf(stderr, "sfsim exec: %s\n", err);
-        return EXIT_INPUT;
-    }
-    TimedCore tc;
-    int orc = timedcore_open(&tc, &cfg, &obj, timed, err, sizeof err);
-    if (orc != 0) {
-        if (orc == -2)
-            fprintf(stderr, "sfsim exec: %s\n", err);
-        else
-            fprintf(stderr, "sfsim exec: %s: %s\n", prog, err);
-        asm_object_free(&obj);
-        return EXIT_INPUT;
-    }
-    Core *c = tc.core;
-    Timing *tm = tc.tm;
-    double t0 = util_now();
-    CoreExit ex = run_with_progress(c, (uint64_t)cfg.sim_max_instructions, progress);
-    double secs = util_now() - t0;
-    if (tm)
-        timing_end(tm);
-    uint64_t ni = core_instructions(c);
-    printf("sfsim exec: %s on N = %d lanes: %s after %llu instructions (%.3f s, %.1f M instructions/s)\n", prog,
-           core_lanes(c), ex == CORE_EXIT_HALT ? "halted" : ex == CORE_EXIT_TRAP ? "trapped" : "stopped at the limit",
-           (unsigned long long)ni, secs, secs > 0 ? 1e-6 * (double)ni / secs : 0.0);
-    int rc = EXIT_OK;
-    if (!quiet)
-        print_state(c);
-    for (int i = 0; i < ndumps; i++)
-        dump_print(c, &dd[i]);
-    if (tm) {
-        if (print_timing(timing_stats(tm), &cfg, timing_error(tm)))
-            rc = EXIT_PROGRAM;
-    }
-    if (ex == CORE_EXIT_LIMIT) {
-        fprintf(stderr, "sfsim exec: %s\n", core_trap_message(c));
-        rc = EXIT_PROGRAM;
-    } else if (ex != CORE_EXIT_HALT) {
-        fprintf(stderr, "sfsim exec: %s\n", core_trap_message(c));
-        rc = EXIT_PROGRAM;
-    }
-    timedcore_close(&tc);
-    asm_object_free(&obj);
-    return rc;
-}
+enum { C_DUMP = CLI_LONG, C_MARKDOWN, C_SET };
+static const struct option config_longs[] = {
+    {"dump", no_argument, NULL, C_DUMP},        {"markdown", no_argument, NULL, C_MARKDOWN},
+    {"config", required_argument, NULL, 'c'},   {"set", required_argument, NULL, C_SET},
+    {"help", no_argument, NULL, CLI_HELP},      {"version", no_argument, NULL, CLI_VERSION},
+    {NULL, 0, NULL, 0}};
 
 static int cmd_config(int argc, char **argv)
 {
-    ConfigArgs ca = {0};
-    int dump = 0, markdown = 0;
-    for (int i = 0; i < argc; i++) {
-        const char *a = argv[i];
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            usage_config(stdout);
-            return EXIT_OK;
-        } else if (!strcmp(a, "--dump")) {
-            dump = 1;
-        } else if (!strcmp(a, "--markdown")) {
-            markdown = 1;
-        } else if ((!strcmp(a, "-c") || !strcmp(a, "--config")) && i + 1 < argc) {
-            ca.path = argv[++i];
-        } else if (!strcmp(a, "--set") && i + 1 < argc) {
-            if (add_set(&ca, argv[++i]))
-                return EXIT_USAGE;
-        } else {
-            fprintf(stderr, "sfsim config: unknown option or missing value: %s (sfsim help config)\n", a);
-            return EXIT_USAGE;
+    CliParse p = {"sfsim config", "config", config_longs, "c:h", argc, argv, 0};
+    CliConfig ca = {0};
+    int dump = 0, markdown = 0, code, rc = EXIT_USAGE;
+    const char *v;
+    while ((code = cli_next(&p, &v)) > 0) {
+        if (cli_common(&p, code, help_config)) {
+            rc = EXIT_OK;
+            goto out;
         }
+        if (code == C_DUMP)
+            dump = 1;
+        else if (code == C_MARKDOWN)
+            markdown = 1;
+        else if (code == 'c')
+            ca.path = v;
+        else if (code == C_SET && cli_config_set(&ca, v))
+            goto out;
+    }
+    if (code < 0)
+        goto out;
+    if (cli_first_operand() < argc) {
+        fprintf(stderr, "sfsim config: unexpected argument '%s' (sfsim help config)\n", argv[cli_first_operand()]);
+        goto out;
     }
     if (dump == markdown) {
-        usage_config(stderr);
-        return EXIT_USAGE;
+        fprintf(stderr, "sfsim config: give one of --dump and --markdown (sfsim help config)\n");
+        goto out;
     }
+    rc = EXIT_OK;
     if (markdown) {
         cfg_markdown(stdout);
-        return EXIT_OK;
+    } else {
+        CfgMachine cfg;
+        if (cli_config_build(&ca, &cfg))
+            rc = EXIT_INPUT;
+        else
+            cfg_dump(&cfg, stdout);
     }
-    CfgMachine cfg;
-    if (build_config(&ca, &cfg))
-        return EXIT_INPUT;
-    cfg_dump(&cfg, stdout);
-    return EXIT_OK;
+out:
+    cli_config_free(&ca);
+    return rc;
 }
 
-static void usage_compare(FILE *out)
+/* ---- compare ----------------------------------------------------------------------------------- */
+
+enum { K_MAX_RMSE = CLI_LONG, K_MIN_PSNR, K_MAX_DIFF };
+static const struct option compare_longs[] = {
+    {"max-rmse", required_argument, NULL, K_MAX_RMSE}, {"min-psnr", required_argument, NULL, K_MIN_PSNR},
+    {"max-diff", required_argument, NULL, K_MAX_DIFF}, {"help", no_argument, NULL, CLI_HELP},
+    {"version", no_argument, NULL, CLI_VERSION},       {NULL, 0, NULL, 0}};
+
+/* A threshold's value: a finite number (a PSNR may be negative; the others are >= 0). */
+static int threshold(const char *opt, const char *s, int signed_ok, double *out)
 {
-    fprintf(out,
-            "usage: sfsim compare A B\n"
-            "\n"
-            "Compares two images of the same size (any format OpenImageIO reads; EXR compares linear\n"
-            "radiance, PNG the stored 0..1 values) and prints RMSE, PSNR (peak 1), the largest channel\n"
-            "difference, both means and the NaN/Inf counts. The values are compared as stored, never\n"
-            "converted: a linear image (EXR, HDR, PFM) against a display image (PNG, JPEG) gets a warning\n"
-            "on stderr, since PNG's values are sRGB-encoded, exposure-scaled and clamped. Exit 0 when it\n"
-            "could compare, 1 when an image cannot be read or the sizes differ, 4 when sfsim's image library\n"
-            "does not load.\n");
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (end == s || *end || errno || !isfinite(v) || (!signed_ok && v < 0)) {
+        fprintf(stderr, "sfsim compare: %s %s: expected a finite number%s\n", opt, s, signed_ok ? "" : " >= 0");
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+/* Prints the figures; EXIT_OK, or EXIT_DIFFER when a threshold given was exceeded (said). */
+static int compare_report(const char *na, const char *nb, int w, int h, const ImgCompare *c, const double lim[3],
+                          const int given[3])
+{
+    printf("%s vs %s (%d x %d)\n", na, nb, w, h);
+    printf("  RMSE        %.6g\n  PSNR        %.2f dB\n  max diff    %.6g\n", c->rmse, c->psnr, c->max_abs);
+    printf("  mean        %.6g vs %.6g\n  NaN/Inf     %ld vs %ld\n", c->mean_a, c->mean_b, c->nan_a, c->nan_b);
+    static const char *const names[3] = {"--max-rmse", "--min-psnr", "--max-diff"};
+    const double got[3] = {c->rmse, c->psnr, c->max_abs};
+    int rc = EXIT_OK;
+    for (int k = 0; k < 3; k++) {
+        if (!given[k])
+            continue;
+        int bad = c->nan_a != c->nan_b || isnan(got[k]) || (k == 1 ? got[k] < lim[k] : got[k] > lim[k]);
+        if (bad) {
+            fprintf(stderr, "sfsim compare: %s %g exceeded: %s %.6g%s\n", names[k], lim[k],
+                    k == 0 ? "RMSE" : k == 1 ? "PSNR" : "largest difference", got[k],
+                    c->nan_a != c->nan_b ? " (and the NaN/Inf counts differ)" : "");
+            rc = EXIT_DIFFER;
+        }
+    }
+    return rc;
 }
 
 static int cmd_compare(int argc, char **argv)
 {
-    if (argc == 1 && (!strcmp(argv[0], "--help") || !strcmp(argv[0], "-h"))) {
-        usage_compare(stdout);
-        return EXIT_OK;
+    CliParse p = {"sfsim compare", "compare", compare_longs, "h", argc, argv, 0};
+    double lim[3] = {0};
+    int given[3] = {0}, code;
+    const char *v;
+    while ((code = cli_next(&p, &v)) > 0) {
+        if (cli_common(&p, code, help_compare))
+            return EXIT_OK;
+        int k = code - K_MAX_RMSE;
+        if (k >= 0 && k < 3) {
+            if (threshold(k == 0 ? "--max-rmse" : k == 1 ? "--min-psnr" : "--max-diff", v, k == 1, &lim[k]))
+                return EXIT_INPUT;
+            given[k] = 1;
+        }
     }
-    if (argc != 2 || argv[0][0] == '-' || argv[1][0] == '-') {
-        usage_compare(stderr);
+    if (code < 0)
+        return EXIT_USAGE;
+    int first = cli_first_operand();
+    if (argc - first != 2) {
+        fprintf(stderr, "sfsim compare: expected two images, A and B (sfsim help compare)\n");
         return EXIT_USAGE;
     }
+    const char *na = argv[first], *nb = argv[first + 1];
     float *a = NULL, *b = NULL;
     int wa, ha, wb, hb;
     char err[8192];
@@ -545,253 +163,315 @@ static int cmd_compare(int argc, char **argv)
         return EXIT_IO;
     }
     int rc = EXIT_INPUT;
-    if (img_read(argv[0], &a, &wa, &ha, err, sizeof err) != 0 || img_read(argv[1], &b, &wb, &hb, err, sizeof err) != 0) {
+    if (img_read(na, &a, &wa, &ha, err, sizeof err) != 0 || img_read(nb, &b, &wb, &hb, err, sizeof err) != 0) {
         fprintf(stderr, "sfsim compare: %s\n", err);
     } else if (wa != wb || ha != hb) {
-        fprintf(stderr, "sfsim compare: sizes differ: %s is %d x %d, %s is %d x %d\n", argv[0], wa, ha, argv[1], wb, hb);
+        fprintf(stderr, "sfsim compare: sizes differ: %s is %d x %d, %s is %d x %d\n", na, wa, ha, nb, wb, hb);
     } else {
-        ImgEncoding ea = img_encoding(argv[0]), eb = img_encoding(argv[1]);
+        ImgEncoding ea = img_encoding(na), eb = img_encoding(nb);
         if (ea != eb && ea != IMG_ENC_UNKNOWN && eb != IMG_ENC_UNKNOWN)
             fprintf(stderr,
                     "sfsim compare: warning: %s holds %s and %s %s: the figures below compare different encodings, "
                     "not the renders (compare frame.exr with frame.exr, or frame.png with frame.png)\n",
-                    argv[0], ea == IMG_ENC_LINEAR ? "linear radiance" : "display values (sRGB-encoded, clamped to 0..1)",
-                    argv[1], eb == IMG_ENC_LINEAR ? "linear radiance" : "display values (sRGB-encoded, clamped to 0..1)");
+                    na, ea == IMG_ENC_LINEAR ? "linear radiance" : "display values (sRGB-encoded, clamped to 0..1)",
+                    nb, eb == IMG_ENC_LINEAR ? "linear radiance" : "display values (sRGB-encoded, clamped to 0..1)");
         ImgCompare c;
         img_compare(a, b, wa, ha, &c);
-        printf("%s vs %s (%d x %d)\n", argv[0], argv[1], wa, ha);
-        printf("  RMSE        %.6g\n  PSNR        %.2f dB\n  max diff    %.6g\n", c.rmse, c.psnr, c.max_abs);
-        printf("  mean        %.6g vs %.6g\n  NaN/Inf     %ld vs %ld\n", c.mean_a, c.mean_b, c.nan_a, c.nan_b);
-        rc = EXIT_OK;
+        rc = compare_report(na, nb, wa, ha, &c, lim, given);
     }
     free(a);
     free(b);
     return rc;
 }
 
-/* An integer option value in lo..hi; a bad value is bad input (EXIT_INPUT), said by the caller. */
-static int parse_int(const char *cmd, const char *opt, const char *s, long lo, long hi, long *out)
+/* ---- run --------------------------------------------------------------------------------------- */
+
+enum { R_MODE = CLI_LONG, R_SET, R_EXPOSURE, R_SAMPLE, R_TARGET, R_NO_IMAGE, R_SEED, R_NOPROG, R_KERNEL };
+static const struct option run_longs[] = {
+    {"scene", required_argument, NULL, 's'},         {"out", required_argument, NULL, 'o'},
+    {"config", required_argument, NULL, 'c'},        {"mode", required_argument, NULL, R_MODE},
+    {"threads", required_argument, NULL, 'j'},       {"set", required_argument, NULL, R_SET},
+    {"exposure", required_argument, NULL, R_EXPOSURE}, {"sample", required_argument, NULL, R_SAMPLE},
+    {"target-error", required_argument, NULL, R_TARGET}, {"no-image", no_argument, NULL, R_NO_IMAGE},
+    {"sample-seed", required_argument, NULL, R_SEED}, {"no-progress", no_argument, NULL, R_NOPROG},
+    {"kernel", required_argument, NULL, R_KERNEL},   {"help", no_argument, NULL, CLI_HELP},
+    {"version", no_argument, NULL, CLI_VERSION},     {NULL, 0, NULL, 0}};
+
+/* What a run was given, before the one check of how the options go together. */
+typedef struct RunArgs {
+    RenderOptions o;
+    CliConfig ca;
+    RunMode mode;
+    int sample_given, target_given;
+} RunArgs;
+
+/* A render key (render.width=..., sim/render.h's table) into o: 1 taken, 0 not a render key, -1 a
+ * bad value (said). */
+static int run_render_key(const CliParse *p, RenderOptions *o, const char *s)
 {
-    long long v;
-    if (util_parse_int(s, lo, hi, &v)) {
-        fprintf(stderr, "sfsim %s: %s %s: expected an integer in %ld..%ld\n", cmd, opt, s, lo, hi);
-        return -1;
+    for (int k = 0; k < RENDER_KEY_COUNT; k++) {
+        size_t kl = strlen(render_keys[k].key);
+        if (strncmp(s, render_keys[k].key, kl) != 0 || s[kl] != '=')
+            continue;
+        char opt[64];
+        long long v;
+        snprintf(opt, sizeof opt, "--set %s =", render_keys[k].key);
+        if (cli_int(p, opt, s + kl + 1, render_keys[k].lo, render_keys[k].hi, &v))
+            return -1;
+        int *field[] = {&o->width, &o->height, &o->spp, &o->max_depth, NULL};
+        if (k == RENDER_KEY_SEED)
+            o->seed = (uint32_t)v;
+        else
+            *field[k] = (int)v;
+        return 1;
     }
-    *out = (long)v;
     return 0;
 }
 
-static int cmd_run(int argc, char **argv)
+/* A fraction in (lo, hi) or (lo, hi] for --sample / --target-error / --exposure: 0 or -1 (said). */
+static int run_fraction(const char *opt, const char *s, double lo, double hi, int hi_in, const char *what, double *out)
 {
-    ConfigArgs ca = {0};
-    RenderOptions o;
-    render_default_options(&o);
-    o.scene_path = NULL; /* default: the shipped Cornell box, found beside the binary */
-    o.out_dir = "out";
-    o.progress = isatty(2);
-    const char *mode = "detailed";
-    int sample_given = 0, target_given = 0;
-    for (int i = 0; i < argc; i++) {
-        const char *a = argv[i];
-        int has_next = i + 1 < argc;
-        long v;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            usage_run(stdout);
-            return EXIT_OK;
-        } else if ((!strcmp(a, "-s") || !strcmp(a, "--scene")) && has_next) {
-            o.scene_path = argv[++i];
-        } else if ((!strcmp(a, "-o") || !strcmp(a, "--out")) && has_next) {
-            o.out_dir = argv[++i];
-        } else if ((!strcmp(a, "-c") || !strcmp(a, "--config")) && has_next) {
-            ca.path = argv[++i];
-        } else if (!strcmp(a, "--mode") && has_next) {
-            mode = argv[++i];
-        } else if ((!strcmp(a, "-j") || !strcmp(a, "--threads")) && has_next) {
-            if (parse_int("run", a, argv[++i], 1, 1024, &v))
-                return EXIT_INPUT;
-            o.threads = (int)v;
-        } else if (!strcmp(a, "--exposure") && has_next) {
-            char *end;
-            o.exposure = strtof(argv[++i], &end);
-            if (end == argv[i] || *end || !isfinite(o.exposure) || !(o.exposure > 0.0f)) {
-                fprintf(stderr, "sfsim run: --exposure %s: expected a finite positive number (a float)\n", argv[i]);
-                return EXIT_INPUT;
-            }
-        } else if (!strcmp(a, "--sample") && has_next) {
-            char *end;
-            o.sample = strtod(argv[++i], &end);
-            if (*end || !(o.sample > 0.0 && o.sample <= 1.0)) {
-                fprintf(stderr, "sfsim run: --sample %s: expected a fraction of the units in (0, 1], e.g. 0.05\n",
-                        argv[i]);
-                return EXIT_INPUT;
-            }
-            sample_given = 1;
-        } else if (!strcmp(a, "--target-error") && has_next) {
-            char *end;
-            o.target_error = strtod(argv[++i], &end);
-            if (end == argv[i] || *end || !(o.target_error > 0.0 && o.target_error < 1.0)) {
-                fprintf(stderr, "sfsim run: --target-error %s: expected a fraction in (0, 1), e.g. 0.01 for +-1%%\n",
-                        argv[i]);
-                return EXIT_INPUT;
-            }
-            target_given = 1;
-        } else if (!strcmp(a, "--no-image")) {
-            o.no_image = 1;
-        } else if (!strcmp(a, "--sample-seed") && has_next) {
-            if (parse_int("run", a, argv[++i], 0, 4294967295L, &v))
-                return EXIT_INPUT;
-            o.sample_seed = (uint32_t)v;
-        } else if (!strcmp(a, "--no-progress")) {
-            o.progress = 0;
-        } else if (!strcmp(a, "--kernel") && has_next) {
-            o.kernel_path = argv[++i];
-        } else if (!strcmp(a, "--set") && has_next) {
-            const char *s = argv[++i];
-            int handled = 0;
-            for (int k = 0; k < RENDER_KEY_COUNT; k++) {
-                size_t kl = strlen(render_keys[k].key);
-                if (strncmp(s, render_keys[k].key, kl) != 0 || s[kl] != '=')
-                    continue;
-                char opt[64];
-                snprintf(opt, sizeof opt, "--set %s =", render_keys[k].key);
-                if (parse_int("run", opt, s + kl + 1, (long)render_keys[k].lo, (long)render_keys[k].hi, &v))
-                    return EXIT_INPUT;
-                if (k == RENDER_KEY_WIDTH) o.width = (int)v;
-                if (k == RENDER_KEY_HEIGHT) o.height = (int)v;
-                if (k == RENDER_KEY_SPP) o.spp = (int)v;
-                if (k == RENDER_KEY_MAX_DEPTH) o.max_depth = (int)v;
-                if (k == RENDER_KEY_SEED) o.seed = (uint32_t)v;
-                handled = 1;
-            }
-            if (!handled && add_set(&ca, s))
-                return EXIT_USAGE;
-        } else {
-            fprintf(stderr, "sfsim run: unknown option or missing value: %s (sfsim help run)\n", a);
-            return EXIT_USAGE;
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (end == s || *end || errno || !isfinite(v) || !(v > lo) || (hi_in ? v > hi : v >= hi)) {
+        fprintf(stderr, "sfsim run: %s %s: expected %s\n", opt, s, what);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+/* One option of run into a: EXIT_OK, or the exit code after saying what was wrong. */
+static int run_option(const CliParse *p, RunArgs *a, int code, const char *v)
+{
+    RenderOptions *o = &a->o;
+    long long n;
+    double x;
+    switch (code) {
+    case 's': o->scene_path = v; break;
+    case 'o': o->out_dir = v; break;
+    case 'c': a->ca.path = v; break;
+    case R_MODE:
+        if (run_mode_parse(v, &a->mode) != 0) {
+            fprintf(stderr, "sfsim run: --mode %s: expected detailed, sampled, functional or reference (sfsim help run)\n", v);
+            return EXIT_INPUT;
         }
+        break;
+    case 'j':
+        if (cli_int(p, "-j", v, 1, 1024, &n))
+            return EXIT_INPUT;
+        o->threads = (int)n;
+        break;
+    case R_EXPOSURE:
+        if (run_fraction("--exposure", v, 0.0, 3.0e38, 1, "a finite positive number (a float)", &x))
+            return EXIT_INPUT;
+        o->exposure = (float)x;
+        break;
+    case R_SAMPLE:
+        if (run_fraction("--sample", v, 0.0, 1.0, 1, "a fraction of the units in (0, 1], e.g. 0.05", &o->sample))
+            return EXIT_INPUT;
+        a->sample_given = 1;
+        break;
+    case R_TARGET:
+        if (run_fraction("--target-error", v, 0.0, 1.0, 0, "a fraction in (0, 1), e.g. 0.01 for +-1%", &o->target_error))
+            return EXIT_INPUT;
+        a->target_given = 1;
+        break;
+    case R_NO_IMAGE: o->no_image = 1; break;
+    case R_SEED:
+        if (cli_int(p, "--sample-seed", v, 0, 4294967295LL, &n))
+            return EXIT_INPUT;
+        o->sample_seed = (uint32_t)n;
+        break;
+    case R_NOPROG: o->progress = 0; break;
+    case R_KERNEL: o->kernel_path = v; break;
+    case R_SET: {
+        int r = run_render_key(p, o, v);
+        if (r < 0)
+            return EXIT_INPUT;
+        if (r == 0 && cli_config_set(&a->ca, v))
+            return EXIT_USAGE;
+        break;
     }
-    if (strcmp(mode, "reference") != 0 && strcmp(mode, "functional") != 0 && strcmp(mode, "detailed") != 0 &&
-        strcmp(mode, "sampled") != 0) {
-        fprintf(stderr, "sfsim run: --mode %s: expected detailed, sampled, functional or reference (sfsim help run)\n",
-                mode);
-        return EXIT_INPUT;
+    default: return EXIT_USAGE;
     }
-    if ((sample_given || target_given || o.no_image) && strcmp(mode, "sampled") != 0) {
+    return EXIT_OK;
+}
+
+/* The one check of how run's options go together, after all of them were read. */
+static int run_check(RunArgs *a)
+{
+    if ((a->sample_given || a->target_given || a->o.no_image) && a->mode != RUN_SAMPLED) {
         fprintf(stderr, "sfsim run: --sample, --target-error and --no-image apply to --mode sampled only "
                         "(sfsim help run)\n");
         return EXIT_USAGE;
     }
-    if (sample_given && target_given) {
+    if (a->sample_given && a->target_given) {
         fprintf(stderr, "sfsim run: --sample F (a fixed fraction) and --target-error E (as many units as E needs) "
                         "exclude each other (sfsim help run)\n");
         return EXIT_USAGE;
     }
-    if (sample_given)
-        o.target_error = 0.0; /* the fixed-size design */
-    o.mode = mode;
+    if (a->sample_given)
+        a->o.target_error = 0.0; /* the fixed-size design */
+    a->o.mode = run_mode_names[a->mode];
+    return EXIT_OK;
+}
+
+static int run_parse(int argc, char **argv, RunArgs *a)
+{
+    CliParse p = {"sfsim run", "run", run_longs, "s:o:c:j:h", argc, argv, 0};
+    render_default_options(&a->o);
+    a->o.scene_path = NULL; /* default: the shipped Cornell box, found beside the binary */
+    a->o.out_dir = "out";
+    a->o.progress = isatty(2);
+    a->mode = RUN_DETAILED;
+    int code, rc;
+    const char *v;
+    while ((code = cli_next(&p, &v)) > 0) {
+        if (cli_common(&p, code, help_run))
+            return -1;
+        if ((rc = run_option(&p, a, code, v)) != EXIT_OK)
+            return rc;
+    }
+    if (code < 0)
+        return EXIT_USAGE;
+    if (cli_first_operand() < argc) {
+        fprintf(stderr, "sfsim run: unexpected argument '%s': the scene is given with -s (sfsim help run)\n",
+                argv[cli_first_operand()]);
+        return EXIT_USAGE;
+    }
+    return run_check(a);
+}
+
+static int cmd_run(int argc, char **argv)
+{
+    RunArgs a = {0};
+    int rc = run_parse(argc, argv, &a);
+    if (rc != EXIT_OK) {
+        cli_config_free(&a.ca);
+        return rc < 0 ? EXIT_OK : rc;
+    }
+    RenderOptions *o = &a.o;
     static char default_scene[4096];
-    if (!o.scene_path) {
+    CfgMachine cfg;
+    rc = EXIT_INPUT;
+    if (!o->scene_path) {
         char derr[8192];
         if (!datadir_path(DATADIR_DEFAULT_SCENE, default_scene, sizeof default_scene, derr, sizeof derr)) {
             fprintf(stderr, "sfsim run: no -s SCENE given and the default scene is missing: %s\n", derr);
-            return EXIT_INPUT;
+            goto out;
         }
-        o.scene_path = default_scene;
+        o->scene_path = default_scene;
     }
-    CfgMachine cfg;
-    if (build_config(&ca, &cfg))
-        return EXIT_INPUT;
-    o.cfg = &cfg;
-    o.config_path = ca.path;
+    if (cli_config_build(&a.ca, &cfg))
+        goto out;
+    o->cfg = &cfg;
+    o->config_path = a.ca.path;
     static char err[65536];
     /* The images a run writes (frame.exr, frame.png, cost.png, frame.partial.exr) go through
      * OpenEXR, libpng and FreeType linked into this binary (sim/img_write.c, sim/heatmap.c): a run
      * never loads the image library, OpenImageIO's reader (docs/performance.md, "Start-up"). */
-    int rrc = render_run(&o, err, sizeof err);
+    int rrc = render_run(o, err, sizeof err);
     if (rrc != 0) {
         fprintf(stderr, "sfsim run: %s\n", err);
         /* -3: an output could not be written (trace_run's convention, for render_run's writers) */
-        return rrc == -2 ? EXIT_PROGRAM : rrc == -3 ? EXIT_IO : EXIT_INPUT;
+        rc = rrc == -2 ? EXIT_PROGRAM : rrc == -3 ? EXIT_IO : EXIT_INPUT;
+        goto out;
     }
-    printf("sfsim run: wrote %s/%sreport.txt, report.json%s\n", o.out_dir, o.no_image ? "" : "frame.png, frame.exr, ",
-           !strcmp(mode, "detailed") || !strcmp(mode, "sampled") ? ", cost.png" : "");
-    return EXIT_OK;
+    size_t n = strlen(o->out_dir);
+    const char *sep = n && o->out_dir[n - 1] == '/' ? "" : "/";
+    printf("sfsim run: wrote %s%s%sreport.txt, report.json%s\n", o->out_dir, sep,
+           o->no_image ? "" : "frame.png, frame.exr, ", run_mode_timed(a.mode) ? ", cost.png" : "");
+    rc = EXIT_OK;
+out:
+    cli_config_free(&a.ca);
+    return rc;
 }
 
-static void usage_trace(FILE *out)
+/* ---- trace ------------------------------------------------------------------------------------- */
+
+enum { T_RAYS = CLI_LONG, T_MODE, T_SET, T_BINARY, T_KERNEL };
+static const struct option trace_longs[] = {
+    {"scene", required_argument, NULL, 's'},   {"rays", required_argument, NULL, T_RAYS},
+    {"out", required_argument, NULL, 'o'},     {"mode", required_argument, NULL, T_MODE},
+    {"config", required_argument, NULL, 'c'},  {"set", required_argument, NULL, T_SET},
+    {"binary", no_argument, NULL, T_BINARY},   {"threads", required_argument, NULL, 'j'},
+    {"kernel", required_argument, NULL, T_KERNEL}, {"help", no_argument, NULL, CLI_HELP},
+    {"version", no_argument, NULL, CLI_VERSION}, {NULL, 0, NULL, 0}};
+
+/* trace's options into o and ca: EXIT_OK, -1 (help printed), or the exit code (said). */
+static int trace_parse(int argc, char **argv, TraceOptions *o, CliConfig *ca)
 {
-    fprintf(out,
-            "usage: sfsim trace -s SCENE --rays FILE -o HITS [options]\n"
-            "\n"
-            "Traces each ray of FILE (text or binary, docs/trace.md) against SCENE and writes its closest hit\n"
-            "(distance, primitive, barycentrics) or miss, or for any-hit rays whether it is occluded, to HITS.\n"
-            "\n"
-            "options:\n"
-            "  --mode functional|detailed|reference  the kernel's traversal and intersection on the\n"
-            "                           functional core (default), the same timed on the machine of the\n"
-            "                           config (prints cycles and stalls by cause), or the golden model's\n"
-            "  -c, --config FILE        machine config; --set SECTION.KEY=VALUE overrides a key\n"
-            "  --binary                 write HITS in the binary format (default: text)\n"
-            "  -j, --threads N          host threads (default: all cores; results do not change)\n"
-            "  --kernel FILE            the kernel source (default: kernels/pathtrace.s beside the binary)\n");
+    CliParse p = {"sfsim trace", "trace", trace_longs, "s:o:c:j:h", argc, argv, 0};
+    RunMode mode = RUN_FUNCTIONAL;
+    long long n;
+    int code;
+    const char *v;
+    while ((code = cli_next(&p, &v)) > 0) {
+        if (cli_common(&p, code, help_trace))
+            return -1;
+        switch (code) {
+        case 's': o->scene_path = v; break;
+        case T_RAYS: o->rays_path = v; break;
+        case 'o': o->out_path = v; break;
+        case 'c': ca->path = v; break;
+        case T_MODE:
+            if (run_mode_parse(v, &mode) != 0 || mode == RUN_SAMPLED) {
+                fprintf(stderr, "sfsim trace: --mode %s: expected functional, detailed or reference\n", v);
+                return EXIT_INPUT;
+            }
+            break;
+        case T_SET:
+            if (cli_config_set(ca, v))
+                return EXIT_USAGE;
+            break;
+        case T_BINARY: o->binary = 1; break;
+        case 'j':
+            if (cli_int(&p, "-j", v, 1, 1024, &n))
+                return EXIT_INPUT;
+            o->threads = (int)n;
+            break;
+        case T_KERNEL: o->kernel_path = v; break;
+        default: return EXIT_USAGE;
+        }
+    }
+    if (code < 0)
+        return EXIT_USAGE;
+    if (cli_first_operand() < argc) {
+        fprintf(stderr, "sfsim trace: unexpected argument '%s' (sfsim help trace)\n", argv[cli_first_operand()]);
+        return EXIT_USAGE;
+    }
+    if (!o->scene_path || !o->rays_path || !o->out_path) {
+        fprintf(stderr, "sfsim trace: -s SCENE, --rays FILE and -o HITS are required (sfsim help trace)\n");
+        return EXIT_USAGE;
+    }
+    o->mode = run_mode_names[mode];
+    if (o->threads == 0)
+        o->threads = (int)sysconf(_SC_NPROCESSORS_ONLN);
+    return EXIT_OK;
 }
 
 static int cmd_trace(int argc, char **argv)
 {
-    ConfigArgs ca = {0};
+    CliConfig ca = {0};
     TraceOptions o;
     memset(&o, 0, sizeof o);
-    o.mode = "functional";
-    for (int i = 0; i < argc; i++) {
-        const char *a = argv[i];
-        int has_next = i + 1 < argc;
-        long v;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            usage_trace(stdout);
-            return EXIT_OK;
-        } else if ((!strcmp(a, "-s") || !strcmp(a, "--scene")) && has_next) {
-            o.scene_path = argv[++i];
-        } else if (!strcmp(a, "--rays") && has_next) {
-            o.rays_path = argv[++i];
-        } else if ((!strcmp(a, "-o") || !strcmp(a, "--out")) && has_next) {
-            o.out_path = argv[++i];
-        } else if (!strcmp(a, "--mode") && has_next) {
-            o.mode = argv[++i];
-        } else if ((!strcmp(a, "-c") || !strcmp(a, "--config")) && has_next) {
-            ca.path = argv[++i];
-        } else if (!strcmp(a, "--set") && has_next) {
-            if (add_set(&ca, argv[++i]))
-                return EXIT_USAGE;
-        } else if (!strcmp(a, "--binary")) {
-            o.binary = 1;
-        } else if ((!strcmp(a, "-j") || !strcmp(a, "--threads")) && has_next) {
-            if (parse_int("trace", a, argv[++i], 1, 1024, &v))
-                return EXIT_INPUT;
-            o.threads = (int)v;
-        } else if (!strcmp(a, "--kernel") && has_next) {
-            o.kernel_path = argv[++i];
-        } else {
-            fprintf(stderr, "sfsim trace: unknown option or missing value: %s (sfsim help trace)\n", a);
-            return EXIT_USAGE;
-        }
+    int rc = trace_parse(argc, argv, &o, &ca);
+    if (rc != EXIT_OK) {
+        cli_config_free(&ca);
+        return rc < 0 ? EXIT_OK : rc;
     }
-    if (!o.scene_path || !o.rays_path || !o.out_path) {
-        fprintf(stderr, "sfsim trace: -s SCENE, --rays FILE and -o HITS are required (sfsim help trace)\n");
-        return EXIT_USAGE;
-    }
-    if (strcmp(o.mode, "functional") != 0 && strcmp(o.mode, "reference") != 0 && strcmp(o.mode, "detailed") != 0) {
-        fprintf(stderr, "sfsim trace: --mode %s: expected functional, detailed or reference\n", o.mode);
-        return EXIT_INPUT;
-    }
-    if (o.threads == 0)
-        o.threads = (int)sysconf(_SC_NPROCESSORS_ONLN);
     CfgMachine cfg;
-    if (build_config(&ca, &cfg))
+    if (cli_config_build(&ca, &cfg)) {
+        cli_config_free(&ca);
         return EXIT_INPUT;
+    }
     o.cfg = &cfg;
     static char err[65536];
     TraceSummary sum;
-    int rc = trace_run(&o, &sum, err, sizeof err);
+    rc = trace_run(&o, &sum, err, sizeof err);
+    cli_config_free(&ca);
     if (rc != 0) {
         fprintf(stderr, "sfsim trace: %s\n", err);
         return rc == -2 ? EXIT_PROGRAM : rc == -3 ? EXIT_IO : EXIT_INPUT;
@@ -801,73 +481,70 @@ static int cmd_trace(int argc, char **argv)
     if (sum.sim_instructions)
         printf(", %llu simulated instructions", (unsigned long long)sum.sim_instructions);
     printf("; wrote %s\n", o.out_path);
-    if (sum.timed && print_timing(&sum.timing, &cfg, NULL))
+    if (sum.timed && cli_print_timing(&sum.timing, &cfg, NULL))
         return EXIT_PROGRAM;
+    return EXIT_OK;
+}
+
+/* ---- the commands ------------------------------------------------------------------------------ */
+
+static const struct {
+    const char *name;
+    int (*run)(int argc, char **argv); /* argv[0] is the command's name */
+    void (*help)(FILE *out);
+} commands[] = {
+    {"run", cmd_run, help_run},         {"exec", cmd_exec, help_exec},       {"config", cmd_config, help_config},
+    {"compare", cmd_compare, help_compare}, {"trace", cmd_trace, help_trace}, {"sweep", sweep_main, sweep_usage},
+    {"merge", merge_main, merge_usage}};
+enum { NCOMMANDS = sizeof commands / sizeof commands[0] };
+
+static int cmd_help(int argc, char **argv)
+{
+    if (argc > 2) {
+        fprintf(stderr, "sfsim help: one topic at a time, not '%s %s' (sfsim help help)\n", argv[1], argv[2]);
+        return EXIT_USAGE;
+    }
+    const char *t = argc > 1 ? argv[1] : NULL;
+    if (!t) {
+        help_commands(stdout);
+    } else if (!strcmp(t, "help") || !strcmp(t, "--help") || !strcmp(t, "-h")) {
+        help_help(stdout);
+    } else if (!strcmp(t, "exit-codes")) {
+        help_exit_codes(stdout);
+    } else {
+        for (int i = 0; i < NCOMMANDS; i++)
+            if (!strcmp(t, commands[i].name)) {
+                commands[i].help(stdout);
+                return EXIT_OK;
+            }
+        fprintf(stderr, "sfsim help: unknown command '%s' (sfsim help help)\n", t);
+        return EXIT_USAGE;
+    }
     return EXIT_OK;
 }
 
 static int dispatch(int argc, char **argv)
 {
     if (argc < 2) {
-        usage(stderr);
+        help_commands(stderr);
         return EXIT_USAGE;
     }
     const char *cmd = argv[1];
     if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h")) {
-        usage(stdout);
+        help_commands(stdout);
         return EXIT_OK;
     }
     if (!strcmp(cmd, "--version")) {
         printf("sfsim %s (commit %s)\n", version_string(), version_commit());
         return EXIT_OK;
     }
-    if (!strcmp(cmd, "help")) {
-        if (argc > 3) {
-            fprintf(stderr, "sfsim help: one topic at a time, not '%s %s' (sfsim help help)\n", argv[2], argv[3]);
-            return EXIT_USAGE;
-        }
-        if (argc < 3)
-            usage(stdout);
-        else if (!strcmp(argv[2], "help") || !strcmp(argv[2], "--help") || !strcmp(argv[2], "-h"))
-            usage_help(stdout);
-        else if (!strcmp(argv[2], "exit-codes"))
-            usage_exit_codes(stdout);
-        else if (!strcmp(argv[2], "exec"))
-            usage_exec(stdout);
-        else if (!strcmp(argv[2], "config"))
-            usage_config(stdout);
-        else if (!strcmp(argv[2], "run"))
-            usage_run(stdout);
-        else if (!strcmp(argv[2], "compare"))
-            usage_compare(stdout);
-        else if (!strcmp(argv[2], "trace"))
-            usage_trace(stdout);
-        else if (!strcmp(argv[2], "sweep"))
-            sweep_usage(stdout);
-        else if (!strcmp(argv[2], "merge"))
-            merge_usage(stdout);
-        else {
-            fprintf(stderr, "sfsim help: unknown command '%s' (sfsim help help)\n", argv[2]);
-            return EXIT_USAGE;
-        }
-        return EXIT_OK;
-    }
-    if (!strcmp(cmd, "exec"))
-        return cmd_exec(argc - 2, argv + 2);
-    if (!strcmp(cmd, "config"))
-        return cmd_config(argc - 2, argv + 2);
-    if (!strcmp(cmd, "run"))
-        return cmd_run(argc - 2, argv + 2);
-    if (!strcmp(cmd, "compare"))
-        return cmd_compare(argc - 2, argv + 2);
-    if (!strcmp(cmd, "trace"))
-        return cmd_trace(argc - 2, argv + 2);
-    if (!strcmp(cmd, "sweep"))
-        return sweep_main(argc - 2, argv + 2);
-    if (!strcmp(cmd, "merge"))
-        return merge_main(argc - 2, argv + 2);
+    if (!strcmp(cmd, "help"))
+        return cmd_help(argc - 1, argv + 1);
+    for (int i = 0; i < NCOMMANDS; i++)
+        if (!strcmp(cmd, commands[i].name))
+            return commands[i].run(argc - 1, argv + 1);
     fprintf(stderr, "sfsim: unknown command '%s'\n\n", cmd);
-    usage(stderr);
+    help_commands(stderr);
     return EXIT_USAGE;
 }
 

@@ -37,7 +37,7 @@ int main(void)
            "| `sfsim exec` | `OK` (halted); `INPUT` (config, object file, a `--dump-mem` spec: checked before the program runs); `USAGE`; `PROGRAM` (trap, instruction limit, or the timing model failed its own check) |\n"
            "| `sfsim trace` | `OK` (0 rays included); `INPUT` (scene, ray file, config, option values); `USAGE`; `PROGRAM` (the kernel failed); `IO` (the hit file could not be written) |\n"
            "| `sfsim config` | `OK`; `INPUT` (the config or a `--set`); `USAGE` |\n"
-           "| `sfsim compare` | `OK` (compared; a warning on stderr when a linear image is compared with a display image); `INPUT` (an image cannot be read, or the sizes differ); `USAGE`; `IO` (the image library did not load) |\n"
+           "| `sfsim compare` | `OK` (compared; a warning on stderr when a linear image is compared with a display image); `INPUT` (an image cannot be read, or the sizes differ); `USAGE`; `IO` (the image library did not load); `DIFFER` (a threshold given was exceeded) |\n"
            "| `sfsim sweep`, `sfsim merge` | as docs/sweep.md says; `POINTS` when some points failed; `IO` when sweep.csv or a plot could not be written whole |\n"
            "| `sfsim help` | `OK`; `USAGE` (an unknown topic) |\n"
            "| `sfasm` | `OK`; `INPUT` (errors in the source, or an object that cannot be read with `-d`); `USAGE`; `IO` (the object or the disassembly could not be written) |\n"

@@ -12,8 +12,10 @@
 #include <errno.h>
 #include <unistd.h>
 
+#include "../cli/opts.h"
 #include "../datadir.h"
 #include "../exitcodes.h"
+#include "../run/run.h"
 #include "sweep_int.h"
 
 void sweep_usage(FILE *out)
@@ -49,7 +51,12 @@ void sweep_usage(FILE *out)
             "exit: 0 every point done, 1 an input error (nothing is run), 2 usage, 4 an output could\n"
             "not be written or DIR is in use by another sweep or merge, 5 a point failed (the others\n"
             "still run), 128 + signal: 130/143 stopped by SIGINT/SIGTERM (run the same command again\n"
-            "to resume)\n");
+            "to resume)\n"
+            "\n"
+            "examples:\n"
+            "  sfsim sweep --sweep configs/sweeps/width.ini -o width -j2\n"
+            "  sfsim sweep --sweep configs/sweeps/width.ini -o width --mode sampled --set=render.spp=4\n"
+            "  sfsim sweep --sweep configs/sweeps/kdtree.ini -o kd --emit slurm && sbatch kd/sweep.slurm\n");
 }
 
 void merge_usage(FILE *out)
@@ -62,21 +69,62 @@ void merge_usage(FILE *out)
             "are done, failed and unfinished. Exit 0 when every point is done, 5 otherwise (the CSV is\n"
             "written all the same, with rows of status failed or unfinished); 1 when DIR holds no\n"
             "sweep; 4 when the CSV cannot be written, or while a sweep or its --point tasks run in DIR\n"
-            "(merge refuses, naming the pid that holds DIR's lock). docs/sweep.md.\n");
+            "(merge refuses, naming the pid that holds DIR's lock). docs/sweep.md.\n"
+            "\n"
+            "examples:\n"
+            "  sfsim sweep --sweep configs/sweeps/width.ini -o width --emit parallel\n"
+            "  parallel < width/sweep.parallel; sfsim merge width\n");
 }
 
-static int parse_int_opt(const char *opt, const char *s, long lo, long hi, int *out)
+enum { W_SWEEP = CLI_LONG, W_MODE, W_SAMPLE, W_SET, W_TPP, W_RETRY, W_EMIT, W_POINT };
+static const struct option sweep_longs[] = {
+    {"config", required_argument, NULL, 'c'},  {"sweep", required_argument, NULL, W_SWEEP},
+    {"scene", required_argument, NULL, 's'},   {"out", required_argument, NULL, 'o'},
+    {"jobs", required_argument, NULL, 'j'},    {"mode", required_argument, NULL, W_MODE},
+    {"sample", required_argument, NULL, W_SAMPLE}, {"set", required_argument, NULL, W_SET},
+    {"threads-per-point", required_argument, NULL, W_TPP}, {"retry-failed", no_argument, NULL, W_RETRY},
+    {"emit", required_argument, NULL, W_EMIT}, {"point", required_argument, NULL, W_POINT},
+    {"help", no_argument, NULL, CLI_HELP},     {"version", no_argument, NULL, CLI_VERSION},
+    {NULL, 0, NULL, 0}};
+
+/* One option into a: 0, -1 usage error (said), -2 a bad value (said). */
+static int args_option(const CliParse *p, SweepArgs *a, int code, const char *v)
 {
-    long long v;
-    if (util_parse_int(s, lo, hi, &v)) {
-        fprintf(stderr, "sfsim sweep: %s %s: expected an integer in %ld..%ld\n", opt, s, lo, hi);
-        return -1;
+    long long n;
+    switch (code) {
+    case 'c': a->config = v; break;
+    case W_SWEEP: a->sweep = v; break;
+    case 's': a->scene = v; break;
+    case 'o': a->out = v; break;
+    case 'j':
+        if (cli_int(p, "-j", v, 1, 4096, &n))
+            return -2;
+        a->jobs = (int)n;
+        break;
+    case W_MODE: a->mode = v; break;
+    case W_SAMPLE: a->sample = v; break;
+    case W_SET:
+        a->sets = xrealloc(a->sets, (size_t)(a->nsets + 1) * sizeof *a->sets);
+        a->sets[a->nsets++] = v;
+        break;
+    case W_TPP:
+        if (cli_int(p, "--threads-per-point", v, 1, 1024, &n))
+            return -2;
+        a->threads = (int)n;
+        break;
+    case W_RETRY: a->retry = 1; break;
+    case W_EMIT: a->emit = v; break;
+    case W_POINT:
+        if (cli_int(p, "--point", v, 0, SWEEP_MAX_POINTS - 1, &n))
+            return -2;
+        a->point = (int)n;
+        break;
+    default: return -1;
     }
-    *out = (int)v;
     return 0;
 }
 
-/* 0 ok, 1 --help printed, -1 usage error printed, -2 an option's value is bad (printed). */
+/* 0 ok, 1 --help or --version printed, -1 usage error printed, -2 an option's value is bad (printed). */
 static int args_parse(int argc, char **argv, SweepArgs *a)
 {
     memset(a, 0, sizeof *a);
@@ -86,50 +134,27 @@ static int args_parse(int argc, char **argv, SweepArgs *a)
     a->point = -1;
     long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
     a->jobs = ncpu > 0 ? (int)ncpu : 1;
-    for (int i = 0; i < argc; i++) {
-        const char *o = argv[i];
-        int has = i + 1 < argc;
-        if (!strcmp(o, "--help") || !strcmp(o, "-h")) {
-            sweep_usage(stdout);
+    CliParse p = {"sfsim sweep", "sweep", sweep_longs, "c:s:o:j:h", argc, argv, 0};
+    int code, rc;
+    const char *v;
+    while ((code = cli_next(&p, &v)) > 0) {
+        if (cli_common(&p, code, sweep_usage))
             return 1;
-        } else if ((!strcmp(o, "-c") || !strcmp(o, "--config")) && has) {
-            a->config = argv[++i];
-        } else if (!strcmp(o, "--sweep") && has) {
-            a->sweep = argv[++i];
-        } else if ((!strcmp(o, "-s") || !strcmp(o, "--scene")) && has) {
-            a->scene = argv[++i];
-        } else if ((!strcmp(o, "-o") || !strcmp(o, "--out")) && has) {
-            a->out = argv[++i];
-        } else if ((!strcmp(o, "-j") || !strcmp(o, "--jobs")) && has) {
-            if (parse_int_opt(o, argv[++i], 1, 4096, &a->jobs))
-                return -2;
-        } else if (!strcmp(o, "--mode") && has) {
-            a->mode = argv[++i];
-        } else if (!strcmp(o, "--sample") && has) {
-            a->sample = argv[++i];
-        } else if (!strcmp(o, "--set") && has) {
-            a->sets = xrealloc(a->sets, (size_t)(a->nsets + 1) * sizeof *a->sets);
-            a->sets[a->nsets++] = argv[++i];
-        } else if (!strcmp(o, "--threads-per-point") && has) {
-            if (parse_int_opt(o, argv[++i], 1, 1024, &a->threads))
-                return -2;
-        } else if (!strcmp(o, "--retry-failed")) {
-            a->retry = 1;
-        } else if (!strcmp(o, "--emit") && has) {
-            a->emit = argv[++i];
-        } else if (!strcmp(o, "--point") && has) {
-            if (parse_int_opt(o, argv[++i], 0, SWEEP_MAX_POINTS - 1, &a->point))
-                return -2;
-        } else {
-            fprintf(stderr, "sfsim sweep: unknown option or missing value: %s (sfsim help sweep)\n", o);
-            return -1;
-        }
+        if ((rc = args_option(&p, a, code, v)) != 0)
+            return rc;
+    }
+    if (code < 0)
+        return -1;
+    if (cli_first_operand() < argc) {
+        fprintf(stderr, "sfsim sweep: unexpected argument '%s' (sfsim help sweep)\n", argv[cli_first_operand()]);
+        return -1;
     }
     if (!a->sweep || !a->out) {
         fprintf(stderr, "sfsim sweep: --sweep FILE and -o DIR are required (sfsim help sweep)\n");
         return -1;
     }
-    if (strcmp(a->mode, "detailed") && strcmp(a->mode, "functional") && strcmp(a->mode, "sampled")) {
+    RunMode mode;
+    if (run_mode_parse(a->mode, &mode) != 0 || mode == RUN_REFERENCE) {
         fprintf(stderr, "sfsim sweep: --mode %s: expected detailed, functional or sampled\n", a->mode);
         return -2;
     }
@@ -188,7 +213,7 @@ static void print_resume(int argc, char **argv)
 {
     UtilBuf b = {0};
     util_buf_puts(&b, "sfsim sweep");
-    for (int i = 0; i < argc; i++) {
+    for (int i = 1; i < argc; i++) { /* argv[0] is "sweep" */
         util_buf_puts(&b, " ");
         sweep_shell_word(&b, argv[i], 0);
     }
@@ -328,16 +353,24 @@ out:
     return rc;
 }
 
+static const struct option merge_longs[] = {
+    {"help", no_argument, NULL, CLI_HELP}, {"version", no_argument, NULL, CLI_VERSION}, {NULL, 0, NULL, 0}};
+
 int merge_main(int argc, char **argv)
 {
-    if (argc == 1 && (!strcmp(argv[0], "--help") || !strcmp(argv[0], "-h"))) {
-        merge_usage(stdout);
-        return EXIT_OK;
-    }
-    if (argc != 1 || argv[0][0] == '-') {
-        merge_usage(stderr);
+    CliParse p = {"sfsim merge", "merge", merge_longs, "h", argc, argv, 0};
+    int code;
+    const char *v;
+    while ((code = cli_next(&p, &v)) > 0)
+        if (cli_common(&p, code, merge_usage))
+            return EXIT_OK;
+    if (code < 0)
+        return EXIT_USAGE;
+    if (argc - cli_first_operand() != 1) {
+        fprintf(stderr, "sfsim merge: expected one sweep folder, DIR (sfsim help merge)\n");
         return EXIT_USAGE;
     }
+    argv += cli_first_operand();
     const char *dir = argv[0];
     char err[PATH_MAX + 256];
     char *manifest = xasprintf("%s/sweep.json", dir);

@@ -1,0 +1,211 @@
+/* sim/cli/help.c -- what `sfsim help COMMAND` and `sfsim COMMAND --help` print: every command's
+ * usage, options and examples (sweep and merge print theirs from sim/sweep/sweep.c).
+ *
+ * Owns: the help texts. Must not: parse options (each command's table is in sim/main.c and
+ * sim/cli/exec.c) or name internal labels (issue numbers, "seed 000"): users read this.
+ */
+#include "help.h"
+
+#include "../exithelp.h"
+
+void help_commands(FILE *out)
+{
+    fprintf(out,
+            "usage: sfsim <command> [options]\n"
+            "\n"
+            "sfsim simulates a stream-filtering ray tracing processor (Gribble & Ramani 2008).\n"
+            "\n"
+            "commands:\n"
+            "  run      render a scene: --mode detailed (default: the kernel on the timed machine),\n"
+            "           sampled (a sample of the work timed: cycles and fps with 95%% intervals),\n"
+            "           functional (the kernel, no timing) or reference (the golden model)\n"
+            "  exec     run an assembled program (.sfo) on the functional core; print registers\n"
+            "           and counters\n"
+            "  config   list the machine-config keys (--dump) or write their reference (--markdown)\n"
+            "  compare  compare two images: RMSE, PSNR, largest difference, NaN/Inf counts\n"
+            "  trace    closest-hit / any-hit queries for a file of rays, through the kernel or the golden model\n"
+            "  sweep    run a scene over many machine configs in parallel (sweep files, resumable; CSV, plots)\n"
+            "  merge    build a sweep's CSV and plots from its point folders (after Slurm or GNU parallel)\n"
+            "  help     help on a command (sfsim help exec), or on the exit codes (sfsim help exit-codes)\n"
+            "\n"
+            "options everywhere: --help, --version. Options take their value as --set KEY=V, --set=KEY=V,\n"
+            "-j 2 or -j2, and may come before or after the operands.\n"
+            "\n"
+            "examples:\n"
+            "  sfsim run -o out                            the shipped Cornell box on the paper's machine\n"
+            "  sfsim run --mode sampled --set core.simd_width=8 -o n8\n"
+            "  sfsim sweep --sweep configs/sweeps/width.ini -o sweep -j2\n"
+            "  sfsim help run                              every option of a command, with examples\n"
+            "\n"
+            "exit codes (every command; docs/exit-codes.md):\n");
+    exithelp_print(out);
+    fprintf(out, "\ndocumentation: docs/README.md\n");
+}
+
+void help_help(FILE *out)
+{
+    fprintf(out,
+            "usage: sfsim help [COMMAND | exit-codes]\n"
+            "\n"
+            "Prints the help of COMMAND (run, exec, config, compare, trace, sweep, merge, help), the exit\n"
+            "codes every command returns (exit-codes), or without an argument the list of commands.\n"
+            "`sfsim COMMAND --help` prints the same as `sfsim help COMMAND`.\n"
+            "\n"
+            "examples:\n"
+            "  sfsim help run\n"
+            "  sfsim help exit-codes\n");
+}
+
+void help_exit_codes(FILE *out)
+{
+    fprintf(out,
+            "Exit codes of every sfsim and sfasm command (sim/exitcodes.def; docs/exit-codes.md):\n"
+            "\n");
+    exithelp_print(out);
+}
+
+void help_exec(FILE *out)
+{
+    fprintf(out,
+            "usage: sfsim exec PROG.sfo [options]\n"
+            "\n"
+            "Runs an object produced by sfasm on the functional core until halt, a trap, or the\n"
+            "instruction limit, then prints the scalar registers, the non-zero vector lanes, the\n"
+            "masks and the counters per stage (instructions, operations by category, SIMD\n"
+            "utilization = active lanes / (N x vector instructions)). With --timing the timing model\n"
+            "runs beside it and the cycles are printed too: total, busy, stalls by cause, per stage,\n"
+            "and the units' counters (docs/model.md).\n"
+            "\n"
+            "options:\n"
+            "  -c, --config FILE        machine config (default: the built-in streamray machine)\n"
+            "  --set SECTION.KEY=VALUE  override a config key (repeatable)\n"
+            "  --width N                SIMD width, same as --set core.simd_width=N\n"
+            "  --max-instructions N     instruction limit, same as --set sim.max_instructions=N\n"
+            "  --dump-mem MEM:ADDR:WORDS  print WORDS words of MEM (rb0 rb1 idm spad scene fb) from\n"
+            "                           byte address ADDR (a multiple of 4) after the run (repeatable)\n"
+            "  -t, --timing             time the run on the machine of the config (detailed mode)\n"
+            "  -q, --quiet              print only the summary line (and the timing, with --timing)\n"
+            "  --no-progress            no progress line: a run still going after 2 s otherwise says on\n"
+            "                           stderr, every 5 s, how many instructions it ran of the limit\n"
+            "\n"
+            "The --dump-mem specs are checked against the config's memory sizes before the program runs.\n"
+            "Exit codes: 0 halted, 1 bad input (config, object, --dump-mem spec), 2 usage, 3 trap or the\n"
+            "instruction limit (sfsim help exit-codes).\n"
+            "\n"
+            "examples:\n"
+            "  sfasm prog.s -o prog.sfo && sfsim exec prog.sfo\n"
+            "  sfsim exec prog.sfo --timing --width 8           cycles and stalls on an 8-lane machine\n"
+            "  sfsim exec prog.sfo --dump-mem spad:0:16 -q      16 words of the scratchpad after the run\n");
+}
+
+void help_config(FILE *out)
+{
+    fprintf(out,
+            "usage: sfsim config (--dump | --markdown) [-c FILE] [--set SECTION.KEY=VALUE]...\n"
+            "\n"
+            "  --dump       every key with its value, type, default, range and help\n"
+            "  --markdown   the key reference as Markdown (docs/config.md is this output)\n"
+            "\n"
+            "examples:\n"
+            "  sfsim config --dump                                  the built-in machine\n"
+            "  sfsim config --dump -c configs/streamray.ini --set core.simd_width=8\n");
+}
+
+void help_run(FILE *out)
+{
+    fprintf(out,
+            "usage: sfsim run [-s SCENE] [-o DIR] [-c CONFIG] [--mode detailed|sampled|functional|reference] [options]\n"
+            "\n"
+            "Renders SCENE (a .gltf/.glb file or a scene.ini) and writes DIR/frame.exr (linear),\n"
+            "DIR/frame.png (tone-mapped sRGB), DIR/report.json and DIR/report.txt, and in detailed\n"
+            "mode DIR/cost.png (simulated cycles per pixel, per tile). docs/report.md lists the fields.\n"
+            "\n"
+            "modes:\n"
+            "  detailed    (default) the path-tracing kernel (kernels/pathtrace.s) on the functional core\n"
+            "              with the cycle-accurate timing model of the machine in CONFIG: cycles, fps,\n"
+            "              stalls by cause, per stage, generation and tile, the units' counters\n"
+            "              (docs/model.md); the same image bits as functional mode\n"
+            "  sampled     the golden model renders the image (the same bits) and counts every (tile, pass)\n"
+            "              unit's work; a seeded random sample of the units runs on the timed kernel and the\n"
+            "              rest are skipped; cycles, instructions and fps estimated with 95%% confidence\n"
+            "              intervals (docs/sampling.md): by default until the cycles are known to +-1%%\n"
+            "  functional  the kernel executed instruction by instruction, no timing (fastest\n"
+            "              simulation): operation mix, SIMD utilization and stream lengths per stage\n"
+            "  reference   the golden model: a plain C path tracer over the packed scene memory\n"
+            "\n"
+            "options:\n"
+            "  -s, --scene FILE         scene (default: the shipped Cornell box, scenes/cornell/scene.ini\n"
+            "                           in sfsim's data folder, found beside the binary: docs/install.md)\n"
+            "  -o, --out DIR            output folder (default: out): checked before any work, made when the\n"
+            "                           outputs are written, each file whole or not at all (exit 4 if not;\n"
+            "                           docs/report.md)\n"
+            "  -c, --config FILE        machine config (stream.rays sets the tile: sqrt(M) pixels)\n"
+            "  --set SECTION.KEY=VALUE  override a config key, or render.width, render.height,\n"
+            "                           render.spp, render.max_depth, render.seed\n"
+            "  -j, --threads N          host threads (default: all cores; results do not change)\n"
+            "  --exposure X             scale before tone mapping frame.png (default 1)\n"
+            "  --no-progress            no progress bar (it is shown only on a terminal anyway)\n"
+            "  --target-error E         sampled mode: time units until the 95%% interval of the cycles is\n"
+            "                           within +-E (a fraction: 0.01 = 1%%, the default), or every unit\n"
+            "  --sample F               sampled mode: time a fixed fraction F of the units, (0, 1], instead\n"
+            "  --sample-seed S          sampled mode: which units (default 1)\n"
+            "  --no-image               sampled mode: no image; the golden model runs only a pilot pass per\n"
+            "                           tile for the units' counts (the estimate alone, fastest)\n"
+            "  --kernel FILE            kernel modes: the kernel source (default:\n"
+            "                           kernels/pathtrace.s in the data folder, or $SFSIM_KERNEL)\n"
+            "\n"
+            "examples:\n"
+            "  sfsim run -o out                                        the Cornell box, detailed mode\n"
+            "  sfsim run -s scene.gltf --set render.spp=4 --set=core.simd_width=8 -j2 -o n8\n"
+            "  sfsim run --mode sampled --target-error 0.005 -o samp   cycles and fps to +-0.5%% (95%%)\n"
+            "  sfsim run --mode reference -o ref && sfsim compare ref/frame.exr out/frame.exr\n");
+}
+
+void help_compare(FILE *out)
+{
+    fprintf(out,
+            "usage: sfsim compare A B [--max-rmse X] [--min-psnr DB] [--max-diff X]\n"
+            "\n"
+            "Compares two images of the same size (any format OpenImageIO reads; EXR compares linear\n"
+            "radiance, PNG the stored 0..1 values) and prints RMSE, PSNR (peak 1), the largest channel\n"
+            "difference, both means and the NaN/Inf counts. The values are compared as stored, never\n"
+            "converted: a linear image (EXR, HDR, PFM) against a display image (PNG, JPEG) gets a warning\n"
+            "on stderr, since PNG's values are sRGB-encoded, exposure-scaled and clamped.\n"
+            "\n"
+            "thresholds, for scripts (each optional; the figures are printed either way):\n"
+            "  --max-rmse X     exit 6 when the RMSE is above X\n"
+            "  --min-psnr DB    exit 6 when the PSNR is below DB decibels\n"
+            "  --max-diff X     exit 6 when the largest channel difference is above X\n"
+            "  Images with different counts of NaN or Inf values fail every threshold.\n"
+            "\n"
+            "Exit 0 when it compared (and every threshold given held), 1 when an image cannot be read or the\n"
+            "sizes differ, 4 when sfsim's image library does not load, 6 when a threshold was exceeded (the\n"
+            "message says which).\n"
+            "\n"
+            "examples:\n"
+            "  sfsim compare ref/frame.exr out/frame.exr\n"
+            "  sfsim compare ref/frame.exr out/frame.exr --max-rmse 1e-3 || echo \"images differ\"\n");
+}
+
+void help_trace(FILE *out)
+{
+    fprintf(out,
+            "usage: sfsim trace -s SCENE --rays FILE -o HITS [options]\n"
+            "\n"
+            "Traces each ray of FILE (text or binary, docs/trace.md) against SCENE and writes its closest hit\n"
+            "(distance, primitive, barycentrics) or miss, or for any-hit rays whether it is occluded, to HITS.\n"
+            "\n"
+            "options:\n"
+            "  --mode functional|detailed|reference  the kernel's traversal and intersection on the\n"
+            "                           functional core (default), the same timed on the machine of the\n"
+            "                           config (prints cycles and stalls by cause), or the golden model's\n"
+            "  -c, --config FILE        machine config; --set SECTION.KEY=VALUE overrides a key\n"
+            "  --binary                 write HITS in the binary format (default: text)\n"
+            "  -j, --threads N          host threads (default: all cores; results do not change)\n"
+            "  --kernel FILE            the kernel source (default: kernels/pathtrace.s beside the binary)\n"
+            "\n"
+            "examples (a ray per line: origin, direction, and optionally tmax and any; docs/trace.md):\n"
+            "  printf '278 273 -800  0 0 1\\n' > rays.txt\n"
+            "  sfsim trace -s scenes/cornell/scene.ini --rays rays.txt -o hits.txt\n"
+            "  sfsim trace -s scene.gltf --rays rays.bin --mode detailed -j2 -o hits.txt\n");
+}
