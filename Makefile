@@ -1,6 +1,12 @@
 # sfsim -- build, test, run. `make run` and `make test` install missing Debian packages first
 # (scripts/deps.sh), then re-enter make so pkg-config sees them.
 
+# A parallel build by default, on every core (as `make -jN` would); an explicit -j wins.
+NPROC   := $(shell nproc 2>/dev/null || echo 1)
+ifeq ($(filter -j%,$(MAKEFLAGS)),)
+MAKEFLAGS += -j$(NPROC)
+endif
+
 CC      ?= cc
 CXX     ?= c++
 CLANG   ?= clang
@@ -97,7 +103,7 @@ SHIM_ASAN_OBJ = $(patsubst %.cpp,$(BUILD)/asan/%.o,$(SHIM_SRC))
 LIBDIR  := $(patsubst ./%,%,$(dir $(BIN))lib)
 IMGLIB  := $(LIBDIR)/sfsim/libsfsim-img.so
 
-.PHONY: all deps install run test test-standalone test-asan test-unit test-hard test-slurm test-portable fuzz fuzz-run bench validation paper docs check-docs clean run-built test-built check-outputs help
+.PHONY: all deps install uninstall run test test-standalone test-asan test-unit test-hard test-slurm test-portable fuzz fuzz-run bench validation paper docs check-docs clean run-built test-built check-outputs help
 
 all: $(BIN)/sfasm $(BIN)/sfsim $(IMGLIB)
 
@@ -118,6 +124,7 @@ help:
 	@echo "make check-outputs  the same-outputs table alone (tests/outputs/check.sh; part of make test)"
 	@echo "make test-portable  the same table from a PORTABLE=1 build (the default builds for this host's CPU)"
 	@echo "make install    install into PREFIX (default /usr/local; DESTDIR honoured): docs/install.md"
+	@echo "make uninstall  remove what make install put into PREFIX"
 
 # The same-outputs table (tests/outputs/outputs.tsv): cycles, instructions, image and report hashes.
 check-outputs: all $(BUILD)/outputs_digest
@@ -439,9 +446,15 @@ install: all
 	install -m 644 configs/*.ini $(DATADIR)/configs/
 	install -m 644 configs/sweeps/*.ini $(DATADIR)/configs/sweeps/
 	install -m 644 $(SHIPPED_SCENES) $(DATADIR)/scenes/cornell/
-	install -m 644 README.md $(DOCDIR)/
+	install -m 644 README.md LICENSE $(DOCDIR)/
 	install -m 644 docs/*.md $(wildcard docs/*.png) $(DOCDIR)/docs/
 	@echo "installed sfsim into $(DESTDIR)$(PREFIX) (data: $(PREFIX)/share/sfsim)"
+
+# What make install put there, and nothing else: the two programs and sfsim's own folders.
+uninstall:
+	rm -f $(DESTDIR)$(PREFIX)/bin/sfsim $(DESTDIR)$(PREFIX)/bin/sfasm
+	rm -rf $(DESTDIR)$(PREFIX)/lib/sfsim $(DATADIR) $(DOCDIR)
+	@echo "removed sfsim from $(DESTDIR)$(PREFIX)"
 
 clean:
 	rm -rf $(BUILD) bin lib

@@ -70,7 +70,7 @@ for f in bin/sfsim bin/sfasm lib/sfsim/libsfsim-img.so lib/sfsim/libsfsim-img.so
     share/sfsim/kernels/lib/kconst.inc share/sfsim/kernels/lib/frames.inc share/sfsim/kernels/filters/traverse.inc \
     share/sfsim/configs/streamray.ini share/sfsim/configs/sweeps/width.ini share/sfsim/scenes/cornell/scene.ini \
     share/sfsim/scenes/cornell/cornell-box.gltf share/sfsim/scenes/cornell/cornell-box.bin \
-    share/doc/sfsim/README.md share/doc/sfsim/docs/README.md; do
+    share/doc/sfsim/README.md share/doc/sfsim/LICENSE share/doc/sfsim/docs/README.md; do
     [ -s "$T/prefix/$f" ] || no "$f is not installed"
 done
 end
@@ -173,6 +173,16 @@ run_ld "$SFSIM" config --dump
 run_ld "$SFSIM" exec "$T/demo.sfo"
 run_ld "$SFSIM" trace -s scenes/cornell/scene.ini --rays tests/cli/cornell_rays.txt -o "$T/hits.txt"
 run_ld "$SFSIM" run -o "$T/out-noload" "${SMALL[@]}"
+end
+
+begin "make uninstall PREFIX=... removes what make install put there, and nothing else"
+touch "$T/prefix/bin/other-tool"
+run make --no-print-directory uninstall PREFIX="$T/prefix"
+want_rc 0
+for f in bin/sfsim bin/sfasm lib/sfsim share/sfsim share/doc/sfsim; do
+    [ ! -e "$T/prefix/$f" ] || no "$f is still there"
+done
+[ -e "$T/prefix/bin/other-tool" ] || no "a file make install did not put there was removed"
 end
 
 cli_summary standalone
