@@ -21,6 +21,7 @@
 #include "exithelp.h"
 #include "img.h"
 #include "imglib.h"
+#include "provenance.h"
 #include "render.h"
 #include "run/timedcore.h"
 #include "stats.h"
@@ -872,6 +873,7 @@ static int dispatch(int argc, char **argv)
 
 int main(int argc, char **argv)
 {
+    prov_set_command(argc, argv);   /* what made the run, for its reports (sim/provenance.h) */
     int rc = dispatch(argc, argv);
     /* What went to stdout (a config dump, help, registers, the summary) is an output too: a full
      * disk or closed pipe must not pass for success. */
