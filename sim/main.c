@@ -24,6 +24,7 @@
 #include "exitcodes.h"
 #include "img.h"
 #include "imglib.h"
+#include "provenance.h"
 #include "render.h"
 #include "run/run.h"
 #include "sweep/sweep.h"
@@ -381,7 +382,7 @@ static int cmd_run(int argc, char **argv)
     }
     size_t n = strlen(o->out_dir);
     const char *sep = n && o->out_dir[n - 1] == '/' ? "" : "/";
-    printf("sfsim run: wrote %s%s%sreport.txt, report.json%s\n", o->out_dir, sep,
+    printf("sfsim run: wrote %s%s%sreport.txt, report.json, stats.txt%s\n", o->out_dir, sep,
            o->no_image ? "" : "frame.png, frame.exr, ", run_mode_timed(a.mode) ? ", cost.png" : "");
     rc = EXIT_OK;
 out:
@@ -551,6 +552,7 @@ static int dispatch(int argc, char **argv)
 int main(int argc, char **argv)
 {
     outfile_process_init();
+    prov_set_command(argc, argv); /* what made the run, for its reports (sim/provenance.h) */
     int rc = dispatch(argc, argv);
     /* What went to stdout (a config dump, help, registers, the summary) is an output too: a full
      * disk or closed pipe must not pass for success. */

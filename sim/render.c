@@ -24,6 +24,7 @@
 #include "heatmap.h"
 #include "img.h"
 #include "../host/outfile.h"
+#include "provenance.h"
 #include "reference.h"
 #include "report.h"
 #include "run/run.h"
@@ -87,8 +88,8 @@ static void note_cb(void *ctx, const char *line)
 }
 
 /* The outputs of a run, and the names an earlier run may have left that this one does not write. */
-static const char *const run_outputs[] = {"frame.exr", "frame.png", "report.txt", "report.json", "cost.png",
-                                          "frame.partial.exr"};
+static const char *const run_outputs[] = {"frame.exr", "frame.png", "report.txt", "report.json", "stats.txt",
+                                          "cost.png", "frame.partial.exr"};
 
 /* Remove dir's run outputs not in keep[] (NULL-terminated): a file an earlier run left would
  * otherwise sit beside this run's as if it belonged to it. */
@@ -147,11 +148,12 @@ static int write_cost_map(OutSet *set, const char *dir, const FuncStats *f, cons
 }
 
 /* A run whose kernel failed: frame.partial.exr (the finished tiles, the others black) and a
- * report.json with "status": "failed" replace an earlier run's outputs, whose complete-looking
- * files would now mislead (docs/kernel.md). 0, or -1 with werr saying what could not be written
+ * report.json with "status": "failed" (and what made the run) replace an earlier run's outputs,
+ * whose complete-looking files would now mislead (docs/kernel.md). It has no statistics, so no
+ * stats.txt: gem5 too writes none for a run that did not finish. 0, or -1 with werr saying what could not be written
  * (then nothing of this run is in the folder). */
 static int write_partial(const RenderOptions *o, const float *rgb, int width, int height, const FuncStats *f,
-                         const char *why, char *werr, size_t werrlen)
+                         int threads, const char *why, char *werr, size_t werrlen)
 {
     static const char *const keep[] = {"frame.partial.exr", "report.json", NULL};
     OutDirs dirs = {0};
@@ -169,6 +171,11 @@ static int write_partial(const RenderOptions *o, const float *rgb, int width, in
     if (img_write_linear(set, path, rgb, width, height, werr, werrlen) != 0)
         goto out;
     cJSON_AddStringToObject(fr, "mode", o->mode);
+    cJSON *made = cJSON_AddObjectToObject(fr, "run");
+    if (!made || prov_json(made) != 0 || !cJSON_AddNumberToObject(made, "threads", threads)) {
+        snprintf(werr, werrlen, "out of memory");
+        goto out;
+    }
     cJSON_AddStringToObject(fr, "status", "failed");
     cJSON_AddStringToObject(fr, "error", why);
     cJSON_AddNumberToObject(fr, "tiles_done", f->tiles_done);
@@ -232,10 +239,21 @@ static int stage_outputs(OutSet *set, const Report *r, char *err, size_t errlen)
     cJSON_free(json_text);
     if (rc != 0)
         return -1;
-    char txt[16384];
+    char txt[65536];   /* (the command line it opens with can be long) */
     report_txt(r, txt, sizeof txt);
     snprintf(path, sizeof path, "%s/report.txt", o->out_dir);
     if (outfile_write_file(set, path, txt, strlen(txt), err, errlen) != 0)
+        return -1;
+    char *stats = NULL;
+    size_t stats_len = 0;
+    snprintf(path, sizeof path, "%s/stats.txt", o->out_dir);
+    if (report_stats_txt(r, &stats, &stats_len) != 0) {
+        snprintf(err, errlen, "%s: out of memory", path);
+        return -1;
+    }
+    rc = outfile_write_file(set, path, stats, stats_len, err, errlen);
+    free(stats);
+    if (rc != 0)
         return -1;
     if (run_mode_timed(r->mode) && write_cost_map(set, o->out_dir, &r->fr->f, r->fr->has_est ? r->fr->tile_cycles : NULL,
                                                   s->render.width, s->render.height, err, errlen) != 0)
@@ -248,9 +266,10 @@ static int stage_outputs(OutSet *set, const Report *r, char *err, size_t errlen)
  * frame.partial.exr) removed. 0, or -1 with a message; then nothing of this run is in the folder. */
 static int write_outputs(const Report *r, char *err, size_t errlen)
 {
-    static const char *const keep_timed[] = {"frame.exr", "frame.png", "report.txt", "report.json", "cost.png", NULL};
-    static const char *const keep_untimed[] = {"frame.exr", "frame.png", "report.txt", "report.json", NULL};
-    static const char *const keep_no_image[] = {"report.txt", "report.json", "cost.png", NULL};
+    static const char *const keep_timed[] = {"frame.exr", "frame.png", "report.txt", "report.json", "stats.txt",
+                                             "cost.png", NULL};
+    static const char *const keep_untimed[] = {"frame.exr", "frame.png", "report.txt", "report.json", "stats.txt", NULL};
+    static const char *const keep_no_image[] = {"report.txt", "report.json", "stats.txt", "cost.png", NULL};
     const char *dir = r->o->out_dir;
     const char *const *keep = r->o->no_image ? keep_no_image : run_mode_timed(r->mode) ? keep_timed : keep_untimed;
     OutDirs dirs = {0};
@@ -274,7 +293,7 @@ static int write_outputs(const Report *r, char *err, size_t errlen)
 static void keep_partial(const RenderOptions *o, const RunScene *sc, const RunFrame *fr, char *err, size_t errlen)
 {
     char werr[4400], text[16384];
-    if (write_partial(o, fr->rgb, sc->s.render.width, sc->s.render.height, &fr->f, err, werr, sizeof werr) == 0)
+    if (write_partial(o, fr->rgb, sc->s.render.width, sc->s.render.height, &fr->f, fr->threads, err, werr, sizeof werr) == 0)
         snprintf(text, sizeof text, "%s\n(%u of %u tiles finished: %s/frame.partial.exr; unfinished tiles are black)",
                  err, fr->f.tiles_done, fr->f.ntiles, o->out_dir);
     else

@@ -1,7 +1,8 @@
-/* sim/report.c -- what `sfsim run` says about a run: report.json and report.txt (docs/report.md).
+/* sim/report.c -- what `sfsim run` says about a run: report.json, report.txt and stats.txt
+ * (docs/report.md).
  *
- * Owns: the blocks that describe the run (mode, scene, config, render, kernel, kd-tree, image, host)
- * and report.txt's lines for them. The statistics themselves come from the registry's walk
+ * Owns: the blocks that describe the run (mode, what made it, scene, config, render, kernel,
+ * kd-tree, image, host), report.txt's lines for them and stats.txt's header. The statistics themselves come from the registry's walk
  * (sim/stats.def, sim/stats.c). Must not: run anything, or write files (sim/render.c does).
  */
 #include "report.h"
@@ -9,8 +10,11 @@
 #include <cjson/cJSON.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
+#include "../host/version.h"
+#include "provenance.h"
 #include "stats.h"
 
 /* A SAH cost for report.txt: "%.2f", or why there is none (a cost is a ratio of surface areas,
@@ -139,7 +143,10 @@ cJSON *report_json(const Report *r)
      * (sim/stats.def; the timing fields are null unless timed); the blocks below describe the run. */
     StatsCtx sx = stats_ctx(r);
     cJSON *root = cJSON_CreateObject();
-    if (!root || !cJSON_AddStringToObject(root, "mode", o->mode) || stats_json(root, &sx) != 0) {
+    /* What made the run (sim/provenance.h): it changes with every run, so the same-outputs digest
+     * leaves the whole object out (tools/outputs_digest.c). */
+    cJSON *made = root && cJSON_AddStringToObject(root, "mode", o->mode) ? cJSON_AddObjectToObject(root, "run") : NULL;
+    if (!made || prov_json(made) != 0 || !cJSON_AddNumberToObject(made, "threads", threads) || stats_json(root, &sx) != 0) {
         cJSON_Delete(root);
         return NULL;
     }
@@ -234,6 +241,9 @@ void report_txt(const Report *r, char *txt, size_t cap)
     const char *thr = threads == 1 ? "thread" : "threads";
     int len = snprintf(txt, cap,
              "sfsim report -- mode %s (%s)\n"
+             "run          sfsim %s (commit %s), started %s on %s, %d host %s\n"
+             "command      %s\n"
+             "             in %s\n"
              "scene        %s\n"
              "             %u triangles, %u spheres, %u lights; needs: %s\n"
              "             BVH %u nodes, %u leaves, depth %u, SAH cost %s; %u bytes of scene memory\n"
@@ -245,7 +255,9 @@ void report_txt(const Report *r, char *txt, size_t cap)
              : sampled    ? "the golden model's image; sampled (tile, pass) units on the timed kernel, the frame's cycles estimated"
              : functional ? "the kernel on the functional core: no timing"
                           : "golden model: no timing",
-             o->scene_path, sp->ntris, sp->nspheres, pp->nlights, needs[0] ? needs : "-", pp->bvh.nnodes,
+             version_string(), version_commit(), prov_date(), prov_host()[0] ? prov_host() : "an unnamed host", threads,
+             thr, prov_argc() ? prov_command() : "(none: not run from sfsim's command line)",
+             prov_cwd()[0] ? prov_cwd() : "(a folder that could not be read)", o->scene_path, sp->ntris, sp->nspheres, pp->nlights, needs[0] ? needs : "-", pp->bvh.nnodes,
              pp->bvh.nleaves, pp->bvh.depth, sah_text(pp->bvh.sah_cost, sah, sizeof sah), pp->size,
              o->config_path ? o->config_path : "built-in (the defaults of sim/config.def)", sp->render.width,
              sp->render.height, sp->render.spp, sp->render.max_depth, o->seed, tiles_txt, r->mean,
@@ -283,3 +295,24 @@ void report_txt(const Report *r, char *txt, size_t cap)
                         threads, thr, secs > 0 ? 1e-6 * (double)total_rays / secs : 0.0, r->sc->load_seconds, r->sc->accel.pack_seconds);
 }
 
+
+/* stats.txt (docs/report.md): a comment naming the sfsim that wrote it, then the statistics in
+ * gem5's form from the registry's walk. 0, or -1 when out of memory. */
+int report_stats_txt(const Report *r, char **text, size_t *len)
+{
+    StatsCtx sx = stats_ctx(r);
+    *text = NULL;
+    *len = 0;
+    FILE *fp = open_memstream(text, len);
+    if (!fp)
+        return -1;
+    fprintf(fp, "# sfsim %s (commit %s), mode %s; the command line, date and host: report.json's \"run\"\n",
+            version_string(), version_commit(), r->o->mode);
+    int rc = stats_gem5(fp, &sx);
+    if (fclose(fp) != 0 || rc != 0) {
+        free(*text);
+        *text = NULL;
+        return -1;
+    }
+    return 0;
+}

@@ -1,4 +1,4 @@
-/* sim/report.h -- report.json and report.txt of one `sfsim run` (docs/report.md).
+/* sim/report.h -- report.json, report.txt and stats.txt of one `sfsim run` (docs/report.md).
  *
  * Owns: their content. Must not: write files (sim/render.c stages and commits them).
  */
@@ -28,5 +28,7 @@ typedef struct Report {
 struct cJSON *report_json(const Report *r);
 /* report.txt into txt (truncated to cap). */
 void report_txt(const Report *r, char *txt, size_t cap);
+/* stats.txt, gem5's form, into *text (malloc'd; free it) of *len bytes. 0, or -1 when out of memory. */
+int report_stats_txt(const Report *r, char **text, size_t *len);
 
 #endif

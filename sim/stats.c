@@ -538,6 +538,16 @@ void stats_walk(const StatsCtx *c, void (*visit)(void *w, const StatsRow *r), vo
 
 /* ---- report.json ---------------------------------------------------------------------------- */
 
+/* The number report.json holds (stats.txt prints the same): rounded for F(ROUND); a flag 1 or 0. */
+double stats_row_report_value(const StatsCtx *c, const StatsRow *r, const int *idx)
+{
+    int na;
+    double v = stats_row_value(c, r, idx, &na);
+    if (r->unit == STATS_U_FLAG)
+        return v != 0;
+    return r->flags & STATS_F_ROUND ? round(v) : v;
+}
+
 typedef struct JsonW {
     const StatsCtx *c;
     cJSON *root;
@@ -561,11 +571,8 @@ static cJSON *json_value(JsonW *w)
         }
         return a;
     }
-    int na;
-    double v = stats_row_value(w->c, r, w->idx, &na);
-    if (r->unit == STATS_U_FLAG)
-        return cJSON_CreateBool(v != 0);
-    return cJSON_CreateNumber(r->flags & STATS_F_ROUND ? round(v) : v);
+    double v = stats_row_report_value(w->c, r, w->idx);
+    return r->unit == STATS_U_FLAG ? cJSON_CreateBool(v != 0) : cJSON_CreateNumber(v);
 }
 
 /* The container a key holds: an array when the next segment indexes one. */

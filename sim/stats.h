@@ -1,7 +1,7 @@
 /* sim/stats.h -- the statistics registry: every counter and derived figure of a run, once
  * (sim/stats.def), and the one walk over it that writes them.
  *
- * Owns: the statistics part of report.json, report.txt's statistics lines, the `sfsim exec
+ * Owns: the statistics part of report.json, report.txt's statistics lines, stats.txt, the `sfsim exec
  * --timing` (and `sfsim trace --mode detailed`) print-out, the sweep CSV's columns and their
  * reading back from report.json, and every derived figure (utilization, timed utilization,
  * stream lengths, shares, hit rate, fps, the sampled-mode estimate): computed here only, used by
@@ -13,7 +13,7 @@
  * Adding a counter: its row in sim/stats.def and the code that counts it; report.json,
  * report.txt, the exec print-out, the CSV and docs/report.md follow from the row.
  * Files: sim/stats.c (the table, the figures, the walk, report.json), sim/stats_text.c
- * (report.txt, the exec print-out), sim/stats_csv.c (the CSV), sim/stats_walk.h (between them).
+ * (report.txt, the exec print-out, stats.txt), sim/stats_csv.c (the CSV), sim/stats_walk.h (between them).
  */
 #ifndef SFSIM_STATS_H
 #define SFSIM_STATS_H
@@ -199,6 +199,12 @@ void stats_text(char *buf, size_t cap, size_t *len, const StatsCtx *c);
 /* The exec print-out: the headline "timing: C cycles = B busy + S stall", then one line per value
  * ("  stall control  2"; elements that are 0 left out). */
 void stats_print_exec(FILE *out, const StatsCtx *c);
+
+/* stats.txt (docs/report.md): gem5's "---------- Begin Simulation Statistics ----------", a line
+ * per number of report.json's statistics, "name  value  # description (unit)", with the name the
+ * report.json path in dots and a vector's element "name::key" (a summing one's "name::total"
+ * after its elements), then gem5's End line. 0, or -1 when fp reports an error. */
+int stats_gem5(FILE *fp, const StatsCtx *c);
 
 /* ---- derived figures: computed here, and only here ---------------------------------------- */
 double stats_ratio(uint64_t a, uint64_t b);            /* a / b; 0 when b = 0 */

@@ -1,9 +1,12 @@
-/* sim/stats_text.c -- the statistics registry's text: report.txt's statistics lines and the
- * `sfsim exec --timing` print-out, from the walk over sim/stats.def.
+/* sim/stats_text.c -- the statistics registry's text: report.txt's statistics lines, the
+ * `sfsim exec --timing` print-out and stats.txt (gem5's form), from the walk over sim/stats.def.
  *
- * Owns: the layout (a line per row group, a table for 2-D rows, the headline sentences) and the
- * number format of each unit. Must not: compute a figure (sim/stats.c does) or name a counter.
+ * Owns: the layout (a line per row group, a table for 2-D rows, the headline sentences; stats.txt's
+ * names and lines) and the number format of each unit. Must not: compute a figure (sim/stats.c
+ * does) or name a counter.
  */
+#include <cjson/cJSON.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
@@ -203,4 +206,114 @@ void stats_print_exec(FILE *fp, const StatsCtx *c)
 {
     TextW w = {.c = c, .fp = fp};
     stats_walk(c, exec_row, &w);
+}
+
+/* ---- stats.txt: gem5's form (docs/report.md, "stats.txt") ------------------------------------ */
+
+/* Elements of d add up to a whole, so that a vector over d gets gem5's "::total" (a kd counter's
+ * elements are different counters; a bound's are the two ends of an interval). */
+static int dim_sums(StatsDim d)
+{
+    switch (d) {
+    case STATS_D_STAGE: case STATS_D_FILTER: case STATS_D_CAUSE: case STATS_D_CATEGORY: case STATS_D_GEN:
+    case STATS_D_TILE: case STATS_D_OPCODE: case STATS_D_UNIT: case STATS_D_KIND: return 1;
+    case STATS_D_COUNTER: case STATS_D_BOUND: case STATS_D_COUNT: break;
+    }
+    return 0;
+}
+
+/* A unit whose values add up (counts, cycles, bytes), unlike ratios, rates and per-ray means. */
+static int unit_sums(StatsUnit u)
+{
+    switch (u) {
+    case STATS_U_CYCLES: case STATS_U_INSTRUCTIONS: case STATS_U_RAYS: case STATS_U_STREAMS: case STATS_U_EVENTS:
+    case STATS_U_TILES: case STATS_U_UNITS: case STATS_U_ACCESSES: case STATS_U_LINES: case STATS_U_IDS:
+    case STATS_U_VECTORS: case STATS_U_TRANSFERS: case STATS_U_PARTITIONS: case STATS_U_BYTES: return 1;
+    case STATS_U_RAYS_PER_STREAM: case STATS_U_PER_RAY: case STATS_U_RATIO: case STATS_U_FPS: case STATS_U_MHZ:
+    case STATS_U_CPI: case STATS_U_NUMBER: case STATS_U_PIXELS: case STATS_U_SECONDS: case STATS_U_FLAG:
+    case STATS_U_NAMES: case STATS_U_COUNT: break;
+    }
+    return 0;
+}
+
+/* The segment is an element of a dimension alone ("{stage}", "[gen]"), not a key around one. */
+static int seg_is_element(const Seg *g) { return g->array || (g->dim >= 0 && g->prelen == 0 && g->postlen == 0); }
+
+/* Element idx's stats.txt name: the report.json path with dots, an array index as its number (or
+ * the dimension's key: lo, hi), and a last segment that is an element written gem5's "::key". With
+ * total, that last segment is "total". */
+static const char *gem5_name(const Seg *seg, int nseg, const StatsRow *r, const int *idx, int total, char *buf, size_t len)
+{
+    size_t n = 0;
+    char key[128];
+    buf[0] = '\0';
+    for (int s = 0; s < nseg && n < len; s++) {
+        const Seg *g = &seg[s];
+        int last = s == nseg - 1 && seg_is_element(g);
+        const char *k = g->array ? stats_dim_key(r->dims[g->dim], idx[g->dim]) : stats_seg_key(g, r, idx, key, sizeof key);
+        if (g->array && !k[0]) {
+            snprintf(key, sizeof key, "%d", idx[g->dim]);
+            k = key;
+        }
+        int w = snprintf(buf + n, len - n, "%s%s", last ? "::" : s ? "." : "", last && total ? "total" : k);
+        n += w > 0 ? (size_t)w : 0;
+    }
+    return buf;
+}
+
+/* v as report.json writes it, by cJSON itself (15 digits when they read back within an epsilon,
+ * else 17), so that the two files hold the same number to the last bit. */
+static const char *gem5_number(double v, char *buf, size_t len)
+{
+    cJSON *n = cJSON_CreateNumber(v);
+    char *s = n ? cJSON_PrintUnformatted(n) : NULL;
+    if (s)
+        snprintf(buf, len, "%s", s);
+    else   /* (out of memory: 17 digits read back exactly, if not as report.json prints them) */
+        snprintf(buf, len, "%.17g", v);
+    cJSON_free(s);
+    cJSON_Delete(n);
+    return buf;
+}
+
+static void gem5_line(FILE *fp, const char *name, double v, const StatsRow *r)
+{
+    char num[40];
+    fprintf(fp, "%-40s %12s  # %s (%s)\n", name, gem5_number(v, num, sizeof num), r->desc, stats_unit_names[r->unit]);
+}
+
+/* One row: a line per element report.json holds (the same skipped: a sparse row's zeros), then
+ * "::total" after each run of a summing last dimension. Lists of names and nulls are not numbers. */
+static void gem5_row(void *wp, const StatsRow *r)
+{
+    TextW *w = wp;
+    Seg seg[MAX_SEGS];
+    int nseg = r->path ? stats_path_parse(r, seg) : -1, idx[STATS_MAX_DIMS] = {0}, na;
+    if (nseg < 0 || !stats_row_present(r, w->c->mode) || (r->flags & (STATS_F_LIST_NZ | STATS_F_LIST_Z)))
+        return;
+    const Seg *lastseg = &seg[nseg - 1];
+    int totals = seg_is_element(lastseg) && unit_sums(r->unit) && dim_sums(r->dims[lastseg->dim]);
+    double sum = 0.0;
+    char name[512];
+    for (int ok = stats_idx_first(w->c, r, idx); ok; ok = stats_idx_next(w->c, r, idx)) {
+        double v = stats_row_report_value(w->c, r, idx);
+        int shown = !(r->flags & STATS_F_SPARSE) || stats_row_value(w->c, r, idx, &na) != 0;
+        if (shown && isfinite(v))   /* (report.json would hold null) */
+            gem5_line(w->fp, gem5_name(seg, nseg, r, idx, 0, name, sizeof name), v, r);
+        sum += v;
+        if (totals && idx[lastseg->dim] == stats_dim_len(w->c, r->dims[lastseg->dim]) - 1) {
+            if (isfinite(sum))
+                gem5_line(w->fp, gem5_name(seg, nseg, r, idx, 1, name, sizeof name), sum, r);
+            sum = 0.0;
+        }
+    }
+}
+
+int stats_gem5(FILE *fp, const StatsCtx *c)
+{
+    TextW w = {.c = c, .fp = fp};
+    fprintf(fp, "\n---------- Begin Simulation Statistics ----------\n");
+    stats_walk(c, gem5_row, &w);
+    fprintf(fp, "\n---------- End Simulation Statistics   ----------\n");
+    return ferror(fp) ? -1 : 0;
 }

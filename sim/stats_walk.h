@@ -21,6 +21,9 @@ typedef struct Seg {
 int stats_dim_len(const StatsCtx *c, StatsDim d);
 /* The value of r's element idx; *na = 1 when it has no meaning. */
 double stats_row_value(const StatsCtx *c, const StatsRow *r, const int *idx, int *na);
+/* The number report.json (and stats.txt) holds for r's element idx: the value rounded for
+ * F(ROUND), a flag 1 or 0 (report.json: true or false). */
+double stats_row_report_value(const StatsCtx *c, const StatsRow *r, const int *idx);
 /* r appears in mode (STATS_M_*, with STATS_M_KD when the kernel traverses a kd-tree). */
 int stats_row_present(const StatsRow *r, unsigned mode);
 /* r's first element (all 0; 0 when the row has none in this run), and the next, row-major. */

@@ -8,7 +8,9 @@
  * mode has none); image is a 64-bit
  * FNV-1a hash of frame.exr's float pixel bits (the EXR file itself carries a capture date); report
  * hashes every value of report.json except the "host" block (host time, threads), host times
- * elsewhere (keys "seconds" and "*_seconds") and "config_file" (a path), in a canonical form -- keys sorted, numbers printed with 17 digits --
+ * elsewhere (keys "seconds" and "*_seconds"), "config_file" (a path) and the "run" block (what made
+ * the run: version, commit, command line, folder, date, host name, threads; it changes with every
+ * run and every commit, by design, and says nothing of the results), in a canonical form -- keys sorted, numbers printed with 17 digits --
  * so that moving the code that writes the report cannot hide a changed value, and reordering
  * keys does not count as one. cost.png's pixels are part of the report hash.
  *
@@ -184,6 +186,7 @@ int main(int argc, char **argv)
     }
     cJSON_DeleteItemFromObjectCaseSensitive(root, "host");
     cJSON_DeleteItemFromObjectCaseSensitive(root, "config_file");
+    cJSON_DeleteItemFromObjectCaseSensitive(root, "run");   /* provenance: see the top */
 
     Fnv image = {14695981039346656037ull}, report = {14695981039346656037ull};
     snprintf(path, sizeof path, "%s/frame.exr", argv[1]);

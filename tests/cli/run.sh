@@ -475,7 +475,7 @@ end
 TINY=(--set render.width=32 --set render.height=32 --set render.spp=1 -j 2 --no-progress)
 TRAP=(--mode functional --kernel "$T/trap_kernel.s" -s scenes/cornell/scene.ini --set render.width=32 --set render.height=16
       --set stream.rays=1024 --set core.simd_width=4 --set stream.mode=packet --set render.spp=1 -j 1 --no-progress)
-RUN_OUTPUTS="frame.exr frame.png report.txt report.json cost.png frame.partial.exr"
+RUN_OUTPUTS="frame.exr frame.png report.txt report.json stats.txt cost.png frame.partial.exr"
 
 # no_temporaries DIR: no temporary file of host/outfile.c anywhere under DIR.
 no_temporaries() {
@@ -610,9 +610,9 @@ want_rc 1; want_err "bad_kernel.s:1:"
 [ ! -e "$T/fw/new" ] || no "$T/fw/new was created"
 end
 
-begin "sfsim run on a real full disk (a 64 KiB tmpfs, filled in steps): exit 0 with whole files, or 4 with nothing"
+begin "sfsim run on a real full disk (a 128 KiB tmpfs, filled in steps): exit 0 with whole files, or 4 with nothing"
 mkdir -p "$T/tmpfs"
-if ! mount -t tmpfs -o size=64k tmpfs "$T/tmpfs" 2>"$T/err"; then
+if ! mount -t tmpfs -o size=128k tmpfs "$T/tmpfs" 2>"$T/err"; then
     echo "note: cannot mount a tmpfs ($(head -1 "$T/err")): the fault hook above covers full disks alone"
 else
     trap 'umount "$T/tmpfs" 2>/dev/null; rm -rf "$T"' EXIT
