@@ -83,8 +83,11 @@ no_temporaries "$T/sw1"
 [ -z "$(find "$T/sw1/points" -name 'frame.*')" ] || no "a point kept a partial image"
 end
 
-begin "sfsim sweep under a limit only the plots exceed: exit 4, no partial PNG, the plots named"
-limited 12 "$SFSIM" "${SW[@]}" -o "$T/sw2"
+begin "sfsim merge under a limit only the plots exceed: exit 4, no partial PNG, the plots named"
+run "$SFSIM" "${SW[@]}" -o "$T/sw2"
+want_rc 0
+[ "$(find "$T/sw2/plots" -name '*.png' | wc -l)" -ge 2 ] || no "the sweep drew no plots to replace"
+limited 12 "$SFSIM" merge "$T/sw2"
 want_rc 4; want_err "plots/.*\.png: .*incomplete"
 want_err "0 plots"
 no_temporaries "$T/sw2"
@@ -98,7 +101,7 @@ want_rc 0
 n=$(find "$T/sw2/plots" -name '*.png' | wc -l)
 [ "$n" -ge 2 ] || no "$n plots after the merge"
 for f in "$T"/sw2/plots/*.png; do
-    [ "$(tail -c 8 "$f" | head -c 4)" = "IEND" ] || no "$f does not end with IEND"
+    [ -e "$f" ] && [ "$(tail -c 8 "$f" | head -c 4)" = "IEND" ] || no "$f does not end with IEND"
 done
 end
 
