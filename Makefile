@@ -44,7 +44,9 @@ IMGW_LIBS := $(or $(filter -L% -lOpenEXRCore%,$(shell pkg-config --libs OpenEXR 
 # OpenImageIO is not in LDLIBS: it only reads images now, and bin/sfsim loads it with dlopen
 # inside the image library (IMGLIB below) when `sfsim compare` needs it; the test and tool
 # binaries that read images link its objects and $(OIIO).
-LDLIBS  := $(GLTF) $(CJSON) $(IMGW_LIBS) -lstdc++ -lpthread -ldl -lm
+# GSL: sampled mode's numerics (sim/sampling.c: the t quantile, the fit's Cholesky solves).
+GSL     := $(shell pkg-config --libs gsl 2>/dev/null || echo -lgsl -lgslcblas -lm)
+LDLIBS  := $(GLTF) $(CJSON) $(IMGW_LIBS) $(GSL) -lstdc++ -lpthread -ldl -lm
 INIH    := $(shell pkg-config --cflags --libs inih 2>/dev/null || echo -linih)
 CRIT    := $(shell pkg-config --libs criterion 2>/dev/null || echo -lcriterion)
 EMBREE  := -lembree3

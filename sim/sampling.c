@@ -1,8 +1,16 @@
 /* sim/sampling.c -- seeded samples, the regression estimator and the sequential stopping rule
  * (formulas and the rule: sampling.h; design: docs/sampling.md). Pure functions: no I/O, no
- * threads, no allocation. Must not run or time anything. */
+ * threads, no allocation. Must not run or time anything. The numerics are GSL's: the t quantile
+ * (gsl_cdf_tdist_Pinv) and the fit's Cholesky factor, triangular and Cholesky solves
+ * (gsl_linalg_cholesky_decomp1, gsl_blas_dtrsv, gsl_linalg_cholesky_solve) on views of the Fit's
+ * arrays; the estimator, its column choice and its jackknife are defined here. */
 #include "sampling.h"
 
+#include <gsl/gsl_blas.h>
+#include <gsl/gsl_cdf.h>
+#include <gsl/gsl_linalg.h>
+#include <gsl/gsl_matrix.h>
+#include <gsl/gsl_vector.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -47,19 +55,9 @@ void sample_order(uint32_t N, uint32_t seed, uint32_t *order)
 
 double sample_t975(uint32_t df)
 {
-    static const double table[30] = {12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228,
-                                     2.201,  2.179, 2.160, 2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086,
-                                     2.080,  2.074, 2.069, 2.064, 2.060, 2.056, 2.052, 2.048, 2.045, 2.042};
     if (df == 0)
         return INFINITY;
-    if (df <= 30)
-        return table[df - 1];
-    /* Cornish-Fisher expansion around the normal quantile (Abramowitz & Stegun 26.7.5). */
-    const double z = 1.959963984540054, d = (double)df;
-    double z3 = z * z * z, z5 = z3 * z * z, z7 = z5 * z * z;
-    double g1 = (z3 + z) / 4.0, g2 = (5 * z5 + 16 * z3 + 3 * z) / 96.0,
-           g3 = (3 * z7 + 19 * z5 + 17 * z3 - 15 * z) / 384.0;
-    return z + g1 / d + g2 / (d * d) + g3 / (d * d * d);
+    return gsl_cdf_tdist_Pinv(0.975, (double)df);
 }
 
 /* ---- the regression (GREG) estimator ---------------------------------------------------------- */
@@ -75,7 +73,8 @@ typedef struct Fit {
     double raw[SAMPLE_MAX_AUX];      /* uncentred sums of squares */
     double b[SAMPLE_MAX_AUX];        /* slopes per original column (0 for dropped ones) */
     double sse;                      /* sum of squared residuals, from the data */
-    double L[SAMPLE_MAX_AUX][SAMPLE_MAX_AUX], sc[SAMPLE_MAX_AUX]; /* the kept columns' scaled Cholesky factor */
+    double L[SAMPLE_MAX_AUX][SAMPLE_MAX_AUX], sc[SAMPLE_MAX_AUX]; /* the kept columns' scaled Cholesky factor
+                                                                    (GSL's: L lower, L' upper), their scales */
 } Fit;
 
 /* Sample means, then centred cross-products in a second pass (the two-pass form does not lose
@@ -108,72 +107,82 @@ static int fit_moments(Fit *f, const double *ys, const double *x, const uint32_t
     return 0;
 }
 
+/* u = C^-1 v over the kept columns (C: their centred cross-products, = D L L' D with D the
+ * scales), v and u indexed by kept position: GSL's Cholesky solve of the scaled system. */
+static void fit_cinv(const Fit *f, const double *v, double *u)
+{
+    const uint32_t m = f->nkeep;
+    if (m == 0)
+        return;
+    double a[SAMPLE_MAX_AUX];
+    for (uint32_t p = 0; p < m; p++)
+        a[p] = v[p] / f->sc[p];
+    gsl_matrix_const_view L = gsl_matrix_const_view_array_with_tda(&f->L[0][0], m, m, SAMPLE_MAX_AUX);
+    gsl_vector_const_view av = gsl_vector_const_view_array(a, m);
+    gsl_vector_view uv = gsl_vector_view_array(u, m);
+    gsl_linalg_cholesky_solve(&L.matrix, &av.vector, &uv.vector);
+    for (uint32_t p = 0; p < m; p++)
+        u[p] /= f->sc[p];
+}
+
+/* The scaled cross-product of columns j and q (scales scj, scq): S_jq / (scj scq). */
+static double fit_scaled(const Fit *f, uint32_t j, uint32_t q, double scj, double scq)
+{
+    return (j > q ? f->s[j][q] : f->s[q][j]) / (scj * scq);
+}
+
+/* L (its m x m top left corner): GSL's Cholesky factor of the first m kept columns' scaled
+ * cross-products. They are positive definite: every kept column's pivot exceeded FIT_PIVOT_TOL. */
+static void fit_factor(Fit *f, uint32_t m)
+{
+    for (uint32_t p = 0; p < m; p++)
+        for (uint32_t q = 0; q < m; q++)
+            f->L[p][q] = fit_scaled(f, f->keep[p], f->keep[q], f->sc[p], f->sc[q]);
+    gsl_matrix_view L = gsl_matrix_view_array_with_tda(&f->L[0][0], m, m, SAMPLE_MAX_AUX);
+    gsl_linalg_cholesky_decomp1(&L.matrix);
+}
+
+/* Column j's squared Cholesky pivot against the kept columns, 1 - R^2 of j on them:
+ * 1 - |L^-1 r|^2 with r its scaled cross-products with them (sc: j's scale). */
+static double fit_pivot(const Fit *f, uint32_t j, double sc)
+{
+    const uint32_t m = f->nkeep;
+    if (m == 0)
+        return 1.0;
+    double c[SAMPLE_MAX_AUX], cc;
+    for (uint32_t p = 0; p < m; p++)
+        c[p] = fit_scaled(f, j, f->keep[p], sc, f->sc[p]);
+    gsl_matrix_const_view L = gsl_matrix_const_view_array_with_tda(&f->L[0][0], m, m, SAMPLE_MAX_AUX);
+    gsl_vector_view cv = gsl_vector_view_array(c, m);
+    gsl_blas_dtrsv(CblasLower, CblasNoTrans, CblasNonUnit, &L.matrix, &cv.vector);
+    gsl_blas_ddot(&cv.vector, &cv.vector, &cc);
+    return 1.0 - cc;
+}
+
 /* Chooses the columns (constant and collinear ones dropped, then the last kept ones until
  * n - k - 1 >= 1) and solves the normal equations of the kept ones, scaled to unit sums of
  * squares, by Cholesky: L L' beta = c, b_j = beta_j / sqrt(S_jj). */
 static void fit_solve(Fit *f, uint32_t n)
 {
-    double(*L)[SAMPLE_MAX_AUX] = f->L, *sc = f->sc, c[SAMPLE_MAX_AUX];
     for (uint32_t j = 0; j < f->k; j++) {
         double sjj = f->s[j][j];
         if (!(sjj > FIT_CONST_TOL * f->raw[j]) || !(sjj > 0.0))
             continue;
-        uint32_t m = f->nkeep;
-        sc[m] = sqrt(sjj);
-        double d = 1.0;
-        for (uint32_t p = 0; p < m; p++) { /* row m of L: the scaled column j against kept column p */
-            uint32_t q = f->keep[p];
-            double v = (j > q ? f->s[j][q] : f->s[q][j]) / (sc[m] * sc[p]);
-            for (uint32_t r = 0; r < p; r++)
-                v -= L[m][r] * L[p][r];
-            L[m][p] = v / L[p][p];
-            d -= L[m][p] * L[m][p];
-        }
-        if (!(d > FIT_PIVOT_TOL))
+        double sc = sqrt(sjj);
+        if (!(fit_pivot(f, j, sc) > FIT_PIVOT_TOL))
             continue;
-        L[m][m] = sqrt(d);
-        f->keep[m] = j;
-        f->nkeep++;
+        f->sc[f->nkeep] = sc;
+        f->keep[f->nkeep++] = j;
+        fit_factor(f, f->nkeep);
     }
-    if (f->nkeep + 1 >= n) /* df = n - k - 1 must stay >= 1 (n >= 2 here) */
+    if (f->nkeep + 1 >= n) /* df = n - k - 1 must stay >= 1 (n >= 2 here); L's corner stays their factor */
         f->nkeep = n - 2;
-    const uint32_t m = f->nkeep;
-    for (uint32_t p = 0; p < m; p++) { /* forward: L c = S_jy scaled */
-        double v = f->sy[f->keep[p]] / sc[p];
-        for (uint32_t r = 0; r < p; r++)
-            v -= L[p][r] * c[r];
-        c[p] = v / L[p][p];
-    }
-    for (uint32_t p = m; p-- > 0;) { /* backward: L' beta = c */
-        double v = c[p];
-        for (uint32_t r = p + 1; r < m; r++)
-            v -= L[r][p] * c[r];
-        c[p] = v / L[p][p];
-    }
-    for (uint32_t p = 0; p < m; p++)
-        f->b[f->keep[p]] = c[p] / sc[p];
-}
-
-/* u = C^-1 v over the kept columns (C: their centred cross-products, = D L L' D with D the
- * scales), v and u indexed by kept position. */
-static void fit_cinv(const Fit *f, const double *v, double *u)
-{
-    const uint32_t m = f->nkeep;
-    double c[SAMPLE_MAX_AUX];
-    for (uint32_t p = 0; p < m; p++) {
-        double a = v[p] / f->sc[p];
-        for (uint32_t r = 0; r < p; r++)
-            a -= f->L[p][r] * c[r];
-        c[p] = a / f->L[p][p];
-    }
-    for (uint32_t p = m; p-- > 0;) {
-        double a = c[p];
-        for (uint32_t r = p + 1; r < m; r++)
-            a -= f->L[r][p] * c[r];
-        c[p] = a / f->L[p][p];
-    }
-    for (uint32_t p = 0; p < m; p++)
-        u[p] = c[p] / f->sc[p];
+    double sy[SAMPLE_MAX_AUX], beta[SAMPLE_MAX_AUX];
+    for (uint32_t p = 0; p < f->nkeep; p++)
+        sy[p] = f->sy[f->keep[p]];
+    fit_cinv(f, sy, beta);
+    for (uint32_t p = 0; p < f->nkeep; p++)
+        f->b[f->keep[p]] = beta[p];
 }
 
 /* The delete-one jackknife variance of the regression estimate (sampling.h), or -1 when a unit

@@ -25,7 +25,7 @@
  *     interval Y^ +- t_{0.975, df} sqrt(V^), its lower end raised to sum_s y_s when every sampled
  *     y_s >= 0 (the frame takes at least the cycles measured).
  *    The fit centres the columns on their sample means, scales them to unit sum of squares and
- *    solves the normal equations by Cholesky; a column is dropped (coef 0, not counted in k) when
+ *    solves the normal equations by Cholesky (GSL's: gsl_linalg_cholesky_decomp1 and _solve); a column is dropped (coef 0, not counted in k) when
  *    its centred sum of squares is below 1e-20 of its raw sum of squares (constant), or when its
  *    Cholesky pivot falls below 1e-9 (R^2 > 1 - 1e-9 on the earlier kept columns: collinear).
  *    When n <= k + 1 the LAST kept columns are dropped until df >= 1, so list auxiliaries most
@@ -95,7 +95,8 @@ typedef int (*SampleMeasure)(void *ctx, const uint32_t *units, uint32_t count, d
 int sample_sequential(const double *x, uint32_t k, const uint32_t *order, uint32_t N, uint32_t n0, double target,
                       SampleMeasure measure, void *ctx, double *ys, SampleEstimate *out, uint32_t *rounds);
 
-/* The 0.975 quantile of Student's t distribution with df degrees of freedom (df >= 1). */
+/* The 0.975 quantile of Student's t distribution with df degrees of freedom (df >= 1): GSL's
+ * gsl_cdf_tdist_Pinv; infinite for df = 0. */
 double sample_t975(uint32_t df);
 
 #endif

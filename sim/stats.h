@@ -245,5 +245,19 @@ const char *stats_csv_name(int col, char *buf, size_t len);
 /* One point's figures from its parsed report.json: value[col] and has[col] (0 where the report
  * has no finite number there; shares normalized over their row). Both have stats_csv_count() entries. */
 void stats_csv_read(const struct cJSON *report, double *value, unsigned char *has);
+/* Column col's report.json path ("stall_shares.control", "fps_ci95[1]"); "" when out of range. */
+const char *stats_csv_key(int col, char *buf, size_t len);
+/* A reason a point's report.json cannot give a figure its run must have (stats_csv_check). */
+typedef struct StatsCsvProblem {
+    int col;        /* the figure column */
+    char key[128];  /* the report.json key at fault: the figure's, or one on its path */
+    char what[64];  /* "missing", "is not a number (a string)", "is not an object (null)" ... */
+} StatsCsvProblem;
+/* The figures report lacks, or holds as no finite number, that a run of mode (STATS_M_FUNC, DET
+ * or SAMP, | STATS_M_KD) writes: a row of the mode must be there (a SPARSE row's elements may be
+ * absent); a row the mode does not have may be absent, null or a number, nothing else (a string).
+ * The first max into out (a wrong key on the way to several elements counts once); returns how
+ * many there are, 0 when the report has every figure of its mode. */
+int stats_csv_check(const struct cJSON *report, unsigned mode, StatsCsvProblem *out, int max);
 
 #endif

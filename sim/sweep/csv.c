@@ -11,7 +11,9 @@
 #include "../../host/outfile.h"
 #include "sweep_int.h"
 
+#include <errno.h>
 #include <math.h>
+#include <unistd.h>
 
 /* ---- the figure columns -------------------------------------------------------------------- */
 
@@ -46,13 +48,56 @@ void sweep_row_clear(SweepRow *row)
     memset(row, 0, sizeof *row);
 }
 
-int sweep_row_read_report(SweepRow *row, const char *path, char *err, size_t errlen)
+unsigned sweep_stats_mode(const char *mode)
+{
+    if (mode && !strcmp(mode, "functional"))
+        return STATS_M_FUNC;
+    if (mode && !strcmp(mode, "sampled"))
+        return STATS_M_SAMP;
+    return STATS_M_DET; /* the manifest's default, as sfsim sweep's */
+}
+
+/* The figures report.json lacks or holds wrong for a run of mode (STATS_M_*): their count, and
+ * when there are any, "PATH: key 'K' what; key ..." in err (the first SWEEP_REPORT_PROBLEMS). */
+#define SWEEP_REPORT_PROBLEMS 4
+static int report_problems(const cJSON *j, unsigned mode, const char *path, char *err, size_t errlen)
+{
+    StatsCsvProblem p[SWEEP_REPORT_PROBLEMS];
+    /* report.json has a kd block exactly when the kernel walked a kd-tree (sim/report.c), the
+     * runs whose kd rows are written (STATS_M_KD) */
+    const cJSON *kd = cJSON_GetObjectItemCaseSensitive(j, "kd");
+    if (cJSON_IsObject(kd) && cJSON_IsString(cJSON_GetObjectItemCaseSensitive(kd, "structure")))
+        mode |= STATS_M_KD;
+    int n = stats_csv_check(j, mode, p, SWEEP_REPORT_PROBLEMS);
+    if (n == 0)
+        return 0;
+    size_t o = (size_t)snprintf(err, errlen, "%s:", path);
+    for (int i = 0; i < n && i < SWEEP_REPORT_PROBLEMS && o < errlen; i++)
+        o += (size_t)snprintf(err + o, errlen - o, "%s key '%s' %s", i ? ";" : "", p[i].key, p[i].what);
+    if (n > SWEEP_REPORT_PROBLEMS && o < errlen)
+        snprintf(err + o, errlen - o, " (and %d more)", n - SWEEP_REPORT_PROBLEMS);
+    return n;
+}
+
+int sweep_row_read_report(SweepRow *row, const char *path, unsigned mode, char *err, size_t errlen)
 {
     size_t len;
+    if (access(path, F_OK) != 0 && errno == ENOENT) {
+        snprintf(err, errlen, "%s: missing", path);
+        return -1;
+    }
     char *text = util_file_read(path, &len, err, errlen);
     if (!text)
         return -1;
-    cJSON *j = cJSON_Parse(text);
+    const char *end = NULL;
+    cJSON *j = cJSON_ParseWithLengthOpts(text, len, &end, 0);
+    if (!j) {
+        size_t at = end && end >= text && end <= text + len ? (size_t)(end - text) : len;
+        snprintf(err, errlen, "%s: not valid JSON at byte %zu of %zu%s", path, at, len,
+                 len == 0 ? " (an empty file)" : at + 1 >= len ? " (the text ends there: truncated?)" : "");
+        free(text);
+        return -1;
+    }
     free(text);
     if (!cJSON_IsObject(j)) {
         snprintf(err, errlen, "%s: not a JSON object", path);
@@ -60,11 +105,33 @@ int sweep_row_read_report(SweepRow *row, const char *path, char *err, size_t err
         return -1;
     }
     stats_csv_read(j, row->m, row->has);
+    int rc = mode && report_problems(j, mode, path, err, errlen) > 0 ? -1 : 0;
     cJSON_Delete(j);
-    return 0;
+    return rc;
 }
 
 /* ---- the rows and the file ----------------------------------------------------------------- */
+
+/* A done point whose report.json cannot give the figures its mode writes is failed: its row keeps
+ * the figures that were read, the error names the file and what is wrong, and stderr says so. */
+static void row_read_done(const SweepPlan *pl, const char *dir, int k, SweepRow *row)
+{
+    char *pdir = sweep_point_dir(pl, dir, k);
+    char *report = xasprintf("%s/report.json", pdir);
+    char err[PATH_MAX + 1024];
+    if (sweep_row_read_report(row, report, sweep_stats_mode(pl->mode), err, sizeof err)) {
+        char *label = sweep_point_label(pl, k);
+        fprintf(stderr, "sweep: %s failed: %s\n", label, err);
+        free(label);
+        row->state = SWEEP_FAILED;
+        free(row->error);
+        /* the cell names the file inside the point's folder */
+        const char *rel = strncmp(err, pdir, strlen(pdir)) || err[strlen(pdir)] != '/' ? err : err + strlen(pdir) + 1;
+        row->error = xasprintf("%s", rel);
+    }
+    free(report);
+    free(pdir);
+}
 
 SweepRow *sweep_rows_collect(const SweepPlan *pl, const char *dir, int *ndone, int *nfailed, int *nunfinished)
 {
@@ -75,20 +142,14 @@ SweepRow *sweep_rows_collect(const SweepPlan *pl, const char *dir, int *ndone, i
     for (int k = 0; k < pl->npoints; k++) {
         double secs;
         rows[k].state = sweep_point_state(pl, dir, k, &secs, &rows[k].error);
-        if (rows[k].state == SWEEP_DONE) {
+        if (rows[k].state == SWEEP_DONE)
+            row_read_done(pl, dir, k, &rows[k]);
+        if (rows[k].state == SWEEP_DONE)
             (*ndone)++;
-            char *pdir = sweep_point_dir(pl, dir, k);
-            char *report = xasprintf("%s/report.json", pdir);
-            char err[PATH_MAX + 64];
-            if (sweep_row_read_report(&rows[k], report, err, sizeof err))
-                fprintf(stderr, "sfsim sweep: warning: %s; its row has no figures\n", err);
-            free(report);
-            free(pdir);
-        } else if (rows[k].state == SWEEP_FAILED) {
+        else if (rows[k].state == SWEEP_FAILED)
             (*nfailed)++;
-        } else {
+        else
             (*nunfinished)++;
-        }
     }
     return rows;
 }

@@ -249,9 +249,17 @@ void sweep_row_init(SweepRow *row);
 void sweep_row_clear(SweepRow *row);
 /* The index of the figure column called name, or -1 with an error naming it in err. */
 int sweep_col(const char *name, char *err, size_t errlen);
-/* The figures of a point's report.json into row; -1 with err when it cannot be read. */
-int sweep_row_read_report(SweepRow *row, const char *path, char *err, size_t errlen);
-/* Every point's state and figures (a report that cannot be read is a warning, its row empty). */
+/* The STATS_M_* bit of a manifest's mode ("detailed", "functional", "sampled"; NULL: detailed). */
+unsigned sweep_stats_mode(const char *mode);
+/* The figures of a point's report.json into row (those it holds; the others empty). -1 with err
+ * ("PATH: missing", "PATH: not valid JSON at byte N of M", "PATH: key 'K' is not a number (a
+ * string)", "PATH: key 'K' missing"; several keys joined by "; ") when it cannot be read, or,
+ * when mode (STATS_M_*) is not 0, lacks or holds wrong a figure a run of that mode writes
+ * (stats_csv_check; a figure the mode does not have may be absent or null). */
+int sweep_row_read_report(SweepRow *row, const char *path, unsigned mode, char *err, size_t errlen);
+/* Every point's state and figures. A done point whose report.json fails sweep_row_read_report
+ * for the manifest's mode is failed (named on stderr, the reason in its error, the figures read
+ * kept) and counted in *nfailed, not *ndone. */
 SweepRow *sweep_rows_collect(const SweepPlan *pl, const char *dir, int *ndone, int *nfailed, int *nunfinished);
 void sweep_rows_free(SweepRow *rows, int n);
 /* sweep.csv into path. 0, or -1 with the reason in err. */

@@ -34,14 +34,20 @@ Test(sampling, count)
     cr_expect_eq(sample_count(40, 0.25), 10);
 }
 
+/* Student's t 0.975 quantiles to 1e-9: GSL's, not a 3-digit table or an expansion (the values:
+ * mpmath at 30 digits, the root of the regularized incomplete beta function). */
 Test(sampling, t_quantiles)
 {
-    cr_expect_float_eq(sample_t975(1), 12.706, 1e-3);
-    cr_expect_float_eq(sample_t975(12), 2.179, 1e-3);
-    cr_expect_float_eq(sample_t975(30), 2.042, 1e-3);
-    cr_expect_float_eq(sample_t975(40), 2.021, 2e-3);   /* tables: 2.0211 */
-    cr_expect_float_eq(sample_t975(120), 1.980, 2e-3);  /* 1.9799 */
-    cr_expect_float_eq(sample_t975(100000), 1.960, 1e-3);
+    cr_expect_float_eq(sample_t975(1), 12.706204736174705, 1e-9);
+    cr_expect_float_eq(sample_t975(3), 3.1824463052837096, 1e-9);
+    cr_expect_float_eq(sample_t975(12), 2.1788128296672289, 1e-9);
+    cr_expect_float_eq(sample_t975(19), 2.0930240544083098, 1e-9);
+    cr_expect_float_eq(sample_t975(30), 2.0422724563012383, 1e-9);
+    cr_expect_float_eq(sample_t975(40), 2.0210753903062734, 1e-9);
+    cr_expect_float_eq(sample_t975(59), 2.0009953780882677, 1e-9);
+    cr_expect_float_eq(sample_t975(120), 1.9799304050824408, 1e-9);
+    cr_expect_float_eq(sample_t975(100000), 1.9599877075346096, 1e-9);
+    cr_expect(isinf(sample_t975(0)), "no degrees of freedom: no interval");
 }
 
 /* ---- units in a seeded order, the regression estimator and the sequential rule ---------------- */
@@ -229,10 +235,11 @@ Test(sampling, regression_by_hand)
     cr_expect_float_eq(e.coef[1], 325.0 / 86, 1e-9);
     cr_expect_eq(e.k, 1);
     cr_expect_eq(e.df, 3);
-    cr_expect_float_eq(e.t, 3.182, 1e-9);
+    const double t3 = 3.1824463052837096; /* t(0.975, 3) */
+    cr_expect_float_eq(e.t, t3, 1e-9);
     /* the lower end, raised to the sampled units' own sum (100) where it falls below it */
-    cr_expect_float_eq(e.lo, fmax(10375.0 / 86 - 3.182 * sqrt(V), 100.0), 1e-9);
-    cr_expect_float_eq(e.hi, 10375.0 / 86 + 3.182 * sqrt(V), 1e-9);
+    cr_expect_float_eq(e.lo, fmax(10375.0 / 86 - t3 * sqrt(V), 100.0), 1e-9);
+    cr_expect_float_eq(e.hi, 10375.0 / 86 + t3 * sqrt(V), 1e-9);
     cr_expect_float_eq(e.r2, 1.0 - (719.0 / 86) / 254.0, 1e-12); /* S_yy = 254 */
 
     /* The lower end is raised to the sampled units' own sum when every y >= 0 ... */
@@ -323,7 +330,7 @@ Test(sampling, regression_census_dropped_columns_and_small_samples)
     double yb = (ys[0] + ys[1]) / 2, s2 = (ys[0] - yb) * (ys[0] - yb) + (ys[1] - yb) * (ys[1] - yb);
     cr_expect_float_eq(e.total, N * yb, 1e-9 * N * yb);
     cr_expect_float_eq(e.std_error, sqrt((double)N * N * (1.0 - 2.0 / N) / 2 * s2), 1e-6);
-    cr_expect_float_eq(e.t, 12.706, 1e-9);
+    cr_expect_float_eq(e.t, 12.706204736174705, 1e-9); /* t(0.975, 1) */
     /* k = 0 asked for, with x NULL. */
     cr_assert_eq(sample_regression_estimate(ys, NULL, 0, order, 2, N, &ref), 0);
     cr_expect_float_eq(ref.total, e.total, 0.0);
