@@ -32,6 +32,7 @@ CXXWARN := -Wall -Wextra -Werror
 CXXFLAGS := -std=c++17 $(OPT) $(ARCH) -g $(CXXWARN) $(EXTRA_CXXFLAGS)
 # C++ appears only inside the shims that wrap C++ libraries (ARCHITECTURE.md Sec. 2).
 GLTF    := $(shell pkg-config --libs tinygltf 2>/dev/null || echo -ltinygltf)
+TINYOBJ := $(shell pkg-config --libs tinyobjloader 2>/dev/null || echo -ltinyobjloader)
 OIIO    := $(shell pkg-config --libs OpenImageIO 2>/dev/null || echo -lOpenImageIO -lOpenImageIO_Util)
 CJSON   := $(shell pkg-config --libs libcjson 2>/dev/null || echo -lcjson)
 # The image writers (sim/img_write.c, sim/heatmap.c) are C on C libraries linked into bin/sfsim:
@@ -46,7 +47,7 @@ IMGW_LIBS := $(or $(filter -L% -lOpenEXRCore%,$(shell pkg-config --libs OpenEXR 
 # binaries that read images link its objects and $(OIIO).
 # GSL: sampled mode's numerics (sim/sampling.c: the t quantile, the fit's Cholesky solves).
 GSL     := $(shell pkg-config --libs gsl 2>/dev/null || echo -lgsl -lgslcblas -lm)
-LDLIBS  := $(GLTF) $(CJSON) $(IMGW_LIBS) $(GSL) -lstdc++ -lpthread -ldl -lm
+LDLIBS  := $(GLTF) $(TINYOBJ) $(CJSON) $(IMGW_LIBS) $(GSL) -lstdc++ -lpthread -ldl -lm
 INIH    := $(shell pkg-config --cflags --libs inih 2>/dev/null || echo -linih)
 CRIT    := $(shell pkg-config --libs criterion 2>/dev/null || echo -lcriterion)
 EMBREE  := -lembree3
@@ -327,7 +328,15 @@ $(BUILD)/fuzz/gltf_%.o: scenes/gltf_%.cpp scenes/gltf_internal.hpp scenes/gltf.h
 	$(CLANG)++ -std=c++17 -g -O1 -fsanitize=fuzzer-no-link,address,undefined -isystem /usr/include/stb \
 	    -DSFSIM_TINYGLTF_IMPLEMENTATION -c $< -o $@
 
-$(BUILD)/fuzz/fuzz_scene: tests/fuzz/fuzz_scene.c scenes/scene.c scenes/scene_file.c sim/ini.c host/infile.c $(FUZZ_GLTF_OBJ)
+# The OBJ shim likewise compiles tinyobjloader in (SFSIM_TINYOBJ_IMPLEMENTATION); its image decoder is
+# tinygltf's, in the glTF objects.
+$(BUILD)/fuzz/obj_load.o: scenes/obj_load.cpp scenes/obj.h scenes/scene.h
+	@mkdir -p $(dir $@)
+	$(CLANG)++ -std=c++17 -g -O1 -fsanitize=fuzzer-no-link,address,undefined -DSFSIM_TINYOBJ_IMPLEMENTATION \
+	    -c $< -o $@
+
+$(BUILD)/fuzz/fuzz_scene: tests/fuzz/fuzz_scene.c scenes/scene.c scenes/scene_file.c sim/ini.c host/infile.c $(FUZZ_GLTF_OBJ) \
+		$(BUILD)/fuzz/obj_load.o
 	@mkdir -p $(dir $@)
 	$(CLANG)++ -x c -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined \
 	    $(filter %.c,$^) -x none $(filter %.o,$^) -o $@ -linih -lcjson -lm

@@ -1,4 +1,4 @@
-/* scenes/scene.c -- scene_load: dispatch to the glTF shim or the scene.ini reader, then the
+/* scenes/scene.c -- scene_load: dispatch to the glTF or OBJ shim or the scene.ini reader, then the
  * defaults, bounds, emissive-triangle list, default camera and needs of the loaded scene.
  *
  * Owns: what a loaded scene looks like once complete. Must not: parse files itself (the glTF shim
@@ -14,6 +14,7 @@
 #include <strings.h>
 
 #include "gltf.h"
+#include "obj.h"
 #include "scene_file.h"
 
 void scene_init(Scene *s, const char *source)
@@ -160,8 +161,10 @@ int scene_load(const char *path, Scene *s, char *err, size_t errlen)
         rc = scene_file_load(path, s, err, errlen);
     else if (ends_with(path, ".gltf") || ends_with(path, ".glb"))
         rc = gltf_append(path, NULL, s, err, errlen);
+    else if (ends_with(path, ".obj"))
+        rc = obj_append(path, NULL, s, err, errlen);
     else {
-        snprintf(err, errlen, "%s: unknown scene type (expected .gltf, .glb or .ini)", path);
+        snprintf(err, errlen, "%s: unknown scene type (expected .gltf, .glb, .obj or .ini)", path);
         rc = -1;
     }
     if (rc == 0)

@@ -19,8 +19,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <strings.h>
+#include <sys/stat.h>
+
 #include "../sim/ini.h"
 #include "gltf.h"
+#include "obj.h"
 
 typedef IniEntry Entry;
 
@@ -261,21 +265,41 @@ static char *resolve(const char *ini, const char *rel)
     return out;
 }
 
+static int has_ext(const char *path, const char *ext)
+{
+    size_t a = strlen(path), b = strlen(ext);
+    return a >= b && strcasecmp(path + a - b, ext) == 0;
+}
+
+/* "; where to get the scene: SOURCE (...)" when [scene] source says, else "". */
+static const char *source_note(const IniFile *ini, char *buf, size_t len)
+{
+    const Entry *e = inifile_get(ini, "scene", "source");
+    if (!e || !e->value[0])
+        return "";
+    snprintf(buf, len, "; where to get the scene: %s (docs/scenes.md, Getting the scenes)", e->value);
+    return buf;
+}
+
+/* A mesh file: glTF (.gltf, .glb) or, by its extension, Wavefront OBJ (.obj). */
 static int load_gltf(Parse *p, Scene *s, const Entry *file, const double *xf)
 {
     if (!file->value[0]) {
-        bad_value(p, file, "expected the path of a .gltf or .glb file");
+        bad_value(p, file, "expected the path of a .gltf, .glb or .obj file");
         return -1;
     }
     char *full = resolve(p->path, file->value);
-    char gerr[2048];
+    char gerr[2048], note[512];
     int rc;
+    struct stat st;
     if (!full) {
         diag(p, 0, "out of memory");
         return -1;
     }
-    if ((rc = gltf_append(full, xf, s, gerr, sizeof gerr)) != 0)
-        diag(p, file->line, "key '%s.%s': %s", file->section, file->key, gerr);
+    rc = has_ext(full, ".obj") ? obj_append(full, xf, s, gerr, sizeof gerr) : gltf_append(full, xf, s, gerr, sizeof gerr);
+    if (rc != 0)
+        diag(p, file->line, "key '%s.%s': %s%s", file->section, file->key, gerr,
+             stat(full, &st) != 0 ? source_note(&p->ini, note, sizeof note) : "");
     free(full);
     return rc;
 }
@@ -645,7 +669,7 @@ static void render_section(Parse *p, Scene *s)
 }
 
 static const char *const known_keys[][2] = {
-    {"scene", "gltf"},
+    {"scene", "gltf source"},
     {"camera", "position look_at up fov_y aperture focus_distance"},
     {"render", "width height spp max_depth background ambient"},
     {"gltf", "file translate scale rotate_y"},
@@ -764,4 +788,74 @@ done:
     int nerr = p.nerr;
     write_diags(&p, err, errlen);
     return nerr ? -1 : 0;
+}
+
+/* ---- the files a scene names ----------------------------------------------------------------- */
+
+static void check_append(char *err, size_t errlen, size_t *used, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+static void check_append(char *err, size_t errlen, size_t *used, const char *fmt, ...)
+{
+    if (*used + 1 >= errlen)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(err + *used, errlen - *used, fmt, ap);
+    va_end(ap);
+    if (n > 0)
+        *used = *used + (size_t)n < errlen ? *used + (size_t)n : errlen - 1;
+}
+
+/* "cannot open: ..." or "not a regular file" for path, or NULL when it is a regular file. */
+static const char *file_problem(const char *path, char *buf, size_t len)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        snprintf(buf, len, "cannot open: %s", strerror(errno));
+        return buf;
+    }
+    return S_ISREG(st.st_mode) ? NULL : "not a regular file";
+}
+
+int scene_file_check(const char *path, char *err, size_t errlen)
+{
+    char why[256], note[512];
+    const char *pr = file_problem(path, why, sizeof why);
+    size_t used = 0;
+    if (errlen)
+        err[0] = 0;
+    if (pr) {
+        check_append(err, errlen, &used, "%s: %s", path, pr);
+        return -1;
+    }
+    if (!has_ext(path, ".ini"))
+        return 0;
+    static const char *const repeatable[] = {"scene.gltf", NULL};
+    const IniOptions opt = {0, 0, repeatable};
+    IniFile ini;
+    memset(&ini, 0, sizeof ini);
+    inifile_load(&ini, path, &opt);
+    int bad = 0;
+    if (ini.nerrors && !ini.nsections) { /* not read at all: its first message */
+        check_append(err, errlen, &used, "%s", ini.nmessages ? ini.messages[0].text : path);
+        bad = 1;
+    }
+    for (int i = 0; i < ini.nentries; i++) {
+        const Entry *e = &ini.entries[i];
+        int mesh = (!strcmp(e->section, "scene") && !strcmp(e->key, "gltf")) ||
+                   (named(e->section, "gltf") && !strcmp(e->key, "file"));
+        if (!mesh || !e->value[0])
+            continue; /* an empty path is the loader's error */
+        char *full = resolve(path, e->value);
+        if (full && (pr = file_problem(full, why, sizeof why)) != NULL) {
+            check_append(err, errlen, &used, "%s%s:%d: key '%s.%s': %s: %s", bad ? "\n" : "", path, e->line,
+                         e->section, e->key, full, pr);
+            bad = 1;
+        }
+        free(full);
+    }
+    if (bad)
+        check_append(err, errlen, &used, "%s", source_note(&ini, note, sizeof note));
+    inifile_free(&ini);
+    return bad ? -1 : 0;
 }

@@ -15,4 +15,10 @@
  * returns 0, or -1 when there was any. */
 int scene_file_load(const char *path, Scene *s, char *err, size_t errlen);
 
+/* Whether a scene can be loaded at all, cheaply (sfsim sweep asks before any point runs): the
+ * scene file is a regular file and, for a scene.ini, so is every mesh file it names ([scene] gltf,
+ * [gltf.NAME] file). 0, or -1 with one line per missing file ("FILE:LINE: key 'scene.gltf': PATH:
+ * cannot open: ...") ending with where to get the scene when [scene] source says. */
+int scene_file_check(const char *path, char *err, size_t errlen);
+
 #endif

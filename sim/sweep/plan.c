@@ -13,6 +13,7 @@
 
 #include "../config.h"
 #include "../ini.h"
+#include "../../scenes/scene_file.h"
 
 void sweep_plan_free(SweepPlan *pl)
 {
@@ -174,6 +175,8 @@ cJSON *sweep_manifest_build(const SweepArgs *a)
     scene = realpath(a->scene, NULL);
     if (!scene)
         sweep_err_add(&errs, "scene %s: cannot open: %s", a->scene, strerror(errno));
+    else if (scene_file_check(a->scene, err, sizeof err)) /* its mesh files too, before any point */
+        sweep_err_add(&errs, "%s", err);
     if (inifile_read(a->sweep, &sweep_text, &sweep_len, err, sizeof err))
         sweep_err_add(&errs, "%s", err);
     else if (!(sweep = realpath(a->sweep, NULL)))

@@ -284,7 +284,7 @@ Test(scene_ini_errors, unknown_keys_and_sections)
               "samples = 4\n"
               "[light]\n"
               "type = point\n",
-              4, ":3: key 'scene.file': unknown key (scene takes: gltf)", ":4: unknown section [camra]",
+              4, ":3: key 'scene.file': unknown key (scene takes: gltf source)", ":4: unknown section [camra]",
               ":7: key 'render.samples': unknown key", ":8: unknown section [light]");
 }
 
@@ -367,7 +367,7 @@ Test(scene_ini_errors, broken_gltf_inside)
 Test(scene_ini_errors, directory_as_file)
 {
     ini_fails("[scene]\ngltf = .\n", 2, ":2: key 'scene.gltf': ", "not a regular file");
-    ini_fails("[scene]\ngltf =\n", 1, ":2: key 'scene.gltf': expected the path of a .gltf or .glb file, got ''");
+    ini_fails("[scene]\ngltf =\n", 1, ":2: key 'scene.gltf': expected the path of a .gltf, .glb or .obj file, got ''");
     const char *names[2] = {"dir.gltf", "dir.ini"};
     for (int i = 0; i < 2; i++) {
         char path[128];
