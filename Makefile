@@ -123,7 +123,7 @@ help:
 	@echo "make validation the papers' experiments at reduced size into docs/validation-data.md (needs ../shared)"
 	@echo "make paper      seed 001 Table 6 at the paper's scale in sampled mode, checked by one full detailed run"
 	@echo "                (about 90 min; PAPER_ARGS= skips the detailed run) into docs/validation-data.md"
-	@echo "make docs       regenerate docs/isa.md, docs/exit-codes.md, docs/report.md's statistics, the layout include and docs, the kernel constants, the shipped Cornell box"
+	@echo "make docs       regenerate docs/config.md, docs/isa.md, docs/exit-codes.md, docs/report.md's statistics, the layout include and docs, the kernel constants, the shipped Cornell box"
 	@echo "make check-outputs  the same-outputs table alone (tests/outputs/check.sh; part of make test)"
 	@echo "make test-portable  the same table from a PORTABLE=1 build (the default builds for this host's CPU)"
 	@echo "make install    install into PREFIX (default /usr/local; DESTDIR honoured): docs/install.md"
@@ -241,7 +241,8 @@ $(BUILD)/gen_cornell: tools/gen_cornell.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) tools/gen_cornell.c -o $@ $(CJSON) -lm
 
-docs: $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_exitdoc $(BUILD)/gen_reportdoc $(BUILD)/gen_cornell
+docs: $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_exitdoc $(BUILD)/gen_reportdoc $(BUILD)/gen_cornell $(BIN)/sfsim
+	$(BIN)/sfsim config --markdown > docs/config.md.tmp && mv docs/config.md.tmp docs/config.md
 	$(BUILD)/gen_cornell scenes/cornell
 	$(BUILD)/gen_isadoc > docs/isa.md
 	$(BUILD)/gen_exitdoc > docs/exit-codes.md

@@ -8,10 +8,12 @@
 
 #include <gsl/gsl_blas.h>
 #include <gsl/gsl_cdf.h>
+#include <gsl/gsl_errno.h>
 #include <gsl/gsl_linalg.h>
 #include <gsl/gsl_matrix.h>
 #include <gsl/gsl_vector.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -53,8 +55,18 @@ void sample_order(uint32_t N, uint32_t seed, uint32_t *order)
     }
 }
 
+/* GSL's default error handler aborts the process, and library code must never end it: it is
+ * turned off before any GSL call. The factorization's status is checked (fit_factor); the
+ * solves and products fail only on mismatched sizes, which the Fit's views rule out. */
+static pthread_once_t gsl_once = PTHREAD_ONCE_INIT;
+static void gsl_quiet(void)
+{
+    gsl_set_error_handler_off();
+}
+
 double sample_t975(uint32_t df)
 {
+    pthread_once(&gsl_once, gsl_quiet);
     if (df == 0)
         return INFINITY;
     return gsl_cdf_tdist_Pinv(0.975, (double)df);
@@ -133,13 +145,13 @@ static double fit_scaled(const Fit *f, uint32_t j, uint32_t q, double scj, doubl
 
 /* L (its m x m top left corner): GSL's Cholesky factor of the first m kept columns' scaled
  * cross-products. They are positive definite: every kept column's pivot exceeded FIT_PIVOT_TOL. */
-static void fit_factor(Fit *f, uint32_t m)
+static int fit_factor(Fit *f, uint32_t m)
 {
     for (uint32_t p = 0; p < m; p++)
         for (uint32_t q = 0; q < m; q++)
             f->L[p][q] = fit_scaled(f, f->keep[p], f->keep[q], f->sc[p], f->sc[q]);
     gsl_matrix_view L = gsl_matrix_view_array_with_tda(&f->L[0][0], m, m, SAMPLE_MAX_AUX);
-    gsl_linalg_cholesky_decomp1(&L.matrix);
+    return gsl_linalg_cholesky_decomp1(&L.matrix) == GSL_SUCCESS ? 0 : -1;
 }
 
 /* Column j's squared Cholesky pivot against the kept columns, 1 - R^2 of j on them:
@@ -173,7 +185,11 @@ static void fit_solve(Fit *f, uint32_t n)
             continue;
         f->sc[f->nkeep] = sc;
         f->keep[f->nkeep++] = j;
-        fit_factor(f, f->nkeep);
+        /* Rounding could leave the cross-products not positive definite even past the pivot
+         * test: then j is collinear after all, and the factor of the columns before it is
+         * restored (it succeeded before, on the same numbers). */
+        if (fit_factor(f, f->nkeep) != 0 && --f->nkeep > 0)
+            (void)fit_factor(f, f->nkeep);
     }
     if (f->nkeep + 1 >= n) /* df = n - k - 1 must stay >= 1 (n >= 2 here); L's corner stays their factor */
         f->nkeep = n - 2;
@@ -235,6 +251,7 @@ static void fit_residuals(Fit *f, const double *ys, const double *x, const uint3
 int sample_regression_estimate(const double *ys, const double *x, uint32_t k, const uint32_t *sample,
                                uint32_t n, uint32_t N, SampleEstimate *out)
 {
+    pthread_once(&gsl_once, gsl_quiet);
     memset(out, 0, sizeof *out);
     out->n = n;
     out->N = N;

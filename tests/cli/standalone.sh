@@ -152,7 +152,7 @@ begin "a compare that loaded the image library ends with _exit: its figures stil
 # "Start-up"). stdout is a file here, so the figures are in stdio's buffer until main flushes it.
 run env LD_DEBUG=files "$SFSIM" run -o "$T/out-exit" "${SMALL[@]}"
 want_rc 0
-want_out "^sfsim run: wrote $T/out-exit/frame.png, frame.exr, report.txt, report.json, cost.png$"
+want_out "^sfsim run: wrote $T/out-exit/frame.png, frame.exr, report.txt, report.json, stats.txt, cost.png$"
 [ -s "$T/out-exit/cost.png" ] || no "no cost.png"
 run env LD_DEBUG=files "$SFSIM" compare "$T/out-exit/frame.png" "$T/out-exit/frame.png"
 want_rc 0
