@@ -187,6 +187,7 @@ struct Loader {
     std::vector<SceneLight> lights;
     bool camera_set = false;
     SceneCamera camera{};
+    std::string camera_where; // "node 2 'cam': camera 0 'main'", for the camera's limit checks
 
     Loader(const tinygltf::Model &model, const char *name, Scene *scene) : m(model), file(name), s(scene) {}
     ~Loader()

@@ -312,8 +312,12 @@ bool commit(Loader &L)
     L.mats.clear(); // owned by the Scene now
     L.texs.clear();
     L.lights.clear();
-    if (L.camera_set && s->camera.source == SCENE_CAMERA_DEFAULT)
+    if (L.camera_set && s->camera.source == SCENE_CAMERA_DEFAULT) {
         s->camera = L.camera;
+        std::free(s->camera_from);
+        if (!(s->camera_from = strdup((L.file + ": " + L.camera_where).c_str())))
+            return L.fail("out of memory");
+    }
     return true;
 }
 
@@ -444,6 +448,17 @@ int load_memory(const unsigned char *data, size_t len, const char *name, const s
         return -1;
     }
     bool binary = len >= 4 && std::memcmp(data, "glTF", 4) == 0;
+    if (binary && len >= 12) {
+        // The GLB header (glTF 2.0 Sec. 4.4.2): magic, version, length. tinygltf 2.7 reads a
+        // version 1 container (binary glTF 1.0, whose JSON means something else) without a word.
+        uint32_t version;
+        std::memcpy(&version, data + 4, 4);
+        if (version != 2) {
+            std::snprintf(err, errlen, "%s: GLB header version %u, not 2: sfsim reads glTF 2.0 only", name,
+                          (unsigned)version);
+            return -1;
+        }
+    }
     const unsigned char *json = data;
     size_t json_len = len;
     if (binary && len >= 20) { // the JSON chunk; tinygltf checks the header itself

@@ -298,12 +298,24 @@ bool load_materials(Loader &L)
         sm.transmission = (float)ext_number(gm.extensions, "KHR_materials_transmission", "transmissionFactor", 0.0);
         sm.ior = (float)ext_number(gm.extensions, "KHR_materials_ior", "ior", 1.5);
         double strength = ext_number(gm.extensions, "KHR_materials_emissive_strength", "emissiveStrength", 1.0);
+        // What the renderers multiply: the emitted radiance (limits of scene values, scene.h).
+        char why[320];
+        double em[3];
         for (int k = 0; k < 3; k++)
-            sm.emission[k] = gm.emissiveFactor.size() == 3 ? (float)(gm.emissiveFactor[(size_t)k] * strength) : 0.0f;
+            em[k] = gm.emissiveFactor.size() == 3 ? gm.emissiveFactor[(size_t)k] * strength : 0.0;
+        if (scene_limit_check(SCENE_LIMIT_RADIANCE, em, 3, why, sizeof why) != 0)
+            return L.fail(where + ": emission (emissiveFactor x KHR_materials_emissive_strength) " + why);
+        for (int k = 0; k < 3; k++)
+            sm.emission[k] = (float)em[k];
         for (int k = 0; k < 3; k++)
             if (!std::isfinite(sm.base_color[k]) || !std::isfinite(sm.emission[k]) || sm.base_color[k] < 0.0f ||
                 sm.emission[k] < 0.0f)
                 return L.fail(where + ": colour component is negative or not finite");
+        double base[3] = {sm.base_color[0], sm.base_color[1], sm.base_color[2]};
+        if (scene_limit_check(SCENE_LIMIT_REFLECTANCE, base, 3, why, sizeof why) != 0 &&
+            scene_warn(L.s, "%s: %s: baseColorFactor %s: such a surface reflects more light than it receives",
+                       L.file.c_str(), where.c_str(), why) != 0)
+            return L.fail("out of memory");
         if (!std::isfinite(sm.alpha) || !std::isfinite(sm.metallic) || !std::isfinite(sm.roughness) ||
             !std::isfinite(sm.transmission) || !std::isfinite((float)gm.alphaCutoff))
             return L.fail(where + ": a factor is not finite");
@@ -311,9 +323,11 @@ bool load_materials(Loader &L)
             // KHR_materials_ior: 0 means 1 / infinity (a perfect mirror); anything else below 1 is invalid.
             if (sm.ior == 0.0f)
                 sm.ior = 1.0f;
-            else
+            else if (std::isfinite(sm.ior))
                 return L.fail(where + ": KHR_materials_ior ior " + std::to_string(sm.ior) + " is below 1");
         }
+        if (scene_limit_check1(SCENE_LIMIT_IOR, sm.ior, why, sizeof why) != 0)
+            return L.fail(where + ": KHR_materials_ior ior " + why);
         // ARCHITECTURE.md Sec. 1: transmission > 0 -> dielectric; metallic > 0 or roughness < 1 ->
         // coupled glossy; otherwise Lambertian.
         if (sm.transmission > 0.0f)

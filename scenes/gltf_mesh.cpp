@@ -126,16 +126,18 @@ bool read_uvs(Loader &L, const tinygltf::Primitive &p, const std::string &where,
         return false;
     out.resize(2 * nverts);
     const double *m = map.m;
+    bool identity = m[0] == 1 && m[1] == 0 && m[2] == 0 && m[3] == 0 && m[4] == 1 && m[5] == 0;
     for (size_t v = 0; v < nverts; v++) {
         double u = vt.get(v, 0), w = vt.get(v, 1);
         double t[2] = {m[0] * u + m[1] * w + m[2], m[3] * u + m[4] * w + m[5]};
         for (int k = 0; k < 2; k++) {
             if (!std::isfinite((float)t[k]))
                 return L.fail(where + " " + attr + ": vertex " + std::to_string(v) + " is not finite" +
-                              (map.m[0] == 1 && map.m[1] == 0 && map.m[2] == 0 && map.m[3] == 0 && map.m[4] == 1 &&
-                                       map.m[5] == 0
-                                   ? ""
-                                   : " after KHR_texture_transform"));
+                              (identity ? "" : " after KHR_texture_transform"));
+            char why[320];
+            if (scene_limit_check1(SCENE_LIMIT_UV, t[k], why, sizeof why) != 0)
+                return L.fail(where + " " + attr + ": vertex " + std::to_string(v) + " coordinate " +
+                              std::to_string(k) + (identity ? " " : " after KHR_texture_transform ") + why);
             out[2 * v + (size_t)k] = (float)t[k];
         }
     }
@@ -300,19 +302,16 @@ bool transform_vertices(Loader &L, const Attributes &a, const std::string &where
             if (!std::isfinite(in[k]))
                 return L.fail(pw + std::to_string(v) + " coordinate " + std::to_string(k) + " is not finite (" +
                               std::to_string(in[k]) + ")");
-            if (std::fabs(in[k]) > SCENE_COORD_LIMIT)
-                return L.fail(pw + std::to_string(v) + " coordinate " + std::to_string(k) + " is " + num(in[k]) +
-                              ", beyond the limit of " + num(SCENE_COORD_LIMIT) +
-                              " on scene coordinates (docs/scenes.md, Limits)");
+            char why[320];
+            if (scene_limit_check1(SCENE_LIMIT_COORD, in[k], why, sizeof why) != 0)
+                return L.fail(pw + std::to_string(v) + " coordinate " + std::to_string(k) + " " + why);
         }
         xform_point(full, in, out);
-        for (int k = 0; k < 3; k++) {
-            if (!std::isfinite(out[k]) || std::fabs(out[k]) > SCENE_COORD_LIMIT)
-                return L.fail(pw + std::to_string(v) + " is (" + num(out[0]) + ", " + num(out[1]) + ", " + num(out[2]) +
-                              ") after the node transforms, beyond the limit of " + num(SCENE_COORD_LIMIT) +
-                              " on scene coordinates (docs/scenes.md, Limits)");
+        char why[320];
+        if (scene_limit_check(SCENE_LIMIT_COORD, out, 3, why, sizeof why) != 0)
+            return L.fail(pw + std::to_string(v) + " after the node transforms " + why);
+        for (int k = 0; k < 3; k++)
             w.wp[3 * v + (size_t)k] = (float)out[k];
-        }
         if (has_n) {
             double n[3] = {vn.get(v, 0), vn.get(v, 1), vn.get(v, 2)}, o[3] = {n[0], n[1], n[2]};
             if (nm_ok)
@@ -339,8 +338,8 @@ bool transform_vertices(Loader &L, const Attributes &a, const std::string &where
 // normals (a vertex without a usable normal gets the geometric one), texture coordinates, colours
 // and materials (the emitting twin where the triangle touches an emitting texel). A mirroring
 // transform reverses the winding (glTF 2.0 Sec. 3.7.4).
-bool write_triangles(Loader &L, const Mat4 &full, const std::vector<uint32_t> &tri, const PrimMaterial &pm,
-                     const Vertices &w)
+bool write_triangles(Loader &L, const std::string &where, const Mat4 &full, const std::vector<uint32_t> &tri,
+                     const PrimMaterial &pm, const Vertices &w)
 {
     const MatInfo *mi = pm.mi;
     int mat = pm.mat, twin = pm.twin;
@@ -378,6 +377,14 @@ bool write_triangles(Loader &L, const Mat4 &full, const std::vector<uint32_t> &t
         gn[0] = e1[1] * e2[2] - e1[2] * e2[1];
         gn[1] = e1[2] * e2[0] - e1[0] * e2[2];
         gn[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        // The renderers square |e1 x e2| in binary32 for the triangle's normal (and an emitting
+        // triangle's area): beyond the AREA limit it is inf and the triangle turns black.
+        char why[320];
+        if (scene_limit_check1(SCENE_LIMIT_AREA, std::sqrt(gn[0] * gn[0] + gn[1] * gn[1] + gn[2] * gn[2]), why,
+                               sizeof why) != 0)
+            return L.fail(where + ": triangle " + std::to_string(t) + " (vertices " + std::to_string(tri[3 * t]) +
+                          ", " + std::to_string(tri[3 * t + 1]) + ", " + std::to_string(tri[3 * t + 2]) +
+                          "): |e1 x e2| " + why);
         if (!normalize(gn)) { // a degenerate triangle: any unit vector keeps later stages NaN-free
             gn[0] = gn[2] = 0.0;
             gn[1] = 1.0;
@@ -438,7 +445,7 @@ bool load_primitive(Loader &L, const Mat4 &full, int mesh, int pi)
     if (!read_uvs(L, p, where, pm.mi->base_uv, a.vp.count, w.wt, w.has_t) ||
         (pm.mi->emit_tex && !read_uvs(L, p, where, pm.mi->emit_uv, a.vp.count, w.we, w.has_e)))
         return false;
-    return transform_vertices(L, a, where, full, w) && write_triangles(L, full, tri, pm, w);
+    return transform_vertices(L, a, where, full, w) && write_triangles(L, where, full, tri, pm, w);
 }
 
 // Triangles the primitives under `roots` will produce, so the arrays grow once. Malformed

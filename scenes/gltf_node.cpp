@@ -83,6 +83,10 @@ bool normalize(double *v)
 
 namespace {
 
+// How far a node matrix's bottom row may be from 0 0 0 1 (absolute, per entry): a few binary32
+// ulps of 1 (2^-23 = 1.2e-7) and more, far below any projection.
+const double AFFINE_TOLERANCE = 1e-6;
+
 // ---- nodes -----------------------------------------------------------------------------------
 
 bool local_matrix(Loader &L, int node, const tinygltf::Node &n, Mat4 &r)
@@ -129,6 +133,15 @@ bool local_matrix(Loader &L, int node, const tinygltf::Node &n, Mat4 &r)
     for (double v : r.m)
         if (!std::isfinite(v))
             return L.fail(elem("node", node, n.name) + ": transform is not finite");
+    // glTF 2.0 Sec. 5.25: a node's matrix is affine (TRS is by construction). A bottom row other
+    // than 0 0 0 1 would be a projection, which xform_point (and the renderers) cannot apply:
+    // refused, within AFFINE_TOLERANCE of each entry (exporters round-trip through binary32).
+    const double bottom[4] = {r.m[3], r.m[7], r.m[11], r.m[15]};
+    if (std::fabs(bottom[0]) > AFFINE_TOLERANCE || std::fabs(bottom[1]) > AFFINE_TOLERANCE ||
+        std::fabs(bottom[2]) > AFFINE_TOLERANCE || std::fabs(bottom[3] - 1.0) > AFFINE_TOLERANCE)
+        return L.fail(elem("node", node, n.name) + ": matrix is not affine: its bottom row is (" + num(bottom[0]) +
+                      ", " + num(bottom[1]) + ", " + num(bottom[2]) + ", " + num(bottom[3]) +
+                      "), not (0, 0, 0, 1) within " + num(AFFINE_TOLERANCE));
     return true;
 }
 
@@ -161,6 +174,9 @@ bool load_camera(Loader &L, int node, const tinygltf::Node &n, const Mat4 &full)
     L.camera.focus_distance = 0.0f;
     L.camera.source = SCENE_CAMERA_GLTF;
     L.camera_set = true;
+    // Checked against the limits once the scene is whole (scene_finish): a scene.ini [camera] may
+    // still replace what is out of range.
+    L.camera_where = elem("node", node, n.name) + ": " + elem("camera", n.camera, cam.name);
     return true;
 }
 
@@ -207,6 +223,17 @@ bool load_light(Loader &L, int node, const tinygltf::Node &n, const Mat4 &full)
     sl.intensity = (float)gl.intensity;
     if (!std::isfinite(sl.intensity) || sl.intensity < 0.0f)
         return L.fail(lw + ": intensity is negative or not finite");
+    // What the renderers use: the position (a shadow ray's end) and colour x intensity, the
+    // radiance scenes/pack.c stores (in binary32, as here).
+    char why[320];
+    double rad[3], pos[3] = {po[0], po[1], po[2]};
+    for (int k = 0; k < 3; k++)
+        rad[k] = (double)(sl.color[k] * sl.intensity);
+    if (sl.kind != SCENE_LIGHT_DIRECTIONAL && scene_limit_check(SCENE_LIMIT_COORD, pos, 3, why, sizeof why) != 0)
+        return L.fail(where + " " + lw + ": position " + why);
+    if (scene_limit_check(sl.kind == SCENE_LIGHT_DIRECTIONAL ? SCENE_LIMIT_RADIANCE : SCENE_LIMIT_INTENSITY, rad, 3,
+                          why, sizeof why) != 0)
+        return L.fail(lw + ": color x intensity " + why);
     if (sl.kind == SCENE_LIGHT_SPOT) {
         sl.inner_cone = (float)gl.spot.innerConeAngle;
         sl.outer_cone = (float)gl.spot.outerConeAngle;
@@ -234,6 +261,9 @@ bool visit(Loader &L, int node, const Mat4 &parent, int depth)
     if (!local_matrix(L, node, n, local))
         return false;
     Mat4 world = mul(parent, local), full = mul(L.pre, world);
+    for (double v : full.m)
+        if (!std::isfinite(v))
+            return L.fail(elem("node", node, n.name) + ": transform composed with its parents' is not finite");
     if (n.mesh >= 0) {
         if ((size_t)n.mesh >= m.meshes.size())
             return L.fail(elem("node", node, n.name) + ": mesh " + std::to_string(n.mesh) + " does not exist");

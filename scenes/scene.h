@@ -130,6 +130,8 @@ typedef struct Scene {
     SceneSphere *spheres;     uint32_t nspheres;
 
     SceneCamera camera;
+    char *camera_from;        /* a glTF camera's file, node and camera ("x.gltf: node 2 'cam':
+                                 camera 0 'main'"), for messages; NULL for other cameras */
     SceneRender render;
     float bounds_min[3], bounds_max[3];  /* of triangles and spheres */
     uint32_t needs;           /* SCENE_NEED_* */
@@ -141,11 +143,69 @@ typedef struct Scene {
     char **warnings;          uint32_t nwarnings;
 } Scene;
 
-/* The largest magnitude of a triangle vertex coordinate in the world (after all transforms). The
- * renderers multiply coordinates pairwise in binary32 (edge functions, cross products, box areas),
- * which stay finite up to about 1e18 (1e36 < FLT_MAX; docs/numerics.md); beyond, hits would be
- * lost to inf and NaN without a word, so the loader refuses such vertices (docs/scenes.md). */
-#define SCENE_COORD_LIMIT 1e18
+/* The limits of scene values, one row each: the largest magnitude a value of that kind may have
+ * where it enters the renderers' binary32 arithmetic, and what messages call it. Every loader
+ * checks against this table through scene_limit_check; docs/scenes.md ("Limits of scene values")
+ * derives each limit from the arithmetic the value enters.
+ *   COORD     positions: triangle vertices (after all transforms), the camera's position, look_at
+ *             and lens, point and spot light positions, quad light corners, sphere boxes. The
+ *             triangle test multiplies differences of coordinates pairwise, a light's shadow ray
+ *             squares its length: (2e18)^2 x 3 = 1.2e37 < FLT_MAX = 3.4e38.
+ *   AREA      |e1 x e2| of a triangle (twice its area) or a quad light (its area): normals and
+ *             light areas square it (|e1 x e2|^2 <= FLT_MAX: 1.8e19).
+ *   VIEW      a camera ray's direction before it is normalized: the focus distance x
+ *             sqrt(1 + tan^2(fov_y / 2) (1 + aspect^2)) + aperture / 2, squared when it is
+ *             normalized: 1e19^2 = 1e38 < FLT_MAX.
+ *   RADIANCE  radiance: emission, a quad light's and a directional light's colour x intensity,
+ *             background, ambient. Multiplied by the path's throughput and geometry; 1e18 leaves
+ *             them a factor of 3.4e20.
+ *   INTENSITY a point or spot light's colour x intensity (W/sr): divided by the squared distance
+ *             it lights, so it scales with the scene's size squared. RADIANCE x AREA (1e36), what
+ *             the largest quad light gives; colour x intensity / d^2 overflows only closer than
+ *             sqrt(1e36 / FLT_MAX) = 0.054 to the light.
+ *   REFLECTANCE a base colour: a warning above it, not a refusal (glTF allows 0..1, scene.ini
+ *             any value >= 0). A Lambertian bounce multiplies the throughput by base x 2 / 0.95
+ *             at most (the direct/indirect split, Russian roulette); with base <= 1 the deepest
+ *             path (64 generations) gains at most 2.1^63 = 2.4e20 < FLT_MAX / RADIANCE.
+ *   IOR       index of refraction: the refraction squares it.
+ *   UV        texture coordinates (after KHR_texture_transform): interpolated at a hit.
+ * SCENE_LIMIT(NAME, largest magnitude, what messages call it) */
+#define SCENE_LIMITS(X)                                                                          \
+    X(COORD, 1e18, "scene coordinates")                                                          \
+    X(AREA, 1e18, "areas (|e1 x e2| of a triangle, the area of a quad light)")                   \
+    X(VIEW, 1e19, "camera ray lengths (focus distance x the image plane's half-diagonal)")       \
+    X(RADIANCE, 1e18, "radiance (emission, background, ambient, quad and directional lights)")   \
+    X(INTENSITY, 1e36, "point and spot light intensities (colour x intensity)")                   \
+    X(REFLECTANCE, 1, "reflectances (base colour)")                                               \
+    X(IOR, 1e18, "indices of refraction")                                                         \
+    X(UV, 1e18, "texture coordinates")
+
+typedef enum SceneLimit {
+#define SCENE_LIMIT_ENUM(name, value, what) SCENE_LIMIT_##name,
+    SCENE_LIMITS(SCENE_LIMIT_ENUM)
+#undef SCENE_LIMIT_ENUM
+    SCENE_LIMIT_COUNT
+} SceneLimit;
+
+/* The largest magnitude of a value of kind k. */
+double scene_limit(SceneLimit k);
+/* Checks n values of kind k: 0 when each is finite and within the limit; else -1 with why the
+ * caller's "LOCATION: VALUE " is refused: "is not finite (nan)", or "is 1e+30, beyond the limit
+ * of 1e+18 on scene coordinates (docs/scenes.md, Limits of scene values)" (n > 1: "is (0, 0,
+ * 1e+30), ..."). */
+int scene_limit_check(SceneLimit k, const double *v, int n, char *why, size_t len);
+/* The same for one value that must be at most limit(k) and is not itself written in the file
+ * (a derived quantity): "is 2e+20, beyond ...". */
+int scene_limit_check1(SceneLimit k, double v, char *why, size_t len);
+/* |e1 x e2| for the edges b - a and c - a, in double (what AREA limits). */
+double scene_cross_norm(const float *a, const float *b, const float *c);
+/* The camera's positions (position, look_at and the lens within COORD): 0, or -1 with
+ * "position is (...), beyond ..." naming the value. */
+int scene_camera_check(const SceneCamera *c, char *why, size_t len);
+/* Its ray lengths (VIEW) for a width x height image: 0, or -1 with "ray length (...) is ...".
+ * scene_finish checks the scene's own [render] size; a caller that imposes another size checks
+ * again. */
+int scene_camera_view_check(const SceneCamera *c, int width, int height, char *why, size_t len);
 
 /* Load a scene: a .gltf/.glb file, or a scene.ini that names one. Fills every field (defaults,
  * camera framing the bounds when none is given, needs). 0, or -1 with a message naming the file

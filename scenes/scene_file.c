@@ -224,6 +224,42 @@ static int parse_int(Parse *p, const Entry *e, long lo, long hi, int *out)
     return 0;
 }
 
+/* n values of kind k (scene.h's limits of scene values), reported at entry e, or at the section's
+ * line when e is NULL: "FILE:LINE: key 'light.a.intensity': color x intensity is 1e+30, beyond
+ * ...". 0, or -1. */
+static int limit_check(Parse *p, const Entry *e, const char *section, const char *what, SceneLimit k,
+                       const double *v, int n)
+{
+    char why[320];
+    if (scene_limit_check(k, v, n, why, sizeof why) == 0)
+        return 0;
+    if (e)
+        diag(p, e->line, "key '%s.%s': %s %s", e->section, e->key, what, why);
+    else
+        diag(p, inifile_section(&p->ini, section) ? inifile_section(&p->ini, section)->line : 0,
+             "section [%s]: %s %s", section, what, why);
+    return -1;
+}
+
+/* A radiance (r g b) against the limit of scene values. */
+static int radiance_check(Parse *p, const Entry *e, const float *rgb)
+{
+    double v[3] = {rgb[0], rgb[1], rgb[2]};
+    return limit_check(p, e, e->section, "radiance", SCENE_LIMIT_RADIANCE, v, 3);
+}
+
+/* A base colour above the reflectance limit: a warning (scene.h), not an error. 0, or -1 out of
+ * memory. */
+static int reflectance_warn(Parse *p, Scene *s, const Entry *e, const float *rgb)
+{
+    char why[320];
+    double v[3] = {rgb[0], rgb[1], rgb[2]};
+    if (scene_limit_check(SCENE_LIMIT_REFLECTANCE, v, 3, why, sizeof why) == 0)
+        return 0;
+    return scene_warn(s, "%s:%d: key '%s.%s': %s: such a surface reflects more light than it receives", p->path,
+                      e->line, e->section, e->key, why);
+}
+
 /* ---- sections -------------------------------------------------------------------------------- */
 
 /* The NAME of a "kind.NAME" section, or NULL. */
@@ -381,8 +417,11 @@ static void material_section(Parse *p, Scene *s, const char *section, const char
             bad = 1;
         }
     }
-    bad |= eb && parse_nonneg3(p, eb, base) != 0;
-    bad |= ee && parse_nonneg3(p, ee, em) != 0;
+    if (eb && parse_nonneg3(p, eb, base) != 0)
+        bad = 1;
+    else if (eb && !bad && reflectance_warn(p, s, eb, base) != 0)
+        diag(p, 0, "out of memory");
+    bad |= ee && (parse_nonneg3(p, ee, em) != 0 || radiance_check(p, ee, em) != 0);
     bad |= er && parse_range(p, er, 0.0f, 1.0f, &rough) != 0;
     bad |= em_ && parse_range(p, em_, 0.0f, 1.0f, &metal) != 0;
     bad |= ei && parse_range(p, ei, 1.0f, 10.0f, &ior) != 0;
@@ -446,6 +485,40 @@ static const LightKey light_keys[] = {
     {"intensity", 0xF, 0},
 };
 static const char *const light_type_names[] = {"point", "spot", "directional", "quad"};
+
+/* What the renderers take from a light (scene.h's limits): its position, or a quad's four corners
+ * and area, within reach of a shadow ray; colour x intensity as the radiance scenes/pack.c stores
+ * (in binary32, as here). 0, or -1 with the key named. */
+static int light_limits(Parse *p, const char *section, const SceneLight *l)
+{
+    const Entry *ep = get(p, section, "position"), *ei = get(p, section, "intensity");
+    double rad[3];
+    for (int k = 0; k < 3; k++)
+        rad[k] = (double)(l->color[k] * l->intensity);
+    SceneLimit lim = l->kind == SCENE_LIGHT_POINT || l->kind == SCENE_LIGHT_SPOT ? SCENE_LIMIT_INTENSITY
+                                                                                   : SCENE_LIMIT_RADIANCE;
+    if (limit_check(p, ei ? ei : get(p, section, "color"), section, "color x intensity", lim, rad, 3) != 0)
+        return -1;
+    if (l->kind == SCENE_LIGHT_DIRECTIONAL)
+        return 0;
+    for (int c = 0; c < (l->kind == SCENE_LIGHT_QUAD ? 4 : 1); c++) {
+        double v[3];
+        for (int k = 0; k < 3; k++)
+            v[k] = (double)l->position[k] + (c & 1 ? l->edge_u[k] : 0.0f) + (c & 2 ? l->edge_v[k] : 0.0f);
+        static const char *const corner[] = {"the position", "the corner position + edge_u",
+                                             "the corner position + edge_v", "the corner position + edge_u + edge_v"};
+        if (limit_check(p, c == 0 ? ep : get(p, section, c == 2 ? "edge_v" : "edge_u"), section, corner[c],
+                        SCENE_LIMIT_COORD, v, 3) != 0)
+            return -1;
+    }
+    if (l->kind == SCENE_LIGHT_QUAD) {
+        float z[3] = {0, 0, 0};
+        double area = scene_cross_norm(z, l->edge_u, l->edge_v);
+        if (limit_check(p, NULL, section, "the area |edge_u x edge_v|", SCENE_LIMIT_AREA, &area, 1) != 0)
+            return -1;
+    }
+    return 0;
+}
 
 /* [light.NAME]: type = point | spot | directional | quad and the keys of that type. */
 static void light_section(Parse *p, Scene *s, const char *section, const char *name)
@@ -535,6 +608,8 @@ static void light_section(Parse *p, Scene *s, const char *section, const char *n
             return;
         }
     }
+    if (light_limits(p, section, &l) != 0)
+        return;
     l.inner_cone = inner * (float)M_PI / 180.0f;
     l.outer_cone = outer * (float)M_PI / 180.0f;
     SceneLight *arr = realloc(s->lights, sizeof *arr * ((size_t)s->nlights + 1));
@@ -577,6 +652,14 @@ static void sphere_section(Parse *p, Scene *s, const char *section, const char *
         }
     }
     if (bad)
+        return;
+    /* The ray/sphere test squares the radius and the distance to the centre: the sphere's box
+     * lies within the coordinate limit, as a triangle's vertices do. */
+    double c[3] = {sp.center[0], sp.center[1], sp.center[2]}, box[3];
+    for (int k = 0; k < 3; k++)
+        box[k] = fabs(c[k]) + sp.radius;
+    if (limit_check(p, ec, section, "center", SCENE_LIMIT_COORD, c, 3) != 0 ||
+        limit_check(p, er, section, "|center| + radius", SCENE_LIMIT_COORD, box, 3) != 0)
         return;
     SceneSphere *arr = realloc(s->spheres, sizeof *arr * ((size_t)s->nspheres + 1));
     if (!arr || !(sp.name = strdup(name))) {
@@ -628,11 +711,17 @@ static void camera_section(Parse *p, Scene *s)
     }
     if (bad)
         return;
+    /* The limits first: beyond them, look_at and position are often one binary32 number. */
+    int line = section_line(p, "camera");
+    char why[400];
+    if (scene_camera_check(&c, why, sizeof why) != 0) {
+        diag(p, line, "section [camera]: %s", why);
+        return;
+    }
     double d[3], u[3] = {c.up[0], c.up[1], c.up[2]};
     for (int k = 0; k < 3; k++)
         d[k] = (double)c.look_at[k] - c.position[k];
     double cr[3] = {d[1] * u[2] - d[2] * u[1], d[2] * u[0] - d[0] * u[2], d[0] * u[1] - d[1] * u[0]};
-    int line = section_line(p, "camera");
     if (!(d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > 0.0)) {
         diag(p, line, "section [camera]: look_at must differ from position");
         return;
@@ -661,9 +750,9 @@ static void render_section(Parse *p, Scene *s)
     if ((e = get(p, "render", "max_depth")))
         bad |= parse_int(p, e, 0, 63, &r.max_depth);
     if ((e = get(p, "render", "background")))
-        bad |= parse_nonneg3(p, e, r.background);
+        bad |= parse_nonneg3(p, e, r.background) || radiance_check(p, e, r.background);
     if ((e = get(p, "render", "ambient")))
-        bad |= parse_nonneg3(p, e, r.ambient);
+        bad |= parse_nonneg3(p, e, r.ambient) || radiance_check(p, e, r.ambient);
     if (!bad)
         s->render = r;
 }

@@ -297,7 +297,7 @@ Test(scene_gltf_errors, nan_vertex)
     cr_assert_neq(scene_load(path, &s, err, sizeof err), 0);
     snprintf(want, sizeof want,
              "%s: mesh 0 'tri' primitive 0 POSITION: accessor 0: vertex 1 coordinate 1 is 1e+30, beyond the limit of "
-             "1e+18 on scene coordinates (docs/scenes.md, Limits)", path);
+             "1e+18 on scene coordinates (docs/scenes.md, Limits of scene values)", path);
     cr_expect_str_eq(err, want);
     /* at the limit: loads; a node scale that carries it past: the transformed vertex is named */
     pos[4] = 1e18f * 0.999f;
@@ -306,8 +306,8 @@ Test(scene_gltf_errors, nan_vertex)
     g.node = "\"scale\": [1, 10, 1]";
     path = st_put_gltf("scaled.gltf", st_gl_json(&g));
     cr_assert_neq(scene_load(path, &s, err, sizeof err), 0);
-    cr_expect_not_null(strstr(err, "scaled.gltf: mesh 0 'tri' primitive 0 POSITION: accessor 0: vertex 1 is (1, 9.99e+18, 0) "
-                                   "after the node transforms, beyond the limit of 1e+18 on scene coordinates"),
+    cr_expect_not_null(strstr(err, "scaled.gltf: mesh 0 'tri' primitive 0 POSITION: accessor 0: vertex 1 after the node "
+                                   "transforms is (1, 9.99e+18, 0), beyond the limit of 1e+18 on scene coordinates"),
                        "%s", err);
 }
 
