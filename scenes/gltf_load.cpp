@@ -29,6 +29,9 @@
 #include <unistd.h>
 
 #include <cjson/cJSON.h>
+#include <cstdlib>
+
+#include "../host/infile.h"
 
 namespace sfgltf {
 
@@ -207,26 +210,16 @@ bool read_regular_file(std::vector<unsigned char> *out, std::string *err, const 
             *err += "'" + uri + "' lies outside the glTF file's folder\n";
         return false;
     }
-    struct stat st;
-    if (stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) {
+    // The one input check (host/infile.h): a folder, a device or a FIFO is refused by name.
+    char *buf, why[4352];
+    size_t len;
+    if (infile_read(path.c_str(), SCENE_FILE_MAX_BYTES, "a scene file", &buf, &len, why, sizeof why) != 0) {
         if (err)
-            *err += "'" + path + "' is not a regular file\n";
+            *err += std::string(why) + "\n";
         return false;
     }
-    FILE *f = std::fopen(path.c_str(), "rb");
-    if (!f) {
-        if (err)
-            *err += "cannot open '" + path + "': " + std::strerror(errno) + "\n";
-        return false;
-    }
-    out->resize((size_t)st.st_size);
-    size_t n = out->empty() ? 0 : std::fread(out->data(), 1, out->size(), f);
-    std::fclose(f);
-    if (n != out->size()) {
-        if (err)
-            *err += "cannot read '" + path + "'\n";
-        return false;
-    }
+    out->assign(buf, buf + len);
+    std::free(buf);
     return true;
 }
 
@@ -496,19 +489,10 @@ extern "C" int gltf_append(const char *path, const double *xf, Scene *s, char *e
         // The file is read here, not by tinygltf: it sizes files by seeking to their end, which
         // on a directory or a device gives nonsense (a directory "holds" 2^63 bytes), and the
         // JSON is checked before tinygltf parses it (json_too_deep).
-        struct stat st;
-        if (stat(path, &st) != 0) {
-            std::snprintf(err, errlen, "%s: cannot open: %s", path, std::strerror(errno));
-            return -1;
-        }
-        if (!S_ISREG(st.st_mode)) {
-            std::snprintf(err, errlen, "%s: not a regular file", path);
-            return -1;
-        }
         std::vector<unsigned char> data;
         std::string rerr;
         if (!read_regular_file(&data, &rerr, path, nullptr)) { // (the file named by the user: no folder check)
-            std::snprintf(err, errlen, "%s: %s", path, one_line(rerr).c_str());
+            std::snprintf(err, errlen, "%s", one_line(rerr).c_str());
             return -1;
         }
         const char *slash = std::strrchr(path, '/');

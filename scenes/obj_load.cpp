@@ -5,7 +5,7 @@
 // (inside the OBJ file's folder, as for glTF uris); a check of the OBJ text before tinyobjloader
 // parses it, which names the line of each problem tinyobjloader would skip or report without one
 // (faces with fewer than 3 or more than 255 vertices, indices 0 or out of range, coordinates that
-// are not finite or beyond SCENE_COORD_LIMIT, usemtl names no MTL defines); the MTL material
+// are not finite or beyond the coordinate limit (scene_limit), usemtl names no MTL defines); the MTL material
 // rules of docs/scenes.md ("OBJ and MTL"); triangulation of polygons (a fan for convex ones, ear
 // clipping otherwise); and the move of the result into the Scene. Must not: pick scene defaults,
 // compute bounds or needs (scenes/scene.c), print anything, or let an exception or a
@@ -39,6 +39,7 @@
 
 extern "C" {
 #include "obj.h"
+#include "../host/infile.h"
 }
 
 namespace {
@@ -101,18 +102,17 @@ std::string lexical_path(const std::string &path)
 // A whole regular file into out; "" or why not ("cannot open: ...", "not a regular file").
 std::string read_file(const std::string &path, std::string &out)
 {
-    struct stat st;
-    if (stat(path.c_str(), &st) != 0)
-        return std::string("cannot open: ") + std::strerror(errno);
-    if (!S_ISREG(st.st_mode))
-        return "not a regular file";
-    FILE *f = std::fopen(path.c_str(), "rb");
-    if (!f)
-        return std::string("cannot open: ") + std::strerror(errno);
-    out.resize((size_t)st.st_size);
-    size_t n = out.empty() ? 0 : std::fread(&out[0], 1, out.size(), f);
-    std::fclose(f);
-    return n == out.size() ? std::string() : "cannot read";
+    // The one input check (host/infile.h): a folder, a device or a FIFO is refused by name.
+    char *buf, why[4352];
+    size_t len;
+    if (infile_read(path.c_str(), SCENE_FILE_MAX_BYTES, "a scene file", &buf, &len, why, sizeof why) != 0)
+    {
+        size_t n = path.size(); // the reason past "PATH: " (this file's callers name the path their way)
+        return std::strncmp(why, path.c_str(), n) == 0 && why[n] == ':' ? std::string(why + n + 2) : std::string(why);
+    }
+    out.assign(buf, len);
+    std::free(buf);
+    return std::string();
 }
 
 struct Ctx {
@@ -224,9 +224,9 @@ bool check_numbers(Ctx &c, const std::string &at, const std::string &kind, const
             continue; // a normal that is not finite falls back to the geometric normal
         if (!std::isfinite(d) || (kind == "vt" && std::fabs(d) > 3.4e38))
             return c.fail(at + ": vertex coordinate " + std::to_string(k) + " is not finite (" + w + ")");
-        if (kind == "v" && std::fabs(d) > SCENE_COORD_LIMIT)
+        if (kind == "v" && std::fabs(d) > scene_limit(SCENE_LIMIT_COORD))
             return c.fail(at + ": vertex coordinate " + std::to_string(k) + " is " + num(d) + ", beyond the limit of " +
-                          num(SCENE_COORD_LIMIT) + " on scene coordinates (docs/scenes.md, Limits)");
+                          num(scene_limit(SCENE_LIMIT_COORD)) + " on scene coordinates (docs/scenes.md, Limits of scene values)");
     }
     return true;
 }
@@ -426,6 +426,14 @@ bool convert_material(Ctx &c, Out &o, size_t i, const tinyobj::material_t &m)
         return c.fail(who + ": Ns " + num(m.shininess) + " is negative or not finite");
     if (!std::isfinite(m.ior) || m.ior < 0.0f)
         return c.fail(who + ": Ni " + num(m.ior) + " is negative or not finite");
+    // The limits of the arithmetic they enter (scenes/scene.h, SCENE_LIMITS): emission is radiance,
+    // and the refraction squares the index.
+    double ked[3] = {ke[0], ke[1], ke[2]}, ni = m.ior;
+    char why[256];
+    if (scene_limit_check(SCENE_LIMIT_RADIANCE, ked, 3, why, sizeof why) != 0)
+        return c.fail(who + ": Ke " + why);
+    if (scene_limit_check(SCENE_LIMIT_IOR, &ni, 1, why, sizeof why) != 0)
+        return c.fail(who + ": Ni " + why);
     if (!(m.dissolve >= 0.0f && m.dissolve <= 1.0f))
         return c.fail(who + ": d " + num(m.dissolve) + " (or 1 - Tr) is not between 0 and 1");
     if (m.illum < 0 || m.illum > MAX_ILLUM)
@@ -639,14 +647,14 @@ bool build_triangles(Ctx &c, Out &o, const tinyobj::attrib_t &at, const std::vec
                 bool fine = true;
                 for (int r = 0; r < 3; r++) {
                     w[r] = X[r] * v[0] + X[4 + r] * v[1] + X[8 + r] * v[2] + X[12 + r];
-                    fine &= std::isfinite(w[r]) && std::fabs(w[r]) <= SCENE_COORD_LIMIT;
+                    fine &= std::isfinite(w[r]) && std::fabs(w[r]) <= scene_limit(SCENE_LIMIT_COORD);
                     poly[3 * k + (size_t)r] = w[r];
                 }
                 if (!fine)
                     return c.fail(c.file + ": vertex " + std::to_string(ix[k].vertex_index + 1) + " is (" + num(w[0]) +
                                   ", " + num(w[1]) + ", " + num(w[2]) + ")" + (xf ? " after the placement" : "") +
-                                  ", beyond the limit of " + num(SCENE_COORD_LIMIT) +
-                                  " on scene coordinates (docs/scenes.md, Limits)");
+                                  ", beyond the limit of " + num(scene_limit(SCENE_LIMIT_COORD)) +
+                                  " on scene coordinates (docs/scenes.md, Limits of scene values)");
             }
             tri.clear();
             triangulate(poly, tri);

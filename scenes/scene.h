@@ -143,6 +143,11 @@ typedef struct Scene {
     char **warnings;          uint32_t nwarnings;
 } Scene;
 
+/* The largest file a scene loader reads (a glTF, GLB, its buffers and images, an OBJ, its MTL files
+ * and textures), through the one input check (host/infile.h): 16 GiB, far above the largest scenes
+ * of the validation (the 5 M-triangle cases hold a few hundred MB). */
+#define SCENE_FILE_MAX_BYTES (16ull << 30)
+
 /* The limits of scene values, one row each: the largest magnitude a value of that kind may have
  * where it enters the renderers' binary32 arithmetic, and what messages call it. Every loader
  * checks against this table through scene_limit_check; docs/scenes.md ("Limits of scene values")

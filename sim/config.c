@@ -389,6 +389,27 @@ static const char *enum_list(const CfgKeyInfo *k, char *buf, size_t len)
     return buf;
 }
 
+/* A comment of the dump, wrapped at spaces into lines of at most 100 characters: every line of a
+ * dump is read back by the INI reader, whose lines hold at most 198 (docs/ini.md). */
+static void dump_comment(FILE *out, const char *text)
+{
+    enum { WIDTH = 100 - 6 }; /* "    ; " */
+    while (*text) {
+        size_t n = strlen(text);
+        if (n > WIDTH) {
+            n = WIDTH;
+            while (n > 0 && text[n] != ' ')
+                n--;
+            if (n == 0) /* one word longer than a line: cut it */
+                n = WIDTH;
+        }
+        fprintf(out, "    ; %.*s\n", (int)n, text);
+        text += n;
+        while (*text == ' ')
+            text++;
+    }
+}
+
 void cfg_dump(const CfgMachine *cfg, FILE *out)
 {
     const char *sec = "";
@@ -398,17 +419,18 @@ void cfg_dump(const CfgMachine *cfg, FILE *out)
             fprintf(out, "%s[%s]\n", i ? "\n" : "", k->section);
             sec = k->section;
         }
-        char val[64], def[64], lo[64], hi[64];
+        char val[64], def[64], lo[64], hi[64], text[1024];
         fmt_value(k, load(cfg, k), val, sizeof val);
         fmt_value(k, k->def, def, sizeof def);
         fmt_value(k, k->lo, lo, sizeof lo);
         fmt_value(k, k->hi, hi, sizeof hi);
         if (k->type == CFG_ENUM)
-            fprintf(out, "%s = %s\n    ; %s, default %s, one of %s: %s\n", k->key, val, type_name(k->type), def,
+            snprintf(text, sizeof text, "%s, default %s, one of %s: %s", type_name(k->type), def,
                      enum_list(k, lo, sizeof lo), k->help);
         else
-            fprintf(out, "%s = %s\n    ; %s, default %s, range %s..%s: %s\n", k->key, val, type_name(k->type), def,
-                    lo, hi, k->help);
+            snprintf(text, sizeof text, "%s, default %s, range %s..%s: %s", type_name(k->type), def, lo, hi, k->help);
+        fprintf(out, "%s = %s\n", k->key, val);
+        dump_comment(out, text);
     }
 }
 

@@ -57,6 +57,14 @@ static int impose_size(Scene *s, const RunSize *z, char *err, size_t errlen)
                  REF_MAX_GENERATIONS - 1);
         return -1;
     }
+    /* The loader checked the camera's ray lengths at the scene's own size; an imposed aspect can
+     * lengthen them (docs/scenes.md, "Limits of scene values"). */
+    char why[400];
+    if ((z->width > 0 || z->height > 0) &&
+        scene_camera_view_check(&s->camera, s->render.width, s->render.height, why, sizeof why) != 0) {
+        snprintf(err, errlen, "%s: the camera at %d x %d: %s", s->source, s->render.width, s->render.height, why);
+        return -1;
+    }
     return 0;
 }
 

@@ -185,6 +185,24 @@ Test(bvh_build, deterministic)
     free(hi);
 }
 
+/* Boxes of half-size 1e30 (a sphere of that radius, which the scene loader refuses today) have
+ * surface areas beyond single precision; the SAH cost must still be a finite positive number (it
+ * was NaN, printed "-nan" in report.txt and null in report.json). */
+Test(bvh_build, sah_cost_of_boxes_whose_areas_overflow_is_a_number)
+{
+    const float lo[6] = {-1e30f, -1e30f, -1e30f, -1.0f, -1.0f, -3.0f};
+    const float hi[6] = {1e30f, 1e30f, 1e30f, 1.0f, 1.0f, -1.0f};
+    cr_assert(isinf((hi[0] - lo[0]) * (hi[1] - lo[1])), "the case must overflow a float area");
+    BvhParams p;
+    bvh_default_params(&p);
+    Bvh b;
+    char err[256];
+    cr_assert_eq(bvh_build(&p, lo, hi, 2, &b, err, sizeof err), 0, "%s", err);
+    double c = bvh_sah_cost(&b, &p);
+    cr_expect(isfinite(c) && c > 0.0, "sah_cost %g", c);
+    bvh_free(&b);
+}
+
 Test(bvh_errors, nan_box_rejected)
 {
     BvhParams p;

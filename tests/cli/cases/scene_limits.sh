@@ -94,4 +94,23 @@ want_err "warning: .*bright.ini:4: key 'material.paint.base_color': is \(1.5, 0.
 [ -s "$T/o/frame.exr" ] || no "no frame.exr written"
 end
 
+begin "a camera within the limits at the scene's size is refused at a size given on the command line that lengthens its rays"
+run "$SFSIM" run -s tests/scenes/limit_camera_wide.ini -o "$T/cw" --set render.spp=1 --mode reference
+want_rc 0
+rm -rf "$T/cw"
+run "$SFSIM" run -s tests/scenes/limit_camera_wide.ini -o "$T/cw" --set render.spp=1 --mode reference \
+    --set render.width=16384 --set render.height=1
+want_rc 1
+want_err "limit_camera_wide.ini: the camera at 16384 x 1: ray length .* beyond the limit of 1e\+19"
+[ ! -e "$T/cw" ] || no "an output folder was made"
+end
+
+begin "an MTL emission beyond the limit on radiance is refused naming the file and material"
+printf 'newmtl hot\nKd 0.5 0.5 0.5\nKe 1e30 1 1\n' > "$T/hot.mtl"
+printf 'mtllib hot.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl hot\nf 1 2 3\n' > "$T/hot.obj"
+run "$SFSIM" run -s "$T/hot.obj" -o "$T/hot" --set render.width=8 --set render.height=8 --set render.spp=1 --mode reference
+want_rc 1
+want_err "hot.mtl: material 'hot': Ke is \(1e\+30, 1, 1\), beyond the limit of 1e\+18 on radiance"
+end
+
 cli_summary "cli scene_limits"
