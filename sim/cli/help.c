@@ -116,9 +116,10 @@ void help_run(FILE *out)
     fprintf(out,
             "usage: sfsim run [-s SCENE] [-o DIR] [-c CONFIG] [--mode detailed|sampled|functional|reference] [options]\n"
             "\n"
-            "Renders SCENE (a .gltf/.glb file or a scene.ini) and writes DIR/frame.exr (linear),\n"
-            "DIR/frame.png (tone-mapped sRGB), DIR/report.json and DIR/report.txt, and in detailed\n"
-            "mode DIR/cost.png (simulated cycles per pixel, per tile). docs/report.md lists the fields.\n"
+            "Renders SCENE (a .gltf/.glb or .obj file, or a scene.ini) and writes DIR/frame.exr (linear),\n"
+            "DIR/frame.png (tone-mapped sRGB), DIR/report.json, DIR/report.txt and DIR/stats.txt (every\n"
+            "statistic, one per line, as gem5 writes them), and in detailed and sampled mode DIR/cost.png\n"
+            "(simulated cycles per pixel, per tile; sampled: estimated). docs/report.md lists the fields.\n"
             "\n"
             "modes:\n"
             "  detailed    (default) the path-tracing kernel (kernels/pathtrace.s) on the functional core\n"
