@@ -315,7 +315,7 @@ static int run_check(RunArgs *a)
     }
     if (a->sample_given)
         a->o.target_error = 0.0; /* the fixed-size design */
-    a->o.mode = run_mode_names[a->mode];
+    a->o.mode = a->mode;
     return EXIT_OK;
 }
 
@@ -447,7 +447,7 @@ static int trace_parse(int argc, char **argv, TraceOptions *o, CliConfig *ca)
         fprintf(stderr, "sfsim trace: -s SCENE, --rays FILE and -o HITS are required (sfsim help trace)\n");
         return EXIT_USAGE;
     }
-    o->mode = run_mode_names[mode];
+    o->mode = mode;
     if (o->threads == 0)
         o->threads = (int)sysconf(_SC_NPROCESSORS_ONLN);
     return EXIT_OK;
@@ -478,7 +478,7 @@ static int cmd_trace(int argc, char **argv)
         return rc == -2 ? EXIT_PROGRAM : rc == -3 ? EXIT_IO : EXIT_INPUT;
     }
     printf("sfsim trace: %u rays (%s): %u hits, %u misses, %u occluded, %u clear, %u invalid; %.3f s",
-           sum.rays, o.mode, sum.hits, sum.misses, sum.occluded, sum.clear, sum.invalid, sum.seconds);
+           sum.rays, run_mode_names[o.mode], sum.hits, sum.misses, sum.occluded, sum.clear, sum.invalid, sum.seconds);
     if (sum.sim_instructions)
         printf(", %llu simulated instructions", (unsigned long long)sum.sim_instructions);
     printf("; wrote %s\n", o.out_path);

@@ -46,7 +46,7 @@ void render_default_options(RenderOptions *o)
     o->threads = 0;
     o->width = o->height = o->spp = o->max_depth = -1;
     o->exposure = 1.0f;
-    o->mode = "detailed";
+    o->mode = RUN_DETAILED;
     o->sample = 0.05;        /* used only when target_error is 0 (sfsim run --sample) */
     o->target_error = 0.01;
     o->sample_seed = 1;
@@ -170,7 +170,7 @@ static int write_partial(const RenderOptions *o, const float *rgb, int width, in
     snprintf(path, sizeof path, "%s/frame.partial.exr", o->out_dir);
     if (img_write_linear(set, path, rgb, width, height, werr, werrlen) != 0)
         goto out;
-    cJSON_AddStringToObject(fr, "mode", o->mode);
+    cJSON_AddStringToObject(fr, "mode", run_mode_names[o->mode]);
     cJSON *made = cJSON_AddObjectToObject(fr, "run");
     if (!made || prov_json(made) != 0 || !cJSON_AddNumberToObject(made, "threads", threads)) {
         snprintf(werr, werrlen, "out of memory");
@@ -311,10 +311,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     RunSpec spec = {.cfg = cfg, .kernel_path = o->kernel_path, .seed = o->seed, .threads = o->threads,
                     .sample = o->sample, .sample_seed = o->sample_seed, .progress = progress_cb, .note = note_cb,
                     .progress_ctx = &pr};
-    if (run_mode_parse(o->mode, &spec.mode) != 0) {
-        snprintf(err, errlen, "--mode %s: expected detailed, sampled, functional or reference", o->mode);
-        return -1;
-    }
+    spec.mode = o->mode;
     if (spec.mode == RUN_SAMPLED) {
         spec.target_error = o->target_error;
         spec.no_image = o->no_image;

@@ -10,6 +10,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "run/run.h"
+
 typedef struct RenderOptions {
     const char *scene_path;    /* .gltf/.glb or scene.ini */
     const char *out_dir;       /* created if missing, once there is something to write */
@@ -18,7 +20,7 @@ typedef struct RenderOptions {
     int width, height, spp, max_depth; /* overrides of the scene's [render]; -1 = keep */
     float exposure;            /* for frame.png */
     int progress;              /* 1: progress bar on stderr (the CLI sets it when stderr is a tty) */
-    const char *mode;          /* "detailed", "sampled", "functional" or "reference" */
+    RunMode mode;              /* parsed once, by the command line (run_mode_parse) */
     const struct CfgMachine *cfg; /* the machine (functional mode; NULL: defaults) */
     const char *config_path;   /* the -c file as given, for the report; NULL: the built-in defaults */
     const char *kernel_path;   /* kernel modes: the kernel source (NULL: next to the binary) */

@@ -145,7 +145,7 @@ cJSON *report_json(const Report *r)
     cJSON *root = cJSON_CreateObject();
     /* What made the run (sim/provenance.h): it changes with every run, so the same-outputs digest
      * leaves the whole object out (tools/outputs_digest.c). */
-    cJSON *made = root && cJSON_AddStringToObject(root, "mode", o->mode) ? cJSON_AddObjectToObject(root, "run") : NULL;
+    cJSON *made = root && cJSON_AddStringToObject(root, "mode", run_mode_names[o->mode]) ? cJSON_AddObjectToObject(root, "run") : NULL;
     if (!made || prov_json(made) != 0 || !cJSON_AddNumberToObject(made, "threads", threads) || stats_json(root, &sx) != 0) {
         cJSON_Delete(root);
         return NULL;
@@ -250,7 +250,7 @@ void report_txt(const Report *r, char *txt, size_t cap)
              "config       %s\n"
              "image        %d x %d, %d spp, max depth %d, seed %u, %s\n"
              "             mean %.5f, non-finite values %ld\n",
-             o->mode,
+             run_mode_names[o->mode],
              detailed     ? "the kernel on the timing model of the machine"
              : sampled    ? "the golden model's image; sampled (tile, pass) units on the timed kernel, the frame's cycles estimated"
              : functional ? "the kernel on the functional core: no timing"
@@ -307,7 +307,7 @@ int report_stats_txt(const Report *r, char **text, size_t *len)
     if (!fp)
         return -1;
     fprintf(fp, "# sfsim %s (commit %s), mode %s; the command line, date and host: report.json's \"run\"\n",
-            version_string(), version_commit(), r->o->mode);
+            version_string(), version_commit(), run_mode_names[r->o->mode]);
     int rc = stats_gem5(fp, &sx);
     if (fclose(fp) != 0 || rc != 0) {
         free(*text);

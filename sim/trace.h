@@ -12,12 +12,13 @@
 #include <stdint.h>
 
 #include "config.h"
+#include "run/run.h"
 #include "raybatch.h"
 #include "timing.h"
 
 typedef struct TraceOptions {
     const char *scene_path, *rays_path, *out_path;
-    const char *mode;             /* "functional" (default), "detailed" (the kernel, timed) or "reference" */
+    RunMode mode;                 /* RUN_FUNCTIONAL (the default), RUN_DETAILED (the kernel, timed) or RUN_REFERENCE */
     const char *kernel_path;      /* NULL: next to the executable */
     const CfgMachine *cfg;
     int threads;

@@ -33,7 +33,7 @@ static cJSON *run_reference(const char *scene, char **txt)
     render_default_options(&o);
     o.scene_path = scene;
     o.out_dir = dir;
-    o.mode = "reference";
+    o.mode = RUN_REFERENCE;
     o.width = o.height = 8;
     o.spp = 1;
     o.threads = 1;

@@ -55,7 +55,7 @@ static cJSON *run(const CfgMachine *cfg, const char *kernel, char **txt)
     RenderOptions o;
     render_default_options(&o);
     o.scene_path = "scenes/cornell/scene.ini";
-    o.mode = "functional";
+    o.mode = RUN_FUNCTIONAL;
     o.cfg = cfg;
     o.kernel_path = kernel;
     o.width = 128;
@@ -202,7 +202,7 @@ Test(render, report_names_files_tiles_and_threads, .timeout = 120)
     RenderOptions o;
     render_default_options(&o);
     o.scene_path = "scenes/cornell/scene.ini";
-    o.mode = "reference";
+    o.mode = RUN_REFERENCE;
     o.width = 32;
     o.height = 32;
     o.spp = 1;

@@ -190,7 +190,7 @@ Test(stats, csv_reads_a_real_report)
     RenderOptions o;
     render_default_options(&o);
     o.scene_path = "scenes/cornell/scene.ini";
-    o.mode = "detailed";
+    o.mode = RUN_DETAILED;
     o.cfg = &cfg;
     o.kernel_path = "tests/unit/kd_stub.s";
     o.width = o.height = 64;
