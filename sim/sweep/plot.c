@@ -134,6 +134,31 @@ static void dat_num(UtilBuf *b, const SweepRow *row, int m)
     util_buf_printf(b, " %s", v);
 }
 
+/* The tallest stack of series m0 .. m0 + n - 1 over the rows given (0 when none has a figure). */
+static double stack_max(const SweepRow *rows, const int *idx, int count, int m0, int n)
+{
+    double top = 0.0;
+    for (int j = 0; j < count; j++) {
+        double sum = 0.0;
+        for (int c = 0; c < n; c++)
+            if (rows[idx[j]].has[m0 + c] && rows[idx[j]].m[m0 + c] > 0.0)
+                sum += rows[idx[j]].m[m0 + c];
+        top = sum > top ? sum : top;
+    }
+    return top;
+}
+
+/* The y range of stacked bars: [0:1] for shares; otherwise one range for every panel, from 0 to
+ * the tallest stack of all of them and a margin, so that side-by-side panels compare by eye (each
+ * panel scaled on its own made equal heights mean different cycles). */
+static void stack_yrange(UtilBuf *gp, int unit_range, double top)
+{
+    if (unit_range || !(top > 0.0))
+        util_buf_printf(gp, "set yrange [0:%s]\n", unit_range ? "1" : "*");
+    else
+        util_buf_printf(gp, "set yrange [0:%.17g]\n", top * 1.05);
+}
+
 /* A group of rows: the points that share the values of the swept keys other than x. */
 typedef struct Group {
     char *label;
@@ -526,9 +551,18 @@ static void plot_stacked(Plotter *p, const char *xkey, const Series *se)
         }
     }
     gp_head(p, &gp, base, 820 * cols, 480 * rws + 60, se->what, xkey);
+    /* rowstacked puts the first series at the bottom; "invert" lists the key in the same order,
+     * the top of the stack first, so that legend and bars read alike. */
     util_buf_puts(&gp, "set style data histograms\nset style histogram rowstacked\n"
-                       "set style fill solid 0.85 border -1\nset boxwidth 0.7 relative\nset key outside right top\n");
-    util_buf_printf(&gp, "set yrange [0:%s]\nset ylabel \"%s\"\nset xlabel ", se->unit_range ? "1" : "*", se->ylabel);
+                       "set style fill solid 0.85 border -1\nset boxwidth 0.7 relative\n"
+                       "set key outside right top invert\n");
+    double top = 0.0;
+    for (int i = 0; i < ng; i++) {
+        double t = stack_max(p->rows, g[i].rows, g[i].n, se->m0, se->n);
+        top = t > top ? t : top;
+    }
+    stack_yrange(&gp, se->unit_range, top);
+    util_buf_printf(&gp, "set ylabel \"%s\"\nset xlabel ", se->ylabel);
     axis_label(&gp, xkey);
     util_buf_puts(&gp, "\n");
     gp_palette(&gp, se->n);
@@ -639,7 +673,7 @@ static void plot_bars(Plotter *p, int kind)
         util_buf_puts(&gp, "\n");
     } else {
         util_buf_printf(&gp, "set style data histograms\nset style histogram rowstacked\nset boxwidth 0.7 relative\n"
-                             "set yrange [0:%s]\nset ylabel \"%s\"\nset key outside right top\n",
+                             "set yrange [0:%s]\nset ylabel \"%s\"\nset key outside right top invert\n",
                    se->unit_range ? "1" : "*", se->ylabel);
         gp_palette(&gp, se->n);
         for (int c = 0; c < se->n; c++)

@@ -50,17 +50,61 @@ void sweep_fmt_duration(double s, char *buf, size_t len)
         snprintf(buf, len, "%ldh%02ldm", t / 3600, t % 3600 / 60);
 }
 
+/* A min-heap of slot times, for sweep_eta. */
+static void heap_down(double *h, int n, int i)
+{
+    for (;;) {
+        int l = 2 * i + 1, m = i;
+        if (l < n && h[l] < h[m])
+            m = l;
+        if (l + 1 < n && h[l + 1] < h[m])
+            m = l + 1;
+        if (m == i)
+            return;
+        double t = h[i];
+        h[i] = h[m];
+        h[m] = t;
+        i = m;
+    }
+}
+
+double sweep_eta(double mean, const double *elapsed, int nrunning, int queued, int jobs)
+{
+    if (jobs < 1 || !(mean > 0.0))
+        return 0.0;
+    if (jobs > SWEEP_MAX_JOBS)
+        jobs = SWEEP_MAX_JOBS;
+    /* Each of the jobs slots is free at a time from now: a running point's at the mean less what
+     * it ran (0 once it ran longer), an idle slot's at once. The queued points, each of the mean
+     * length, go to the slot free first (as the runner starts them); the last to end is the
+     * estimate. Points are not divisible: near the end fewer slots work, and a fluid estimate
+     * ((work left) / jobs) rose as the last points finished. */
+    double h[SWEEP_MAX_JOBS];
+    for (int i = 0; i < jobs; i++)
+        h[i] = i < nrunning ? fmax(0.0, mean - elapsed[i]) : 0.0;
+    for (int i = jobs / 2 - 1; i >= 0; i--)
+        heap_down(h, jobs, i);
+    for (int q = 0; q < queued; q++) {
+        h[0] += mean;
+        heap_down(h, jobs, 0);
+    }
+    double end = 0.0;
+    for (int i = 0; i < jobs; i++)
+        end = fmax(end, h[i]);
+    return end;
+}
+
 static void progress_line(const SweepRunner *r, UtilBuf *b)
 {
     util_buf_printf(b, "sweep: %d/%d done, %d running, %d failed", r->done, r->total, r->nkids, r->failed);
     int remaining = r->total - r->done - r->failed;
     if (remaining > 0 && r->secs_n > 0) {
-        double mean = r->secs_sum / r->secs_n, t = util_now(), running = 0;
-        for (int i = 0; i < r->nkids; i++)
-            running += fmin(t - r->kids[i].t0, mean);
-        int par = remaining < r->jobs ? remaining : r->jobs;
+        double mean = r->secs_sum / r->secs_n, t = util_now(), elapsed[SWEEP_MAX_JOBS];
+        int n = r->nkids < SWEEP_MAX_JOBS ? r->nkids : SWEEP_MAX_JOBS;
+        for (int i = 0; i < n; i++)
+            elapsed[i] = t - r->kids[i].t0;
         char d[32];
-        sweep_fmt_duration(fmax(0, (remaining * mean - running) / par), d, sizeof d);
+        sweep_fmt_duration(sweep_eta(mean, elapsed, n, remaining - r->nkids, r->jobs), d, sizeof d);
         util_buf_printf(b, ", ~%s left", d);
     }
 }

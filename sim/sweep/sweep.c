@@ -97,7 +97,7 @@ static int args_option(const CliParse *p, SweepArgs *a, int code, const char *v)
     case 's': a->scene = v; break;
     case 'o': a->out = v; break;
     case 'j':
-        if (cli_int(p, "-j", v, 1, 4096, &n))
+        if (cli_int(p, "-j", v, 1, SWEEP_MAX_JOBS, &n))
             return -2;
         a->jobs = (int)n;
         break;

@@ -33,6 +33,8 @@
 
 /* The one limit: more points than this is an error that says so. */
 #define SWEEP_MAX_POINTS 100000
+/* The most points a sweep runs at once (-j). */
+#define SWEEP_MAX_JOBS 4096
 #define SWEEP_MANIFEST_FORMAT "sfsim sweep 1"
 /* Lines of a failed point's log kept in its `failed` marker. */
 #define SWEEP_TAIL_LINES 12
@@ -170,6 +172,12 @@ typedef struct SweepTally {
     double secs_sum;
     int secs_n;
 } SweepTally;
+
+/* The progress line's estimate of the seconds left: nrunning points that ran elapsed[i] seconds
+ * and queued points not started, on jobs slots, every point taking mean seconds. The runner's
+ * schedule, simulated (the queued points go to the slot free first), so that with points of one
+ * length the estimate falls by the time that passes, second for second. */
+double sweep_eta(double mean, const double *elapsed, int nrunning, int queued, int jobs);
 
 /* Resuming: the points of pl still to run in dir, in order, into todo (pl->npoints long):
  * unfinished ones, and failed ones when retry; the others are counted in *t. Returns how many. */

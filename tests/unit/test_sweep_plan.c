@@ -7,6 +7,7 @@
  * Suites: sweep_expand, sweep_plan, sweep_diff, sweep_resume.
  */
 #include <criterion/criterion.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -449,4 +450,33 @@ Test(sweep_resume, a_done_marker_wins_over_a_failed_one)
     cr_expect_float_eq(secs, 4.0, 1e-9);
     sweep_plan_free(&pl);
     tu_remove_tree(dir);
+}
+
+/* The progress line's estimate of the time left (sweep_eta): with points of one length (10 s), 7
+ * of them on 2 slots, the sweep ends at 40 s; at every moment the estimate is the time to then.
+ * The fluid estimate it replaced ((work left) / jobs) said 5 s left at 29.9 s and rose as points
+ * finished. */
+Test(sweep_eta, falls_second_for_second_with_points_of_one_length)
+{
+    const double len = 10.0, end = 40.0;
+    for (double t = 0.0; t < end; t += 0.25) {
+        /* The runner's state at t: points start in pairs at 0, 10, 20; the 7th alone at 30. */
+        int started = t < 10 ? 2 : t < 20 ? 4 : t < 30 ? 6 : 7;
+        int finished = t < 10 ? 0 : t < 20 ? 2 : t < 30 ? 4 : 6;
+        int running = started - finished;
+        double elapsed[2];
+        for (int i = 0; i < running; i++)
+            elapsed[i] = t - 10.0 * (int)(t / 10.0);
+        double eta = sweep_eta(len, elapsed, running, 7 - started, 2);
+        cr_expect(fabs(eta - (end - t)) < 1e-9, "at %g s: %g s left, expected %g", t, eta, end - t);
+    }
+}
+
+Test(sweep_eta, idle_slots_and_overrun_points)
+{
+    double el[3] = {25.0, 3.0, 0.0};
+    /* a point that ran past the mean is taken to end now; the queued 4 go to the 3 slots */
+    cr_expect_float_eq(sweep_eta(10.0, el, 3, 4, 3), 20.0, 1e-9);
+    cr_expect_float_eq(sweep_eta(10.0, NULL, 0, 5, 8), 10.0, 1e-9, "5 points on 8 idle slots take one length");
+    cr_expect_float_eq(sweep_eta(10.0, NULL, 0, 0, 2), 0.0, 1e-9);
 }
