@@ -105,3 +105,32 @@ void tu_write_file(const char *path, const char *text)
     cr_assert_geq(fputs(text, f), 0, "cannot write %s", path);
     cr_assert_eq(fclose(f), 0, "cannot write %s", path);
 }
+
+static FILE *captured;
+static int saved_stderr = -1;
+
+void tu_stderr_begin(void)
+{
+    fflush(stderr);
+    captured = tmpfile();
+    cr_assert_not_null(captured, "no temporary file for stderr");
+    saved_stderr = dup(2);
+    cr_assert(saved_stderr >= 0 && dup2(fileno(captured), 2) >= 0, "cannot redirect stderr");
+}
+
+char *tu_stderr_end(void)
+{
+    cr_assert_not_null(captured, "tu_stderr_end without tu_stderr_begin");
+    fflush(stderr);
+    dup2(saved_stderr, 2);
+    close(saved_stderr);
+    saved_stderr = -1;
+    long n = fseek(captured, 0, SEEK_END) == 0 ? ftell(captured) : -1; /* fd 2 wrote past the FILE's view */
+    cr_assert(n >= 0 && fseek(captured, 0, SEEK_SET) == 0);
+    char *buf = malloc((size_t)n + 1);
+    cr_assert_not_null(buf);
+    buf[fread(buf, 1, (size_t)n, captured)] = 0;
+    fclose(captured);
+    captured = NULL;
+    return buf;
+}

@@ -23,4 +23,11 @@ void tu_write_file(const char *path, const char *text);
 /* Removes a test's temporary folder and everything in it (a missing folder is fine). */
 void tu_remove_tree(const char *dir);
 
+/* A negative test's expected messages: tu_stderr_begin() sends stderr into a temporary file,
+ * tu_stderr_end() puts it back and returns what was written meanwhile (free() it), for the test
+ * to assert on. The messages are checked, and do not reach make test's output, where they would
+ * read as failures. */
+void tu_stderr_begin(void);
+char *tu_stderr_end(void);
+
 #endif

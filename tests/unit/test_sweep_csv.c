@@ -545,7 +545,12 @@ Test(sweep_csv, rows_hold_keys_status_error_and_figures)
     SweepPlan pl;
     csv_sweep(dir, &pl);
     int nd, nf, nu;
+    tu_stderr_begin();
     SweepRow *rows = sweep_rows_collect(&pl, dir, &nd, &nf, &nu);
+    char *said = tu_stderr_end();
+    cr_expect(strstr(said, "sweep: point 3 failed: ") && strstr(said, "points/003/report.json: missing"),
+              "the point without its report is named: %s", said);
+    free(said);
     cr_expect_eq(nd, 1);
     cr_expect_eq(nf, 2, "point 3, done without its report.json, is failed");
     cr_expect_eq(nu, 1);
@@ -611,7 +616,13 @@ Test(sweep_csv, a_done_point_with_a_wrong_figure_is_failed_and_keeps_the_rest)
     tu_write_file(path, text);
     free(text);
     int nd, nf, nu;
+    tu_stderr_begin();
     SweepRow *rows = sweep_rows_collect(&pl, dir, &nd, &nf, &nu);
+    char *said = tu_stderr_end();
+    cr_expect(strstr(said, "sweep: point 0 failed: ") && strstr(said, "points/000/report.json: key 'cycles' is not a number"),
+              "the failed point is named: %s", said);
+    cr_expect(strstr(said, "sweep: point 3 failed: ") && strstr(said, "points/003/report.json: missing"), "%s", said);
+    free(said);
     cr_expect_eq(nd, 0);
     cr_expect_eq(nf, 3);
     cr_expect_eq(rows[0].state, SWEEP_FAILED);

@@ -334,7 +334,13 @@ Test(sweep_diff, a_folder_holding_another_sweep_is_refused)
     close(fd);
     free(abs);
     load(manifest(dir, text, "functional", NULL, 0), &b);
-    cr_expect_eq(sweep_dir_open(out, &b, 1, &fd, &abs), EXIT_INPUT, "another sweep in the folder");
+    tu_stderr_begin();
+    int rc = sweep_dir_open(out, &b, 1, &fd, &abs);
+    char *said = tu_stderr_end();
+    cr_expect_eq(rc, EXIT_INPUT, "another sweep in the folder");
+    cr_expect(strstr(said, "holds another sweep") && strstr(said, "--mode: detailed there, functional here"),
+              "the refusal says what differs: %s", said);
+    free(said);
     cr_expect_eq(fd, -1);
     cr_expect_null(abs);
     sweep_plan_free(&a);
