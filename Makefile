@@ -252,17 +252,17 @@ docs: $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_e
 	$(BUILD)/gen_kconst > kernels/lib/kconst.inc
 
 # ---- tests ----------------------------------------------------------------------------------
-$(BUILD)/tests/unit: $(TEST_SRC) $(BUILD)/libsfsim.a $(SHIM_OBJ) $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_exitdoc $(BUILD)/gen_reportdoc
+$(BUILD)/tests/unit: $(TEST_SRC) $(BUILD)/libsfsim.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_exitdoc $(BUILD)/gen_reportdoc
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(LDAS) $(TEST_SRC) $(SHIM_OBJ) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(INIH) $(LDLIBS) $(OIIO)
+	$(CC) $(CFLAGS) $(LDAS) $(TEST_SRC) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
 
 $(BUILD)/tests/io: $(IO_TEST_SRC) $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(LDAS) $(IO_TEST_SRC) $(SHIM_OBJ) $(BUILD)/libsfsim.a -o $@ $(CRIT) $(EMBREE) $(INIH) $(LDLIBS) $(OIIO)
 
-$(BUILD)/tests/unit-asan: $(TEST_SRC) $(BUILD)/libsfsim-asan.a $(SHIM_ASAN_OBJ) $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_exitdoc $(BUILD)/gen_reportdoc
+$(BUILD)/tests/unit-asan: $(TEST_SRC) $(BUILD)/libsfsim-asan.a $(BUILD)/gen_isadoc $(BUILD)/gen_layout $(BUILD)/gen_kconst $(BUILD)/gen_exitdoc $(BUILD)/gen_reportdoc
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(SAN) $(LDAS) $(TEST_SRC) $(SHIM_ASAN_OBJ) $(BUILD)/libsfsim-asan.a -o $@ $(CRIT) $(INIH) $(LDLIBS) $(OIIO)
+	$(CC) $(CFLAGS) $(SAN) $(LDAS) $(TEST_SRC) $(BUILD)/libsfsim-asan.a -o $@ $(CRIT) $(INIH) $(LDLIBS)
 
 $(BUILD)/tests/io-asan: $(IO_TEST_SRC) $(BUILD)/libsfsim-asan.a $(SHIM_ASAN_OBJ)
 	@mkdir -p $(dir $@)
