@@ -355,7 +355,7 @@ fuzz: $(BUILD)/fuzz/fuzz_asm $(BUILD)/fuzz/fuzz_scene $(BUILD)/fuzz/fuzz_rays $(
 fuzz-run: fuzz
 	@mkdir -p $(BUILD)/fuzz/corpus $(BUILD)/fuzz/scene_corpus
 	$(BUILD)/fuzz/fuzz_asm -max_total_time=$(FUZZ_SECONDS) -max_len=4096 $(BUILD)/fuzz/corpus tests/fuzz/seeds
-	$(BUILD)/fuzz/fuzz_scene -max_total_time=$(FUZZ_SECONDS) -max_len=65536 -timeout=30 $(BUILD)/fuzz/scene_corpus tests/scenes
+	$(BUILD)/fuzz/fuzz_scene -max_total_time=$(FUZZ_SECONDS) -max_len=65536 -timeout=30 $(BUILD)/fuzz/scene_corpus tests/scenes tests/scenes/obj
 	@mkdir -p $(BUILD)/fuzz/ray_corpus
 	$(BUILD)/fuzz/fuzz_rays -max_total_time=$(FUZZ_SECONDS) -max_len=8192 $(BUILD)/fuzz/ray_corpus tests/fuzz/ray_seeds
 	@mkdir -p $(BUILD)/fuzz/config_corpus

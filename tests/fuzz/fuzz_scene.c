@@ -1,7 +1,9 @@
 /* tests/fuzz/fuzz_scene.c -- libFuzzer target for the scene loader.
  *
- * Every input is read three ways: as a glTF document from memory (binary when it starts with
- * "glTF", JSON otherwise; odd-sized inputs go through a mirroring placement transform), and as
+ * Every input is read four ways: as a glTF document from memory (binary when it starts with
+ * "glTF", JSON otherwise; odd-sized inputs go through a mirroring placement transform), as a
+ * Wavefront OBJ from memory whose mtllib lines all read the same bytes as MTL (the OBJ shim,
+ * scenes/obj_load.cpp: its own line checks and triangulation, then tinyobjloader), and as
  * a scene.ini written to a private folder that also holds a small valid glTF file (a.gltf) and
  * the Cornell box (box.glb) for the ini to name. A load must return 0 or -1 with a message; it
  * must not crash, leak, or read past a buffer.
@@ -22,6 +24,7 @@
 #include <unistd.h>
 
 #include "../../scenes/gltf.h"
+#include "../../scenes/obj.h"
 #include "../../scenes/scene.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -102,7 +105,20 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     scene_free(&s);
 
-    /* 2. scene.ini */
+    /* 2. OBJ (+ the same bytes as every MTL it names) from memory */
+    scene_init(&s, "fuzz");
+    if (obj_append_memory((const char *)data, size, (const char *)data, size, "fuzz.obj", size % 2 ? mirror : NULL,
+                          &s, err, sizeof err) == 0) {
+        if (scene_finish(&s, err, sizeof err) == 0) {
+            char needs[256];
+            scene_needs_string(s.needs, needs, sizeof needs);
+        }
+    } else if (!err[0]) {
+        abort(); /* a failure must say why */
+    }
+    scene_free(&s);
+
+    /* 3. scene.ini */
     if (names_device(data, size))
         return 0;
     FILE *f = fopen(g_ini, "wb");
