@@ -32,6 +32,7 @@
 #include <cstdlib>
 
 #include "../host/infile.h"
+#include "scene_path.hpp"
 
 namespace sfgltf {
 
@@ -141,43 +142,12 @@ struct FsContext {
     std::string refused;  // the first uri refused, as the file wrote it
 };
 
-// path made absolute (from the working directory) with "." and ".." resolved by name alone.
-std::string lexical_path(const std::string &path)
-{
-    std::string full = path;
-    if (full.empty() || full[0] != '/') {
-        char cwd[4096];
-        if (!getcwd(cwd, sizeof cwd))
-            return std::string();
-        full = std::string(cwd) + "/" + full;
-    }
-    std::vector<std::string> parts;
-    size_t i = 0;
-    while (i <= full.size()) {
-        size_t j = full.find('/', i);
-        if (j == std::string::npos)
-            j = full.size();
-        std::string part = full.substr(i, j - i);
-        if (part == "..") {
-            if (!parts.empty())
-                parts.pop_back();
-        } else if (!part.empty() && part != ".") {
-            parts.push_back(part);
-        }
-        i = j + 1;
-    }
-    std::string out;
-    for (const auto &part : parts)
-        out += "/" + part;
-    return out.empty() ? "/" : out;
-}
-
 bool under(const std::string &path, const std::string &dir) { return path.compare(0, dir.size(), dir) == 0; }
 
 // Whether `path` stays inside the folder: by name, and, when it exists, through symbolic links.
 bool inside_folder(const FsContext &c, const std::string &path)
 {
-    if (!under(lexical_path(path), c.root))
+    if (!under(scene_lexical_path(path), c.root))
         return false;
     char *r = realpath(path.c_str(), nullptr);
     if (!r)
@@ -499,7 +469,7 @@ extern "C" int gltf_append(const char *path, const double *xf, Scene *s, char *e
         std::string base_dir = slash ? std::string(path, (size_t)(slash - path) + 1) : std::string();
         FsContext ctx;
         ctx.base = base_dir;
-        ctx.root = lexical_path(base_dir.empty() ? "." : base_dir);
+        ctx.root = scene_lexical_path(base_dir.empty() ? "." : base_dir);
         char *real = realpath(base_dir.empty() ? "." : base_dir.c_str(), nullptr);
         ctx.real = real ? real : ctx.root;
         std::free(real);

@@ -40,6 +40,7 @@
 extern "C" {
 #include "obj.h"
 #include "../host/infile.h"
+#include "scene_path.hpp"
 }
 
 namespace {
@@ -68,36 +69,6 @@ std::string one_line(std::string s)
 
 // ---- files -----------------------------------------------------------------------------------
 
-// path made absolute with "." and ".." resolved by name alone.
-std::string lexical_path(const std::string &path)
-{
-    std::string full = path;
-    if (full.empty() || full[0] != '/') {
-        char cwd[4096];
-        if (!getcwd(cwd, sizeof cwd))
-            return std::string();
-        full = std::string(cwd) + "/" + full;
-    }
-    std::vector<std::string> parts;
-    size_t i = 0;
-    while (i <= full.size()) {
-        size_t j = full.find('/', i);
-        if (j == std::string::npos)
-            j = full.size();
-        std::string part = full.substr(i, j - i);
-        if (part == "..") {
-            if (!parts.empty())
-                parts.pop_back();
-        } else if (!part.empty() && part != ".") {
-            parts.push_back(part);
-        }
-        i = j + 1;
-    }
-    std::string out;
-    for (const auto &part : parts)
-        out += "/" + part;
-    return out + "/";
-}
 
 // A whole regular file into out; "" or why not ("cannot open: ...", "not a regular file").
 std::string read_file(const std::string &path, std::string &out)
@@ -143,7 +114,7 @@ struct Ctx {
         full = r[0] == '/' ? r : dir + r;
         if (allow_outside)
             return true;
-        bool in = lexical_path(full).compare(0, root.size(), root) == 0;
+        bool in = scene_lexical_path(full).compare(0, root.size(), root) == 0;
         char *rp = in ? realpath(full.c_str(), nullptr) : nullptr;
         if (rp) {
             in = (std::string(rp) + "/").compare(0, real.size(), real) == 0;
@@ -846,7 +817,7 @@ void set_folder(Ctx &c, const char *path)
 {
     const char *slash = std::strrchr(path, '/');
     c.dir = slash ? std::string(path, (size_t)(slash - path) + 1) : std::string();
-    c.root = lexical_path(c.dir.empty() ? "." : c.dir);
+    c.root = scene_lexical_path(c.dir.empty() ? "." : c.dir);
     char *real = realpath(c.dir.empty() ? "." : c.dir.c_str(), nullptr);
     c.real = real ? std::string(real) + "/" : c.root;
     std::free(real);
