@@ -105,4 +105,24 @@ for f in "$T"/sw2/plots/*.png; do
 done
 end
 
+begin "sfsim sweep on a real full disk (a small tmpfs): exit 4 or 5, every file left whole, no temporary"
+mkdir -p "$T/full"
+if mount -t tmpfs -o size=160k tmpfs "$T/full" 2>"$T/err"; then
+    run "$SFSIM" "${SW[@]}" -o "$T/full/sw"
+    [ "$rc" -eq 4 ] || [ "$rc" -eq 5 ] || no "exit $rc on a full disk, expected 4 or 5"
+    no_temporaries "$T/full"
+    for f in $(find "$T/full" -name '*.json'); do
+        python3 -c 'import json, sys; json.load(open(sys.argv[1]))' "$f" 2>/dev/null || no "$f is not whole JSON"
+    done
+    for f in $(find "$T/full" -name '*.png'); do
+        [ "$(tail -c 8 "$f" | head -c 4)" = "IEND" ] || no "$f is not a whole PNG"
+    done
+    grep -qE "No space left on device|incomplete PNG" "$T/err" "$T/full/sw"/points/*/log.txt 2>/dev/null ||
+        no "no failure named a file the full disk cut short"
+    umount "$T/full"
+else
+    echo "note: cannot mount a tmpfs ($(head -1 "$T/err")): the fault hook covers full disks alone"
+fi
+end
+
 cli_summary "cli outputs"
