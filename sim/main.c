@@ -510,6 +510,8 @@ static int cmd_help(int argc, char **argv)
         help_commands(stdout);
     } else if (!strcmp(t, "help") || !strcmp(t, "--help") || !strcmp(t, "-h")) {
         help_help(stdout);
+    } else if (!strcmp(t, "--version")) {
+        printf("sfsim %s (commit %s)\n", version_string(), version_commit());
     } else if (!strcmp(t, "exit-codes")) {
         help_exit_codes(stdout);
     } else {

@@ -13,7 +13,7 @@ trap 'rm -rf "$T"' EXIT
 version=$(tr -d ' \n\r\t' < VERSION)
 TINY=(--mode reference --set render.width=8 --set render.height=8 --no-progress)
 
-for cmd in run exec config compare trace sweep merge; do
+for cmd in run exec config compare trace sweep merge help; do
     begin "sfsim $cmd --version prints the version and exits 0"
     run "$SFSIM" "$cmd" --version
     want_rc 0; want_out "^sfsim $version \(commit "
