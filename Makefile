@@ -3,7 +3,8 @@
 
 # A parallel build by default, on every core (as `make -jN` would); an explicit -j wins.
 NPROC   := $(shell nproc 2>/dev/null || echo 1)
-ifeq ($(filter -j%,$(MAKEFLAGS)),)
+# Only the top-level make sets it: a sub-make shares its parent's jobs (GNU make's jobserver).
+ifeq ($(MAKELEVEL)$(filter -j% --jobserver%,$(MAKEFLAGS)),0)
 MAKEFLAGS += -j$(NPROC)
 endif
 
