@@ -325,14 +325,14 @@ $(BUILD)/fuzz/fuzz_asm: tests/fuzz/fuzz_asm.c $(HOST_SRC) $(ISA_SRC) $(ASM_SRC)
 # acts on SFSIM_TINYGLTF_IMPLEMENTATION) so the sanitizers see inside them (the project's
 # normal build links Debian's libtinygltf).
 FUZZ_GLTF_OBJ := $(patsubst scenes/%.cpp,$(BUILD)/fuzz/%.o,$(wildcard scenes/gltf_*.cpp))
-$(BUILD)/fuzz/gltf_%.o: scenes/gltf_%.cpp scenes/gltf_internal.hpp scenes/scene_path.hpp scenes/gltf.h scenes/scene.h
+$(BUILD)/fuzz/gltf_%.o: scenes/gltf_%.cpp scenes/gltf_internal.hpp scenes/shim_util.hpp scenes/gltf.h scenes/scene.h
 	@mkdir -p $(dir $@)
 	$(CLANG)++ -std=c++17 -g -O1 -fsanitize=fuzzer-no-link,address,undefined -isystem /usr/include/stb \
 	    -DSFSIM_TINYGLTF_IMPLEMENTATION -c $< -o $@
 
 # The OBJ shim likewise compiles tinyobjloader in (SFSIM_TINYOBJ_IMPLEMENTATION); its image decoder is
 # tinygltf's, in the glTF objects.
-$(BUILD)/fuzz/obj_load.o: scenes/obj_load.cpp scenes/obj.h scenes/scene_path.hpp scenes/scene.h
+$(BUILD)/fuzz/obj_load.o: scenes/obj_load.cpp scenes/obj.h scenes/shim_util.hpp scenes/scene.h
 	@mkdir -p $(dir $@)
 	$(CLANG)++ -std=c++17 -g -O1 -fsanitize=fuzzer-no-link,address,undefined -DSFSIM_TINYOBJ_IMPLEMENTATION \
 	    -c $< -o $@

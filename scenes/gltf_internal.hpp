@@ -27,6 +27,7 @@
 
 extern "C" {
 #include "gltf.h"
+#include "shim_util.hpp"
 }
 
 namespace sfgltf {
@@ -53,10 +54,8 @@ bool normalize(double *v);
 std::string elem(const char *kind, int index, const std::string &name);
 const char *mode_name(int mode);
 const char *ctype_name(int ctype);
-// A number for messages, as printf's %g writes it (1e+30, 0.5, inf).
-std::string num(double x);
-// One line from tinygltf's multi-line error and warning text.
-std::string one_line(std::string s);
+using scene_shim::num;      // scenes/shim_util.hpp
+using scene_shim::one_line;
 
 // ---- the loader's shared types ----------------------------------------------------------------
 

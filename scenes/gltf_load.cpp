@@ -32,7 +32,6 @@
 #include <cstdlib>
 
 #include "../host/infile.h"
-#include "scene_path.hpp"
 
 namespace sfgltf {
 
@@ -74,24 +73,6 @@ const char *ctype_name(int ctype)
     }
 }
 
-// A number for messages, as printf's %g writes it (1e+30, 0.5, inf).
-std::string num(double x)
-{
-    char b[32];
-    std::snprintf(b, sizeof b, "%g", x);
-    return b;
-}
-
-// One line from tinygltf's multi-line error and warning text.
-std::string one_line(std::string s)
-{
-    for (char &c : s)
-        if (c == '\n' || c == '\r')
-            c = ' ';
-    while (!s.empty() && s.back() == ' ')
-        s.pop_back();
-    return s;
-}
 
 namespace {
 
@@ -147,7 +128,7 @@ bool under(const std::string &path, const std::string &dir) { return path.compar
 // Whether `path` stays inside the folder: by name, and, when it exists, through symbolic links.
 bool inside_folder(const FsContext &c, const std::string &path)
 {
-    if (!under(scene_lexical_path(path), c.root))
+    if (!under(scene_shim::lexical_path(path), c.root))
         return false;
     char *r = realpath(path.c_str(), nullptr);
     if (!r)
@@ -469,7 +450,7 @@ extern "C" int gltf_append(const char *path, const double *xf, Scene *s, char *e
         std::string base_dir = slash ? std::string(path, (size_t)(slash - path) + 1) : std::string();
         FsContext ctx;
         ctx.base = base_dir;
-        ctx.root = scene_lexical_path(base_dir.empty() ? "." : base_dir);
+        ctx.root = scene_shim::lexical_path(base_dir.empty() ? "." : base_dir);
         char *real = realpath(base_dir.empty() ? "." : base_dir.c_str(), nullptr);
         ctx.real = real ? real : ctx.root;
         std::free(real);

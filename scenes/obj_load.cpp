@@ -37,10 +37,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "shim_util.hpp"
+
 extern "C" {
 #include "obj.h"
 #include "../host/infile.h"
-#include "scene_path.hpp"
 }
 
 namespace {
@@ -50,22 +51,8 @@ const size_t MAX_FACE_VERTICES = 255;
 // An MTL illumination model is 0..10 (Wavefront's MTL specification).
 const int MAX_ILLUM = 10;
 
-std::string num(double x)
-{
-    char b[32];
-    std::snprintf(b, sizeof b, "%g", x);
-    return b;
-}
-
-std::string one_line(std::string s)
-{
-    for (char &c : s)
-        if (c == '\n' || c == '\r')
-            c = ' ';
-    while (!s.empty() && s.back() == ' ')
-        s.pop_back();
-    return s;
-}
+using scene_shim::num; // scenes/shim_util.hpp
+using scene_shim::one_line;
 
 // ---- files -----------------------------------------------------------------------------------
 
@@ -114,7 +101,7 @@ struct Ctx {
         full = r[0] == '/' ? r : dir + r;
         if (allow_outside)
             return true;
-        bool in = scene_lexical_path(full).compare(0, root.size(), root) == 0;
+        bool in = scene_shim::lexical_path(full).compare(0, root.size(), root) == 0;
         char *rp = in ? realpath(full.c_str(), nullptr) : nullptr;
         if (rp) {
             in = (std::string(rp) + "/").compare(0, real.size(), real) == 0;
@@ -817,7 +804,7 @@ void set_folder(Ctx &c, const char *path)
 {
     const char *slash = std::strrchr(path, '/');
     c.dir = slash ? std::string(path, (size_t)(slash - path) + 1) : std::string();
-    c.root = scene_lexical_path(c.dir.empty() ? "." : c.dir);
+    c.root = scene_shim::lexical_path(c.dir.empty() ? "." : c.dir);
     char *real = realpath(c.dir.empty() ? "." : c.dir.c_str(), nullptr);
     c.real = real ? std::string(real) + "/" : c.root;
     std::free(real);
