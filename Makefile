@@ -347,7 +347,10 @@ $(BUILD)/fuzz/fuzz_rays: tests/fuzz/fuzz_rays.c sim/raybatch.c host/outfile.c ho
 	@mkdir -p $(dir $@)
 	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ -lm
 
-$(BUILD)/fuzz/fuzz_config: tests/fuzz/fuzz_config.c sim/config.c sim/ini.c host/infile.c sim/timing.c sim/event.c $(wildcard sim/machine/*.c) isa/isa.c
+# The timing model of one core: what fuzz_config builds from the config it fuzzes.
+TM_SRC := sim/timing.c sim/event.c $(wildcard sim/machine/*.c sim/timing/*.c) sim/mem/cache.c sim/mem/bus.c
+
+$(BUILD)/fuzz/fuzz_config: tests/fuzz/fuzz_config.c sim/config.c sim/ini.c host/infile.c $(TM_SRC) isa/isa.c
 	@mkdir -p $(dir $@)
 	$(CLANG) -std=c11 -g -O1 -D_GNU_SOURCE -Wall -Wextra -Werror -fsanitize=fuzzer,address,undefined $^ -o $@ $(INIH) $(CJSON) -lm
 

@@ -321,7 +321,7 @@ FIG(scene_cache) { UNUSED_FIG_ARGS; return c->cfg->scene_cache_kb > 0; }
 FIG(hit_rate)
 {
     (void)idx;
-    return defined_if(stats_ratio(c->t->scene.hits, c->t->scene.accesses), c->t->scene.accesses > 0, na);
+    return defined_if(stats_ratio(c->t->l1.hits, c->t->l1.accesses), c->t->l1.accesses > 0, na);
 }
 FIG(kd_per_ray)
 {

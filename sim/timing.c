@@ -222,13 +222,9 @@ struct Timing {
     EvQueue q;
     uint64_t now;                  /* the cycle the next instruction may issue in */
     uint64_t fetch_at;             /* while simd.fetch_pending: the cycle the bubble ends (EV_FETCH) */
-    SimdUnit simd;
-    RayBufs rb;
-    Agus agu;
-    Xbar xbar;
-    PartUnit part;
-    Spad spad;
-    SceneMem mem;
+#define TM_UNIT(field, Type, Params, Stats, params_fn, prefix) Type field;
+#include "machine/units.def" /* the units, each with its parameters, state and counters */
+#undef TM_UNIT
     TmDesc *desc;                  /* by pc (describe()); grown to the program's size once */
     uint32_t desc_cap;
     uint32_t run;                  /* runs since timing_new, from 1 (TmDesc.run) */
@@ -270,13 +266,9 @@ struct Timing {
 void timing_params(const CfgMachine *c, TimingParams *p)
 {
     memset(p, 0, sizeof *p);
-    simd_params(c, &p->simd);
-    rb_params(c, &p->rb);
-    agu_params(c, &p->agu);
-    xbar_params(c, &p->xbar);
-    part_params(c, &p->part);
-    spad_params(c, &p->spad);
-    mem_params(c, &p->scene);
+#define TM_UNIT(field, Type, Params, Stats, params_fn, prefix) params_fn(c, &p->field);
+#include "machine/units.def"
+#undef TM_UNIT
 }
 
 Timing *timing_new(const TimingParams *p, char *err, size_t errlen)
@@ -289,17 +281,17 @@ Timing *timing_new(const TimingParams *p, char *err, size_t errlen)
         return NULL;
     }
     evq_init(&t->q);
-    simd_init(&t->simd, &p->simd);
-    agu_init(&t->agu, &p->agu);
-    xbar_init(&t->xbar, &p->xbar);
-    part_init(&t->part, &p->part);
-    spad_init(&t->spad, &p->spad);
-    mem_init(&t->mem, &p->scene);
-    if (rb_init(&t->rb, &p->rb)) {
+    int bad = 0;
+#define TM_UNIT(field, Type, Params, Stats, params_fn, prefix) bad |= prefix##_init(&t->field, &p->field);
+#include "machine/units.def"
+#undef TM_UNIT
+    if (bad) {
         snprintf(err, errlen, "out of memory");
         timing_free(t);
         return NULL;
     }
+    /* The ports: the L1's misses go to the paper's bus. */
+    cache_connect(&t->l1, bus_port(&t->bus));
     timing_reset(t);
     return t;
 }
@@ -312,8 +304,9 @@ void timing_free(Timing *t)
     for (uint32_t i = 0; i < t->desc_cap; i++)
         free(t->desc[i].memo);
     free(t->desc);
-    mem_free(&t->mem);
-    rb_free(&t->rb);
+#define TM_UNIT(field, Type, Params, Stats, params_fn, prefix) prefix##_free(&t->field);
+#include "machine/units.def"
+#undef TM_UNIT
     free(t);
 }
 
@@ -330,11 +323,9 @@ void timing_reset(Timing *t)
 {
     evq_clear(&t->q);
     t->now = 0;
-    simd_reset(&t->simd);
-    part_reset(&t->part);
-    agu_reset(&t->agu);
-    xbar_reset(&t->xbar);
-    mem_reset(&t->mem);
+#define TM_UNIT(field, Type, Params, Stats, params_fn, prefix) prefix##_reset(&t->field);
+#include "machine/units.def"
+#undef TM_UNIT
     t->halted = 0;
     memo_none(t);
     if (++t->run == 0) { /* wrapped: no entry may look current */
@@ -351,8 +342,10 @@ const TimingStats *timing_stats(const Timing *t)
 {
     memo_fold_all((Timing *)t); /* the replays' counts (MemoEntry.lz_n) */
     TimingStats *s = &((Timing *)t)->st;
-    /* The scene-memory counters live in SceneMem; copy them in. */
-    s->scene = t->mem.st;
+    /* Each unit's counters, from the unit. */
+#define TM_UNIT(field, Type, Params, Stats, params_fn, prefix) s->field = t->field.st;
+#include "machine/units.def"
+#undef TM_UNIT
     /* The busy counters and the cycles per stage and generation, from the issue counts and the
      * stalls charged. */
     s->busy = 0;
@@ -399,9 +392,9 @@ static inline void charge(Timing *t, int cause, uint64_t cycles, int stage, int 
 static inline void count_issue(Timing *t, const TmDesc *d, int stage, int gen)
 {
     t->issues[stage][gen][d->vec]++;
-    t->st.unit_uses[d->unit]++;
+    t->simd.st.uses[d->unit]++;
     if (__builtin_expect(d->spad, 0))
-        spad_count_scalar(&t->st.spad_accesses, &t->st.spad_lines, 1);
+        spad_count_scalar(&t->spad, 1);
 }
 
 static void internal_error(Timing *t, const char *msg)
@@ -661,7 +654,7 @@ static inline void extra(Timing *t, Issue *is, int cause, uint64_t cycles, const
  * port is charged to interconnect, and the instruction issues when it has one. */
 static inline uint64_t dp_transfer(Timing *t, uint64_t at, uint64_t len, int stage, int gen)
 {
-    uint64_t s = xbar_transfer(&t->xbar, XBAR_DP, at, len, t->now, &t->st);
+    uint64_t s = xbar_transfer(&t->xbar, XBAR_DP, at, len, t->now);
     charge(t, TM_INTERCONNECT, s - at, stage, gen);
     return s;
 }
@@ -675,7 +668,7 @@ static void issue_units(Timing *t, const IsaOpInfo *oi, const CoreRecord *rec, I
         if (isa_id_fetch(fl)) { /* sfetch: the vector the AGUs fetched ahead, or a fetch now */
             AguWait w;
             uint64_t s = agu_serve(&t->agu, &t->part, &t->xbar, rec->base, rec->naddr, rec->count, is->at, t->now,
-                                   &w, &t->st);
+                                   &w);
             if (t->xbar.overflow)
                 internal_error(t, "too many AGU transfers in flight");
             charge(t, TM_PARTITION, w.partition, rec->stage, rec->gen);
@@ -714,7 +707,7 @@ static uint64_t result_time(Timing *t, const IsaOpInfo *oi, const CoreRecord *re
         break;
     case ISA_U_PART:
         if (fl & ISA_FL_IDM) { /* part: the unit runs on beside the data path */
-            uint64_t e = part_start(&t->part, &t->xbar, rec->base, rec->count, is->at, t->now, &t->st);
+            uint64_t e = part_start(&t->part, &t->xbar, rec->base, rec->count, is->at, t->now);
             if (part_hold(&t->part, end))
                 push(t, e, EV_PART, 0, 0, TM_PARTITION);
             agu_drop_range(&t->agu, t->part.lo, t->part.hi); /* IDs fetched ahead from there are stale */
@@ -786,7 +779,7 @@ static inline void issue_rb_c(Timing *t, const TmDesc *d, const CoreRecord *rec,
 
 static __attribute__((noinline)) void issue_rb(Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at)
 {
-    issue_rb_c(t, d, rec, at, rec->naddr ? rb_access(&t->rb, rec->addr, rec->naddr, &t->st) : 0);
+    issue_rb_c(t, d, rec, at, rec->naddr ? rb_access(&t->rb, rec->addr, rec->naddr) : 0);
 }
 
 /* The first cycle from now in which the instruction d is free of hazards (the events due by then
@@ -816,7 +809,7 @@ static void time_gather_c(Timing *t, const TmDesc *d, const CoreRecord *rec, int
 static void time_scene_hit(Timing *t, const TmDesc *d, const CoreRecord *rec, size_t way)
 {
     const uint64_t at = hazards_cleared(t, d, rec, TM_NO_FLOW);
-    const uint64_t r = at + (uint64_t)t->mem.p.hit_latency, line = t->mem.ready[way];
+    const uint64_t r = at + (uint64_t)t->l1.p.hit_latency, line = t->l1.ready[way];
     count_issue(t, d, rec->stage, rec->gen);
     complete_as(t, d, rec, at, at + 1, r > line ? r : line, TM_SCENE_MEMORY, TM_NO_FLOW);
 }
@@ -826,7 +819,7 @@ static __attribute__((noinline)) void issue_spad(Timing *t, const TmDesc *d, con
     const int stage = rec->stage, gen = rec->gen;
     uint64_t ext = 0;
     if (rec->naddr) {
-        ext = spad_access(&t->spad, rec->addr, rec->naddr, &t->st) - 1;
+        ext = spad_access(&t->spad, rec->addr, rec->naddr) - 1;
         charge(t, TM_SCRATCHPAD, ext, stage, gen);
     }
     count_issue(t, d, stage, gen);
@@ -840,7 +833,7 @@ static __attribute__((noinline)) void issue_scene(Timing *t, const TmDesc *d, co
     uint64_t ext = 0, ready = 0;
     int cause = TM_DATA_DEPENDENCY;
     if (rec->naddr) {
-        ext = mem_issue(&t->mem, isa_ops[d->op].flags, rec->addr, rec->naddr, at, &ready, &t->st) - 1;
+        ext = mem_issue(&t->mem, &t->l1, isa_ops[d->op].flags, rec->addr, rec->naddr, at, &ready) - 1;
         if (ready == UINT64_MAX)
             internal_error(t, "out of memory for the scene cache");
         charge(t, TM_SCENE_MEMORY, ext, stage, gen);
@@ -1011,10 +1004,10 @@ static __attribute__((noinline)) void memo_fold(Timing *t, MemoEntry *e)
     t->issues[stage][gen][0] += n * e->issues[0];
     t->issues[stage][gen][1] += n * e->issues[1];
     for (int i = 0; i < e->nunits; i++)
-        t->st.unit_uses[e->unit[i]] += n * e->unit_n[i];
+        t->simd.st.uses[e->unit[i]] += n * e->unit_n[i];
     if (e->nspad)
-        spad_count_scalar(&t->st.spad_accesses, &t->st.spad_lines, n * e->nspad);
-    t->st.icn_transfers += n * e->nicn;
+        spad_count_scalar(&t->spad, n * e->nspad);
+    t->xbar.st.transfers += n * e->nicn;
     e->lz_n = 0;
 }
 
@@ -1045,13 +1038,13 @@ static void memo_count_later(Timing *t, const MemoEntry *e, uint32_t to)
     if (!n)
         return;
     if (g0 == MEMO_SCENE) {
-        mem_hits(&t->mem, t->m_sway, n);
-        t->st.scene_instr += n;
+        cache_hits(&t->l1, t->m_sway, n);
+        t->mem.st.instructions += n;
     } else {
-        t->st.rb_accesses += n;
-        t->st.rb_lines += n * t->m_glines;
+        t->rb.st.accesses += n;
+        t->rb.st.lines += n * t->m_glines;
         if (g0 > 1)
-            t->st.rb_conflicted += n;
+            t->rb.st.conflicted += n;
     }
 }
 
@@ -1493,7 +1486,7 @@ static __attribute__((noinline)) int memo_gather(Timing *t, TmDesc *d, const Cor
     const int c = rec->naddr ? rb_cycles(&t->rb, rec->addr, rec->naddr) : MEMO_NO_LANES; /* (counted below) */
     if (memo_begin(t, d, rec, &(const MemoFirst){c, 0, 0})) {
         if (c != MEMO_NO_LANES) { /* the first gather's access, counted as it comes */
-            rb_count(&t->rb, &t->st);
+            rb_count(&t->rb, 1);
             t->m_glines = (uint32_t)t->rb.last_lines;
         }
         return 1;
@@ -1515,7 +1508,7 @@ static int memo_scene_joins(const Timing *t, const TmDesc *d, const IsaInstr *in
     if (!g0 || t->m_rec.gc[0] != MEMO_SCENE || in->op != g0->op || in->b != g0->b || in->mask != g0->mask)
         return 0;
     const int64_t at = (int64_t)t->m_rec.sc_off + (int64_t)(int32_t)in->imm - (int64_t)(int32_t)g0->imm;
-    if (at < 0 || at >= (int64_t)t->mem.p.line_bytes)
+    if (at < 0 || at >= (int64_t)t->l1.p.line_bytes)
         return 0;
     return memo_reads_unwritten(t, d);
 }
@@ -1535,17 +1528,17 @@ static __attribute__((noinline)) int memo_scene(Timing *t, TmDesc *d, const Core
         memo_store(t);
     }
     size_t way;
-    if (!load || d->short_block || t->memo_off || !mem_peek(&t->mem, 0, rec->addr[0], &way))
+    if (!load || d->short_block || t->memo_off || !cache_peek(&t->l1, rec->addr[0], &way))
         return 0;
-    const uint64_t line = t->mem.ready[way], hit = t->now + (uint64_t)t->mem.p.hit_latency;
+    const uint64_t line = t->l1.ready[way], hit = t->now + (uint64_t)t->l1.p.hit_latency;
     if (line > hit && line - t->now > UINT32_MAX)
         return 0;
-    const MemoFirst f = {MEMO_SCENE, rec->addr[0] & (uint32_t)(t->mem.p.line_bytes - 1),
+    const MemoFirst f = {MEMO_SCENE, rec->addr[0] & (uint32_t)(t->l1.p.line_bytes - 1),
                          line > hit ? (uint32_t)(line - t->now) : 0u};
     t->m_sway = way;
     if (memo_begin(t, d, rec, &f)) {
-        mem_hits(&t->mem, way, 1); /* the first load's access */
-        t->st.scene_instr++;
+        cache_hits(&t->l1, way, 1); /* the first load's access */
+        t->mem.st.instructions++;
         return 1;
     }
     if (t->mmode == MM_RECORD) {

@@ -37,6 +37,8 @@
 #include "machine/scenemem.h"
 #include "machine/simd.h"
 #include "machine/spad.h"
+#include "mem/bus.h"
+#include "mem/cache.h"
 
 /* Stall causes (ARCHITECTURE.md Sec. 3), in the order reports list them. */
 #define TM_CAUSES(X) \
@@ -61,14 +63,10 @@ typedef enum TmCause {
 extern const char *const tm_cause_keys[TM_CAUSE_COUNT];
 extern const char *const tm_cause_descs[TM_CAUSE_COUNT];
 
-typedef struct TimingParams {  /* each unit's part, filled from the config by its *_params */
-    SimdParams simd;
-    RbParams rb;
-    AguParams agu;
-    XbarParams xbar;
-    PartParams part;
-    SpadParams spad;
-    SceneMemParams scene;
+typedef struct TimingParams {  /* each unit's part (machine/units.def), filled from the config */
+#define TM_UNIT(field, Type, Params, Stats, params_fn, prefix) Params field;
+#include "machine/units.def"
+#undef TM_UNIT
 } TimingParams;
 
 void timing_params(const CfgMachine *cfg, TimingParams *p);
@@ -82,15 +80,10 @@ typedef struct TimingStats {
     uint64_t gen_cycles[CORE_GENERATIONS], gen_busy[CORE_GENERATIONS];
     uint64_t gen_stalls[CORE_GENERATIONS][TM_CAUSE_COUNT];
     uint64_t runs;                                          /* programs timed (passes of tiles; trace batches) */
-    /* units */
-    uint64_t rb_accesses, rb_lines, rb_conflicted;          /* gathers/scatters, lines, those with a conflict */
-    uint64_t agu_fetches, agu_ahead;                        /* ID vectors fetched; of them fetched ahead */
-    uint64_t icn_transfers, icn_unit_delay;                 /* data-path transfers; cycles AGU/partition work waited for a port */
-    uint64_t partitions, partition_ids, partition_cycles;
-    uint64_t spad_accesses, spad_lines;
-    uint64_t scene_instr;                                   /* scene-memory and framebuffer instructions */
-    SceneMemStats scene;
-    uint64_t unit_uses[ISA_U_COUNT];                        /* instructions per unit class */
+    /* each unit's counters, under its field name (machine/units.def) */
+#define TM_UNIT(field, Type, Params, Stats, params_fn, prefix) Stats field;
+#include "machine/units.def"
+#undef TM_UNIT
 } TimingStats;
 
 typedef struct Timing Timing;

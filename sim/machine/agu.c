@@ -7,8 +7,6 @@
 
 #include <string.h>
 
-#include "../timing.h"
-
 void agu_params(const CfgMachine *c, AguParams *p)
 {
     p->lanes = c->core_simd_width;
@@ -19,11 +17,14 @@ void agu_params(const CfgMachine *c, AguParams *p)
     p->latency = c->latency_agu;
 }
 
-void agu_init(Agus *a, const AguParams *p)
+int agu_init(Agus *a, const AguParams *p)
 {
     memset(a, 0, sizeof *a);
     a->p = *p;
+    return 0;
 }
+
+void agu_free(Agus *a) { (void)a; }
 
 void agu_reset(Agus *a)
 {
@@ -32,8 +33,7 @@ void agu_reset(Agus *a)
 }
 
 /* Schedule the fetch of n IDs at addr, starting no earlier than `from`. */
-static AguEntry fetch(Agus *a, const PartUnit *pu, Xbar *x, uint32_t addr, uint32_t n, uint64_t from, uint64_t now,
-                      TimingStats *st)
+static AguEntry fetch(Agus *a, const PartUnit *pu, Xbar *x, uint32_t addr, uint32_t n, uint64_t from, uint64_t now)
 {
     AguEntry e = {addr, n, 0, 0, 0};
     uint64_t s = from > a->free ? from : a->free;
@@ -42,16 +42,16 @@ static AguEntry fetch(Agus *a, const PartUnit *pu, Xbar *x, uint32_t addr, uint3
         e.part_end = s;
     }
     uint64_t len = (n + (uint32_t)a->p.ids_per_cycle - 1) / (uint32_t)a->p.ids_per_cycle;
-    uint64_t g = xbar_transfer(x, XBAR_AGU, s, len, now, st);
+    uint64_t g = xbar_transfer(x, XBAR_AGU, s, len, now);
     e.icn_delay = g - s;
     a->free = g + len;
     e.ready = g + len + (uint64_t)a->p.latency;
-    st->agu_fetches++;
+    a->st.fetches++;
     return e;
 }
 
 uint64_t agu_serve(Agus *a, const PartUnit *pu, Xbar *x, uint32_t addr, uint32_t k, uint32_t avail, uint64_t at,
-                   uint64_t now, AguWait *w, TimingStats *st)
+                   uint64_t now, AguWait *w)
 {
     AguEntry e;
     memset(w, 0, sizeof *w);
@@ -59,10 +59,10 @@ uint64_t agu_serve(Agus *a, const PartUnit *pu, Xbar *x, uint32_t addr, uint32_t
         e = a->q[a->head];
         a->head = (a->head + 1) % AGU_MAX;
         a->n--;
-        st->agu_ahead++;
+        a->st.ahead++;
     } else {
         a->n = 0; /* another stream: what was fetched ahead is dropped */
-        e = fetch(a, pu, x, addr, k, at, now, st);
+        e = fetch(a, pu, x, addr, k, at, now);
     }
     if (e.ready > at) { /* the wait, in segments: partition, then interconnect, then the fetch */
         uint64_t wait = e.ready - at, c;
@@ -89,7 +89,7 @@ uint64_t agu_serve(Agus *a, const PartUnit *pu, Xbar *x, uint32_t addr, uint32_t
     }
     while (a->n < a->p.depth && left > 0) {
         uint32_t n = left < (uint32_t)a->p.lanes ? left : (uint32_t)a->p.lanes;
-        a->q[(a->head + a->n) % AGU_MAX] = fetch(a, pu, x, next, n, at, now, st);
+        a->q[(a->head + a->n) % AGU_MAX] = fetch(a, pu, x, next, n, at, now);
         a->n++;
         next += 4 * n;
         left -= n;

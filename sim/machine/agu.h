@@ -5,7 +5,7 @@
  *
  * Owns: agu.ids_per_cycle, agu.queue_depth and latency.agu for a fetch, the queue of ID vectors
  * fetched ahead of the data path and the AGUs' next free cycle, the cost of a fetch, and the
- * counters agu_fetches and agu_ahead. Must not: charge a stall (agu_serve says how the wait
+ * counters (AguStats). Must not: charge a stall (agu_serve says how the wait
  * splits; the timing core charges it), or read an ID (the functional core does).
  *
  * A fetch of n IDs: ceil(n / ids_per_cycle) cycles on an interconnect port, then latency.agu of
@@ -21,7 +21,6 @@
 #include "interconnect.h"
 #include "partition.h"
 
-struct TimingStats;
 
 typedef struct AguParams {
     int lanes;                 /* N: the IDs of one vector */
@@ -41,11 +40,17 @@ typedef struct AguEntry {      /* an ID vector the AGUs fetch */
     uint64_t icn_delay;        /* cycles it waited for an interconnect port */
 } AguEntry;
 
+typedef struct AguStats {      /* uint64_t only (timing_stats_add) */
+    uint64_t fetches;          /* ID vectors fetched */
+    uint64_t ahead;            /* of them fetched ahead of the data path's ask */
+} AguStats;
+
 typedef struct Agus {
     AguParams p;
     AguEntry q[AGU_MAX];       /* fetched ahead, oldest first, from q[head] */
     int head, n;
     uint64_t free;             /* the first cycle the AGUs can start another fetch */
+    AguStats st;
 } Agus;
 
 /* How an sfetch's wait for its vector splits: the part spent behind the partition unit, behind
@@ -54,7 +59,8 @@ typedef struct AguWait {
     uint64_t partition, interconnect, fetch;
 } AguWait;
 
-void agu_init(Agus *a, const AguParams *p);
+int agu_init(Agus *a, const AguParams *p);
+void agu_free(Agus *a);
 /* Empty queue, idle units for the next program run. */
 void agu_reset(Agus *a);
 
@@ -63,7 +69,7 @@ void agu_reset(Agus *a);
  * queue or fetches it, then fetches the stream's next vectors ahead. Returns the cycle it issues
  * in; *w says how the wait until then splits. */
 uint64_t agu_serve(Agus *a, const PartUnit *pu, Xbar *x, uint32_t addr, uint32_t k, uint32_t avail, uint64_t at,
-                   uint64_t now, AguWait *w, struct TimingStats *st);
+                   uint64_t now, AguWait *w);
 
 /* A partition starts reordering IDM bytes [lo, hi): IDs fetched ahead from there are stale. */
 void agu_drop_range(Agus *a, uint32_t lo, uint32_t hi);

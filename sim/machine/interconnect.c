@@ -8,8 +8,6 @@
 
 #include <string.h>
 
-#include "../timing.h"
-
 void xbar_params(const CfgMachine *c, XbarParams *p)
 {
     /* Gribble & Ramani 2008, Sec. 3.3: the multiplexers are "sized to allow for single-cycle
@@ -19,11 +17,14 @@ void xbar_params(const CfgMachine *c, XbarParams *p)
     p->ports = c->interconnect_ports;
 }
 
-void xbar_init(Xbar *x, const XbarParams *p)
+int xbar_init(Xbar *x, const XbarParams *p)
 {
     memset(x, 0, sizeof *x);
     x->p = *p;
+    return 0;
 }
+
+void xbar_free(Xbar *x) { (void)x; }
 
 void xbar_reset(Xbar *x)
 {
@@ -101,21 +102,21 @@ int xbar_dp_free(const Xbar *x, uint64_t t)
     return running(x, t, XBAR_DP) < x->p.ports;
 }
 
-uint64_t xbar_transfer(Xbar *x, XbarUser user, uint64_t from, uint64_t len, uint64_t now, TimingStats *st)
+uint64_t xbar_transfer(Xbar *x, XbarUser user, uint64_t from, uint64_t len, uint64_t now)
 {
     /* fewer transfers running than ports (nearly always): a port is free at from */
     const uint64_t s = running(x, from, user) < x->p.ports ? from : earliest(x, from, len ? len : 1, user);
     switch (user) {
     case XBAR_DP:
         x->dp = (XbarIvl){s, s + len};
-        st->icn_transfers++;
+        x->st.transfers++;
         break;
     case XBAR_AGU:
-        st->icn_unit_delay += s - from;
+        x->st.unit_delay += s - from;
         hold_agu(x, s, s + len, now);
         break;
     case XBAR_PART:
-        st->icn_unit_delay += s - from;
+        x->st.unit_delay += s - from;
         x->part = (XbarIvl){s, s + len};
         break;
     }

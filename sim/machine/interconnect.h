@@ -3,7 +3,7 @@
  *
  * Owns: interconnect.latency and interconnect.ports, the port reservations of its three users
  * (the data path's last transfer, the AGUs' transfers in flight, the partition unit's run), the
- * counters icn_transfers and icn_unit_delay. Must not: charge a stall (the timing core charges
+ * counters (XbarStats). Must not: charge a stall (the timing core charges
  * a late transfer to `interconnect`) or decide when a unit wants a port (its caller does).
  *
  * A transfer of len cycles gets the first window, from the cycle asked for on, in which a port is
@@ -16,7 +16,6 @@
 
 #include "../config.h"
 
-struct TimingStats;
 
 typedef struct XbarParams {
     int latency;               /* cycles a transfer adds between banks and lanes */
@@ -32,6 +31,11 @@ enum { XBAR_AGU_MAX = 128 };   /* AGU transfers in flight at once (far more than
 
 typedef struct XbarIvl { uint64_t s, e; } XbarIvl;   /* cycles [s, e) */
 
+typedef struct XbarStats {     /* uint64_t only (timing_stats_add) */
+    uint64_t transfers;        /* data-path transfers */
+    uint64_t unit_delay;       /* cycles AGU and partition work waited for a port */
+} XbarStats;
+
 typedef struct Xbar {
     XbarParams p;
     XbarIvl dp;                /* the data path's last transfer */
@@ -39,16 +43,18 @@ typedef struct Xbar {
     XbarIvl agu[XBAR_AGU_MAX]; /* the AGUs' transfers that had not ended at the last reservation */
     int agu_n;
     int overflow;              /* set when more AGU transfers were in flight than XBAR_AGU_MAX */
+    XbarStats st;
 } Xbar;
 
-void xbar_init(Xbar *x, const XbarParams *p);
+int xbar_init(Xbar *x, const XbarParams *p);
+void xbar_free(Xbar *x);
 /* Idle ports for the next program run. */
 void xbar_reset(Xbar *x);
 /* A transfer for `user` of len cycles asked for at cycle `from` (now: the cycle the current
  * instruction may issue in; AGU transfers that ended before it are forgotten). Finds a window with
  * a free port (at least one cycle long), holds a port for [s, s + len) and returns s. Counts a
  * data-path transfer, or the cycles a unit (AGU, partition) waited for the port. */
-uint64_t xbar_transfer(Xbar *x, XbarUser user, uint64_t from, uint64_t len, uint64_t now, struct TimingStats *st);
+uint64_t xbar_transfer(Xbar *x, XbarUser user, uint64_t from, uint64_t len, uint64_t now);
 /* 1 when a data-path transfer asked for at any cycle from t on starts at once, as far as the
  * reservations made so far go: fewer of the other users' transfers not ended by t than ports
  * (fewer still at any later cycle, until another is made). */

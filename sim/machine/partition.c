@@ -7,8 +7,6 @@
 
 #include <string.h>
 
-#include "../timing.h"
-
 void part_params(const CfgMachine *c, PartParams *p)
 {
     p->setup = c->partition_setup_cycles;
@@ -17,11 +15,14 @@ void part_params(const CfgMachine *c, PartParams *p)
     p->ids_per_cycle = c->partition_ids_per_cycle ? c->partition_ids_per_cycle : c->core_simd_width;
 }
 
-void part_init(PartUnit *u, const PartParams *p)
+int part_init(PartUnit *u, const PartParams *p)
 {
     memset(u, 0, sizeof *u);
     u->p = *p;
+    return 0;
 }
+
+void part_free(PartUnit *u) { (void)u; }
 
 void part_reset(PartUnit *u)
 {
@@ -42,16 +43,16 @@ int part_blocks(const PartUnit *u, const IsaOpInfo *oi, const CoreRecord *rec)
     return 0;
 }
 
-uint64_t part_start(PartUnit *u, Xbar *x, uint32_t base, uint32_t n, uint64_t at, uint64_t now, TimingStats *st)
+uint64_t part_start(PartUnit *u, Xbar *x, uint32_t base, uint32_t n, uint64_t at, uint64_t now)
 {
     /* Assumption (docs/model.md): a stable partition by a mask is one pass over the stream. */
     const uint64_t cost = (uint64_t)u->p.setup + (n + (uint64_t)u->p.ids_per_cycle - 1) / (uint64_t)u->p.ids_per_cycle;
-    const uint64_t s = xbar_transfer(x, XBAR_PART, at, cost, now, st);
+    const uint64_t s = xbar_transfer(x, XBAR_PART, at, cost, now);
     u->e = s + cost;
     u->lo = base;
     u->hi = base + 4 * n;
-    st->partitions++;
-    st->partition_ids += n;
-    st->partition_cycles += cost;
+    u->st.runs++;
+    u->st.ids += n;
+    u->st.cycles += cost;
     return u->e;
 }

@@ -4,7 +4,7 @@
  *
  * Owns: partition.setup_cycles and partition.ids_per_cycle, the unit's state (busy, the end of
  * its run, the byte range of IDM it reorders), its cost, which instructions it holds back, and the
- * counters partitions, partition_ids, partition_cycles. Must not: charge a stall (the timing core
+ * counters (PartStats). Must not: charge a stall (the timing core
  * charges what it holds back to `partition`), push events (the timing core does, at part_hold's
  * time), or move an ID (the functional core does).
  *
@@ -20,7 +20,6 @@
 #include "../core.h"
 #include "interconnect.h"
 
-struct TimingStats;
 
 typedef struct PartParams {
     int setup;                 /* fixed cycles of one partition */
@@ -29,14 +28,22 @@ typedef struct PartParams {
 
 void part_params(const CfgMachine *c, PartParams *p);
 
+typedef struct PartStats {     /* uint64_t only (timing_stats_add) */
+    uint64_t runs;             /* partitions */
+    uint64_t ids;              /* ray IDs they moved */
+    uint64_t cycles;           /* cycles the unit ran */
+} PartStats;
+
 typedef struct PartUnit {
     PartParams p;
     int busy;                  /* still running at the data path's next issue slot */
     uint64_t e;                /* the cycle the last run ends (its port: interconnect.h) */
     uint32_t lo, hi;           /* the IDM byte range it reorders */
+    PartStats st;
 } PartUnit;
 
-void part_init(PartUnit *u, const PartParams *p);
+int part_init(PartUnit *u, const PartParams *p);
+void part_free(PartUnit *u);
 /* Idle for the next program run. */
 void part_reset(PartUnit *u);
 
@@ -53,8 +60,7 @@ int part_blocks(const PartUnit *u, const IsaOpInfo *oi, const CoreRecord *rec);
 
 /* `part` issues at cycle at over n IDs from byte address base: the run starts when an interconnect
  * port is free for it. Returns the cycle the run ends (its result is ready then). */
-uint64_t part_start(PartUnit *u, Xbar *x, uint32_t base, uint32_t n, uint64_t at, uint64_t now,
-                    struct TimingStats *st);
+uint64_t part_start(PartUnit *u, Xbar *x, uint32_t base, uint32_t n, uint64_t at, uint64_t now);
 
 /* After `part` issued: whether the run outlasts the next issue slot `end` (then the unit is busy
  * until u->e, and the timing core schedules part_done for then). */

@@ -4,8 +4,7 @@
  *
  * Owns: raybuf.banks, raybuf.line_bytes, raybuf.access_cycles and raybuf.align_cycles, the
  * per-bank line counts of one access, the cost of a gather or scatter and of an ID vector off a
- * line boundary, when a read's data are back, and the counters rb_accesses, rb_lines and
- * rb_conflicted. Must not: charge a stall (the timing core charges bank conflicts and
+ * line boundary, when a read's data are back, and its counters (RbStats). Must not: charge a stall (the timing core charges bank conflicts and
  * alignment) or hold data (the functional core does).
  *
  * Line L lives in bank L mod banks; an access takes one cycle per distinct line in its busiest
@@ -19,7 +18,6 @@
 #include "../config.h"
 #include "interconnect.h"
 
-struct TimingStats;
 
 typedef struct RbParams {
     int banks;                 /* banks per buffer */
@@ -29,6 +27,13 @@ typedef struct RbParams {
 } RbParams;
 
 void rb_params(const CfgMachine *c, RbParams *p);
+
+/* Its counters (uint64_t only: timing_stats_add adds a TimingStats as an array). */
+typedef struct RbStats {
+    uint64_t accesses;         /* gathers and scatters with lanes */
+    uint64_t lines;            /* lines they touched */
+    uint64_t conflicted;       /* of them with a bank conflict (more than one cycle) */
+} RbStats;
 
 typedef struct RayBufs {
     RbParams p;
@@ -44,22 +49,24 @@ typedef struct RayBufs {
     _Alignas(64) uint32_t last_addr[ISA_MAX_LANES]; /* (compared and copied in vector pieces) */
     int last_n;                /* its lanes (0: none yet) */
     int last_cycles, last_lines;
+    RbStats st;
 } RayBufs;
 
 /* 0, or -1 when out of memory (then rb_free). */
 int rb_init(RayBufs *rb, const RbParams *p);
+void rb_reset(RayBufs *rb);
 void rb_free(RayBufs *rb);
 
 /* A gather or scatter of naddr lanes (naddr >= 1): the cycles the banks need, the most distinct
  * lines any one bank serves. Counts the access, its lines and whether it had a conflict. addr
  * holds at least 16 words however small naddr is (a CoreRecord's addr does): the access is kept
  * for the next as 16 words in one copy, the words past naddr never compared. */
-int rb_access(RayBufs *rb, const uint32_t *addr, int naddr, struct TimingStats *st);
+int rb_access(RayBufs *rb, const uint32_t *addr, int naddr);
 /* rb_access in two steps: the cycles (the lines in last_lines), counting nothing; then the
  * counts of that access (a gather a replayed block takes in: the timing model's memo compares
  * the cycles first, and counts the access only when its replay goes on). */
 int rb_cycles(RayBufs *rb, const uint32_t *addr, int naddr);
-void rb_count(const RayBufs *rb, struct TimingStats *st);
+void rb_count(RayBufs *rb, uint64_t n);
 
 /* Extra issue cycles of an ID vector read or appended at byte address base. */
 static inline uint64_t rb_align_cycles(const RayBufs *rb, uint32_t base)

@@ -61,12 +61,15 @@ static void build_op_regs(SimdOpRegs *ops)
     }
 }
 
-void simd_init(SimdUnit *u, const SimdParams *p)
+int simd_init(SimdUnit *u, const SimdParams *p)
 {
     memset(u, 0, sizeof *u);
     u->p = *p;
     build_op_regs(u->ops);
+    return 0;
 }
+
+void simd_free(SimdUnit *u) { (void)u; }
 
 void simd_reset(SimdUnit *u)
 {

@@ -37,6 +37,10 @@ typedef struct SimdOpRegs {    /* registers an opcode reads and writes, from the
     uint8_t mask_src;          /* reads the exec mask register */
 } SimdOpRegs;
 
+typedef struct SimdStats {     /* uint64_t only (timing_stats_add) */
+    uint64_t uses[ISA_U_COUNT]; /* instructions issued per unit class */
+} SimdStats;
+
 typedef struct SimdUnit {
     SimdParams p;
     SimdOpRegs ops[ISA_OP_COUNT];
@@ -47,9 +51,11 @@ typedef struct SimdUnit {
                                           nothing waits (the common case needs no loop) */
     uint8_t unit_pending[ISA_U_COUNT]; /* the class is inside its issue interval */
     uint8_t fetch_pending;             /* the bubble after a taken branch */
+    SimdStats st;
 } SimdUnit;
 
-void simd_init(SimdUnit *u, const SimdParams *p);
+int simd_init(SimdUnit *u, const SimdParams *p);
+void simd_free(SimdUnit *u);
 /* Nothing in flight for the next program run. */
 void simd_reset(SimdUnit *u);
 

@@ -7,7 +7,6 @@
 
 #include <string.h>
 
-#include "../timing.h"
 #include "lines.h"
 
 void spad_params(const CfgMachine *c, SpadParams *p)
@@ -17,14 +16,19 @@ void spad_params(const CfgMachine *c, SpadParams *p)
     p->line = c->spad_line_bytes;
 }
 
-void spad_init(Spad *s, const SpadParams *p)
+int spad_init(Spad *s, const SpadParams *p)
 {
     memset(s, 0, sizeof *s);
     s->p = *p;
     s->shift = lines_log2(p->line);
+    return 0;
 }
 
-uint64_t spad_access(const Spad *s, const uint32_t *addr, int naddr, TimingStats *st)
+void spad_reset(Spad *s) { (void)s; }
+
+void spad_free(Spad *s) { (void)s; }
+
+uint64_t spad_access(Spad *s, const uint32_t *addr, int naddr)
 {
     int k = 1; /* a scalar access (spld, spst): one line, no search */
     if (naddr > 1) {
@@ -33,7 +37,7 @@ uint64_t spad_access(const Spad *s, const uint32_t *addr, int naddr, TimingStats
             lines[i] = addr[i] >> s->shift;
         k = lines_distinct(lines, naddr, d);
     }
-    st->spad_accesses++;
-    st->spad_lines += (uint64_t)k;
+    s->st.accesses++;
+    s->st.lines += (uint64_t)k;
     return ((uint64_t)k + (uint64_t)s->p.ports - 1) / (uint64_t)s->p.ports;
 }

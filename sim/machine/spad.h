@@ -2,7 +2,7 @@
  * scratchpad holds the traversal stack and intermediates).
  *
  * Owns: spad.ports, spad.latency and spad.line_bytes, the cost of one access, when a load's data
- * are back, and the counters spad_accesses and spad_lines. Must not: charge a stall (the timing
+ * are back, and its counters (SpadStats). Must not: charge a stall (the timing
  * core charges the extra port cycles to `scratchpad`) or hold data (the functional core does).
  *
  * An access touching k distinct lines takes ceil(k / ports) issue cycles; a load's data are
@@ -15,7 +15,6 @@
 
 #include "../config.h"
 
-struct TimingStats;
 
 typedef struct SpadParams {
     int ports;                 /* lines per cycle */
@@ -25,16 +24,24 @@ typedef struct SpadParams {
 
 void spad_params(const CfgMachine *c, SpadParams *p);
 
+typedef struct SpadStats {     /* uint64_t only (timing_stats_add) */
+    uint64_t accesses;         /* scratchpad accesses */
+    uint64_t lines;            /* lines they touched */
+} SpadStats;
+
 typedef struct Spad {
     SpadParams p;
     int shift;                 /* byte address -> line */
+    SpadStats st;
 } Spad;
 
-void spad_init(Spad *s, const SpadParams *p);
+int spad_init(Spad *s, const SpadParams *p);
+void spad_reset(Spad *s);
+void spad_free(Spad *s);
 
 /* An access of naddr lanes (naddr >= 1): its issue cycles, ceil(distinct lines / ports).
  * Counts the access and its lines. */
-uint64_t spad_access(const Spad *s, const uint32_t *addr, int naddr, struct TimingStats *st);
+uint64_t spad_access(Spad *s, const uint32_t *addr, int naddr);
 
 /* When a load whose last issue cycle is `last` delivers. */
 static inline uint64_t spad_load_ready(const Spad *s, uint64_t last)
@@ -45,10 +52,10 @@ static inline uint64_t spad_load_ready(const Spad *s, uint64_t last)
 /* n scalar accesses (spld, spst: one word each) counted. One word is one line, so such an access
  * takes one issue cycle at any port count and a load's data are ready spad.latency after it,
  * whatever its address: the timing core times it as a plain instruction and counts it here. */
-static inline void spad_count_scalar(uint64_t *accesses, uint64_t *lines, uint64_t n)
+static inline void spad_count_scalar(Spad *s, uint64_t n)
 {
-    *accesses += n;
-    *lines += n;
+    s->st.accesses += n;
+    s->st.lines += n;
 }
 
 #endif

@@ -103,10 +103,10 @@ Test(detailed, same_image_bits_as_functional_and_every_cycle_accounted, .fini = 
     cr_expect_gt(t->cycles, t->busy, "a real kernel stalls");
     cr_expect_gt(t->stalls[TM_DATA_DEPENDENCY], 0);
     cr_expect_gt(t->stalls[TM_CONTROL], 0);
-    cr_expect_gt(t->rb_accesses, 0);
-    cr_expect_gt(t->agu_fetches, 0);
-    cr_expect_gt(t->partitions, 0);
-    cr_expect_gt(t->scene.accesses, 0);
+    cr_expect_gt(t->rb.accesses, 0);
+    cr_expect_gt(t->agu.fetches, 0);
+    cr_expect_gt(t->part.runs, 0);
+    cr_expect_gt(t->l1.accesses, 0);
     printf("detailed: cornell spheres 64x48 2 spp M=1024: %llu cycles, %llu busy, %llu instructions\n",
            (unsigned long long)t->cycles, (unsigned long long)t->busy, (unsigned long long)ds.instructions);
     free(f);
@@ -168,10 +168,10 @@ Test(detailed, machine_changes_move_the_cycles_the_right_way, .fini = unload)
     TimingStats slowagu = run_with("agu.ids_per_cycle=1");
     TimingStats conflict = run_with("raybuf.banks=1");
     cr_expect_gt(n8.busy, base.busy, "N = 8 needs more instructions than N = 16");
-    cr_expect_gt(port1.stalls[TM_INTERCONNECT] + port1.icn_unit_delay, base.stalls[TM_INTERCONNECT] + base.icn_unit_delay);
+    cr_expect_gt(port1.stalls[TM_INTERCONNECT] + port1.xbar.unit_delay, base.stalls[TM_INTERCONNECT] + base.xbar.unit_delay);
     cr_expect_eq(port1.busy, base.busy, "the interconnect does not change the program");
     cr_expect_gt(nocache.stalls[TM_SCENE_MEMORY], base.stalls[TM_SCENE_MEMORY]);
-    cr_expect_eq(nocache.scene.hits, 0);
+    cr_expect_eq(nocache.l1.hits, 0);
     cr_expect_gt(slowpart.stalls[TM_PARTITION], base.stalls[TM_PARTITION]);
     cr_expect_gt(slowagu.stalls[TM_ADDRESS_FETCH], base.stalls[TM_ADDRESS_FETCH]);
     cr_expect_gt(conflict.stalls[TM_BANK_CONFLICT], base.stalls[TM_BANK_CONFLICT]);

@@ -99,15 +99,15 @@ Test(raybuf, access_counts_match_the_definition_on_every_path)
             make_vector(a, n, iter % 6, p.line, p.banks);
             int distinct;
             int want = reference(a, n, p.line, p.banks, &distinct);
-            TimingStats st;
-            memset(&st, 0, sizeof st);
-            int got = rb_access(&rb, a, n, &st);
+            memset(&rb.st, 0, sizeof rb.st);
+            int got = rb_access(&rb, a, n);
+            const RbStats st = rb.st;
             cr_assert_eq(got, want, "banks %d, kind %d, n %d: %d cycles, the definition gives %d", p.banks,
                          iter % 6, n, got, want);
-            cr_assert_eq(st.rb_accesses, 1u);
-            cr_assert_eq(st.rb_lines, (uint64_t)distinct, "banks %d, kind %d, n %d: %llu lines, want %d",
-                         p.banks, iter % 6, n, (unsigned long long)st.rb_lines, distinct);
-            cr_assert_eq(st.rb_conflicted, (uint64_t)(want > 1));
+            cr_assert_eq(st.accesses, 1u);
+            cr_assert_eq(st.lines, (uint64_t)distinct, "banks %d, kind %d, n %d: %llu lines, want %d",
+                         p.banks, iter % 6, n, (unsigned long long)st.lines, distinct);
+            cr_assert_eq(st.conflicted, (uint64_t)(want > 1));
             fast_seen += want == 1 && distinct > 1;
             conflict_seen += want > 1;
         }
@@ -157,15 +157,15 @@ Test(raybuf, an_access_moved_by_whole_lines_keeps_the_counts_and_no_other_does)
             }
             int distinct;
             const int want = reference(a, n, p.line, p.banks, &distinct);
-            TimingStats st;
-            memset(&st, 0, sizeof st);
-            const int got = rb_access(&rb, a, n, &st);
+            memset(&rb.st, 0, sizeof rb.st);
+            const int got = rb_access(&rb, a, n);
+            const RbStats st = rb.st;
             cr_assert_eq(got, want, "banks %d, step %d, n %d: %d cycles, the definition gives %d", p.banks, step, n,
                          got, want);
-            cr_assert_eq(st.rb_lines, (uint64_t)distinct, "banks %d, step %d, n %d: %llu lines, want %d", p.banks,
-                         step, n, (unsigned long long)st.rb_lines, distinct);
-            cr_assert_eq(st.rb_accesses, 1u);
-            cr_assert_eq(st.rb_conflicted, (uint64_t)(want > 1));
+            cr_assert_eq(st.lines, (uint64_t)distinct, "banks %d, step %d, n %d: %llu lines, want %d", p.banks,
+                         step, n, (unsigned long long)st.lines, distinct);
+            cr_assert_eq(st.accesses, 1u);
+            cr_assert_eq(st.conflicted, (uint64_t)(want > 1));
             conflicts += want > 1;
         }
         cr_assert(conflicts > 200, "banks %d: only %d conflicting accesses", p.banks, conflicts);
@@ -178,24 +178,22 @@ Test(raybuf, interconnect_port_search_waits_only_when_every_port_is_taken)
     XbarParams p = {.latency = 1, .ports = 2};
     Xbar x;
     xbar_init(&x, &p);
-    TimingStats st;
-    memset(&st, 0, sizeof st);
     /* one AGU transfer in flight: a port is left for the data path at once */
-    cr_assert_eq(xbar_transfer(&x, XBAR_AGU, 10, 4, 10, &st), 10u);
-    cr_assert_eq(xbar_transfer(&x, XBAR_DP, 11, 2, 11, &st), 11u);
+    cr_assert_eq(xbar_transfer(&x, XBAR_AGU, 10, 4, 10), 10u);
+    cr_assert_eq(xbar_transfer(&x, XBAR_DP, 11, 2, 11), 11u);
     /* the AGU and the data path hold both ports over [11, 13): the partition unit waits to 13 */
-    cr_assert_eq(xbar_transfer(&x, XBAR_PART, 11, 1, 11, &st), 13u);
-    cr_assert_eq(st.icn_unit_delay, 2u);
+    cr_assert_eq(xbar_transfer(&x, XBAR_PART, 11, 1, 11), 13u);
+    cr_assert_eq(x.st.unit_delay, 2u);
     /* two transfers in the window, but only one at cycle 12 itself: no wait */
-    cr_assert_eq(xbar_transfer(&x, XBAR_AGU, 12, 1, 12, &st), 12u);
-    cr_assert_eq(st.icn_unit_delay, 2u);
+    cr_assert_eq(xbar_transfer(&x, XBAR_AGU, 12, 1, 12), 12u);
+    cr_assert_eq(x.st.unit_delay, 2u);
     /* the partition unit and the first AGU transfer hold both ports at 13: the data path waits */
-    cr_assert_eq(xbar_transfer(&x, XBAR_DP, 13, 1, 13, &st), 14u);
+    cr_assert_eq(xbar_transfer(&x, XBAR_DP, 13, 1, 13), 14u);
     /* with one port every transfer serializes */
     p.ports = 1;
     xbar_init(&x, &p);
-    cr_assert_eq(xbar_transfer(&x, XBAR_AGU, 0, 3, 0, &st), 0u);
-    cr_assert_eq(xbar_transfer(&x, XBAR_DP, 1, 1, 1, &st), 3u);
+    cr_assert_eq(xbar_transfer(&x, XBAR_AGU, 0, 3, 0), 0u);
+    cr_assert_eq(xbar_transfer(&x, XBAR_DP, 1, 1, 1), 3u);
 }
 
 /* The data path's transfer by definition: the first cycle s >= from at which, over every cycle of
@@ -236,15 +234,14 @@ Test(raybuf, interconnect_data_path_transfer_matches_the_definition)
         }
         const uint64_t len = test_rng_u32(&rng) % 5;
         const uint64_t want = dp_reference(&x, from, len);
-        TimingStats st;
-        memset(&st, 0, sizeof st);
-        const uint64_t got = xbar_transfer(&x, XBAR_DP, from, len, from, &st);
+        memset(&x.st, 0, sizeof x.st);
+        const uint64_t got = xbar_transfer(&x, XBAR_DP, from, len, from);
         cr_assert_eq(got, want, "trial %d: ports %d, part [%llu, %llu), %d AGU transfers, len %llu: %llu, want %llu",
                      trial, p.ports, (unsigned long long)x.part.s, (unsigned long long)x.part.e, x.agu_n,
                      (unsigned long long)len, (unsigned long long)got, (unsigned long long)want);
         cr_assert_eq(x.dp.s, got);
         cr_assert_eq(x.dp.e, got + len);
-        cr_assert_eq(st.icn_transfers, 1u);
+        cr_assert_eq(x.st.transfers, 1u);
         if (got == from)
             fast++;
         else

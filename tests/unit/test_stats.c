@@ -286,7 +286,7 @@ Test(stats, exec_print_out)
     t.stalls[TM_CONTROL] = 2;
     t.stage_cycles[ISA_STAGE_TRAVERSAL] = 10;
     t.stage_busy[ISA_STAGE_TRAVERSAL] = 8;
-    t.rb_accesses = 3;
+    t.rb.accesses = 3;
     StatsCtx c = {.mode = STATS_M_EXEC, .cfg = &cfg, .t = &t};
     char *text = NULL;
     size_t len = 0;

@@ -1,5 +1,6 @@
 /* tests/unit/test_timing.c -- the timing model: the micro-benchmarks of kernels/bench/ against
- * their hand-derived cycle counts, the event queue, the scene cache, and the accounting identity.
+ * their hand-derived cycle counts, the event queue, and the accounting identity (the scene cache:
+ * test_cache.c).
  *
  * Each kernels/bench file carries `;@ run NAME [define S=V]... [set K=V]... expect KEY=V...`
  * lines (kernels/bench/README.md); every run is assembled with its defines, timed on the default
@@ -17,7 +18,6 @@
 #include "../../sim/config.h"
 #include "../../sim/core.h"
 #include "../../sim/event.h"
-#include "../../sim/machine/scenemem.h"
 #include "../../sim/timing.h"
 #include "../support/asm_fixture.h"
 #include "../support/rng.h"
@@ -30,13 +30,13 @@ static long long figure(const TimingStats *s, const char *key)
     for (int c = 0; c < TM_CAUSE_COUNT; c++)
         if (!strcmp(key, tm_cause_keys[c]))
             return (long long)s->stalls[c];
-    if (!strcmp(key, "rb_conflicted")) return (long long)s->rb_conflicted;
-    if (!strcmp(key, "agu_fetches")) return (long long)s->agu_fetches;
-    if (!strcmp(key, "agu_ahead")) return (long long)s->agu_ahead;
-    if (!strcmp(key, "partitions")) return (long long)s->partitions;
-    if (!strcmp(key, "scene_hits")) return (long long)s->scene.hits;
-    if (!strcmp(key, "scene_misses")) return (long long)s->scene.misses;
-    if (!strcmp(key, "icn_unit_delay")) return (long long)s->icn_unit_delay;
+    if (!strcmp(key, "rb_conflicted")) return (long long)s->rb.conflicted;
+    if (!strcmp(key, "agu_fetches")) return (long long)s->agu.fetches;
+    if (!strcmp(key, "agu_ahead")) return (long long)s->agu.ahead;
+    if (!strcmp(key, "partitions")) return (long long)s->part.runs;
+    if (!strcmp(key, "scene_hits")) return (long long)s->l1.hits;
+    if (!strcmp(key, "scene_misses")) return (long long)s->l1.misses;
+    if (!strcmp(key, "icn_unit_delay")) return (long long)s->xbar.unit_delay;
     return -1;
 }
 
@@ -161,144 +161,6 @@ Test(timing, event_queue_orders_by_time_then_insertion)
     for (int i = 0; i < 8; i++)
         cr_expect_eq(order[i], want[i], "position %d: event %d, expected %d", i, order[i], want[i]);
     evq_free(&q);
-}
-
-Test(timing, scene_ports_serve_lines_in_slots)
-{
-    /* 64 sets x 4 ways (a power of two: the set is a mask) and 3 sets x 4 ways (a division); 3
-     * ports; hit latency 2. Seven lines are filled, then one gather of the same seven hits them:
-     * line i goes through slot at + i / 3, so the last is served at 100 + 2, ready 104, and the
-     * gather needs ceil(7 / 3) = 3 issue cycles. */
-    static const int cache_bytes[2] = {64 * 4 * 64, 3 * 4 * 64};
-    for (int c = 0; c < 2; c++) {
-        SceneMemParams p = {10, 16, 64, 2, cache_bytes[c], 4, 3};
-        SceneMem m;
-        mem_init(&m, &p);
-        uint32_t addr[7];
-        for (int i = 0; i < 7; i++) {
-            addr[i] = 64u * (uint32_t)i + 4u;
-            mem_access(&m, 0, addr[i], 0, 0);
-        }
-        TimingStats st = {0};
-        uint64_t ready = 0;
-        cr_expect_eq(mem_issue(&m, 0, addr, 7, 100, &ready, &st), 3, "cache of %d bytes", cache_bytes[c]);
-        cr_expect_eq(ready, 104, "cache of %d bytes: ready %llu", cache_bytes[c], (unsigned long long)ready);
-        cr_expect_eq(m.st.hits, 7, "cache of %d bytes", cache_bytes[c]);
-        mem_free(&m);
-    }
-}
-
-Test(timing, scene_cache_lru_and_bus)
-{
-    /* 2 sets x 2 ways of 64-byte lines; latency 10, 16 bytes per cycle (4 cycles a line); one port. */
-    SceneMemParams p = {10, 16, 64, 1, 256, 2, 1};
-    SceneMem m;
-    mem_init(&m, &p);
-    cr_assert_eq(m.instantiated, 0, "the tag array exists before the first access");
-    cr_expect_eq(mem_access(&m, 0, 0, 0, 0), 14);       /* miss: bus 0..3, ready 0 + 10 + 4 */
-    cr_expect_eq(m.instantiated, 1);
-    cr_expect_eq(mem_access(&m, 0, 128, 0, 0), 18);     /* same set, other way: bus 4..7 */
-    cr_expect_eq(mem_access(&m, 0, 4, 20, 0), 21);      /* hit on line 0 (now most recent) */
-    cr_expect_eq(mem_access(&m, 0, 256, 30, 1), 44);    /* miss evicts line 128 (LRU), dirty */
-    cr_expect_eq(mem_access(&m, 0, 0, 50, 0), 51);      /* line 0 still there */
-    cr_expect_eq(mem_access(&m, 0, 128, 60, 0), 78);    /* 128 again: evicts dirty 256: write-back 60..63, fill 64..67 */
-    cr_expect_eq(m.st.writebacks, 1);
-    cr_expect_eq(m.st.hits, 2);
-    cr_expect_eq(m.st.misses, 4);
-    cr_expect_eq(mem_access(&m, 1, 0, 100, 0), 114);    /* framebuffer address 0 is another line */
-    mem_reset(&m);
-    cr_expect_eq(mem_access(&m, 0, 0, 0, 0), 14, "reset leaves a cold cache");
-    mem_free(&m);
-}
-
-/* A plain set-associative LRU cache with the same bus and latencies as docs/model.md gives them
- * ("Scene memory"): the reference for the cache's shortcuts (the way of the last hit tried first). */
-typedef struct RefCache {
-    int sets, ways;
-    uint64_t tag[64][8], ready[64][8], used[64][8], clock, bus_free;
-    uint8_t dirty[64][8];
-    uint64_t hits, misses, writebacks;
-} RefCache;
-
-static uint64_t ref_cache_access(RefCache *c, const SceneMemParams *p, int space, uint32_t addr, uint64_t t,
-                                 int write)
-{
-    const uint64_t line = ((uint64_t)space << 32 | addr) / (uint64_t)p->line_bytes;
-    const int set = (int)(line % (uint64_t)c->sets), xfer = (p->line_bytes + p->bytes_per_cycle - 1) / p->bytes_per_cycle;
-    c->clock++;
-    for (int w = 0; w < c->ways; w++)
-        if (c->tag[set][w] == line + 1) {
-            c->hits++;
-            c->used[set][w] = c->clock;
-            c->dirty[set][w] |= (uint8_t)(write != 0);
-            const uint64_t r = t + (uint64_t)p->hit_latency;
-            return r > c->ready[set][w] ? r : c->ready[set][w];
-        }
-    c->misses++;
-    int v = 0;
-    for (int w = 1; w < c->ways; w++)
-        if (c->used[set][w] < c->used[set][v])
-            v = w;
-    if (c->tag[set][v] && c->dirty[set][v]) {
-        c->writebacks++;
-        c->bus_free = (t > c->bus_free ? t : c->bus_free) + (uint64_t)xfer;
-    }
-    const uint64_t s = t > c->bus_free ? t : c->bus_free;
-    c->bus_free = s + (uint64_t)xfer;
-    c->tag[set][v] = line + 1;
-    c->used[set][v] = c->clock;
-    c->dirty[set][v] = (uint8_t)(write != 0);
-    c->ready[set][v] = s + (uint64_t)p->latency + (uint64_t)xfer;
-    return c->ready[set][v];
-}
-
-Test(timing, scene_cache_matches_a_plain_lru_cache_on_random_accesses)
-{
-    /* Runs of words of one line (a node read word by word), lines of one set in turn, other lines,
-     * the framebuffer and writes, at 1, 2 and 4 ways and power-of-two and other set counts. */
-    static const int shapes[][2] = {{16, 4}, {3, 4}, {8, 2}, {5, 1}, {64, 1}};
-    uint64_t seed = TEST_RNG_SEED;
-    for (size_t k = 0; k < sizeof shapes / sizeof *shapes; k++) {
-        const int sets = shapes[k][0], ways = shapes[k][1];
-        SceneMemParams p = {10, 16, 64, 2, sets * ways * 64, ways, 1};
-        SceneMem m;
-        mem_init(&m, &p);
-        static RefCache ref;
-        memset(&ref, 0, sizeof ref);
-        ref.sets = sets;
-        ref.ways = ways;
-        uint32_t addr = 0;
-        uint64_t t = 0;
-        for (int i = 0; i < 40000; i++) {
-            const uint32_t r = test_rng_u32(&seed) % 16u;
-            if (r < 8) /* the next word of the same line */
-                addr = (addr & ~63u) | ((addr + 4u) & 63u);
-            else if (r < 12) /* another line of the same set */
-                addr += 64u * (uint32_t)sets * (1u + test_rng_u32(&seed) % (uint32_t)(ways + 1));
-            else /* anywhere in 64 KB */
-                addr = 4u * (test_rng_u32(&seed) % 16384u);
-            const int space = test_rng_u32(&seed) % 16u == 0, write = test_rng_u32(&seed) % 8u == 0;
-            t += test_rng_u32(&seed) % 6u;
-            const uint64_t got = mem_access(&m, space, addr, t, write);
-            const uint64_t want = ref_cache_access(&ref, &p, space, addr, t, write);
-            cr_assert_eq(got, want, "%d sets x %d ways, access %d (address %u, space %d): ready %llu, want %llu", sets,
-                         ways, i, addr, space, (unsigned long long)got, (unsigned long long)want);
-            if (i == 20000) { /* a reset leaves both cold */
-                mem_reset(&m);
-                memset(ref.tag, 0, sizeof ref.tag);
-                memset(ref.used, 0, sizeof ref.used);
-                memset(ref.ready, 0, sizeof ref.ready);
-                memset(ref.dirty, 0, sizeof ref.dirty);
-                ref.clock = ref.bus_free = 0;
-            }
-        }
-        cr_expect_eq(m.st.hits, ref.hits, "%d sets x %d ways", sets, ways);
-        cr_expect_eq(m.st.misses, ref.misses, "%d sets x %d ways", sets, ways);
-        cr_expect_eq(m.st.writebacks, ref.writebacks, "%d sets x %d ways", sets, ways);
-        cr_expect(ref.hits > 10000 && ref.misses > 1000, "%d sets x %d ways: %llu hits, %llu misses", sets, ways,
-                  (unsigned long long)ref.hits, (unsigned long long)ref.misses);
-        mem_free(&m);
-    }
 }
 
 Test(timing, every_cause_has_a_key_and_a_description)
@@ -637,11 +499,11 @@ static void expect_memo_modes_agree(const BenchProg *prog, const char *src, cons
                   "%s, memo mode %d: cycles %llu with the memo, %llu without; ray-buffer accesses %llu, %llu, "
                   "lines %llu, %llu; transfers %llu, %llu; scene accesses %llu, %llu, hits %llu, %llu",
                   prog->file, memo, (unsigned long long)on.cycles, (unsigned long long)off->cycles,
-                  (unsigned long long)on.rb_accesses, (unsigned long long)off->rb_accesses,
-                  (unsigned long long)on.rb_lines, (unsigned long long)off->rb_lines,
-                  (unsigned long long)on.icn_transfers, (unsigned long long)off->icn_transfers,
-                  (unsigned long long)on.scene.accesses, (unsigned long long)off->scene.accesses,
-                  (unsigned long long)on.scene.hits, (unsigned long long)off->scene.hits);
+                  (unsigned long long)on.rb.accesses, (unsigned long long)off->rb.accesses,
+                  (unsigned long long)on.rb.lines, (unsigned long long)off->rb.lines,
+                  (unsigned long long)on.xbar.transfers, (unsigned long long)off->xbar.transfers,
+                  (unsigned long long)on.l1.accesses, (unsigned long long)off->l1.accesses,
+                  (unsigned long long)on.l1.hits, (unsigned long long)off->l1.hits);
         cr_expect_gt(r_on, 100u, "%s: the blocks recur: %llu replayed", prog->file, (unsigned long long)r_on);
         check(memo);
         for (uint64_t limit = 1; limit < on.busy; limit += limit < 300 ? 1 : 7) {
@@ -675,7 +537,7 @@ Test(timing, memoized_blocks_with_gathers_give_the_same_figures)
     all_gathers = gather_calls;
     cr_expect(memcmp(&koff, &off, sizeof koff) == 0);
     cr_expect_gt(off.stalls[TM_BANK_CONFLICT], 0u, "the gathers meet bank conflicts");
-    cr_expect_gt(off.rb_conflicted, 0u);
+    cr_expect_gt(off.rb.conflicted, 0u);
     expect_memo_modes_agree(&prog, memo_gathers, &off, gathers_check);
 }
 
@@ -734,8 +596,8 @@ Test(timing, memoized_blocks_with_scene_loads_give_the_same_figures)
     uint64_t r_off;
     TimingStats off = run_memo_src(&prog, memo_scene_loads, MEMO_KINDS_OFF, 0, &r_off);
     all_ldb = ldb_calls;
-    cr_expect_gt(off.scene.misses, 20u, "the nodes' first loads miss at first");
-    cr_expect_gt(off.scene.hits, 1000u);
+    cr_expect_gt(off.l1.misses, 20u, "the nodes' first loads miss at first");
+    cr_expect_gt(off.l1.hits, 1000u);
     expect_memo_modes_agree(&prog, memo_scene_loads, &off, scene_loads_check);
 }
 
@@ -830,7 +692,7 @@ Test(timing, memoized_blocks_give_the_same_figures_as_timing_each_instruction)
         cr_expect_gt(on.stalls[TM_FU_BUSY] + on.stalls[TM_DATA_DEPENDENCY], 0u, "the loop stalls");
         /* its scalar scratchpad accesses are plain instructions inside its blocks, counted when
          * a block is replayed too */
-        cr_expect_eq(on.spad_accesses, 3 * 150u, "scratchpad accesses %llu", (unsigned long long)on.spad_accesses);
+        cr_expect_eq(on.spad.accesses, 3 * 150u, "scratchpad accesses %llu", (unsigned long long)on.spad.accesses);
         /* the statistics read between slices of the run (a replayed block's counts reach them
          * when they are read: MemoEntry.lz_n): the same at the end; after the first slice, those
          * of a run stopped there but for the records of a block still being replayed (at most
@@ -844,8 +706,8 @@ Test(timing, memoized_blocks_give_the_same_figures_as_timing_each_instruction)
                 cr_expect(first.busy <= stop.busy && stop.busy - first.busy < 16,
                           "after %llu instructions: %llu issue cycles read, %llu in a run stopped there",
                           (unsigned long long)slice, (unsigned long long)first.busy, (unsigned long long)stop.busy);
-                cr_expect(first.unit_uses[ISA_U_VADD] <= stop.unit_uses[ISA_U_VADD] &&
-                          stop.unit_uses[ISA_U_VADD] - first.unit_uses[ISA_U_VADD] < 16);
+                cr_expect(first.simd.uses[ISA_U_VADD] <= stop.simd.uses[ISA_U_VADD] &&
+                          stop.simd.uses[ISA_U_VADD] - first.simd.uses[ISA_U_VADD] < 16);
             }
         for (uint64_t limit = 1; limit < on.busy; limit += limit < 400 ? 1 : 13) {
             TimingStats a = run_memo_src(&loop, memo_loop, memo, limit, &r_on),

@@ -1,0 +1,70 @@
+/* sim/mem/cache.h -- a set-associative cache with LRU replacement and write-back, in front of a
+ * port to the level below (port.h): the scene cache of a core (its L1).
+ *
+ * Owns: the tags, the LRU stamps, the dirty bits and the fill time of each line, and the hit /
+ * miss / write-back counters. Must not: hold data (the functional core does), know what is
+ * below its port, or charge stalls. The tag array is allocated on the first access: a run that
+ * never touches it never instantiates it.
+ *
+ * One access to a line at cycle t (docs/model.md, "Scene memory"):
+ *   hit:  ready = max(t + hit_latency, the line's fill time if it is still in flight)
+ *   miss: the least recently used way takes the line; a dirty victim is written back first (a
+ *         write request below, nothing waits for it), then the line is read: ready = the read's
+ *         completion as the port answers it
+ *   no cache (size 0): every access is a request below, its completion the ready cycle.
+ */
+#ifndef SFSIM_MEM_CACHE_H
+#define SFSIM_MEM_CACHE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "port.h"
+
+typedef struct CacheParams {
+    int bytes;                    /* 0: no cache */
+    int ways, line_bytes, hit_latency;
+} CacheParams;
+
+typedef struct CacheStats {       /* uint64_t only (timing_stats_add) */
+    uint64_t accesses, hits, misses, writebacks;
+} CacheStats;
+
+typedef struct Cache {
+    CacheParams p;
+    int sets, line_shift;
+    uint64_t set_mask;            /* sets - 1 when sets is a power of two (a mask, not a
+                                     division, per access), else 0 */
+    uint64_t *tag;                /* sets x ways; line address + 1, 0 = empty */
+    uint64_t *ready;              /* fill completion time per way */
+    uint64_t *lru;                /* last-use stamp per way */
+    uint8_t *dirty;
+    uint64_t stamp;
+    size_t last_way;              /* the way of the last hit or fill (tag index), tried first */
+    int instantiated;
+    MemPort below;
+    CacheStats st;
+} Cache;
+
+int cache_init(Cache *c, const CacheParams *p);
+void cache_free(Cache *c);
+/* Cold: empty, nothing in flight; counters kept. */
+void cache_reset(Cache *c);
+/* The level below (before the first access). */
+void cache_connect(Cache *c, MemPort below);
+/* The line of a physical byte address (port.h). */
+static inline uint64_t cache_line(const Cache *c, uint64_t addr)
+{
+    return addr >> c->line_shift;
+}
+/* One access to the line holding physical byte address addr at cycle t; write marks it dirty.
+ * Returns the cycle its data are ready, UINT64_MAX only if the tag array cannot be allocated. */
+uint64_t cache_access(Cache *c, uint64_t addr, uint64_t t, int write);
+/* Whether the line holding addr is in the cache, without touching anything (its way in *way):
+ * 0 on a miss, with no cache, or before the first access. */
+int cache_peek(const Cache *c, uint64_t addr, size_t *way);
+/* n loads that hit the line in `way`, one after another, with nothing between them: their counts
+ * and the line's use (cache_access's hit path n times, but for the cycles it returns). */
+void cache_hits(Cache *c, size_t way, uint64_t n);
+
+#endif
