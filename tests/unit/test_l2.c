@@ -9,44 +9,10 @@
 #include <string.h>
 
 #include "../../sim/mem/l2.h"
-
-enum { BELOW_LATENCY = 20, MAX_ANS = 64 };
-
-/* The memory below: a request pushed at cycle c is answered at c + 20 (pushes come in cycle
- * order, so the answers are a queue). */
-typedef struct Below {
-    uint64_t addr[MAX_ANS], at[MAX_ANS], id[MAX_ANS];
-    int write[MAX_ANS];
-    int n, head;
-} Below;
-
-static void below_push(void *self, uint64_t addr, int write, uint64_t cycle, uint64_t id)
-{
-    Below *b = self;
-    cr_assert_lt(b->n, MAX_ANS);
-    b->addr[b->n] = addr;
-    b->write[b->n] = write;
-    b->at[b->n] = cycle + BELOW_LATENCY;
-    b->id[b->n++] = id;
-}
-
-static uint64_t below_next(const void *self)
-{
-    const Below *b = self;
-    return b->head < b->n ? b->at[b->head] : UINT64_MAX;
-}
-
-static void below_run(void *self, uint64_t until, MemAnswer answer, void *ctx)
-{
-    Below *b = self;
-    while (b->head < b->n && b->at[b->head] < until) {
-        const int i = b->head++;
-        answer(ctx, b->id[i], b->at[i]);
-    }
-}
+#include "../support/fixed_level.h"
 
 typedef struct Fix {
-    Below below;
+    FixedLevel below;
     L2 *l2;
     uint64_t ans[1024]; /* answer cycle by request id, 0 = none yet */
     int nans;
@@ -67,7 +33,7 @@ static void open_fix(Fix *f, L2Params p)
 {
     memset(f, 0, sizeof *f);
     char err[256];
-    f->l2 = l2_new(&p, (MemLevel){&f->below, below_push, below_next, below_run}, err, sizeof err);
+    f->l2 = l2_new(&p, fixed_level(&f->below), err, sizeof err);
     cr_assert_not_null(f->l2, "%s", err);
 }
 
