@@ -192,23 +192,32 @@ static uint32_t slot_new(Noc *n, const Msg *m)
     return i;
 }
 
+/* The message leaves over the sender's port (*port): its head reaches the receiver's port
+ * `latency` cycles after it starts. */
+static void send(Noc *n, uint64_t *port, Msg m, int next)
+{
+    m.cycle = cross(n, port, &m) + (uint64_t)n->p.latency;
+    m.stage = (uint8_t)next;
+    put(n, m);
+}
+
+/* The message crosses the receiver's port (*port): it is there when its last cycle has. */
+static void arrive(Noc *n, uint64_t *port, Msg m, int next)
+{
+    m.cycle = cross(n, port, &m) + m.len;
+    m.stage = (uint8_t)next;
+    put(n, m);
+}
+
 /* One message at its cycle: on to its next stage. */
 static void step(Noc *n, Msg m)
 {
     switch (m.stage) {
-    case AT_CORE_OUT: {
-        const uint64_t s = cross(n, &n->core_out[m.core], &m);
+    case AT_CORE_OUT:
         n->st.bytes += m.write ? (uint64_t)n->p.line_bytes : 0;
-        m.cycle = s + (uint64_t)n->p.latency;
-        m.stage = AT_BANK_IN;
-        put(n, m);
+        send(n, &n->core_out[m.core], m, AT_BANK_IN);
         break;
-    }
-    case AT_BANK_IN:
-        m.cycle = cross(n, &n->bank_in[m.bank], &m) + m.len;
-        m.stage = TO_BEHIND;
-        put(n, m);
-        break;
+    case AT_BANK_IN: arrive(n, &n->bank_in[m.bank], m, TO_BEHIND); break;
     case TO_BEHIND:
         if (m.write) {
             n->behind.push(n->behind.self, m.addr, 1, m.cycle, NOC_WRITE);
@@ -217,19 +226,11 @@ static void step(Noc *n, Msg m)
             n->behind.push(n->behind.self, m.addr, 0, m.cycle, slot_new(n, &m));
         }
         break;
-    case AT_BANK_OUT: {
-        const uint64_t s = cross(n, &n->bank_out[m.bank], &m);
+    case AT_BANK_OUT:
         n->st.bytes += (uint64_t)n->p.line_bytes;
-        m.cycle = s + (uint64_t)n->p.latency;
-        m.stage = AT_CORE_IN;
-        put(n, m);
+        send(n, &n->bank_out[m.bank], m, AT_CORE_IN);
         break;
-    }
-    case AT_CORE_IN:
-        m.cycle = cross(n, &n->core_in[m.core], &m) + m.len;
-        m.stage = TO_CORE;
-        put(n, m);
-        break;
+    case AT_CORE_IN: arrive(n, &n->core_in[m.core], m, TO_CORE); break;
     case TO_CORE:
         n->st.answers++;
         n->answer(n->actx, m.id, m.cycle);
