@@ -68,8 +68,8 @@ DramAddr dram_decode(const DramParams *p, uint64_t addr);
 
 /* Counters per channel: X(name, unit, description). Plain uint64_t fields. */
 #define DRAM_STATS(X)                                                                                            \
-    X(reads,          "requests", "read requests completed")                                                     \
-    X(writes,         "requests", "write requests completed")                                                    \
+    X(reads,          "requests", "read requests served (counted when their RD issues)")                                                     \
+    X(writes,         "requests", "write requests served (counted when their WR issues)")                                                    \
     X(activates,      "commands", "ACT commands")                                                                \
     X(precharges,     "commands", "PRE commands and auto-precharges (closed page)")                             \
     X(row_hits,       "requests", "requests whose row was open when they were served")                          \
@@ -79,8 +79,8 @@ DramAddr dram_decode(const DramParams *p, uint64_t addr);
     X(refresh_cycles, "cycles",   "tRFC x refreshes: cycles a rank was refreshing")                             \
     X(bytes,          "bytes",    "bytes transferred (reads and writes)")                                        \
     X(busy_cycles,    "cycles",   "data-bus cycles carrying data")                                               \
-    X(read_latency,   "cycles",   "sum over reads of completion - arrival")                                      \
-    X(write_latency,  "cycles",   "sum over writes of completion - arrival")                                     \
+    X(read_latency,   "cycles",   "sum over reads of done cycle - arrival cycle")                                      \
+    X(write_latency,  "cycles",   "sum over writes of done cycle - arrival cycle")                                     \
     X(max_latency,    "cycles",   "largest completion - arrival")                                                \
     X(occupancy_sum,  "entry-cycles", "sum over cycles of the read + write queue entries (average = / cycles)") \
     X(occupancy_max,  "entries",  "most read + write queue entries at once")                                     \

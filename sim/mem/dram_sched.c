@@ -53,8 +53,10 @@ typedef struct Chan {
     Bank *bank;
     Group *grp;
     Rank *rank;
-    uint32_t *hit_mark;                /* per bank: == mark when a queued request hits its open row */
-    uint32_t mark;
+    uint16_t *hits[2];                 /* per bank: requests of queue [w] that hit its open row */
+    uint32_t *col_mark, *act_mark;     /* per bank: == mark when col_at / act_at hold this pass's value */
+    uint64_t *col_at, *act_at;         /* per bank: earliest RD/WR, ACT (one pass: the state is fixed) */
+    uint32_t mark;                     /* one evaluation pass of the queue */
     Queue q[2];                        /* [0] reads, [1] writes, oldest first */
     Fifo wait[2];                      /* requests waiting for a slot */
     int mode;                          /* 0 serving reads, 1 draining writes */
@@ -73,7 +75,7 @@ typedef struct Done {
 struct Dram {
     DramParams p;
     Chan *ch;
-    DramStats stats;
+    DramStats *stats;          /* its total is summed by dram_stats, on demand */
     Done *heap;
     size_t nheap, capheap;
     uint64_t now, outstanding;
@@ -200,37 +202,54 @@ static uint64_t act_time(const Dram *d, const Chan *c, const Req *r)
 enum { CMD_NONE, CMD_COL, CMD_ACT, CMD_PRE };
 
 /* The command r needs next and its earliest cycle (CMD_NONE: none while the rank waits for a
- * refresh, or its bank's open row still has queued hits). */
-static int req_cmd(const Dram *d, const Chan *c, const Req *r, uint64_t *when)
+ * refresh, or its bank's open row still has queued hits). Every request of the queue being served
+ * goes one way (reads or writes), so the times depend on its bank alone: computed once a pass. */
+static int req_cmd(const Dram *d, Chan *c, const Req *r, uint64_t *when)
 {
     const Bank *b = bank_of(d, c, r);
+    int k = r->bank;
     if (c->rank[r->rank].ref_pending)
         return CMD_NONE;
     if (b->open_row == r->row) {
-        *when = col_time(d, c, r);
+        if (c->col_mark[k] != c->mark) {
+            c->col_mark[k] = c->mark;
+            c->col_at[k] = col_time(d, c, r);
+        }
+        *when = c->col_at[k];
         return CMD_COL;
     }
     if (b->open_row < 0) {
-        *when = act_time(d, c, r);
+        if (c->act_mark[k] != c->mark) {
+            c->act_mark[k] = c->mark;
+            c->act_at[k] = act_time(d, c, r);
+        }
+        *when = c->act_at[k];
         return CMD_ACT;
     }
-    if (c->hit_mark[r->bank] == c->mark)
+    if (c->hits[c->mode][k])
         return CMD_NONE;
     *when = max64(b->t_pre, c->cmd_ok);
     return CMD_PRE;
 }
 
-/* Marks the banks whose open row a request of the queue being served hits. */
-static void mark_hits(const Dram *d, Chan *c)
+/* A new evaluation pass: the per-bank times computed in the last one are stale. */
+static void new_pass(const Dram *d, Chan *c)
 {
-    const Queue *q = &c->q[c->mode];
     if (++c->mark == 0) {
-        memset(c->hit_mark, 0, (size_t)d->nbanks * sizeof *c->hit_mark);
+        memset(c->col_mark, 0, (size_t)d->nbanks * sizeof *c->col_mark);
+        memset(c->act_mark, 0, (size_t)d->nbanks * sizeof *c->act_mark);
         c->mark = 1;
     }
-    for (int i = 0; i < q->n; i++)
-        if (c->bank[q->e[i].bank].open_row == q->e[i].row)
-            c->hit_mark[q->e[i].bank] = c->mark;
+}
+
+/* The queued hits of bank k, counted afresh (when it opens a row; and, ticking, as a check of the
+ * counts kept as requests come and go). */
+static void count_hits(Chan *c, int k, int w)
+{
+    uint16_t n = 0;
+    for (int i = 0; i < c->q[w].n; i++)
+        n += c->q[w].e[i].bank == k && c->q[w].e[i].row == c->bank[k].open_row;
+    c->hits[w][k] = n;
 }
 
 /* ---- issuing commands --------------------------------------------------------------------------- */
@@ -241,6 +260,8 @@ static void issue_act(const Dram *d, Chan *c, Req *r, uint64_t t)
     Group *g = group_of(d, c, r);
     Rank *k = &c->rank[r->rank];
     b->open_row = r->row;
+    count_hits(c, r->bank, 0);
+    count_hits(c, r->bank, 1);
     b->t_col = t + (uint64_t)d->p.trcd;
     b->t_pre = t + (uint64_t)d->p.tras;
     b->t_act = t + (uint64_t)d->p.trc;
@@ -258,9 +279,11 @@ static void issue_act(const Dram *d, Chan *c, Req *r, uint64_t t)
         r->outcome = OUT_MISS;
 }
 
-static void issue_pre(const Dram *d, Chan *c, Bank *b, uint64_t t)
+static void issue_pre(const Dram *d, Chan *c, int k, uint64_t t)
 {
+    Bank *b = &c->bank[k];
     b->open_row = -1;
+    c->hits[0][k] = c->hits[1][k] = 0;
     b->t_act = max64(b->t_act, t + (uint64_t)d->p.trp);
     c->cmd_ok = t + 1;
     c->st->precharges++;
@@ -276,16 +299,6 @@ static void issue_ref(const Dram *d, Chan *c, int rank, uint64_t t)
     c->cmd_ok = t + 1;
     c->st->refreshes++;
     c->st->refresh_cycles += (uint64_t)d->p.trfc;
-}
-
-/* Another queued request (either queue) hits bank b's open row: closed page keeps it open. */
-static int row_wanted(const Chan *c, int bank, int32_t row)
-{
-    for (int w = 0; w < 2; w++)
-        for (int i = 0; i < c->q[w].n; i++)
-            if (c->q[w].e[i].bank == bank && c->q[w].e[i].row == row)
-                return 1;
-    return 0;
 }
 
 static void account(Dram *d, Chan *c, const Req *r, uint64_t end)
@@ -321,6 +334,7 @@ static void issue_col(Dram *d, Chan *c, int i, uint64_t t)
     Group *g = group_of(d, c, &r);
     Rank *k = &c->rank[r.rank];
     const DramParams *p = &d->p;
+    c->hits[c->mode][r.bank]--;
     uint64_t start = t + (uint64_t)(r.write ? p->cwl : p->cl), end = start + (uint64_t)p->burst_cycles;
     c->bus_free = end;
     c->last_dir = r.write;
@@ -336,7 +350,7 @@ static void issue_col(Dram *d, Chan *c, int i, uint64_t t)
     }
     c->cmd_ok = t + 1;
     account(d, c, &r, end);
-    if (p->page_policy == DRAM_PAGE_CLOSED && !row_wanted(c, r.bank, r.row)) {
+    if (p->page_policy == DRAM_PAGE_CLOSED && !c->hits[0][r.bank] && !c->hits[1][r.bank]) {
         /* auto-precharge: the bank closes at its earliest PRE, without a command slot */
         b->open_row = -1;
         b->t_act = max64(b->t_act, b->t_pre + (uint64_t)p->trp);
@@ -358,7 +372,7 @@ static int refresh_step(Dram *d, Chan *c, uint64_t t)
             if (b->open_row >= 0) {
                 open = 1;
                 if (t >= max64(b->t_pre, c->cmd_ok)) {
-                    issue_pre(d, c, b, t);
+                    issue_pre(d, c, i, t);
                     return 1;
                 }
             }
@@ -372,33 +386,105 @@ static int refresh_step(Dram *d, Chan *c, uint64_t t)
     return 0;
 }
 
-/* FR-FCFS: the oldest request whose RD/WR is legal now (a row hit), else the oldest whose ACT or
- * PRE is legal now. 1 when a command issued. */
-static int schedule(Dram *d, Chan *c, uint64_t t)
+/* Write draining with hysteresis: start at write_high entries or when no read waits; stop at
+ * write_low entries while reads wait, or when the write queue is empty. */
+static void update_mode(const Dram *d, Chan *c)
 {
+    int rq = c->q[0].n, wq = c->q[1].n;
+    if (c->mode == 0 && (wq >= d->p.write_high || (rq == 0 && wq > 0)))
+        c->mode = 1;
+    else if (c->mode == 1 && (wq == 0 || (wq <= d->p.write_low && rq > 0)))
+        c->mode = 0;
+}
+
+/* The earliest cycle a queued request of bank k can issue its command (DRAM_NEVER: none). */
+static uint64_t bank_later(const Dram *d, Chan *c, int k)
+{
+    const Queue *q = &c->q[c->mode];
+    uint64_t n = DRAM_NEVER, when;
+    new_pass(d, c);
+    for (int i = 0; i < q->n; i++)
+        if (q->e[i].bank == k && req_cmd(d, c, &q->e[i], &when) != CMD_NONE && when < n)
+            n = when;
+    return n;
+}
+
+/* The two smallest earliest cycles of a pass, from different banks: after a command to bank k,
+ * every other bank's requests can only have grown later (each timing rule only ever moves an
+ * earliest cycle up), so the smaller one not of bank k is still a lower bound. */
+typedef struct Later {
+    uint64_t t1, t2;
+    int b1;
+} Later;
+
+static void later_add(Later *l, uint64_t when, int bank)
+{
+    if (when < l->t1) {
+        if (bank != l->b1)
+            l->t2 = l->t1;
+        l->t1 = when;
+        l->b1 = bank;
+    } else if (bank != l->b1 && when < l->t2) {
+        l->t2 = when;
+    }
+}
+
+static void issue_row(const Dram *d, Chan *c, Req *r, int cmd, uint64_t t)
+{
+    if (cmd == CMD_ACT) {
+        issue_act(d, c, r, t);
+    } else {
+        issue_pre(d, c, r->bank, t);
+        r->outcome = OUT_CONFLICT;
+    }
+}
+
+/* FR-FCFS: the oldest request whose RD/WR is legal now (a row hit), else the oldest whose ACT or
+ * PRE is legal now, issued. *later: a lower bound of the next cycle a queued request's command is
+ * legal (DRAM_NEVER: none): after a command to bank k, the pass's bound for the other banks and
+ * bank k's requests evaluated afresh; t + 1 when another command was legal too or the mode
+ * changed. Returns 1 when a command issued. */
+static int schedule(Dram *d, Chan *c, uint64_t t, uint64_t *later)
+{
+    *later = t + 1;
     if (refresh_step(d, c, t))
         return 1;
     Queue *q = &c->q[c->mode];
-    mark_hits(d, c);
-    uint64_t when;
-    for (int i = 0; i < q->n; i++)
-        if (req_cmd(d, c, &q->e[i], &when) == CMD_COL && when <= t) {
-            issue_col(d, c, i, t);
-            return 1;
-        }
+    new_pass(d, c);
+    int col = -1, other = -1, other_cmd = CMD_NONE, legal = 0;
+    Later l = {DRAM_NEVER, DRAM_NEVER, -1};
     for (int i = 0; i < q->n; i++) {
+        uint64_t when;
         int cmd = req_cmd(d, c, &q->e[i], &when);
-        if (when > t || cmd == CMD_NONE || cmd == CMD_COL)
+        if (cmd == CMD_NONE)
             continue;
-        if (cmd == CMD_ACT) {
-            issue_act(d, c, &q->e[i], t);
-        } else {
-            issue_pre(d, c, bank_of(d, c, &q->e[i]), t);
-            q->e[i].outcome = OUT_CONFLICT;
+        if (when > t) {
+            later_add(&l, when, q->e[i].bank);
+            continue;
         }
-        return 1;
+        legal++;
+        if (cmd == CMD_COL && col < 0)
+            col = i;
+        else if (cmd != CMD_COL && other < 0) {
+            other = i;
+            other_cmd = cmd;
+        }
     }
-    return 0;
+    if (!legal) {
+        *later = l.t1;
+        return 0;
+    }
+    int mode = c->mode, k = q->e[col >= 0 ? col : other].bank;
+    if (col >= 0)
+        issue_col(d, c, col, t);
+    else
+        issue_row(d, c, &q->e[other], other_cmd, t);
+    update_mode(d, c);
+    if (legal == 1 && mode == c->mode) {
+        uint64_t rest = l.b1 == k ? l.t2 : l.t1, mine = bank_later(d, c, k);
+        *later = rest < mine ? rest : mine;
+    }
+    return 1;
 }
 
 /* ---- the channel's step and its next event ------------------------------------------------------ */
@@ -417,6 +503,7 @@ static void admit(Dram *d, Chan *c, uint64_t t)
                 c->st->backpressure += t - r.arrival;
             }
             c->q[w].e[c->q[w].n++] = r;
+            c->hits[w][r.bank] += c->bank[r.bank].open_row == r.row;
         }
     }
     uint64_t occ = (uint64_t)(c->q[0].n + c->q[1].n);
@@ -424,22 +511,12 @@ static void admit(Dram *d, Chan *c, uint64_t t)
         c->st->occupancy_max = occ;
 }
 
-/* Write draining with hysteresis: start at write_high entries or when no read waits; stop at
- * write_low entries while reads wait, or when the write queue is empty. */
-static void update_mode(const Dram *d, Chan *c)
+/* The first cycle after t at which the channel may do something, given later (the earliest
+ * command of a queued request): a request arrives at a free slot, a refresh falls due, or a
+ * waiting refresh's PRE or REF becomes legal. */
+static uint64_t next_event(const Dram *d, const Chan *c, uint64_t t, uint64_t later)
 {
-    int rq = c->q[0].n, wq = c->q[1].n;
-    if (c->mode == 0 && (wq >= d->p.write_high || (rq == 0 && wq > 0)))
-        c->mode = 1;
-    else if (c->mode == 1 && (wq == 0 || (wq <= d->p.write_low && rq > 0)))
-        c->mode = 0;
-}
-
-/* The first cycle after t at which the channel may do something: a command becomes legal, a
- * request arrives at a free slot, or a refresh falls due. */
-static uint64_t next_event(const Dram *d, Chan *c, uint64_t t)
-{
-    uint64_t n = DRAM_NEVER;
+    uint64_t n = later;
     const int cap[2] = {d->p.read_queue, d->p.write_queue};
     int per = d->p.bankgroups * d->p.banks;
     for (int w = 0; w < 2; w++)
@@ -463,16 +540,11 @@ static uint64_t next_event(const Dram *d, Chan *c, uint64_t t)
         if (!open)
             n = ready < n ? ready : n;
     }
-    const Queue *q = &c->q[c->mode];
-    mark_hits(d, c);
-    for (int i = 0; i < q->n; i++) {
-        uint64_t when;
-        if (req_cmd(d, c, &q->e[i], &when) != CMD_NONE && when < n)
-            n = when;
-    }
     return n <= t ? t + 1 : n;
 }
 
+/* One cycle of the channel: arrivals enter, refreshes fall due, the mode is chosen, at most one
+ * command issues; then the next step is the earliest cycle anything may become legal. */
 static void step(Dram *d, Chan *c, uint64_t t)
 {
     c->st->occupancy_sum += (uint64_t)(c->q[0].n + c->q[1].n) * (t - c->occ_t);
@@ -482,17 +554,27 @@ static void step(Dram *d, Chan *c, uint64_t t)
         if (!c->rank[k].ref_pending && t >= c->rank[k].ref_due)
             c->rank[k].ref_pending = 1;
     update_mode(d, c);
-    if (schedule(d, c, t))
-        update_mode(d, c);
-    c->next = next_event(d, c, t);
+    if (d->tick) /* the test hook also checks the hit counts against a fresh count */
+        for (int k = 0; k < d->nbanks; k++)
+            for (int w = 0; w < 2; w++) {
+                uint16_t kept = c->hits[w][k];
+                count_hits(c, k, w);
+                if (kept != c->hits[w][k])
+                    abort();
+            }
+    uint64_t later;
+    schedule(d, c, t, &later);
+    c->next = next_event(d, c, t, later);
 }
 
 /* ---- the interface ------------------------------------------------------------------------------ */
 
 static void chan_reset(Dram *d, Chan *c)
 {
-    for (int i = 0; i < d->nbanks; i++)
+    for (int i = 0; i < d->nbanks; i++) {
         c->bank[i] = (Bank){-1, 0, 0, 0};
+        c->hits[0][i] = c->hits[1][i] = 0;
+    }
     memset(c->grp, 0, (size_t)(d->p.ranks * d->p.bankgroups) * sizeof *c->grp);
     for (int k = 0; k < d->p.ranks; k++)
         c->rank[k] = (Rank){.ref_due = (uint64_t)d->p.trefi};
@@ -521,7 +603,12 @@ static void chan_free(Chan *c)
     free(c->bank);
     free(c->grp);
     free(c->rank);
-    free(c->hit_mark);
+    free(c->hits[0]);
+    free(c->hits[1]);
+    free(c->col_mark);
+    free(c->act_mark);
+    free(c->col_at);
+    free(c->act_at);
     for (int w = 0; w < 2; w++) {
         free(c->q[w].e);
         free(c->wait[w].e);
@@ -540,20 +627,29 @@ Dram *dram_new(const DramParams *p, char *err, size_t errlen)
     }
     d->nbanks = p->ranks * p->bankgroups * p->banks;
     d->ch = calloc((size_t)p->channels, sizeof *d->ch);
-    d->stats.chan = calloc((size_t)p->channels, sizeof *d->stats.chan);
-    d->stats.channels = p->channels;
-    if (!d->ch || !d->stats.chan)
+    d->stats = calloc(1, sizeof *d->stats);
+    if (d->stats) {
+        d->stats->chan = calloc((size_t)p->channels, sizeof *d->stats->chan);
+        d->stats->channels = p->channels;
+    }
+    if (!d->ch || !d->stats || !d->stats->chan)
         goto oom;
     for (int i = 0; i < p->channels; i++) {
         Chan *c = &d->ch[i];
         c->bank = malloc((size_t)d->nbanks * sizeof *c->bank);
         c->grp = malloc((size_t)(p->ranks * p->bankgroups) * sizeof *c->grp);
         c->rank = malloc((size_t)p->ranks * sizeof *c->rank);
-        c->hit_mark = calloc((size_t)d->nbanks, sizeof *c->hit_mark);
+        c->hits[0] = calloc((size_t)d->nbanks, sizeof *c->hits[0]);
+        c->hits[1] = calloc((size_t)d->nbanks, sizeof *c->hits[1]);
+        c->col_mark = calloc((size_t)d->nbanks, sizeof *c->col_mark);
+        c->act_mark = calloc((size_t)d->nbanks, sizeof *c->act_mark);
+        c->col_at = calloc((size_t)d->nbanks, sizeof *c->col_at);
+        c->act_at = calloc((size_t)d->nbanks, sizeof *c->act_at);
         c->q[0].e = malloc((size_t)p->read_queue * sizeof(Req));
         c->q[1].e = malloc((size_t)p->write_queue * sizeof(Req));
-        c->st = &d->stats.chan[i];
-        if (!c->bank || !c->grp || !c->rank || !c->hit_mark || !c->q[0].e || !c->q[1].e)
+        c->st = &d->stats->chan[i];
+        if (!c->bank || !c->grp || !c->rank || !c->hits[0] || !c->hits[1] || !c->col_mark || !c->act_mark || !c->col_at ||
+            !c->act_at || !c->q[0].e || !c->q[1].e)
             goto oom;
     }
     dram_reset(d);
@@ -571,7 +667,9 @@ void dram_free(Dram *d)
     for (int i = 0; d->ch && i < d->p.channels; i++)
         chan_free(&d->ch[i]);
     free(d->ch);
-    free(d->stats.chan);
+    if (d->stats)
+        free(d->stats->chan);
+    free(d->stats);
     free(d->heap);
     free(d);
 }
@@ -604,12 +702,12 @@ uint64_t dram_outstanding(const Dram *d)
     return d->outstanding;
 }
 
-static void sum_stats(Dram *d)
+static void sum_stats(const Dram *d)
 {
-    DramChanStats *t = &d->stats.total;
+    DramChanStats *t = &d->stats->total;
     memset(t, 0, sizeof *t);
     for (int i = 0; i < d->p.channels; i++) {
-        const DramChanStats *s = &d->stats.chan[i];
+        const DramChanStats *s = &d->stats->chan[i];
 #define DRAM_X(name, unit, desc) t->name += s->name;
         DRAM_STATS(DRAM_X)
 #undef DRAM_X
@@ -620,8 +718,8 @@ static void sum_stats(Dram *d)
     /* Summed, occupancy_max would mean nothing: the largest over channels; cycles are common. */
     t->occupancy_max = t->cycles = 0;
     for (int i = 0; i < d->p.channels; i++) {
-        t->occupancy_max = max64(t->occupancy_max, d->stats.chan[i].occupancy_max);
-        t->cycles = d->stats.chan[i].cycles;
+        t->occupancy_max = max64(t->occupancy_max, d->stats->chan[i].occupancy_max);
+        t->cycles = d->stats->chan[i].cycles;
     }
 }
 
@@ -650,12 +748,12 @@ void dram_run(Dram *d, uint64_t until, DramDone done, void *ctx)
         if (done)
             done(ctx, x.id, x.write, x.cycle);
     }
-    sum_stats(d);
 }
 
 const DramStats *dram_stats(const Dram *d)
 {
-    return &d->stats;
+    sum_stats(d);
+    return d->stats;
 }
 
 const DramParams *dram_get_params(const Dram *d)
