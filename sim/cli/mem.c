@@ -140,7 +140,8 @@ static int replay(Dram *d, MtrReader *t, Replay *r, char *err, size_t errlen)
         return -1;
     }
     for (int k = 0; k <= r->p->channels; k++)
-        qsort(r->lat[k].v, r->lat[k].n, sizeof *r->lat[k].v, cmp_u32);
+        if (r->lat[k].n) /* a channel no request went to has no array */
+            qsort(r->lat[k].v, r->lat[k].n, sizeof *r->lat[k].v, cmp_u32);
     if (!r->nreq)
         r->first = r->last = 0;
     return 0;

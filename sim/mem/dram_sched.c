@@ -442,8 +442,8 @@ static void issue_row(const Dram *d, Chan *c, Req *r, int cmd, uint64_t t)
 /* FR-FCFS: the oldest request whose RD/WR is legal now (a row hit), else the oldest whose ACT or
  * PRE is legal now, issued. *later: a lower bound of the next cycle a queued request's command is
  * legal (DRAM_NEVER: none): after a command to bank k, the pass's bound for the other banks and
- * bank k's requests evaluated afresh; t + 1 when another command was legal too or the mode
- * changed. Returns 1 when a command issued. */
+ * bank k's requests evaluated afresh; t + 1 when a command of another bank was legal too or the
+ * mode changed. Returns 1 when a command issued. */
 static int schedule(Dram *d, Chan *c, uint64_t t, uint64_t *later)
 {
     *later = t + 1;
@@ -451,7 +451,7 @@ static int schedule(Dram *d, Chan *c, uint64_t t, uint64_t *later)
         return 1;
     Queue *q = &c->q[c->mode];
     new_pass(d, c);
-    int col = -1, other = -1, other_cmd = CMD_NONE, legal = 0;
+    int col = -1, other = -1, other_cmd = CMD_NONE, legal_bank = -1, legal_banks = 0;
     Later l = {DRAM_NEVER, DRAM_NEVER, -1};
     for (int i = 0; i < q->n; i++) {
         uint64_t when;
@@ -462,7 +462,9 @@ static int schedule(Dram *d, Chan *c, uint64_t t, uint64_t *later)
             later_add(&l, when, q->e[i].bank);
             continue;
         }
-        legal++;
+        if (legal_bank != q->e[i].bank) /* 1 exactly when every legal command is in one bank */
+            legal_banks++;
+        legal_bank = q->e[i].bank;
         if (cmd == CMD_COL && col < 0)
             col = i;
         else if (cmd != CMD_COL && other < 0) {
@@ -470,7 +472,7 @@ static int schedule(Dram *d, Chan *c, uint64_t t, uint64_t *later)
             other_cmd = cmd;
         }
     }
-    if (!legal) {
+    if (!legal_banks) {
         *later = l.t1;
         return 0;
     }
@@ -480,7 +482,7 @@ static int schedule(Dram *d, Chan *c, uint64_t t, uint64_t *later)
     else
         issue_row(d, c, &q->e[other], other_cmd, t);
     update_mode(d, c);
-    if (legal == 1 && mode == c->mode) {
+    if (legal_banks == 1 && mode == c->mode) { /* bank k's legal ones are evaluated afresh */
         uint64_t rest = l.b1 == k ? l.t2 : l.t1, mine = bank_later(d, c, k);
         *later = rest < mine ? rest : mine;
     }

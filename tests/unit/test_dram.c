@@ -543,20 +543,23 @@ Test(dram_jump, ticking_every_cycle_gives_the_same_results)
         cr_assert_eq(dram_preset((DramPreset)k, &p), 0);
         p.trefi = 700; /* many refreshes in a short trace */
         p.trfc = 90;
-        p.read_queue = 6;
-        p.write_queue = 5;
-        p.write_high = 4;
-        p.write_low = 1;
-        for (int shape = 0; shape < 4; shape++) {
+        for (int shape = 0; shape < 6; shape++) {
+            /* tiny queues (back-pressure, draining at every turn), then the default 32 / 32 */
+            p.read_queue = shape < 4 ? 6 : 32;
+            p.write_queue = shape < 4 ? 5 : 32;
+            p.write_high = shape < 4 ? 4 : 24;
+            p.write_low = shape < 4 ? 1 : 8;
             p.page_policy = shape & 1 ? DRAM_PAGE_CLOSED : DRAM_PAGE_OPEN;
             uint64_t cyc = 0;
             for (int i = 0; i < 3000; i++) {
                 uint64_t x = rng_next(&seed);
-                if (shape < 2) /* random: rows and banks everywhere, bursts of arrivals, gaps */
+                if (shape < 2 || shape >= 4) /* random: rows and banks everywhere, bursts, gaps */
                     cyc += x % 7 == 0 ? x % 200 : x % 3;
                 else /* adversarial: two rows of one bank in turn, same cycle, and far jumps */
                     cyc += i % 64 == 63 ? 1000 + x % 2000 : 0;
-                uint64_t addr = shape < 2 ? (x >> 8) : ((uint64_t)(i & 1) << 26) | ((uint64_t)(i % 5) << 6);
+                uint64_t addr = shape < 2 ? (x >> 8)
+                                : shape >= 4 ? (x >> 52) << 6 /* bits 6-17: two rows a bank, many hits */
+                                             : ((uint64_t)(i & 1) << 26) | ((uint64_t)(i % 5) << 6);
                 r[i] = (Rq){addr, (int)((x >> 3) % 3 == 0), cyc};
             }
             same_both_ways(&p, r, 3000);

@@ -51,6 +51,14 @@ run "$SFSIM" mem --trace "$T/a.mtr"
 want_rc 0; want_out 'sfsim format\), 2 requests, cycles 200\.\.'; want_out ' 2 \(1 reads, 1 writes\)'
 end
 
+begin "mem: an empty trace, and channels no request goes to (regression: no latency array to sort)"
+: >"$T/empty.trc"
+run "$SFSIM" mem --trace "$T/empty.trc"
+want_rc 0; want_out 'requests +0 \(0 reads, 0 writes\)'
+run "$SFSIM" mem --trace "$T/d4/row-idle.trc" --set dram.preset=hbm2_2000
+want_rc 0; want_out '^channel 7'; want_out 'requests +1000 '
+end
+
 begin "mem: -o writes report.txt and report.json; --json prints the JSON"
 run "$SFSIM" mem --trace "$T/d4/seq-idle.trc" -o "$T/rep" --json
 want_rc 0
