@@ -25,6 +25,12 @@ static const struct { const char *section, *key; const char *names[CFG_ENUM_NAME
     {"workload", "kind", {"path", "specular", "diffuse", "phong"}},
     {"accel", "structure", {"bvh", "kd"}},
     {"kd", "traversal", {"stack", "restart", "pushdown", "shortstack", "packet", "stream"}},
+    /* sim/mem/dram_presets.def's rows, in order (DramPreset). */
+    {"dram", "preset", {"ddr4_2400", "ddr5_4800", "lpddr5_6400", "gddr6_14000", "hbm2_2000"}},
+    /* Field orders (sim/mem/dram.h; config keys hold no free strings, `sfsim mem --mapping` takes any). */
+    {"dram", "mapping", {"preset", "ro,ra,ba,co,bg,ch", "ro,ra,bg,ba,co,ch", "ro,ra,ba,bg,co,ch", "ch,ro,ba,bg,ra,co",
+                         "ro,ra,bg,ba,ch,co", "ro,co,ra,ba,bg,ch"}},
+    {"dram", "page_policy", {"open", "closed"}},
 };
 
 static const char *const *enum_of(const char *section, const char *key)

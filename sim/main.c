@@ -18,6 +18,7 @@
 #include "../host/version.h"
 #include "cli/exec.h"
 #include "cli/help.h"
+#include "cli/mem.h"
 #include "cli/opts.h"
 #include "config.h"
 #include "datadir.h"
@@ -496,7 +497,7 @@ static const struct {
 } commands[] = {
     {"run", cmd_run, help_run},         {"exec", cmd_exec, help_exec},       {"config", cmd_config, help_config},
     {"compare", cmd_compare, help_compare}, {"trace", cmd_trace, help_trace}, {"sweep", sweep_main, sweep_usage},
-    {"merge", merge_main, merge_usage}};
+    {"merge", merge_main, merge_usage}, {"mem", cmd_mem, help_mem}};
 enum { NCOMMANDS = sizeof commands / sizeof commands[0] };
 
 static int cmd_help(int argc, char **argv)

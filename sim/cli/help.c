@@ -26,6 +26,7 @@ void help_commands(FILE *out)
             "  trace    closest-hit / any-hit queries for a file of rays, through the kernel or the golden model\n"
             "  sweep    run a scene over many machine configs in parallel (sweep files, resumable; CSV, plots)\n"
             "  merge    build a sweep's CSV and plots from its point folders (after Slurm or GNU parallel)\n"
+            "  mem      replay a memory-access trace through the DRAM model: bandwidth, latency, row buffer\n"
             "  help     help on a command (sfsim help exec), or on the exit codes (sfsim help exit-codes)\n"
             "\n"
             "options everywhere: --help, --version. Options take their value as --set KEY=V, --set=KEY=V,\n"
@@ -47,7 +48,7 @@ void help_help(FILE *out)
     fprintf(out,
             "usage: sfsim help [COMMAND | exit-codes]\n"
             "\n"
-            "Prints the help of COMMAND (run, exec, config, compare, trace, sweep, merge, help), the exit\n"
+            "Prints the help of COMMAND (run, exec, config, compare, trace, sweep, merge, mem, help), the exit\n"
             "codes every command returns (exit-codes), or without an argument the list of commands.\n"
             "`sfsim COMMAND --help` prints the same as `sfsim help COMMAND`.\n"
             "\n"
@@ -209,4 +210,42 @@ void help_trace(FILE *out)
             "  printf '278 273 -800  0 0 1\\n' > rays.txt\n"
             "  sfsim trace -s scenes/cornell/scene.ini --rays rays.txt -o hits.txt\n"
             "  sfsim trace -s scene.gltf --rays rays.bin --mode detailed -j2 -o hits.txt\n");
+}
+
+void help_mem(FILE *out)
+{
+    fprintf(out,
+            "usage: sfsim mem --trace FILE [-c CONFIG] [--set dram.KEY=VALUE]... [--format dramsim3|sfsim|auto]\n"
+            "                 [--mapping ORDER] [-o DIR] [--json]\n"
+            "\n"
+            "Replays a memory-access trace through the DRAM of the config (the [dram] keys: a preset such as\n"
+            "ddr4_2400, ddr5_4800, lpddr5_6400, gddr6_14000 or hbm2_2000, and overrides; docs/dram.md) and\n"
+            "prints per channel and in total: requests, bandwidth in GB/s and its share of the peak, average\n"
+            "and p50/p95/p99 latency (DRAM cycles and ns), row-buffer hits/misses/conflicts, average and\n"
+            "largest queue occupancy, refreshes, and back-pressure (requests that waited for a queue slot).\n"
+            "\n"
+            "trace formats (docs/dram.md):\n"
+            "  dramsim3   DRAMsim3's text trace: '0xADDR READ|WRITE CYCLE' a line, CYCLE in DRAM clocks\n"
+            "  sfsim      a header 'sfsim-memtrace 1 clock_mhz=F', then 'CYCLE R|W 0xADDR [SOURCE]' a line,\n"
+            "             CYCLE in the header's clock (converted exactly: floor(CYCLE x DRAM MHz / F))\n"
+            "  auto       (default) sfsim when the first line is its header, else dramsim3\n"
+            "Cycles never decrease; '#' comment lines and blank lines are skipped.\n"
+            "\n"
+            "options:\n"
+            "  --trace FILE             the trace (required)\n"
+            "  -c, --config FILE        machine config; --set SECTION.KEY=VALUE overrides a key\n"
+            "  --format F               dramsim3, sfsim or auto (see above)\n"
+            "  --mapping ORDER          address mapping, any order of ch,ra,bg,ba,ro,co (most significant\n"
+            "                           first), beyond the orders the key dram.mapping offers\n"
+            "  -o, --out DIR            also write DIR/report.txt and DIR/report.json (each whole or not at all)\n"
+            "  --json                   print the JSON report instead of the text one\n"
+            "\n"
+            "Exit codes: 0 replayed, 1 bad input (the trace: the message names file and line; a config\n"
+            "key), 2 usage, 4 an output could not be written (sfsim help exit-codes).\n"
+            "\n"
+            "examples:\n"
+            "  printf '0x0 READ 0\\n0x40 READ 0\\n0x80 WRITE 10\\n' > t.trc\n"
+            "  sfsim mem --trace t.trc                                   DDR4-2400, one channel\n"
+            "  sfsim mem --trace t.trc --set dram.preset=hbm2_2000 --set dram.page_policy=closed\n"
+            "  sfsim mem --trace run.mtr --mapping ro,ba,bg,ra,co,ch -o memrep --json\n");
 }

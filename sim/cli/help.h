@@ -12,5 +12,6 @@ void help_config(FILE *out);
 void help_run(FILE *out);
 void help_compare(FILE *out);
 void help_trace(FILE *out);
+void help_mem(FILE *out);
 
 #endif
