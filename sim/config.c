@@ -25,6 +25,7 @@ static const struct { const char *section, *key; const char *names[CFG_ENUM_NAME
     {"workload", "kind", {"path", "specular", "diffuse", "phong"}},
     {"accel", "structure", {"bvh", "kd"}},
     {"kd", "traversal", {"stack", "restart", "pushdown", "shortstack", "packet", "stream"}},
+    {"kernel", "schedule", {"none", "list"}},
 };
 
 static const char *const *enum_of(const char *section, const char *key)
