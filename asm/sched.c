@@ -164,9 +164,15 @@ static int apart(const Node *x, const Node *y)
 
 /* ---- one region ------------------------------------------------------------------------------ */
 
+typedef struct RdLink {
+    int node, next;        /* a read of a register by node; the register's previous read */
+} RdLink;
+
 typedef struct Region {
     const AsmSchedModel *m;
     int n;
+    RdLink *links;         /* n x (ISA_MAX_OPERANDS + 1) */
+    int *memlist;          /* n */
     Node *node;            /* n */
     int16_t *lat;          /* n x n: the edge i -> j's latency, or -1 */
     int *height, *npred, *order, *ready;
@@ -179,13 +185,14 @@ static void edge(Region *g, int i, int j, int lat)
         *e = (int16_t)lat;
 }
 
-/* The dependencies of nodes 0..n-1, in program order (see the file's head). */
+/* The dependencies of nodes 0..n-1, in program order (see the file's head): per register its last
+ * writer and its readers since, per memory the instructions that touched it. */
 static void build_edges(Region *g, int last_is_exit)
 {
-    int n = g->n;
-    int last_wr[NREGS], ver[NREGS], last_unit[ISA_U_COUNT];
+    int n = g->n, nlinks = 0, nmem = 0;
+    int last_wr[NREGS], ver[NREGS], rd_head[NREGS], last_unit[ISA_U_COUNT];
     for (int r = 0; r < NREGS; r++)
-        last_wr[r] = -1, ver[r] = 0;
+        last_wr[r] = rd_head[r] = -1, ver[r] = 0;
     for (int u = 0; u < ISA_U_COUNT; u++)
         last_unit[u] = -1;
     memset(g->lat, 0xff, sizeof *g->lat * (size_t)n * (size_t)n);
@@ -196,23 +203,31 @@ static void build_edges(Region *g, int last_is_exit)
         for (int k = 0; k < b->nrd; k++) /* read after write */
             if (last_wr[b->rd[k]] >= 0)
                 edge(g, last_wr[b->rd[k]], j, g->node[last_wr[b->rd[k]]].lat);
-        for (int i = 0; i < j; i++) { /* write after read and after write, memories */
-            const Node *a = &g->node[i];
-            for (int k = 0; k < b->nwr; k++) {
-                for (int q = 0; q < a->nrd; q++)
-                    if (a->rd[q] == b->wr[k])
-                        edge(g, i, j, 1);
-                for (int q = 0; q < a->nwr; q++)
-                    if (a->wr[q] == b->wr[k])
-                        edge(g, i, j, a->lat);
-            }
-            if (a->mem != MEM_NONE && a->mem == b->mem && (a->mwrite || b->mwrite) && !apart(a, b))
-                edge(g, i, j, 1);
+        for (int k = 0; k < b->nwr; k++) { /* write after read, write after write */
+            int r = b->wr[k];
+            for (int l = rd_head[r]; l >= 0; l = g->links[l].next)
+                edge(g, g->links[l].node, j, 1);
+            rd_head[r] = -1;
+            if (last_wr[r] >= 0)
+                edge(g, last_wr[r], j, g->node[last_wr[r]].lat);
         }
-        if ((b->unit == ISA_U_AGU || b->unit == ISA_U_PART) && last_unit[b->unit] >= 0)
-            edge(g, last_unit[b->unit], j, 1);
-        if (b->unit == ISA_U_AGU || b->unit == ISA_U_PART)
+        for (int k = 0; k < b->nrd; k++) {
+            g->links[nlinks] = (RdLink){j, rd_head[b->rd[k]]};
+            rd_head[b->rd[k]] = nlinks++;
+        }
+        if (b->mem != MEM_NONE) {
+            for (int q = 0; q < nmem; q++) {
+                const Node *a = &g->node[g->memlist[q]];
+                if (a->mem == b->mem && (a->mwrite || b->mwrite) && !apart(a, b))
+                    edge(g, g->memlist[q], j, 1);
+            }
+            g->memlist[nmem++] = j;
+        }
+        if (b->unit == ISA_U_AGU || b->unit == ISA_U_PART) {
+            if (last_unit[b->unit] >= 0)
+                edge(g, last_unit[b->unit], j, 1);
             last_unit[b->unit] = j;
+        }
         for (int k = 0; k < b->nwr; k++) {
             last_wr[b->wr[k]] = j;
             ver[b->wr[k]]++;
@@ -404,9 +419,11 @@ static int pass_alloc(Pass *p)
     p->g.npred = malloc(sizeof(int) * w);
     p->g.order = malloc(sizeof(int) * w);
     p->g.ready = malloc(sizeof(int) * w);
+    p->g.links = malloc(sizeof *p->g.links * w * (ISA_MAX_OPERANDS + 1));
+    p->g.memlist = malloc(sizeof(int) * w);
     p->tmp_text = malloc(sizeof *p->tmp_text * w);
     p->tmp_lines = malloc(sizeof *p->tmp_lines * w);
-    return p->in && p->g.node && p->g.lat && p->g.height && p->g.npred && p->g.order && p->g.ready && p->tmp_text &&
+    return p->in && p->g.node && p->g.lat && p->g.height && p->g.npred && p->g.order && p->g.ready && p->g.links && p->g.memlist && p->tmp_text &&
                    p->tmp_lines
                ? 0
                : -1;
@@ -421,6 +438,8 @@ static void pass_free(Pass *p)
     free(p->g.npred);
     free(p->g.order);
     free(p->g.ready);
+    free(p->g.links);
+    free(p->g.memlist);
     free(p->tmp_text);
     free(p->tmp_lines);
 }

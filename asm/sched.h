@@ -53,7 +53,7 @@ typedef struct SchedStats {
 
 /* The longest region the pass schedules at once: longer blocks are cut (the cost of the
  * dependency matrix grows with its square). */
-#define SCHED_WINDOW 256
+#define SCHED_WINDOW 1024
 
 /* Schedules obj's text in place (obj->lines follows it). marks: obj->ntext bytes of SCHED_MARK_*
  * or NULL. With report, one line per region of two or more instructions and a total. Returns 0, or

@@ -303,7 +303,7 @@ Test(sched, random_blocks_compute_the_same, .timeout = 120)
         int lanes = prog % 3 == 0 ? 8 : prog % 3 == 1 ? 16 : 5;
         g.lanes = lanes;
         g.base[1] = 0, g.base[2] = 64, g.base[3] = 128;
-        gen_program(&g, prog % 50 == 0 ? 600 : 4 + (int)rnd(&g, 120));
+        gen_program(&g, prog % 500 == 0 ? 1300 : prog % 50 == 0 ? 600 : 4 + (int)rnd(&g, 120));
         AsmObject src, opt;
         tc_obj_from_prog(&src, g.p, (size_t)g.n);
         tc_obj_from_prog(&opt, g.p, (size_t)g.n);
