@@ -292,6 +292,8 @@ static int choose_defines(const PackedScene *p, const CfgMachine *cfg, uint32_t 
         add_define(defs, nd, list, len, "BOUNCES", cfg->workload_bounces);
     }
     add_define(defs, nd, list, len, "SPAD_BYTES", (uint32_t)cfg->spad_size_kb * 1024u);
+    if (cfg->kernel_unroll_box == 2)
+        add_define(defs, nd, list, len, "BOX_UNROLL", 1);
     scene_defines(p, needs, defs, nd, k);
     if (cfg->accel_structure == CFG_ACCEL_KD) {
         if (sm_u32(p, sm_hdr(p, SM_HDR_KD_NODES)) == 0) {

@@ -76,4 +76,9 @@ begin "every row of the same-outputs table computes the same with kernel.schedul
 bash tests/outputs/check.sh --schedule "$other" > "$T/same" 2>&1 || no "$(grep -A2 FAIL "$T/same" | head -12)"
 end
 
+begin "kernel.unroll_box = 2 renders the same images with fewer stalls on the Cornell box"
+bash tests/outputs/check.sh --images-with kernel.unroll_box=2 cornell-detailed-n16 cornell-packet cornell-trace-detailed \
+    conference-detailed-n16 > "$T/unroll" 2>&1 || no "$(grep -A2 FAIL "$T/unroll" | head -12)"
+end
+
 cli_summary "cli sched"
