@@ -370,6 +370,10 @@ $(BUILD)/bench/core_speed: bench/core_speed.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(LTO_LINK) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
 
+$(BUILD)/bench/sched_speed: bench/sched_speed.c $(BUILD)/libsfasm.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $^ -o $@ -lm
+
 $(BUILD)/bench/embree_xcheck: bench/embree_xcheck.c tests/support/xcheck.c tests/support/shared.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(LTO_LINK) $^ -o $@ $(EMBREE) $(INIH) $(LDLIBS) $(OIIO)
@@ -419,13 +423,14 @@ paper: deps
 
 bench: deps
 	@$(MAKE) --no-print-directory $(BUILD)/bench/core_speed $(BUILD)/bench/embree_xcheck $(BUILD)/bench/functional_speed \
-		$(BUILD)/bench/detailed_speed $(BUILD)/bench/speed_vs_error $(BUILD)/bench/per_ray
+		$(BUILD)/bench/detailed_speed $(BUILD)/bench/speed_vs_error $(BUILD)/bench/per_ray $(BUILD)/bench/sched_speed
 	$(BUILD)/bench/core_speed
 	$(BUILD)/bench/embree_xcheck
 	$(BUILD)/bench/functional_speed
 	$(BUILD)/bench/detailed_speed
 	$(BUILD)/bench/speed_vs_error out/bench
 	$(BUILD)/bench/per_ray
+	$(BUILD)/bench/sched_speed
 
 # ---- the example `make run` executes --------------------------------------------------------
 # The default scene on the default machine in detailed mode, sized to take one to two minutes

@@ -831,6 +831,7 @@ static void free_asm(Asm *a)
     free(a->macros);
     asm_table_free(&a->macrotab);
     free(a->exps);
+    free(a->smarks);
     free(a->text);
     free(a->lines);
     free(a->data.v);
@@ -838,6 +839,29 @@ static void free_asm(Asm *a)
     for (size_t i = 0; i < a->nfiles; i++)
         free(a->files[i]);
     free(a->files);
+}
+
+/* The scheduling pass over the object, with the fences the source set (.barrier, .sched). */
+static void schedule(Asm *a, AsmObject *obj)
+{
+    uint8_t *marks = calloc((size_t)obj->ntext + 1, 1);
+    int off = 0;
+    size_t k = 0;
+    for (uint32_t i = 0; marks && i <= obj->ntext; i++) {
+        for (; k < a->nsmarks && a->smarks[k].at == i; k++) {
+            if (a->smarks[k].kind == ASM_SMARK_BARRIER)
+                marks[i] |= SCHED_MARK_LEADER;
+            else
+                off = a->smarks[k].kind == ASM_SMARK_OFF;
+        }
+        if (off)
+            marks[i] |= SCHED_MARK_FIXED;
+    }
+    if (!marks || sched_object(obj, marks, a->opt->schedule, a->opt->schedule_report, NULL) != 0) {
+        asm_object_free(obj);
+        asm_oom(a);
+    }
+    free(marks);
 }
 
 /* Assembles buf (taken over) as file name. */
@@ -867,8 +891,8 @@ static int assemble(const char *name, char *buf, size_t len, const AsmOptions *o
     }
     if (!a.fatal)
         asm_pass2(&a);
-    if (a.errors == 0)
-        asm_build_object(&a, obj);
+    if (a.errors == 0 && asm_build_object(&a, obj) == 0 && a.opt->schedule)
+        schedule(&a, obj);
     flush_diags(&a);
     int errors = a.errors;
     free_asm(&a);

@@ -11,6 +11,7 @@
 #include <stdio.h>
 
 #include "object.h"
+#include "sched.h"
 
 typedef struct AsmDefine { const char *name; long long value; } AsmDefine;
 
@@ -18,6 +19,9 @@ typedef struct AsmOptions {
     const AsmDefine *defines; int ndefines;     /* -D NAME[=value] (value 1 when omitted) */
     const char *const *include_dirs; int ninclude_dirs; /* -I DIR, searched after the including file's directory */
     FILE *diag;                                 /* where diagnostics go (stderr if NULL) */
+    const AsmSchedModel *schedule;              /* NULL: the source order; else list-schedule the
+                                                   basic blocks for this machine (asm/sched.h) */
+    FILE *schedule_report;                      /* with schedule: the pass's per-block report */
 } AsmOptions;
 
 /* Assemble the file at path. Returns the number of errors (0 on success, *obj filled). */

@@ -134,6 +134,13 @@ typedef struct AsmBytes {
     size_t n, cap;
 } AsmBytes;
 
+/* A scheduling fence at a text index (.barrier, .sched off, .sched on). */
+enum { ASM_SMARK_BARRIER, ASM_SMARK_OFF, ASM_SMARK_ON };
+typedef struct AsmSchedMark {
+    uint32_t at;
+    int kind;
+} AsmSchedMark;
+
 typedef struct Asm {
     const AsmOptions *opt;
     int errors;
@@ -161,6 +168,7 @@ typedef struct Asm {
     uint64_t *text;   AsmLine *lines; size_t ntext, captext, caplines;
     AsmBytes data, spad;
     AsmFixup *fix;    size_t nfix, capfix;
+    AsmSchedMark *smarks; size_t nsmarks, capsmarks;
     int pass;                    /* 1 while reading, 2 while resolving */
     int defer_depth;
 } Asm;

@@ -23,6 +23,9 @@ typedef struct Args {
     const char **include_dirs; int ninclude_dirs;
     const char *input, *output, *disasm;
     int source;
+    int optimize;              /* -O: the scheduling pass */
+    int report;                /* --schedule-report */
+    AsmSchedModel model;       /* sched_model_default, then --latency / --issue / --lanes */
 } Args;
 
 static void usage(FILE *f)
@@ -41,6 +44,14 @@ static void usage(FILE *f)
             "  -I, --include-dir DIR      search DIR for .include files (after the including file's directory)\n"
             "  -d, --disassemble FILE.sfo disassemble FILE.sfo to stdout\n"
             "  --source                   with -d: add each instruction's file:line as a comment\n"
+            "  -O, -O1                    schedule each basic block for the machine (list scheduling by\n"
+            "                             critical path; docs/assembler.md); -O0 keeps the source order (default)\n"
+            "  --latency CLASS=N          with -O: the result latency of unit class CLASS (vfma, vadd, rbuf, ...;\n"
+            "                             the classes of docs/isa.md); default configs/streamray.ini's\n"
+            "  --issue CLASS=N            with -O: cycles between two issues of CLASS (default as --latency)\n"
+            "  --lanes N                  with -O: the SIMD width N the code runs at (default 16)\n"
+            "  --schedule-report          with -O: print, per block, its length, critical path and estimated\n"
+            "                             cycles before and after, then a total, to stdout\n"
             "  -h, --help                 this text\n"
             "  --version                  the version (the same as sfsim's) and the object format's\n"
             "\n"
@@ -50,6 +61,7 @@ static void usage(FILE *f)
             "  sfasm prog.s                                   writes prog.sfo\n"
             "  sfasm kernels/pathtrace.s -I kernels/lib -I kernels -DRAYS=4096 -D SPAD_BYTES=65536 -o k.sfo\n"
             "  sfasm -d k.sfo --source | less                 the disassembly, each line with its source line\n"
+            "  sfasm -O --latency vfma=6 --schedule-report k.s  scheduled for a 6-cycle FMA, with the report\n"
             "\n"
             "exit codes (shared by sfsim; sfasm returns 0, 1, 2 or 4; docs/exit-codes.md):\n");
     exithelp_print(f);
@@ -86,12 +98,47 @@ static int parse_define(Args *a, char *spec)
     return 0;
 }
 
-enum { A_SOURCE = 0x100, A_VERSION };
+enum { A_SOURCE = 0x100, A_VERSION, A_LATENCY, A_ISSUE, A_LANES, A_REPORT };
 static const struct option longs[] = {
     {"output", required_argument, NULL, 'o'},      {"define", required_argument, NULL, 'D'},
     {"include-dir", required_argument, NULL, 'I'}, {"disassemble", required_argument, NULL, 'd'},
     {"source", no_argument, NULL, A_SOURCE},       {"help", no_argument, NULL, 'h'},
-    {"version", no_argument, NULL, A_VERSION},     {NULL, 0, NULL, 0}};
+    {"version", no_argument, NULL, A_VERSION},     {"latency", required_argument, NULL, A_LATENCY},
+    {"issue", required_argument, NULL, A_ISSUE},   {"lanes", required_argument, NULL, A_LANES},
+    {"schedule-report", no_argument, NULL, A_REPORT}, {NULL, 0, NULL, 0}};
+
+/* "N" in lo..hi into *v, or -1. */
+static int parse_int(const char *s, int lo, int hi, int *v)
+{
+    char *end;
+    errno = 0;
+    long x = strtol(s, &end, 10);
+    if (!*s || *end || errno == ERANGE || x < lo || x > hi)
+        return -1;
+    *v = (int)x;
+    return 0;
+}
+
+/* --latency / --issue CLASS=N: a unit class of isa/isa.h and 1..1024 cycles. */
+static int parse_class(Args *a, const char *opt, const char *spec, int issue)
+{
+    char name[32];
+    const char *eq = strchr(spec, '=');
+    size_t n = eq ? (size_t)(eq - spec) : 0;
+    int u = -1, v;
+    if (eq && n < sizeof name) {
+        memcpy(name, spec, n);
+        name[n] = '\0';
+        u = sched_unit_from_name(name);
+    }
+    if (u < 0)
+        return usage_error("--%s %s: expected CLASS=N with CLASS a unit class (vfma, vadd, rbuf, ...: docs/isa.md)",
+                           opt, spec);
+    if (parse_int(eq + 1, 1, 1024, &v) != 0)
+        return usage_error("--%s %s: N must be an integer in 1..1024", opt, spec);
+    (issue ? a->model.issue : a->model.lat)[u] = v;
+    return 0;
+}
 
 /* getopt_long's (glibc) error for the argument it just looked at. */
 static int option_error(int code, int argc, char **argv)
@@ -115,13 +162,32 @@ static int parse_args(int argc, char **argv, Args *a)
         return usage_error("out of memory");
     opterr = 0;
     int code;
-    while ((code = getopt_long(argc, argv, ":o:D:I:d:h", longs, NULL)) != -1) {
+    int tuned = 0;
+    sched_model_default(&a->model);
+    while ((code = getopt_long(argc, argv, ":o:D:I:d:hO::", longs, NULL)) != -1) {
         switch (code) {
         case 'h': usage(stdout); return -1;
         case A_VERSION:
             printf("sfasm %s (commit %s, object format version %u)\n", version_string(), version_commit(), ASM_OBJ_VERSION);
             return -1;
         case A_SOURCE: a->source = 1; break;
+        case 'O':
+            if (optarg && strcmp(optarg, "0") != 0 && strcmp(optarg, "1") != 0)
+                return usage_error("-O%s: the levels are -O0 (source order) and -O or -O1 (scheduled)", optarg);
+            a->optimize = !optarg || optarg[0] == '1';
+            break;
+        case A_LATENCY:
+        case A_ISSUE:
+            if (parse_class(a, code == A_LATENCY ? "latency" : "issue", optarg, code == A_ISSUE) != 0)
+                return EXIT_USAGE;
+            tuned = 1;
+            break;
+        case A_LANES:
+            if (parse_int(optarg, 1, ISA_MAX_LANES, &a->model.lanes) != 0)
+                return usage_error("--lanes %s: N must be an integer in 1..%d", optarg, ISA_MAX_LANES);
+            tuned = 1;
+            break;
+        case A_REPORT: a->report = 1; break;
         case 'D':
             if (parse_define(a, optarg) != 0)
                 return EXIT_USAGE;
@@ -143,6 +209,10 @@ static int parse_args(int argc, char **argv, Args *a)
         return usage_error("--source goes with -d");
     if (!a->disasm && !a->input)
         return usage_error("no input file");
+    if ((tuned || a->report) && !a->optimize)
+        return usage_error("--latency, --issue, --lanes and --schedule-report go with -O");
+    if (a->disasm && a->optimize)
+        return usage_error("-O goes with assembling, not with -d");
     return 0;
 }
 
@@ -179,7 +249,8 @@ static char *default_output(const char *in)
 
 static int assemble(const Args *a)
 {
-    AsmOptions opt = {a->defines, a->ndefines, a->include_dirs, a->ninclude_dirs, stderr};
+    AsmOptions opt = {a->defines, a->ndefines, a->include_dirs, a->ninclude_dirs, stderr,
+                      a->optimize ? &a->model : NULL, a->report ? stdout : NULL};
     AsmObject obj;
     int errors = asm_assemble_file(a->input, &opt, &obj);
     if (errors) {

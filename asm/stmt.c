@@ -367,6 +367,40 @@ static void error_directive(Asm *a, const AsmToken *t, int i)
         asm_error_at(a, t[i].col, "%s", t[i + 1].str);
 }
 
+/* ---- scheduling fences (asm/sched.h) --------------------------------------------------------- */
+
+/* .barrier: a block starts at the next instruction; .sched off / .sched on: the instructions
+ * between stay where they are. Kept as marks at text indices; asm.c hands them to the pass. */
+static void sched_mark(Asm *a, int kind)
+{
+    AsmSchedMark *m = asm_grow(a->smarks, &a->capsmarks, a->nsmarks + 1, sizeof *m);
+    if (!m) {
+        asm_oom(a);
+        return;
+    }
+    a->smarks = m;
+    a->smarks[a->nsmarks++] = (AsmSchedMark){(uint32_t)a->ntext, kind};
+}
+
+static void barrier_directive(Asm *a, const AsmToken *t, int i)
+{
+    if (expect_eol(a, &t[i + 1], &t[i]) == 0)
+        sched_mark(a, ASM_SMARK_BARRIER);
+}
+
+static void sched_directive(Asm *a, const AsmToken *t, int i)
+{
+    char d[64];
+    int on = t[i + 1].kind == ASM_TOK_IDENT && name_is(&t[i + 1], "on");
+    if (!on && !(t[i + 1].kind == ASM_TOK_IDENT && name_is(&t[i + 1], "off"))) {
+        asm_error_at(a, t[i + 1].col, "expected on or off after .sched, found %s",
+                     asm_tok_describe(&t[i + 1], d, sizeof d));
+        return;
+    }
+    if (expect_eol(a, &t[i + 2], &t[i]) == 0)
+        sched_mark(a, on ? ASM_SMARK_ON : ASM_SMARK_OFF);
+}
+
 static void structural_directive(Asm *a, const AsmToken *t, int i)
 {
     asm_error_at(a, t[i].col, "%.*s must begin its line (no label before it)", (int)t[i].len, t[i].text);
@@ -380,7 +414,7 @@ static const struct {
     {".word", data_directive},     {".float", data_directive},     {".byte", data_directive},
     {".space", space_directive},   {".align", align_directive},    {".equ", equ_directive},
     {".set", equ_directive},       {".alias", alias_directive},    {".unalias", unalias_directive},
-    {".regs", regs_directive},
+    {".regs", regs_directive},     {".barrier", barrier_directive}, {".sched", sched_directive},
     {".error", error_directive},   {".if", structural_directive},  {".ifdef", structural_directive},
     {".ifndef", structural_directive}, {".elif", structural_directive}, {".else", structural_directive},
     {".endif", structural_directive},  {".macro", structural_directive}, {".endm", structural_directive},

@@ -157,8 +157,12 @@ enum {
     ISA_FL_SPAD   = 1u << 6, /* touches the scratchpad */
     ISA_FL_SCENE  = 1u << 7, /* touches scene memory */
     ISA_FL_FB     = 1u << 8, /* touches the framebuffer */
-    ISA_FL_WRITE  = 1u << 9  /* writes the memory it touches (store, scatter, append, scatter-add,
+    ISA_FL_WRITE  = 1u << 9, /* writes the memory it touches (store, scatter, append, scatter-add,
                                 in-place partition); without it a memory instruction only reads */
+    ISA_FL_RBN    = 1u << 10, /* with RB: the next ray buffer (RBn), not the current one (RBc) */
+    ISA_FL_SIDE   = 1u << 11  /* an effect no operand or memory flag shows: swaps the ray buffers
+                                 (rswap), moves the statistics to another stage or generation (stage,
+                                 sgen); the scheduling pass (asm/sched.c) moves nothing across it */
 };
 
 /* The two ID-vector moves, told apart by the flags (the timing model dispatches on these, never

@@ -31,6 +31,7 @@ static const struct { const char *section, *key; const char *names[CFG_ENUM_NAME
     {"dram", "mapping", {"preset", "ro,ra,ba,co,bg,ch", "ro,ra,bg,ba,co,ch", "ro,ra,ba,bg,co,ch", "ch,ro,ba,bg,ra,co",
                          "ro,ra,bg,ba,ch,co", "ro,co,ra,ba,bg,ch"}},
     {"dram", "page_policy", {"open", "closed"}},
+    {"kernel", "schedule", {"none", "list"}},
 };
 
 static const char *const *enum_of(const char *section, const char *key)

@@ -35,7 +35,7 @@ static const Group groups[] = {
 };
 #define NGROUPS (sizeof groups / sizeof groups[0])
 
-static const char *const flag_names[] = {"vec", "float", "branch", "end", "rb", "idm", "spad", "scene", "fb", "write"};
+static const char *const flag_names[] = {"vec", "float", "branch", "end", "rb", "idm", "spad", "scene", "fb", "write", "rbn", "side"};
 
 static const char *const flag_descs[] = {
     "operates on N lanes; counts toward SIMD utilization",
@@ -48,6 +48,8 @@ static const char *const flag_descs[] = {
     "touches scene memory",
     "touches the framebuffer",
     "writes the memory it touches (store, scatter, append, scatter-add, in-place partition); without it a memory instruction only reads",
+    "with rb: the next ray buffer (RBn), not the current one (RBc)",
+    "an effect no operand or memory flag shows (swapping the ray buffers, the statistics' stage or generation): the scheduling pass moves nothing across it",
 };
 
 /* Operand placeholder as written in the syntax column: the kind letter and the field letter,

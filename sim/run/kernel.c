@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "../datadir.h"
+#include "schedmodel.h"
 
 const char *kernel_default_path(char *buf, size_t len)
 {
@@ -291,6 +292,8 @@ static int choose_defines(const PackedScene *p, const CfgMachine *cfg, uint32_t 
         add_define(defs, nd, list, len, "BOUNCES", cfg->workload_bounces);
     }
     add_define(defs, nd, list, len, "SPAD_BYTES", (uint32_t)cfg->spad_size_kb * 1024u);
+    if (cfg->kernel_unroll_box == 2)
+        add_define(defs, nd, list, len, "BOX_UNROLL", 1);
     scene_defines(p, needs, defs, nd, k);
     if (cfg->accel_structure == CFG_ACCEL_KD) {
         if (sm_u32(p, sm_hdr(p, SM_HDR_KD_NODES)) == 0) {
@@ -306,8 +309,11 @@ static int choose_defines(const PackedScene *p, const CfgMachine *cfg, uint32_t 
     return 0;
 }
 
-static int assemble(const char *path, const AsmDefine *defs, int nd, AsmObject *obj, char *err, size_t errlen)
+static int assemble(const char *path, const AsmDefine *defs, int nd, const CfgMachine *cfg, AsmObject *obj, char *err,
+                    size_t errlen)
 {
+    AsmSchedModel model; /* kernel.schedule = list: each block scheduled for this machine */
+    schedmodel_fill(cfg, &model);
     char libdir[PATH_MAX + 8];
     snprintf(libdir, sizeof libdir, "%s", path);
     char *slash = strrchr(libdir, '/');
@@ -319,7 +325,7 @@ static int assemble(const char *path, const AsmDefine *defs, int nd, AsmObject *
     char *diag = NULL;
     size_t diaglen = 0;
     FILE *dm = open_memstream(&diag, &diaglen);
-    AsmOptions ao = {defs, nd, incs, 1, dm};
+    AsmOptions ao = {defs, nd, incs, 1, dm, cfg->kernel_schedule == CFG_KERNEL_SCHEDULE_LIST ? &model : NULL, NULL};
     int nerr = asm_assemble_file(path, &ao, obj);
     if (dm)
         fclose(dm);
@@ -379,7 +385,7 @@ int kernel_build(const PackedScene *p, const CfgMachine *cfg, const char *path, 
     int nd = 0;
     if (choose_defines(p, cfg, needs, trace_only, defs, &nd, k, err, errlen) != 0)
         return -1;
-    if (assemble(path, defs, nd, &k->obj, err, errlen) != 0)
+    if (assemble(path, defs, nd, cfg, &k->obj, err, errlen) != 0)
         return -1;
     if (abi_lookup(&k->obj, &k->abi, err, errlen) != 0 ||
         (k->kd && kd_abi_lookup(&k->obj, cfg, &k->abi, err, errlen) != 0))

@@ -126,7 +126,7 @@ Test(isa_table, access_strings_match_formats)
 Test(isa_table, units_categories_flags_and_descriptions_are_valid)
 {
     const uint32_t all_flags = ISA_FL_VEC | ISA_FL_FLOAT | ISA_FL_BRANCH | ISA_FL_END | ISA_FL_RB | ISA_FL_IDM |
-                               ISA_FL_SPAD | ISA_FL_SCENE | ISA_FL_FB | ISA_FL_WRITE;
+                               ISA_FL_SPAD | ISA_FL_SCENE | ISA_FL_FB | ISA_FL_WRITE | ISA_FL_RBN | ISA_FL_SIDE;
     const uint32_t memories = ISA_FL_RB | ISA_FL_IDM | ISA_FL_SPAD | ISA_FL_SCENE | ISA_FL_FB;
     for (int i = 0; i < ISA_OP_COUNT; i++) {
         const IsaOpInfo *oi = &isa_ops[i];
@@ -154,6 +154,8 @@ Test(isa_table, units_categories_flags_and_descriptions_are_valid)
             cr_expect(oi->unit == ISA_U_AGU || oi->unit == ISA_U_PART, "%s: idm flag on unit %s", oi->mnemonic,
                       isa_unit_names[oi->unit]);
         /* the timing model tells loads from stores, gathers from scatters by the write flag */
+        if (oi->flags & ISA_FL_RBN) /* the scheduler tells RBn from RBc by it */
+            cr_expect(oi->flags & ISA_FL_RB, "%s: rbn flag without rb", oi->mnemonic);
         if (oi->flags & ISA_FL_WRITE)
             cr_expect(oi->flags & memories, "%s: write flag without a memory flag", oi->mnemonic);
         if (oi->category == ISA_C_STORE)

@@ -75,7 +75,7 @@ static int run_case(const char *file, int lineno, char *line)
     }
     cr_assert(nexp > 0, "%s:%d: no expectations", file, lineno);
 
-    AsmOptions opt = {defs, ndefs, NULL, 0, NULL};
+    AsmOptions opt = {defs, ndefs, NULL, 0, NULL, NULL, NULL};
     AsmObject obj;
     cr_assert(asm_assemble_file(file, &opt, &obj) == 0, "%s: %s does not assemble", file, name);
     CoreParams cp;
@@ -198,7 +198,7 @@ static Timing *default_timing(CoreParams *cp)
 static void assemble_prog(const BenchProg *p, const char *src, AsmObject *obj)
 {
     AsmDefine def = {p->define, p->value};
-    AsmOptions opt = {&def, p->define ? 1 : 0, NULL, 0, NULL};
+    AsmOptions opt = {&def, p->define ? 1 : 0, NULL, 0, NULL, NULL, NULL};
     if (src)
         ta_assemble_ok(src, NULL, obj);
     else
