@@ -19,7 +19,6 @@
 #include <unistd.h>
 
 #include "run/kernel.h"
-#include "run/run.h"
 #include "run/tiles.h"
 #include "run/timedcore.h"
 
@@ -444,11 +443,10 @@ static int worker_begin(void *ctx, int index)
         fail(j, msg, 0);
         return -1;
     }
-    /* The packed scene into scene memory: mapped copy-on-write from the open scene's image
-     * (run_scene_image), or copied. */
-    const CoreImage *im = run_scene_image(j->p);
-    if (im) {
-        if (core_load_image(w->tc.core, im) != 0) {
+    /* The packed scene into scene memory: mapped copy-on-write from the image the caller passed
+     * (FuncParams.image, the open scene's), or copied. */
+    if (j->fp->image) {
+        if (core_load_image(w->tc.core, j->fp->image) != 0) {
             fail(j, "out of memory loading the scene into scene memory", 0);
             return -1;
         }

@@ -33,6 +33,9 @@ extern const char *const func_kd_counter_keys[FUNC_KD_COUNTERS]; /* "nodes", "le
 typedef struct FuncParams {
     const CfgMachine *cfg;     /* SIMD width, stream size, memories, instruction limit */
     const char *kernel_path;   /* kernels/pathtrace.s */
+    /* p's bytes as a shared image (the opened scene's, RunScene.image: sim/run/run.h), which each
+     * core maps copy-on-write; NULL: each core copies p's bytes. It must hold p's bytes unchanged. */
+    const CoreImage *image;
     uint32_t needs;            /* SCENE_NEED_* of the scene */
     uint32_t seed;
     int threads;

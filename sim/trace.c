@@ -39,7 +39,7 @@ int trace_run(const TraceOptions *o, TraceSummary *sum, char *err, size_t errlen
         goto out;
     }
     RunTrace rt;
-    rc = run_trace(&sc.p, sc.s.needs, &spec, &b, hits, &rt, err, errlen);
+    rc = run_trace(&sc.p, sc.image, sc.s.needs, &spec, &b, hits, &rt, err, errlen);
     sum->timed = rt.timed;
     sum->timing = rt.timing;
     sum->sim_instructions = rt.instructions;

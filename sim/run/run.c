@@ -8,7 +8,6 @@
 #include "run.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -68,58 +67,6 @@ static int impose_size(Scene *s, const RunSize *z, char *err, size_t errlen)
     return 0;
 }
 
-/* The open scenes' images: every trace batch and frame starts cores that load the packed scene, and
- * the image spares each core the copy (26 MB on the conference room, a page fault per 4 KiB). A
- * scene is found by the address of its PackedScene, and only while its bytes are the same block of
- * the same size as at run_scene_open (a pack_free and a new pack at the same address are not). */
-enum { IMAGES_MAX = 64 };
-static struct {
-    const PackedScene *p;
-    const uint8_t *mem;
-    uint32_t size;
-    CoreImage *image;
-} images[IMAGES_MAX];
-static pthread_mutex_t images_lock = PTHREAD_MUTEX_INITIALIZER;
-
-static void image_register(RunScene *sc)
-{
-    sc->image = core_image_new(sc->p.mem, sc->p.size, 0);
-    if (!sc->image || !core_image_shared(sc->image))
-        return; /* no memfd: the cores copy, as they do any other PackedScene */
-    pthread_mutex_lock(&images_lock);
-    for (int i = 0; i < IMAGES_MAX; i++)
-        if (!images[i].p) {
-            images[i].p = &sc->p;
-            images[i].mem = sc->p.mem;
-            images[i].size = sc->p.size;
-            images[i].image = sc->image;
-            break;
-        }
-    pthread_mutex_unlock(&images_lock);
-}
-
-static void image_unregister(RunScene *sc)
-{
-    pthread_mutex_lock(&images_lock);
-    for (int i = 0; i < IMAGES_MAX; i++)
-        if (sc->image && images[i].image == sc->image)
-            memset(&images[i], 0, sizeof images[i]);
-    pthread_mutex_unlock(&images_lock);
-    core_image_free(sc->image);
-    sc->image = NULL;
-}
-
-const CoreImage *run_scene_image(const PackedScene *p)
-{
-    const CoreImage *im = NULL;
-    pthread_mutex_lock(&images_lock);
-    for (int i = 0; i < IMAGES_MAX && !im; i++)
-        if (images[i].p == p && images[i].mem == p->mem && images[i].size == p->size)
-            im = images[i].image;
-    pthread_mutex_unlock(&images_lock);
-    return im;
-}
-
 int run_scene_open(RunScene *sc, const char *path, const RunSize *size, const CfgMachine *cfg, RunMode mode,
                    const char *who, char *err, size_t errlen)
 {
@@ -139,14 +86,18 @@ int run_scene_open(RunScene *sc, const char *path, const RunSize *size, const Cf
     sc->load_seconds = util_now() - t0;
     if (accel_pack(&sc->s, cfg, run_mode_kernel(mode), &sc->p, &sc->accel, err, errlen) != 0)
         return -1;
-    if (run_mode_kernel(mode))
-        image_register(sc);
+    /* The kernel modes start cores that each load the packed scene: one shared image spares them
+     * the copy. Without a memfd the image would only copy, as the cores do without one. */
+    if (run_mode_kernel(mode) && !core_image_shared(sc->image = core_image_new(sc->p.mem, sc->p.size, 0))) {
+        core_image_free(sc->image);
+        sc->image = NULL;
+    }
     return 0;
 }
 
 void run_scene_close(RunScene *sc)
 {
-    image_unregister(sc);
+    core_image_free(sc->image);
     pack_free(&sc->p);
     scene_free(&sc->s);
     memset(sc, 0, sizeof *sc);
@@ -198,6 +149,7 @@ static int kernel_frame(const RunScene *sc, const RunSpec *spec, const CfgMachin
     char kpath[4200];
     FuncParams fp = {.cfg = cfg,
                      .kernel_path = run_spec_kernel(spec, kpath, sizeof kpath),
+                     .image = sc->image,
                      .needs = sc->s.needs,
                      .seed = spec->seed,
                      .threads = fr->threads,
@@ -304,8 +256,8 @@ static void golden_trace(const PackedScene *p, const RayBatch *b, BatchHit *hits
     }
 }
 
-int run_trace(const PackedScene *p, uint32_t needs, const RunSpec *spec, const RayBatch *b, BatchHit *hits,
-              RunTrace *out, char *err, size_t errlen)
+int run_trace(const PackedScene *p, const CoreImage *image, uint32_t needs, const RunSpec *spec, const RayBatch *b,
+              BatchHit *hits, RunTrace *out, char *err, size_t errlen)
 {
     RunTrace local;
     if (!out)
@@ -327,6 +279,7 @@ int run_trace(const PackedScene *p, uint32_t needs, const RunSpec *spec, const R
     char kpath[4200];
     FuncParams fp = {.cfg = cfg,
                      .kernel_path = run_spec_kernel(spec, kpath, sizeof kpath),
+                     .image = image,
                      .needs = needs,
                      .seed = spec->seed ? spec->seed : 1,
                      .threads = spec->threads,

@@ -54,7 +54,11 @@ typedef struct RunScene {
     PackedScene p;
     AccelInfo accel;           /* what was built, and its host time */
     double load_seconds;       /* reading the scene file */
-    CoreImage *image;          /* p's bytes, which the kernel modes' cores share (run_scene_image) */
+    /* p's bytes as one shared image (a sealed memfd, sim/core.h) that the kernel modes' cores map
+     * instead of each copying them (26 MB on the conference room); NULL for the golden model, or
+     * when the host has no memfd (the cores copy). The scene owns it: whoever starts cores on p is
+     * passed it (FuncParams.image, run_trace's image) and p's bytes must not change while it lives. */
+    CoreImage *image;
 } RunScene;
 
 /* Load path, print the scene's warnings on stderr as "<who>: warning: ..." (who NULL: not printed;
@@ -65,10 +69,6 @@ typedef struct RunScene {
 int run_scene_open(RunScene *sc, const char *path, const RunSize *size, const CfgMachine *cfg, RunMode mode,
                    const char *who, char *err, size_t errlen);
 void run_scene_close(RunScene *sc);
-/* The shared image of the packed bytes of an open scene (a RunScene's p, its bytes unchanged since
- * run_scene_open), for the kernel modes' cores to map instead of copying (sim/core.h); NULL for
- * any other PackedScene, whose bytes the cores copy. The bytes of an open scene must not change. */
-const CoreImage *run_scene_image(const PackedScene *p);
 
 /* How to run: the mode, the machine and the host. Zero-initialised fields take the defaults. */
 typedef struct RunSpec {
@@ -138,8 +138,10 @@ typedef struct RunTrace {
 
 /* Trace batch b against p (a scene of needs) as spec says: RUN_REFERENCE (the golden model),
  * RUN_FUNCTIONAL or RUN_DETAILED (the kernel's traversal and intersection); hits[i] for ray i.
- * 0, -1 (input) or -2 (the kernel failed). out may be NULL. */
-int run_trace(const PackedScene *p, uint32_t needs, const RunSpec *spec, const RayBatch *b, BatchHit *hits,
-              RunTrace *out, char *err, size_t errlen);
+ * image: p's shared image (an open scene's RunScene.image) for the kernel's cores to map, or NULL
+ * (they copy p's bytes; the results are the same). 0, -1 (input) or -2 (the kernel failed). out
+ * may be NULL. */
+int run_trace(const PackedScene *p, const CoreImage *image, uint32_t needs, const RunSpec *spec, const RayBatch *b,
+              BatchHit *hits, RunTrace *out, char *err, size_t errlen);
 
 #endif

@@ -264,7 +264,7 @@ int sampled_population(const RunScene *sc, const RunSpec *spec, SampledPopulatio
     const CfgMachine *cfg = run_spec_machine(spec, &defcfg);
     char kpath[4200];
     FuncParams fp = {.cfg = cfg,
-                     .kernel_path = run_spec_kernel(spec, kpath, sizeof kpath),
+                     .kernel_path = run_spec_kernel(spec, kpath, sizeof kpath), .image = sc->image,
                      .needs = sc->s.needs, .seed = spec->seed, .threads = spec->threads, .timed = 1};
     FuncSession *fs;
     if (func_open(&sc->p, &fp, &fs, err, errlen) != 0)

@@ -225,18 +225,20 @@ Test(run_frame, golden_frame_is_the_same_on_any_thread_count)
     run_scene_close(&sc);
 }
 
-/* The kernel modes' cores map an open scene's image (run_scene_image) instead of copying the
- * packed bytes: a batch traced from it gives the same hits, instructions and cycles as from a
- * PackedScene the registry does not know (a struct copy: its cores copy the bytes). */
+/* The kernel modes' cores map the open scene's image (RunScene.image, passed to run_trace)
+ * instead of copying the packed bytes: a batch traced with it gives the same hits, instructions and
+ * cycles as without it (NULL: each core copies the bytes). The golden model's scene has none. */
 Test(run_scene, a_batch_from_the_shared_image_is_the_batch_from_the_copy)
 {
     RunScene sc;
     char err[4096];
+    cr_assert_eq(run_scene_open(&sc, "scenes/cornell/scene.ini", NULL, NULL, RUN_REFERENCE, NULL, err, sizeof err), 0,
+                 "%s", err);
+    cr_expect_null(sc.image, "the golden model starts no cores: no image");
+    run_scene_close(&sc);
     cr_assert_eq(run_scene_open(&sc, "scenes/cornell/scene.ini", NULL, NULL, RUN_DETAILED, NULL, err, sizeof err), 0,
                  "%s", err);
-    cr_assert_not_null(run_scene_image(&sc.p), "an open scene has a shared image (memfd)");
-    PackedScene copy = sc.p;
-    cr_assert_null(run_scene_image(&copy), "another PackedScene has no image");
+    cr_assert_not_null(sc.image, "an open scene of a kernel mode owns a shared image (memfd)");
     enum { N = 700 };
     RayBatch b = {calloc(N, sizeof(BatchRay)), N};
     BatchHit *h[2] = {calloc(N, sizeof(BatchHit)), calloc(N, sizeof(BatchHit))};
@@ -258,8 +260,9 @@ Test(run_scene, a_batch_from_the_shared_image_is_the_batch_from_the_copy)
         for (int threads = 1; threads <= 2; threads++) {
             RunTrace rt[2];
             RunSpec spec = {.mode = modes[m], .kernel_path = "kernels/pathtrace.s", .threads = threads};
-            cr_assert_eq(run_trace(&sc.p, sc.s.needs, &spec, &b, h[0], &rt[0], err, sizeof err), 0, "%s", err);
-            cr_assert_eq(run_trace(&copy, sc.s.needs, &spec, &b, h[1], &rt[1], err, sizeof err), 0, "%s", err);
+            cr_assert_eq(run_trace(&sc.p, sc.image, sc.s.needs, &spec, &b, h[0], &rt[0], err, sizeof err), 0, "%s",
+                         err);
+            cr_assert_eq(run_trace(&sc.p, NULL, sc.s.needs, &spec, &b, h[1], &rt[1], err, sizeof err), 0, "%s", err);
             const char *mn = run_mode_names[modes[m]];
             cr_expect(memcmp(h[0], h[1], N * sizeof(BatchHit)) == 0, "%s, %d threads: hits differ", mn, threads);
             cr_expect_eq(rt[0].instructions, rt[1].instructions, "%s: instructions differ", mn);
@@ -271,7 +274,7 @@ Test(run_scene, a_batch_from_the_shared_image_is_the_batch_from_the_copy)
         hits += b.rays[i].query == RAY_CLOSEST ? h[0][i].prim != UINT32_MAX : h[0][i].prim;
     cr_expect_gt(hits, N / 2, "the batch should hit the box (%u hits of %u)", hits, N);
     run_scene_close(&sc);
-    cr_expect_null(run_scene_image(&sc.p), "a closed scene has no image");
+    cr_expect_null(sc.image, "a closed scene has no image");
     free(b.rays);
     free(h[0]);
     free(h[1]);

@@ -21,8 +21,8 @@ static void open_scene(RunScene *sc, int w, int h, int spp)
 
 static FuncParams timed_params(const CfgMachine *cfg, const RunScene *sc, int threads)
 {
-    FuncParams fp = {.cfg = cfg, .kernel_path = "kernels/pathtrace.s", .needs = sc->s.needs, .seed = 1,
-                     .threads = threads, .timed = 1};
+    FuncParams fp = {.cfg = cfg, .kernel_path = "kernels/pathtrace.s", .image = sc->image, .needs = sc->s.needs,
+                     .seed = 1, .threads = threads, .timed = 1};
     return fp;
 }
 
