@@ -1,5 +1,5 @@
 /* sim/trace.c -- `sfsim trace`: a batch of rays through the kernel's traversal and intersection
- * (sim/functional.c, TRACE_ONLY) or the golden model (sim/ref_trace.c), through the run entry point
+ * (sim/run/engine.c, TRACE_ONLY) or the golden model (sim/ref_trace.c), through the run entry point
  * (sim/run/run.h); hits to a file.
  *
  * Owns: the hit file and the summary. Must not: trace rays itself.

@@ -2,7 +2,7 @@
  * a frame or a ray batch in one of the modes.
  *
  * Owns: the mode names, the render settings' checks, the engine for each mode, and the defaults.
- * Must not: write files, or render or trace itself (sim/functional.c, sim/reference.c and
+ * Must not: write files, or render or trace itself (sim/run/engine.c, sim/reference.c and
  * sim/ref_trace.c do).
  */
 #include "run.h"

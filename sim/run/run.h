@@ -5,7 +5,7 @@
  * `sfsim run` (sim/render.c), `sfsim trace` (sim/trace.c), tools/validation.c and bench/ go through
  * these calls; the pieces behind them are sim/run/accel.c (the structures), sim/run/kernel.c (the
  * kernel build), sim/run/tiles.c (the tile launcher), sim/run/timedcore.c (a core with its timing
- * model: the kernel modes' workers and `sfsim exec`), sim/functional.c (the kernel modes),
+ * model: the kernel modes' workers and `sfsim exec`), sim/run/engine.c (the kernel modes),
  * sim/reference.c and sim/ref_trace.c (the golden model).
  *
  * Owns: choosing the engine for a mode, the defaults every caller would otherwise repeat (the
@@ -22,12 +22,12 @@
 #include "../../scenes/scene.h"
 #include "../config.h"
 #include "../core.h"
-#include "../functional.h"
 #include "../raybatch.h"
 #include "../sampling.h"
 #include "../stats.h"
 #include "../timing.h"
 #include "accel.h"
+#include "engine.h"
 
 /* The modes: the golden model, the kernel on the functional core, the kernel timed on the
  * machine, and a sample of the kernel's (tile, pass) units timed (docs/sampling.md). */

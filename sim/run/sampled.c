@@ -4,7 +4,7 @@
  *
  * Owns: the auxiliary variables taken from the golden model's unit counts, the pilot of
  * --no-image, the rounds of the sequential rule and the figures sampled mode reports.
- * Must not: estimate anything itself (sim/sampling.c does), run the kernel (sim/functional.c) or
+ * Must not: estimate anything itself (sim/sampling.c does), run the kernel (sim/run/engine.c) or
  * write files.
  */
 #include "sampled.h"
