@@ -1,7 +1,7 @@
 /* sim/run/run.c -- the entry point of every simulation (run.h): a scene opened for a machine, then
  * a frame or a ray batch in one of the modes.
  *
- * Owns: the mode names, the render settings' checks, the engine for each mode, and the defaults.
+ * Owns: the opened scene and its shared image, the render size's checks, the engine for each mode.
  * Must not: write files, or render or trace itself (sim/run/engine.c, sim/reference.c and
  * sim/ref_trace.c do).
  */
@@ -11,26 +11,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "../reference.h"
 #include "../ref_trace.h"
 #include "../util.h"
-#include "kernel.h"
 #include "sampled.h"
-#include "tiles.h"
-
-const char *const run_mode_names[RUN_MODE_COUNT] = {"reference", "functional", "detailed", "sampled"};
-
-int run_mode_parse(const char *name, RunMode *mode)
-{
-    for (int m = 0; m < RUN_MODE_COUNT; m++)
-        if (name && !strcmp(name, run_mode_names[m])) {
-            *mode = (RunMode)m;
-            return 0;
-        }
-    return -1;
-}
 
 /* The caller's size over the scene's [render], and the ranges a frame needs. */
 static int impose_size(Scene *s, const RunSize *z, char *err, size_t errlen)
@@ -122,24 +107,6 @@ static int golden_frame(const RunScene *sc, const RunSpec *spec, const CfgMachin
         return -1;
     stats_run_from_ref(&fr->run, &st);
     return 0;
-}
-
-const CfgMachine *run_spec_machine(const RunSpec *spec, CfgMachine *defcfg)
-{
-    if (spec->cfg)
-        return spec->cfg;
-    cfg_defaults(defcfg);
-    return defcfg;
-}
-
-int run_spec_threads(const RunSpec *spec)
-{
-    return spec->threads > 0 ? spec->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
-}
-
-const char *run_spec_kernel(const RunSpec *spec, char *kpath, size_t len)
-{
-    return spec->kernel_path ? spec->kernel_path : kernel_default_path(kpath, len);
 }
 
 /* The kernel's frame, timed as the mode says. */

@@ -3,14 +3,15 @@
  * one of the modes.
  *
  * `sfsim run` (sim/render.c), `sfsim trace` (sim/trace.c), tools/validation.c and bench/ go through
- * these calls; the pieces behind them are sim/run/accel.c (the structures), sim/run/kernel.c (the
- * kernel build), sim/run/tiles.c (the tile launcher), sim/run/timedcore.c (a core with its timing
- * model: the kernel modes' workers and `sfsim exec`), sim/run/engine.c (the kernel modes),
+ * these calls; the pieces behind them are sim/run/spec.c (the modes, RunSpec and its defaults),
+ * sim/run/accel.c (the structures), sim/run/kernel.c (the kernel build), sim/run/tiles.c (the tile
+ * launcher), sim/run/timedcore.c (a core with its timing model: the kernel modes' workers and
+ * `sfsim exec`), sim/run/engine.c (the kernel engine), sim/run/sampled.c (sampled mode's frame),
  * sim/reference.c and sim/ref_trace.c (the golden model).
  *
- * Owns: choosing the engine for a mode, the defaults every caller would otherwise repeat (the
- * machine, the kernel's path, the host threads), and the figures common to all modes.
- * Must not: write files (render.c and trace.c do), parse the command line, or render itself.
+ * Owns: the opened scene (and its shared image), choosing the engine for a mode, and the figures
+ * common to all modes. Must not: write files (render.c and trace.c do), parse the command line, or
+ * render itself. Nothing it calls calls it back: the engines get what they need as arguments.
  */
 #ifndef SFSIM_RUN_RUN_H
 #define SFSIM_RUN_RUN_H
@@ -28,18 +29,7 @@
 #include "../timing.h"
 #include "accel.h"
 #include "engine.h"
-
-/* The modes: the golden model, the kernel on the functional core, the kernel timed on the
- * machine, and a sample of the kernel's (tile, pass) units timed (docs/sampling.md). */
-typedef enum RunMode { RUN_REFERENCE, RUN_FUNCTIONAL, RUN_DETAILED, RUN_SAMPLED, RUN_MODE_COUNT } RunMode;
-extern const char *const run_mode_names[RUN_MODE_COUNT]; /* "reference", "functional", ... */
-
-/* name as a mode: 0, or -1 when it names none. */
-int run_mode_parse(const char *name, RunMode *mode);
-/* The kernel runs (every mode but the golden model's). */
-static inline int run_mode_kernel(RunMode m) { return m != RUN_REFERENCE; }
-/* The timing model runs (on every unit, or on the sample). */
-static inline int run_mode_timed(RunMode m) { return m == RUN_DETAILED || m == RUN_SAMPLED; }
+#include "spec.h"
 
 /* The render size a caller imposes over the scene file's [render]; -1 (or 0 for the sizes) keeps
  * the scene's value. */
@@ -69,34 +59,6 @@ typedef struct RunScene {
 int run_scene_open(RunScene *sc, const char *path, const RunSize *size, const CfgMachine *cfg, RunMode mode,
                    const char *who, char *err, size_t errlen);
 void run_scene_close(RunScene *sc);
-
-/* How to run: the mode, the machine and the host. Zero-initialised fields take the defaults. */
-typedef struct RunSpec {
-    RunMode mode;
-    const CfgMachine *cfg;     /* NULL: the defaults of sim/config.def */
-    const char *kernel_path;   /* NULL: kernels/pathtrace.s beside the binary (sim/run/kernel.h) */
-    uint32_t seed;             /* the path tracer's random stream */
-    int threads;               /* host threads; 0: every core */
-    /* RUN_SAMPLED (docs/sampling.md): the fraction of the (tile, pass) units timed, (0, 1], or
-     * when target_error > 0 as many as the sequential rule needs for a 95 % interval of the cycles
-     * within +-target_error (a fraction, 0.01 = 1 %); sample_seed fixes which units. no_image: the
-     * golden model runs only a pilot (fr->rgb stays black). */
-    double sample;
-    double target_error;
-    uint32_t sample_seed;
-    int no_image;
-    void (*progress)(void *ctx, uint32_t tiles_done, uint32_t tiles_total);
-    /* A line on what a long run is doing (sampled mode's rounds); may be NULL. */
-    void (*note)(void *ctx, const char *line);
-    void *progress_ctx;
-} RunSpec;
-
-/* spec's machine: spec->cfg, or the defaults written into *defcfg. */
-const CfgMachine *run_spec_machine(const RunSpec *spec, CfgMachine *defcfg);
-/* spec's host threads: spec->threads, or every core. */
-int run_spec_threads(const RunSpec *spec);
-/* spec's kernel source: spec->kernel_path, or kernels/pathtrace.s beside the binary (kpath holds it). */
-const char *run_spec_kernel(const RunSpec *spec, char *kpath, size_t len);
 
 /* A rendered frame and its figures. */
 typedef struct RunFrame {
