@@ -6,6 +6,7 @@
  */
 #include "trace.h"
 
+#include <assert.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -17,10 +18,7 @@ int trace_run(const TraceOptions *o, TraceSummary *sum, char *err, size_t errlen
     memset(sum, 0, sizeof *sum);
     RunSpec spec = {.cfg = o->cfg, .kernel_path = o->kernel_path, .seed = 1, .threads = o->threads};
     spec.mode = o->mode;
-    if (spec.mode == RUN_SAMPLED) { /* (the command line refuses it: a caller's mistake) */
-        snprintf(err, errlen, "trace: sampled mode traces no ray batch (functional, detailed or reference)");
-        return -1;
-    }
+    assert(spec.mode != RUN_SAMPLED); /* the command line refuses it (sim/cli/runopts.c) */
     /* Before any work: a hit file that cannot be written would fail the run only at its end. */
     if (outfile_check_file(o->out_path, err, errlen) != 0)
         return -3;

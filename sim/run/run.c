@@ -2,11 +2,13 @@
  * a frame or a ray batch in one of the modes.
  *
  * Owns: the opened scene and its shared image, the render size's checks, the engine for each mode.
+ * The options were checked once by the commands (sim/cli/runopts.c): here they are asserted.
  * Must not: write files, or render or trace itself (sim/run/engine.c, sim/reference.c and
  * sim/ref_trace.c do).
  */
 #include "run.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -92,13 +94,7 @@ void run_scene_close(RunScene *sc)
 static int golden_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg, RunFrame *fr, char *err,
                         size_t errlen)
 {
-    /* The golden model renders the path tracer and the Phong workload; the forced specular and
-     * diffuse workloads exist only as kernel variants (docs/kernel.md). */
-    if (cfg->workload_kind != CFG_WORKLOAD_PATH && cfg->workload_kind != CFG_WORKLOAD_PHONG) {
-        snprintf(err, errlen, "--mode reference: workload.kind = %s has no golden model (path and phong do)",
-                 cfg_enum_name("workload", "kind", cfg->workload_kind));
-        return -1;
-    }
+    assert(run_workload_golden(cfg)); /* spec_holds */
     RefParams rp = {.tile = fr->tile, .seed = spec->seed, .threads = fr->threads, .progress = spec->progress,
                     .progress_ctx = spec->progress_ctx, .bounces = cfg->workload_bounces,
                     .workload = cfg->workload_kind == CFG_WORKLOAD_PHONG ? REF_WORKLOAD_PHONG : REF_WORKLOAD_PATH};
@@ -132,37 +128,16 @@ static int kernel_frame(const RunScene *sc, const RunSpec *spec, const CfgMachin
     return 0;
 }
 
-int run_spec_check(const RunSpec *spec, char *err, size_t errlen)
+/* What the commands' one check of the options guarantees (sim/cli/runopts.c) and every other
+ * caller must hold too (run.h, run_frame). */
+static int spec_holds(const RunSpec *spec, const CfgMachine *cfg)
 {
-    if ((unsigned)spec->mode >= RUN_MODE_COUNT) {
-        snprintf(err, errlen, "run mode %d: no such mode", (int)spec->mode);
-        return -1;
-    }
-    if (spec->mode == RUN_SAMPLED && !(spec->target_error >= 0.0 && spec->target_error < 1.0)) {
-        snprintf(err, errlen, "--target-error %g: expected a fraction in (0, 1), e.g. 0.01 for +-1 %%",
-                 spec->target_error);
-        return -1;
-    }
-    if (spec->mode == RUN_SAMPLED && spec->target_error <= 0.0 && !(spec->sample > 0.0 && spec->sample <= 1.0)) {
-        snprintf(err, errlen, "--sample %g: expected a fraction of the units in (0, 1]", spec->sample);
-        return -1;
-    }
-    if (spec->mode == RUN_SAMPLED && spec->cfg && spec->cfg->workload_kind != CFG_WORKLOAD_PATH &&
-        spec->cfg->workload_kind != CFG_WORKLOAD_PHONG) {
-        snprintf(err, errlen, "--mode sampled: workload.kind = %s has no golden model to draw the units' auxiliary "
-                 "counts from (path and phong do); use --mode detailed",
-                 cfg_enum_name("workload", "kind", spec->cfg->workload_kind));
-        return -1;
-    }
-    if (spec->mode != RUN_SAMPLED && (spec->target_error != 0.0 || spec->no_image)) {
-        snprintf(err, errlen, "--target-error and --no-image belong to --mode sampled");
-        return -1;
-    }
-    if (spec->cfg && spec->cfg->stream_rays != 1024 && spec->cfg->stream_rays != 4096) {
-        snprintf(err, errlen, "stream.rays %d: must be 1024 or 4096", spec->cfg->stream_rays);
-        return -1;
-    }
-    return 0;
+    if ((unsigned)spec->mode >= RUN_MODE_COUNT || (cfg->stream_rays != 1024 && cfg->stream_rays != 4096))
+        return 0;
+    if (spec->mode != RUN_SAMPLED)
+        return spec->target_error == 0.0 && !spec->no_image && (spec->mode != RUN_REFERENCE || run_workload_golden(cfg));
+    return run_workload_golden(cfg) && spec->target_error >= 0.0 && spec->target_error < 1.0 &&
+           (spec->target_error > 0.0 || (spec->sample > 0.0 && spec->sample <= 1.0));
 }
 
 int run_frame(const RunScene *sc, const RunSpec *spec, RunFrame *fr, char *err, size_t errlen)
@@ -170,8 +145,7 @@ int run_frame(const RunScene *sc, const RunSpec *spec, RunFrame *fr, char *err, 
     memset(fr, 0, sizeof *fr);
     CfgMachine defcfg;
     const CfgMachine *cfg = run_spec_machine(spec, &defcfg);
-    if (run_spec_check(spec, err, errlen) != 0)
-        return -1;
+    assert(spec_holds(spec, cfg));
     size_t npx = (size_t)sc->s.render.width * (size_t)sc->s.render.height;
     fr->rgb = calloc(3 * npx, sizeof(float));
     if (!fr->rgb) {
@@ -236,11 +210,7 @@ int run_trace(const PackedScene *p, const CoreImage *image, uint32_t needs, cons
         out->seconds = util_now() - t0;
         return 0;
     }
-    if (spec->mode != RUN_FUNCTIONAL && spec->mode != RUN_DETAILED) {
-        snprintf(err, errlen, "--mode %s: expected functional, detailed or reference",
-                 (unsigned)spec->mode < RUN_MODE_COUNT ? run_mode_names[spec->mode] : "?");
-        return -1;
-    }
+    assert(spec->mode == RUN_FUNCTIONAL || spec->mode == RUN_DETAILED);
     CfgMachine defcfg;
     const CfgMachine *cfg = run_spec_machine(spec, &defcfg);
     char kpath[4200];

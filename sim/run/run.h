@@ -77,14 +77,12 @@ typedef struct RunFrame {
     double seconds;            /* host time rendering */
 } RunFrame;
 
-/* The settings run_frame refuses, checked before any work (a mode out of range; in RUN_SAMPLED a
- * target error outside [0, 1), a sample fraction outside (0, 1] when there is no target, or a
- * workload without a golden model; target_error or no_image in another mode; a stream size the
- * kernel has no tile for): 0, or -1 with a message naming the setting. */
-int run_spec_check(const RunSpec *spec, char *err, size_t errlen);
-
-/* Render sc's frame as spec says. 0; -1 with a message (bad settings, a kernel that does not
- * assemble, memories too small, too few tiles to estimate from); -2 when the simulated program
+/* Render sc's frame as spec says. spec must hold what the commands check once (sim/cli/runopts.c)
+ * and this asserts: a mode; RUN_REFERENCE and RUN_SAMPLED on a workload with a golden model
+ * (run_workload_golden); in RUN_SAMPLED a target error in [0, 1) and, without one, a sample
+ * fraction in (0, 1]; no target error and no no_image in the other modes. 0; -1 with a message
+ * (a kernel that does not assemble, memories too small, too few tiles to estimate from); -2 when
+ * the simulated program
  * failed in a tile: then fr->rgb holds the tiles that finished (fr->f.tiles_done of fr->f.ntiles)
  * and the rest black. fr must be freed with run_frame_free either way. */
 int run_frame(const RunScene *sc, const RunSpec *spec, RunFrame *fr, char *err, size_t errlen);
@@ -99,7 +97,8 @@ typedef struct RunTrace {
 } RunTrace;
 
 /* Trace batch b against p (a scene of needs) as spec says: RUN_REFERENCE (the golden model),
- * RUN_FUNCTIONAL or RUN_DETAILED (the kernel's traversal and intersection); hits[i] for ray i.
+ * RUN_FUNCTIONAL or RUN_DETAILED (the kernel's traversal and intersection; asserted: a batch has
+ * no units to sample); hits[i] for ray i.
  * image: p's shared image (an open scene's RunScene.image) for the kernel's cores to map, or NULL
  * (they copy p's bytes; the results are the same). 0, -1 (input) or -2 (the kernel failed). out
  * may be NULL. */

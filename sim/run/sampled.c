@@ -9,6 +9,7 @@
  */
 #include "sampled.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -63,7 +64,7 @@ static int measure(void *ctx, const uint32_t *units, uint32_t count, double *ys)
 static int golden_units(const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg, RunFrame *fr,
                         RefUnitStats *units, RefStats *rs, char *err, size_t errlen)
 {
-    /* run_spec_check refused the workloads without a golden model */
+    assert(run_workload_golden(cfg)); /* the options' check refused the others (sim/cli/runopts.c) */
     RefParams rp = {.tile = fr->tile, .seed = spec->seed, .threads = fr->threads, .progress = spec->progress,
                     .progress_ctx = spec->progress_ctx, .bounces = cfg->workload_bounces,
                     .workload = cfg->workload_kind == CFG_WORKLOAD_PHONG ? REF_WORKLOAD_PHONG : REF_WORKLOAD_PATH,

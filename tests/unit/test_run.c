@@ -2,8 +2,9 @@
  * the same scene-memory bytes as the by-hand set-up it replaced in tools/validation.c and bench/
  * (scene_load, the size imposed, pack_scene with bvh_default_params, and for the kd-tree kernels
  * accel_add_kd), so their tables and figures did not move when they switched to it; and the
- * entry point's own rules: mode names, the render settings it checks, and the settings run_frame
- * refuses before any work; and the open scene's shared image, whose batches are those of a copy.
+ * entry point's own rules: mode names and the render settings it checks (the options a command
+ * refuses are tests/unit/test_runopts.c's); and the open scene's shared image, whose batches are
+ * those of a copy.
  */
 #include <criterion/criterion.h>
 #include <math.h>
@@ -157,46 +158,6 @@ Test(run_scene, a_size_out_of_range_is_refused_by_name)
     cr_assert_eq(run_scene_open(&sc, "scenes/cornell/scene.ini", NULL, NULL, RUN_REFERENCE, NULL, err, sizeof err), 0,
                  "%s", err);
     cr_expect_gt(sc.p.size, 0u);
-    run_scene_close(&sc);
-}
-
-/* Settings run_frame refuses before it renders anything: no image is left to free. */
-Test(run_frame, bad_settings_are_refused_before_any_work)
-{
-    char err[4096];
-    RunScene sc;
-    RunSize size = {8, 8, 1, 1};
-    cr_assert_eq(run_scene_open(&sc, "scenes/cornell/scene.ini", &size, NULL, RUN_FUNCTIONAL, NULL, err, sizeof err), 0,
-                 "%s", err);
-    CfgMachine spec_cfg;
-    cfg_defaults(&spec_cfg);
-    spec_cfg.workload_kind = CFG_WORKLOAD_SPECULAR;
-    static const struct {
-        RunMode mode;
-        double sample, target;
-        int cfg_specular, no_image;
-        const char *want;
-    } cases[] = {
-        {RUN_SAMPLED, 0.0, 0.0, 0, 0, "--sample 0: expected a fraction of the units in (0, 1]"},
-        {RUN_SAMPLED, 1.5, 0.0, 0, 0, "--sample 1.5: expected a fraction"},
-        {RUN_SAMPLED, 0.0, 1.0, 0, 0, "--target-error 1: expected a fraction in (0, 1)"},
-        {RUN_SAMPLED, 0.0, -0.5, 0, 0, "--target-error -0.5: expected a fraction in (0, 1)"},
-        {RUN_DETAILED, 0.0, 0.01, 0, 0, "belong to --mode sampled"},
-        {RUN_FUNCTIONAL, 0.0, 0.0, 0, 1, "belong to --mode sampled"},
-        {RUN_SAMPLED, 0.0, 0.01, 1, 0, "workload.kind = specular has no golden model"},
-        {RUN_REFERENCE, 0.0, 0.0, 1, 0, "workload.kind = specular has no golden model"},
-        {RUN_MODE_COUNT, 0.0, 0.0, 0, 0, "no such mode"},
-    };
-    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        RunSpec spec = {.mode = cases[i].mode, .cfg = cases[i].cfg_specular ? &spec_cfg : NULL, .seed = 1,
-                        .threads = 1, .sample = cases[i].sample, .target_error = cases[i].target,
-                        .no_image = cases[i].no_image};
-        RunFrame fr;
-        err[0] = 0;
-        cr_expect_eq(run_frame(&sc, &spec, &fr, err, sizeof err), -1, "case %zu", i);
-        cr_expect(strstr(err, cases[i].want) != NULL, "case %zu: %s", i, err);
-        run_frame_free(&fr);
-    }
     run_scene_close(&sc);
 }
 
