@@ -266,7 +266,7 @@ static double ours_time(const RunScene *sc, RunMode mode, const Batch *bt, int r
     double best = INFINITY;
     for (int rep = 0; rep < reps; rep++) {
         RunTrace rt;
-        if (run_trace(&sc->p, sc->s.needs, &spec, &bt->b, hits, &rt, err, sizeof err) != 0) {
+        if (run_trace(&sc->p, sc->image, sc->s.needs, &spec, &bt->b, hits, &rt, err, sizeof err) != 0) {
             fprintf(stderr, "per_ray: %s\n", err);
             return -1.0;
         }
@@ -443,7 +443,7 @@ static int scene_run(const char *path, uint32_t side, int reps, const char *save
     opened = 1;
     make_primary(&sc.p, side, &bt[0]);
     RunSpec golden = {.mode = RUN_REFERENCE, .threads = 1};
-    if (run_trace(&sc.p, sc.s.needs, &golden, &bt[0].b, hits, NULL, err, sizeof err) != 0) {
+    if (run_trace(&sc.p, sc.image, sc.s.needs, &golden, &bt[0].b, hits, NULL, err, sizeof err) != 0) {
         fprintf(stderr, "per_ray: %s\n", err);
         goto out;
     }

@@ -11,7 +11,7 @@
 ; into the tile framebuffer. The algorithm and every float operation follow the golden model
 ; (sim/reference.c, docs/golden-model.md) so the images agree bit for bit.
 ;
-; Assembled by the host (sim/functional.c) with -D RAYS=M, SPAD_BYTES and one -D per scene
+; Assembled by the host (sim/run/kernel.c) with -D RAYS=M, SPAD_BYTES and one -D per scene
 ; feature (HAS_LAMBERT, HAS_GLOSSY, HAS_DIELECTRIC, HAS_TEXTURES, HAS_EMISSIVE_TEX, HAS_COLORS,
 ; HAS_NORMALS, HAS_SPHERES, HAS_PUNCTUAL, HAS_BACKGROUND, HAS_AMBIENT); WORKLOAD (with BOUNCES)
 ; for the utilization workloads; ORDER_FIRST; ACCEL_KD with KD_VARIANT and KD_STACK_DEPTH;

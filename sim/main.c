@@ -1,11 +1,12 @@
 /* sim/main.c -- the `sfsim` command line: which command runs, and the commands run, trace,
  * config and compare (exec is sim/cli/exec.c; sweep and merge sim/sweep/sweep.c).
  *
- * Owns: each command's options (a getopt_long table each, parsed by sim/cli/opts.c), the one check
- * of how they go together, what is printed, and the exit code. Must not: simulate (it calls the
- * config, the renderers and trace). Exit codes: the EXIT_* of sim/exitcodes.def, nothing else; an
- * option value out of range is bad input (EXIT_INPUT), an unknown option, a missing argument or
- * options that do not go together a usage error (EXIT_USAGE).
+ * Owns: the options of config and compare (a getopt_long table each, parsed by sim/cli/opts.c),
+ * what each command prints, and the exit code; run's and trace's options are parsed and checked
+ * once, in sim/cli/runopts.c. Must not: simulate (it calls the config, the renderers and trace).
+ * Exit codes: the EXIT_* of sim/exitcodes.def, nothing else; an option value out of range is bad
+ * input (EXIT_INPUT), an unknown option, a missing argument or options that do not go together a
+ * usage error (EXIT_USAGE).
  */
 #include <errno.h>
 #include <math.h>
@@ -20,8 +21,8 @@
 #include "cli/help.h"
 #include "cli/mem.h"
 #include "cli/opts.h"
+#include "cli/runopts.h"
 #include "config.h"
-#include "datadir.h"
 #include "exitcodes.h"
 #include "img.h"
 #include "imglib.h"
@@ -186,190 +187,17 @@ static int cmd_compare(int argc, char **argv)
     return rc;
 }
 
-/* ---- run --------------------------------------------------------------------------------------- */
-
-enum { R_MODE = CLI_LONG, R_SET, R_EXPOSURE, R_SAMPLE, R_TARGET, R_NO_IMAGE, R_SEED, R_NOPROG, R_KERNEL };
-static const struct option run_longs[] = {
-    {"scene", required_argument, NULL, 's'},         {"out", required_argument, NULL, 'o'},
-    {"config", required_argument, NULL, 'c'},        {"mode", required_argument, NULL, R_MODE},
-    {"threads", required_argument, NULL, 'j'},       {"set", required_argument, NULL, R_SET},
-    {"exposure", required_argument, NULL, R_EXPOSURE}, {"sample", required_argument, NULL, R_SAMPLE},
-    {"target-error", required_argument, NULL, R_TARGET}, {"no-image", no_argument, NULL, R_NO_IMAGE},
-    {"sample-seed", required_argument, NULL, R_SEED}, {"no-progress", no_argument, NULL, R_NOPROG},
-    {"kernel", required_argument, NULL, R_KERNEL},   {"help", no_argument, NULL, CLI_HELP},
-    {"version", no_argument, NULL, CLI_VERSION},     {NULL, 0, NULL, 0}};
-
-/* What a run was given, before the one check of how the options go together. */
-typedef struct RunArgs {
-    RenderOptions o;
-    CliConfig ca;
-    RunMode mode;
-    int sample_given, target_given;
-} RunArgs;
-
-/* A render key (render.width=..., sim/render.h's table) into o: 1 taken, 0 not a render key, -1 a
- * bad value (said). */
-static int run_render_key(const CliParse *p, RenderOptions *o, const char *s)
-{
-    for (int k = 0; k < RENDER_KEY_COUNT; k++) {
-        size_t kl = strlen(render_keys[k].key);
-        if (strncmp(s, render_keys[k].key, kl) != 0 || s[kl] != '=')
-            continue;
-        char opt[64];
-        long long v;
-        snprintf(opt, sizeof opt, "--set %s =", render_keys[k].key);
-        if (cli_int(p, opt, s + kl + 1, render_keys[k].lo, render_keys[k].hi, &v))
-            return -1;
-        int *field[] = {&o->width, &o->height, &o->spp, &o->max_depth, NULL};
-        if (k == RENDER_KEY_SEED)
-            o->seed = (uint32_t)v;
-        else
-            *field[k] = (int)v;
-        return 1;
-    }
-    return 0;
-}
-
-/* A fraction in (lo, hi) or (lo, hi] for --sample / --target-error / --exposure: 0 or -1 (said). */
-static int run_fraction(const char *opt, const char *s, double lo, double hi, int hi_in, const char *what, double *out)
-{
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (end == s || *end || errno || !isfinite(v) || !(v > lo) || (hi_in ? v > hi : v >= hi)) {
-        fprintf(stderr, "sfsim run: %s %s: expected %s\n", opt, s, what);
-        return -1;
-    }
-    *out = v;
-    return 0;
-}
-
-/* One option of run into a: EXIT_OK, or the exit code after saying what was wrong. */
-static int run_option(const CliParse *p, RunArgs *a, int code, const char *v)
-{
-    RenderOptions *o = &a->o;
-    long long n;
-    double x;
-    switch (code) {
-    case 's': o->scene_path = v; break;
-    case 'o': o->out_dir = v; break;
-    case 'c': a->ca.path = v; break;
-    case R_MODE:
-        if (run_mode_parse(v, &a->mode) != 0) {
-            fprintf(stderr, "sfsim run: --mode %s: expected detailed, sampled, functional or reference (sfsim help run)\n", v);
-            return EXIT_INPUT;
-        }
-        break;
-    case 'j':
-        if (cli_int(p, "-j", v, 1, 1024, &n))
-            return EXIT_INPUT;
-        o->threads = (int)n;
-        break;
-    case R_EXPOSURE:
-        if (run_fraction("--exposure", v, 0.0, 3.0e38, 1, "a finite positive number (a float)", &x))
-            return EXIT_INPUT;
-        o->exposure = (float)x;
-        break;
-    case R_SAMPLE:
-        if (run_fraction("--sample", v, 0.0, 1.0, 1, "a fraction of the units in (0, 1], e.g. 0.05", &o->sample))
-            return EXIT_INPUT;
-        a->sample_given = 1;
-        break;
-    case R_TARGET:
-        if (run_fraction("--target-error", v, 0.0, 1.0, 0, "a fraction in (0, 1), e.g. 0.01 for +-1%", &o->target_error))
-            return EXIT_INPUT;
-        a->target_given = 1;
-        break;
-    case R_NO_IMAGE: o->no_image = 1; break;
-    case R_SEED:
-        if (cli_int(p, "--sample-seed", v, 0, 4294967295LL, &n))
-            return EXIT_INPUT;
-        o->sample_seed = (uint32_t)n;
-        break;
-    case R_NOPROG: o->progress = 0; break;
-    case R_KERNEL: o->kernel_path = v; break;
-    case R_SET: {
-        int r = run_render_key(p, o, v);
-        if (r < 0)
-            return EXIT_INPUT;
-        if (r == 0 && cli_config_set(&a->ca, v))
-            return EXIT_USAGE;
-        break;
-    }
-    default: return EXIT_USAGE;
-    }
-    return EXIT_OK;
-}
-
-/* The one check of how run's options go together, after all of them were read. */
-static int run_check(RunArgs *a)
-{
-    if ((a->sample_given || a->target_given || a->o.no_image) && a->mode != RUN_SAMPLED) {
-        fprintf(stderr, "sfsim run: --sample, --target-error and --no-image apply to --mode sampled only "
-                        "(sfsim help run)\n");
-        return EXIT_USAGE;
-    }
-    if (a->sample_given && a->target_given) {
-        fprintf(stderr, "sfsim run: --sample F (a fixed fraction) and --target-error E (as many units as E needs) "
-                        "exclude each other (sfsim help run)\n");
-        return EXIT_USAGE;
-    }
-    if (a->sample_given)
-        a->o.target_error = 0.0; /* the fixed-size design */
-    a->o.mode = a->mode;
-    return EXIT_OK;
-}
-
-static int run_parse(int argc, char **argv, RunArgs *a)
-{
-    CliParse p = {"sfsim run", "run", run_longs, "s:o:c:j:h", argc, argv, 0};
-    render_default_options(&a->o);
-    a->o.scene_path = NULL; /* default: the shipped Cornell box, found beside the binary */
-    a->o.out_dir = "out";
-    a->o.progress = isatty(2);
-    a->mode = RUN_DETAILED;
-    int code, rc;
-    const char *v;
-    while ((code = cli_next(&p, &v)) > 0) {
-        if (cli_common(&p, code, help_run))
-            return -1;
-        if ((rc = run_option(&p, a, code, v)) != EXIT_OK)
-            return rc;
-    }
-    if (code < 0)
-        return EXIT_USAGE;
-    if (cli_first_operand() < argc) {
-        fprintf(stderr, "sfsim run: unexpected argument '%s': the scene is given with -s (sfsim help run)\n",
-                argv[cli_first_operand()]);
-        return EXIT_USAGE;
-    }
-    return run_check(a);
-}
+/* ---- run and trace (their options: sim/cli/runopts.c) ------------------------------------------ */
 
 static int cmd_run(int argc, char **argv)
 {
-    RunArgs a = {0};
-    int rc = run_parse(argc, argv, &a);
+    RunCmd c;
+    int rc = runopts_run(argc, argv, &c);
     if (rc != EXIT_OK) {
-        cli_config_free(&a.ca);
+        cli_config_free(&c.ca);
         return rc < 0 ? EXIT_OK : rc;
     }
-    RenderOptions *o = &a.o;
-    static char default_scene[4096];
-    CfgMachine cfg;
-    rc = EXIT_INPUT;
-    if (!o->scene_path) {
-        char derr[8192];
-        if (!datadir_path(DATADIR_DEFAULT_SCENE, default_scene, sizeof default_scene, derr, sizeof derr)) {
-            fprintf(stderr, "sfsim run: no -s SCENE given and the default scene is missing: %s\n", derr);
-            goto out;
-        }
-        o->scene_path = default_scene;
-    }
-    if (cli_config_build(&a.ca, &cfg))
-        goto out;
-    o->cfg = &cfg;
-    o->config_path = a.ca.path;
+    RenderOptions *o = &c.o;
     static char err[65536];
     /* The images a run writes (frame.exr, frame.png, cost.png, frame.partial.exr) go through
      * OpenEXR, libpng and FreeType linked into this binary (sim/img_write.c, sim/heatmap.c): a run
@@ -384,96 +212,26 @@ static int cmd_run(int argc, char **argv)
     size_t n = strlen(o->out_dir);
     const char *sep = n && o->out_dir[n - 1] == '/' ? "" : "/";
     printf("sfsim run: wrote %s%s%sreport.txt, report.json, stats.txt%s\n", o->out_dir, sep,
-           o->no_image ? "" : "frame.png, frame.exr, ", run_mode_timed(a.mode) ? ", cost.png" : "");
+           o->no_image ? "" : "frame.png, frame.exr, ", run_mode_timed(o->mode) ? ", cost.png" : "");
     rc = EXIT_OK;
 out:
-    cli_config_free(&a.ca);
+    cli_config_free(&c.ca);
     return rc;
-}
-
-/* ---- trace ------------------------------------------------------------------------------------- */
-
-enum { T_RAYS = CLI_LONG, T_MODE, T_SET, T_BINARY, T_KERNEL };
-static const struct option trace_longs[] = {
-    {"scene", required_argument, NULL, 's'},   {"rays", required_argument, NULL, T_RAYS},
-    {"out", required_argument, NULL, 'o'},     {"mode", required_argument, NULL, T_MODE},
-    {"config", required_argument, NULL, 'c'},  {"set", required_argument, NULL, T_SET},
-    {"binary", no_argument, NULL, T_BINARY},   {"threads", required_argument, NULL, 'j'},
-    {"kernel", required_argument, NULL, T_KERNEL}, {"help", no_argument, NULL, CLI_HELP},
-    {"version", no_argument, NULL, CLI_VERSION}, {NULL, 0, NULL, 0}};
-
-/* trace's options into o and ca: EXIT_OK, -1 (help printed), or the exit code (said). */
-static int trace_parse(int argc, char **argv, TraceOptions *o, CliConfig *ca)
-{
-    CliParse p = {"sfsim trace", "trace", trace_longs, "s:o:c:j:h", argc, argv, 0};
-    RunMode mode = RUN_FUNCTIONAL;
-    long long n;
-    int code;
-    const char *v;
-    while ((code = cli_next(&p, &v)) > 0) {
-        if (cli_common(&p, code, help_trace))
-            return -1;
-        switch (code) {
-        case 's': o->scene_path = v; break;
-        case T_RAYS: o->rays_path = v; break;
-        case 'o': o->out_path = v; break;
-        case 'c': ca->path = v; break;
-        case T_MODE:
-            if (run_mode_parse(v, &mode) != 0 || mode == RUN_SAMPLED) {
-                fprintf(stderr, "sfsim trace: --mode %s: expected functional, detailed or reference\n", v);
-                return EXIT_INPUT;
-            }
-            break;
-        case T_SET:
-            if (cli_config_set(ca, v))
-                return EXIT_USAGE;
-            break;
-        case T_BINARY: o->binary = 1; break;
-        case 'j':
-            if (cli_int(&p, "-j", v, 1, 1024, &n))
-                return EXIT_INPUT;
-            o->threads = (int)n;
-            break;
-        case T_KERNEL: o->kernel_path = v; break;
-        default: return EXIT_USAGE;
-        }
-    }
-    if (code < 0)
-        return EXIT_USAGE;
-    if (cli_first_operand() < argc) {
-        fprintf(stderr, "sfsim trace: unexpected argument '%s' (sfsim help trace)\n", argv[cli_first_operand()]);
-        return EXIT_USAGE;
-    }
-    if (!o->scene_path || !o->rays_path || !o->out_path) {
-        fprintf(stderr, "sfsim trace: -s SCENE, --rays FILE and -o HITS are required (sfsim help trace)\n");
-        return EXIT_USAGE;
-    }
-    o->mode = mode;
-    if (o->threads == 0)
-        o->threads = (int)sysconf(_SC_NPROCESSORS_ONLN);
-    return EXIT_OK;
 }
 
 static int cmd_trace(int argc, char **argv)
 {
-    CliConfig ca = {0};
-    TraceOptions o;
-    memset(&o, 0, sizeof o);
-    int rc = trace_parse(argc, argv, &o, &ca);
+    TraceCmd c;
+    int rc = runopts_trace(argc, argv, &c);
     if (rc != EXIT_OK) {
-        cli_config_free(&ca);
+        cli_config_free(&c.ca);
         return rc < 0 ? EXIT_OK : rc;
     }
-    CfgMachine cfg;
-    if (cli_config_build(&ca, &cfg)) {
-        cli_config_free(&ca);
-        return EXIT_INPUT;
-    }
-    o.cfg = &cfg;
+    TraceOptions o = c.o;
     static char err[65536];
     TraceSummary sum;
     rc = trace_run(&o, &sum, err, sizeof err);
-    cli_config_free(&ca);
+    cli_config_free(&c.ca);
     if (rc != 0) {
         fprintf(stderr, "sfsim trace: %s\n", err);
         return rc == -2 ? EXIT_PROGRAM : rc == -3 ? EXIT_IO : EXIT_INPUT;
@@ -483,7 +241,7 @@ static int cmd_trace(int argc, char **argv)
     if (sum.sim_instructions)
         printf(", %llu simulated instructions", (unsigned long long)sum.sim_instructions);
     printf("; wrote %s\n", o.out_path);
-    if (sum.timed && cli_print_timing(&sum.timing, &cfg, NULL))
+    if (sum.timed && cli_print_timing(&sum.timing, &c.cfg, NULL))
         return EXIT_PROGRAM;
     return EXIT_OK;
 }

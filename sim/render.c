@@ -311,13 +311,11 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     RunSpec spec = {.cfg = cfg, .kernel_path = o->kernel_path, .seed = o->seed, .threads = o->threads,
                     .sample = o->sample, .sample_seed = o->sample_seed, .progress = progress_cb, .note = note_cb,
                     .progress_ctx = &pr};
-    spec.mode = o->mode;
+    spec.mode = o->mode; /* o as the command line checked it (sim/cli/runopts.c); run_frame asserts */
     if (spec.mode == RUN_SAMPLED) {
         spec.target_error = o->target_error;
         spec.no_image = o->no_image;
     }
-    if (run_spec_check(&spec, err, errlen) != 0)
-        return -1;
     /* Before any work: an output folder that cannot be made would fail the run only at its end. */
     if (outfile_check_dir(o->out_dir, err, errlen) != 0)
         return -3;

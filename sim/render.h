@@ -42,7 +42,7 @@ extern const RenderKey render_keys[RENDER_KEY_COUNT];
 void render_default_options(RenderOptions *o);
 
 /* A run in o->mode: "reference" (the golden model, sim/reference.c) or "functional" (the
- * kernel on functional cores, sim/functional.c). 0, or -1 with a message naming the file or
+ * kernel on functional cores, sim/run/engine.c). 0, or -1 with a message naming the file or
  * the setting at fault; -2 when the simulated program failed (trap, instruction limit); -3 when
  * an output could not be written (the folder checked before any work, a full disk, ...). Outputs
  * are written whole or not at all (host/outfile.h): after a failure no file of this run is left

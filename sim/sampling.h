@@ -6,7 +6,7 @@
  * sample), the multiple-regression (GREG) estimator, and the sequential stopping rule of
  * --target-error.
  * Must not: run anything, print, allocate, or use threads (sim/run/sampled.c runs the units through
- * sim/functional.c; sim/report.c reports).
+ * sim/run/engine.c; sim/report.c reports).
  *
  * 1. The regression (GREG with intercept) estimator (units, k <= SAMPLE_MAX_AUX auxiliaries x_ij
  *    known exactly for all N units; Cochran 1977 Sec. 7.1-7.2, 7.10; Sarndal, Swensson & Wretman

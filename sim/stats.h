@@ -24,7 +24,7 @@
 
 #include "config.h"
 #include "core.h"
-#include "functional.h"
+#include "run/engine.h"
 #include "sampling.h"
 #include "timing.h"
 

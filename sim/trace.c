@@ -1,11 +1,12 @@
 /* sim/trace.c -- `sfsim trace`: a batch of rays through the kernel's traversal and intersection
- * (sim/functional.c, TRACE_ONLY) or the golden model (sim/ref_trace.c), through the run entry point
+ * (sim/run/engine.c, TRACE_ONLY) or the golden model (sim/ref_trace.c), through the run entry point
  * (sim/run/run.h); hits to a file.
  *
  * Owns: the hit file and the summary. Must not: trace rays itself.
  */
 #include "trace.h"
 
+#include <assert.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -17,10 +18,7 @@ int trace_run(const TraceOptions *o, TraceSummary *sum, char *err, size_t errlen
     memset(sum, 0, sizeof *sum);
     RunSpec spec = {.cfg = o->cfg, .kernel_path = o->kernel_path, .seed = 1, .threads = o->threads};
     spec.mode = o->mode;
-    if (spec.mode == RUN_SAMPLED) { /* (the command line refuses it: a caller's mistake) */
-        snprintf(err, errlen, "trace: sampled mode traces no ray batch (functional, detailed or reference)");
-        return -1;
-    }
+    assert(spec.mode != RUN_SAMPLED); /* the command line refuses it (sim/cli/runopts.c) */
     /* Before any work: a hit file that cannot be written would fail the run only at its end. */
     if (outfile_check_file(o->out_path, err, errlen) != 0)
         return -3;
@@ -39,7 +37,7 @@ int trace_run(const TraceOptions *o, TraceSummary *sum, char *err, size_t errlen
         goto out;
     }
     RunTrace rt;
-    rc = run_trace(&sc.p, sc.s.needs, &spec, &b, hits, &rt, err, errlen);
+    rc = run_trace(&sc.p, sc.image, sc.s.needs, &spec, &b, hits, &rt, err, errlen);
     sum->timed = rt.timed;
     sum->timing = rt.timing;
     sum->sim_instructions = rt.instructions;

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # tests/kernel_identity.sh -- the path-tracing kernel assembles to the same program as a reference
-# tree's kernel, for every -D combination the simulator uses (sim/functional.c builds the list):
+# tree's kernel, for every -D combination the simulator uses (sim/run/kernel.c builds the list):
 # the workloads, BVH (ray and first order) and the six kd-tree variants, TRACE_ONLY, each HAS_*
 # feature alone and all together, and several stream sizes (RAYS 1024, 4096; packet mode's N).
 #

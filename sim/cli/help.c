@@ -1,8 +1,9 @@
 /* sim/cli/help.c -- what `sfsim help COMMAND` and `sfsim COMMAND --help` print: every command's
  * usage, options and examples (sweep and merge print theirs from sim/sweep/sweep.c).
  *
- * Owns: the help texts. Must not: parse options (each command's table is in sim/main.c and
- * sim/cli/exec.c) or name internal labels (issue numbers, "seed 000"): users read this.
+ * Owns: the help texts. Must not: parse options (each command's table is in sim/main.c,
+ * sim/cli/runopts.c and sim/cli/exec.c) or name internal labels (issue numbers, "seed 000"):
+ * users read this.
  */
 #include "help.h"
 

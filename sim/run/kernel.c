@@ -10,6 +10,10 @@
 #include "../datadir.h"
 #include "schedmodel.h"
 
+const char *const func_kd_kind_keys[FUNC_KD_KINDS] = {"camera", "indirect", "shadow"};
+const char *const func_kd_counter_keys[FUNC_KD_COUNTERS] = {"nodes", "leaves", "prims", "restarts", "overflows",
+                                                            "underflows"};
+
 const char *kernel_default_path(char *buf, size_t len)
 {
     const char *env = getenv("SFSIM_KERNEL");

@@ -6,7 +6,7 @@
  * the config (docs/kernel.md: RAYS, SPAD_BYTES, WORKLOAD, BOUNCES, HAS_*, ACCEL_KD, KD_VARIANT,
  * KD_STACK_DEPTH, ORDER_FIRST, TRACE_ONLY); assembling; the ABI symbols (kernels/lib/abi.inc is
  * their only definition); checking that the machine's memories hold what the kernel keeps in
- * them. Must not: run the kernel (sim/functional.c) or time it.
+ * them. Must not: run the kernel (sim/run/engine.c) or time it.
  */
 #ifndef SFSIM_RUN_KERNEL_H
 #define SFSIM_RUN_KERNEL_H
@@ -18,7 +18,18 @@
 #include "../../scenes/pack.h"
 #include "../config.h"
 #include "../core.h"
-#include "../functional.h"
+
+/* The kernel's counters as the host reads them back (kernels/lib/abi.inc defines them; named after
+ * the figures they fill, FuncStats in sim/run/engine.h, which sim/stats.def reads): the generations
+ * it counts at most (its ST_MAX_GEN may not exceed it), and with accel.structure = kd its kd-tree
+ * counters (KC_*) per ray kind, with their names in the report. */
+#define FUNC_MAX_GENERATIONS 64
+enum { FUNC_KD_CAMERA, FUNC_KD_INDIRECT, FUNC_KD_SHADOW, FUNC_KD_KINDS };
+enum { FUNC_KD_NODES, FUNC_KD_LEAVES, FUNC_KD_PRIMS, FUNC_KD_RESTARTS, FUNC_KD_OVERFLOWS, FUNC_KD_UNDERFLOWS,
+       FUNC_KD_COUNTERS };
+extern const char *const func_kd_kind_keys[FUNC_KD_KINDS];       /* "camera", "indirect", "shadow" */
+extern const char *const func_kd_counter_keys[FUNC_KD_COUNTERS]; /* "nodes", "leaves", "prims", "restarts",
+                                                                    "overflows", "underflows" */
 
 /* The ABI constants the host needs, looked up by name. */
 typedef struct KernelAbi {

@@ -1,37 +1,23 @@
 /* sim/run/run.c -- the entry point of every simulation (run.h): a scene opened for a machine, then
  * a frame or a ray batch in one of the modes.
  *
- * Owns: the mode names, the render settings' checks, the engine for each mode, and the defaults.
- * Must not: write files, or render or trace itself (sim/functional.c, sim/reference.c and
+ * Owns: the opened scene and its shared image, the render size's checks, the engine for each mode.
+ * The options were checked once by the commands (sim/cli/runopts.c): here they are asserted.
+ * Must not: write files, or render or trace itself (sim/run/engine.c, sim/reference.c and
  * sim/ref_trace.c do).
  */
 #include "run.h"
 
+#include <assert.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "../reference.h"
 #include "../ref_trace.h"
 #include "../util.h"
-#include "kernel.h"
 #include "sampled.h"
-#include "tiles.h"
-
-const char *const run_mode_names[RUN_MODE_COUNT] = {"reference", "functional", "detailed", "sampled"};
-
-int run_mode_parse(const char *name, RunMode *mode)
-{
-    for (int m = 0; m < RUN_MODE_COUNT; m++)
-        if (name && !strcmp(name, run_mode_names[m])) {
-            *mode = (RunMode)m;
-            return 0;
-        }
-    return -1;
-}
 
 /* The caller's size over the scene's [render], and the ranges a frame needs. */
 static int impose_size(Scene *s, const RunSize *z, char *err, size_t errlen)
@@ -68,58 +54,6 @@ static int impose_size(Scene *s, const RunSize *z, char *err, size_t errlen)
     return 0;
 }
 
-/* The open scenes' images: every trace batch and frame starts cores that load the packed scene, and
- * the image spares each core the copy (26 MB on the conference room, a page fault per 4 KiB). A
- * scene is found by the address of its PackedScene, and only while its bytes are the same block of
- * the same size as at run_scene_open (a pack_free and a new pack at the same address are not). */
-enum { IMAGES_MAX = 64 };
-static struct {
-    const PackedScene *p;
-    const uint8_t *mem;
-    uint32_t size;
-    CoreImage *image;
-} images[IMAGES_MAX];
-static pthread_mutex_t images_lock = PTHREAD_MUTEX_INITIALIZER;
-
-static void image_register(RunScene *sc)
-{
-    sc->image = core_image_new(sc->p.mem, sc->p.size, 0);
-    if (!sc->image || !core_image_shared(sc->image))
-        return; /* no memfd: the cores copy, as they do any other PackedScene */
-    pthread_mutex_lock(&images_lock);
-    for (int i = 0; i < IMAGES_MAX; i++)
-        if (!images[i].p) {
-            images[i].p = &sc->p;
-            images[i].mem = sc->p.mem;
-            images[i].size = sc->p.size;
-            images[i].image = sc->image;
-            break;
-        }
-    pthread_mutex_unlock(&images_lock);
-}
-
-static void image_unregister(RunScene *sc)
-{
-    pthread_mutex_lock(&images_lock);
-    for (int i = 0; i < IMAGES_MAX; i++)
-        if (sc->image && images[i].image == sc->image)
-            memset(&images[i], 0, sizeof images[i]);
-    pthread_mutex_unlock(&images_lock);
-    core_image_free(sc->image);
-    sc->image = NULL;
-}
-
-const CoreImage *run_scene_image(const PackedScene *p)
-{
-    const CoreImage *im = NULL;
-    pthread_mutex_lock(&images_lock);
-    for (int i = 0; i < IMAGES_MAX && !im; i++)
-        if (images[i].p == p && images[i].mem == p->mem && images[i].size == p->size)
-            im = images[i].image;
-    pthread_mutex_unlock(&images_lock);
-    return im;
-}
-
 int run_scene_open(RunScene *sc, const char *path, const RunSize *size, const CfgMachine *cfg, RunMode mode,
                    const char *who, char *err, size_t errlen)
 {
@@ -139,14 +73,18 @@ int run_scene_open(RunScene *sc, const char *path, const RunSize *size, const Cf
     sc->load_seconds = util_now() - t0;
     if (accel_pack(&sc->s, cfg, run_mode_kernel(mode), &sc->p, &sc->accel, err, errlen) != 0)
         return -1;
-    if (run_mode_kernel(mode))
-        image_register(sc);
+    /* The kernel modes start cores that each load the packed scene: one shared image spares them
+     * the copy. Without a memfd the image would only copy, as the cores do without one. */
+    if (run_mode_kernel(mode) && !core_image_shared(sc->image = core_image_new(sc->p.mem, sc->p.size, 0))) {
+        core_image_free(sc->image);
+        sc->image = NULL;
+    }
     return 0;
 }
 
 void run_scene_close(RunScene *sc)
 {
-    image_unregister(sc);
+    core_image_free(sc->image);
     pack_free(&sc->p);
     scene_free(&sc->s);
     memset(sc, 0, sizeof *sc);
@@ -156,13 +94,7 @@ void run_scene_close(RunScene *sc)
 static int golden_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg, RunFrame *fr, char *err,
                         size_t errlen)
 {
-    /* The golden model renders the path tracer and the Phong workload; the forced specular and
-     * diffuse workloads exist only as kernel variants (docs/kernel.md). */
-    if (cfg->workload_kind != CFG_WORKLOAD_PATH && cfg->workload_kind != CFG_WORKLOAD_PHONG) {
-        snprintf(err, errlen, "--mode reference: workload.kind = %s has no golden model (path and phong do)",
-                 cfg_enum_name("workload", "kind", cfg->workload_kind));
-        return -1;
-    }
+    assert(run_workload_golden(cfg)); /* spec_holds */
     RefParams rp = {.tile = fr->tile, .seed = spec->seed, .threads = fr->threads, .progress = spec->progress,
                     .progress_ctx = spec->progress_ctx, .bounces = cfg->workload_bounces,
                     .workload = cfg->workload_kind == CFG_WORKLOAD_PHONG ? REF_WORKLOAD_PHONG : REF_WORKLOAD_PATH};
@@ -173,24 +105,6 @@ static int golden_frame(const RunScene *sc, const RunSpec *spec, const CfgMachin
     return 0;
 }
 
-const CfgMachine *run_spec_machine(const RunSpec *spec, CfgMachine *defcfg)
-{
-    if (spec->cfg)
-        return spec->cfg;
-    cfg_defaults(defcfg);
-    return defcfg;
-}
-
-int run_spec_threads(const RunSpec *spec)
-{
-    return spec->threads > 0 ? spec->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
-}
-
-const char *run_spec_kernel(const RunSpec *spec, char *kpath, size_t len)
-{
-    return spec->kernel_path ? spec->kernel_path : kernel_default_path(kpath, len);
-}
-
 /* The kernel's frame, timed as the mode says. */
 static int kernel_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg, RunFrame *fr, char *err,
                         size_t errlen)
@@ -198,6 +112,7 @@ static int kernel_frame(const RunScene *sc, const RunSpec *spec, const CfgMachin
     char kpath[4200];
     FuncParams fp = {.cfg = cfg,
                      .kernel_path = run_spec_kernel(spec, kpath, sizeof kpath),
+                     .image = sc->image,
                      .needs = sc->s.needs,
                      .seed = spec->seed,
                      .threads = fr->threads,
@@ -213,37 +128,16 @@ static int kernel_frame(const RunScene *sc, const RunSpec *spec, const CfgMachin
     return 0;
 }
 
-int run_spec_check(const RunSpec *spec, char *err, size_t errlen)
+/* What the commands' one check of the options guarantees (sim/cli/runopts.c) and every other
+ * caller must hold too (run.h, run_frame). */
+static int spec_holds(const RunSpec *spec, const CfgMachine *cfg)
 {
-    if ((unsigned)spec->mode >= RUN_MODE_COUNT) {
-        snprintf(err, errlen, "run mode %d: no such mode", (int)spec->mode);
-        return -1;
-    }
-    if (spec->mode == RUN_SAMPLED && !(spec->target_error >= 0.0 && spec->target_error < 1.0)) {
-        snprintf(err, errlen, "--target-error %g: expected a fraction in (0, 1), e.g. 0.01 for +-1 %%",
-                 spec->target_error);
-        return -1;
-    }
-    if (spec->mode == RUN_SAMPLED && spec->target_error <= 0.0 && !(spec->sample > 0.0 && spec->sample <= 1.0)) {
-        snprintf(err, errlen, "--sample %g: expected a fraction of the units in (0, 1]", spec->sample);
-        return -1;
-    }
-    if (spec->mode == RUN_SAMPLED && spec->cfg && spec->cfg->workload_kind != CFG_WORKLOAD_PATH &&
-        spec->cfg->workload_kind != CFG_WORKLOAD_PHONG) {
-        snprintf(err, errlen, "--mode sampled: workload.kind = %s has no golden model to draw the units' auxiliary "
-                 "counts from (path and phong do); use --mode detailed",
-                 cfg_enum_name("workload", "kind", spec->cfg->workload_kind));
-        return -1;
-    }
-    if (spec->mode != RUN_SAMPLED && (spec->target_error != 0.0 || spec->no_image)) {
-        snprintf(err, errlen, "--target-error and --no-image belong to --mode sampled");
-        return -1;
-    }
-    if (spec->cfg && spec->cfg->stream_rays != 1024 && spec->cfg->stream_rays != 4096) {
-        snprintf(err, errlen, "stream.rays %d: must be 1024 or 4096", spec->cfg->stream_rays);
-        return -1;
-    }
-    return 0;
+    if ((unsigned)spec->mode >= RUN_MODE_COUNT || (cfg->stream_rays != 1024 && cfg->stream_rays != 4096))
+        return 0;
+    if (spec->mode != RUN_SAMPLED)
+        return spec->target_error == 0.0 && !spec->no_image && (spec->mode != RUN_REFERENCE || run_workload_golden(cfg));
+    return run_workload_golden(cfg) && spec->target_error >= 0.0 && spec->target_error < 1.0 &&
+           (spec->target_error > 0.0 || (spec->sample > 0.0 && spec->sample <= 1.0));
 }
 
 int run_frame(const RunScene *sc, const RunSpec *spec, RunFrame *fr, char *err, size_t errlen)
@@ -251,8 +145,9 @@ int run_frame(const RunScene *sc, const RunSpec *spec, RunFrame *fr, char *err, 
     memset(fr, 0, sizeof *fr);
     CfgMachine defcfg;
     const CfgMachine *cfg = run_spec_machine(spec, &defcfg);
-    if (run_spec_check(spec, err, errlen) != 0)
-        return -1;
+    int holds = spec_holds(spec, cfg); /* (a build with NDEBUG still uses the function) */
+    assert(holds);
+    (void)holds;
     size_t npx = (size_t)sc->s.render.width * (size_t)sc->s.render.height;
     fr->rgb = calloc(3 * npx, sizeof(float));
     if (!fr->rgb) {
@@ -304,8 +199,8 @@ static void golden_trace(const PackedScene *p, const RayBatch *b, BatchHit *hits
     }
 }
 
-int run_trace(const PackedScene *p, uint32_t needs, const RunSpec *spec, const RayBatch *b, BatchHit *hits,
-              RunTrace *out, char *err, size_t errlen)
+int run_trace(const PackedScene *p, const CoreImage *image, uint32_t needs, const RunSpec *spec, const RayBatch *b,
+              BatchHit *hits, RunTrace *out, char *err, size_t errlen)
 {
     RunTrace local;
     if (!out)
@@ -317,16 +212,13 @@ int run_trace(const PackedScene *p, uint32_t needs, const RunSpec *spec, const R
         out->seconds = util_now() - t0;
         return 0;
     }
-    if (spec->mode != RUN_FUNCTIONAL && spec->mode != RUN_DETAILED) {
-        snprintf(err, errlen, "--mode %s: expected functional, detailed or reference",
-                 (unsigned)spec->mode < RUN_MODE_COUNT ? run_mode_names[spec->mode] : "?");
-        return -1;
-    }
+    assert(spec->mode == RUN_FUNCTIONAL || spec->mode == RUN_DETAILED);
     CfgMachine defcfg;
     const CfgMachine *cfg = run_spec_machine(spec, &defcfg);
     char kpath[4200];
     FuncParams fp = {.cfg = cfg,
                      .kernel_path = run_spec_kernel(spec, kpath, sizeof kpath),
+                     .image = image,
                      .needs = needs,
                      .seed = spec->seed ? spec->seed : 1,
                      .threads = spec->threads,

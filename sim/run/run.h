@@ -3,14 +3,15 @@
  * one of the modes.
  *
  * `sfsim run` (sim/render.c), `sfsim trace` (sim/trace.c), tools/validation.c and bench/ go through
- * these calls; the pieces behind them are sim/run/accel.c (the structures), sim/run/kernel.c (the
- * kernel build), sim/run/tiles.c (the tile launcher), sim/run/timedcore.c (a core with its timing
- * model: the kernel modes' workers and `sfsim exec`), sim/functional.c (the kernel modes),
+ * these calls; the pieces behind them are sim/run/spec.c (the modes, RunSpec and its defaults),
+ * sim/run/accel.c (the structures), sim/run/kernel.c (the kernel build), sim/run/tiles.c (the tile
+ * launcher), sim/run/timedcore.c (a core with its timing model: the kernel modes' workers and
+ * `sfsim exec`), sim/run/engine.c (the kernel engine), sim/run/sampled.c (sampled mode's frame),
  * sim/reference.c and sim/ref_trace.c (the golden model).
  *
- * Owns: choosing the engine for a mode, the defaults every caller would otherwise repeat (the
- * machine, the kernel's path, the host threads), and the figures common to all modes.
- * Must not: write files (render.c and trace.c do), parse the command line, or render itself.
+ * Owns: the opened scene (and its shared image), choosing the engine for a mode, and the figures
+ * common to all modes. Must not: write files (render.c and trace.c do), parse the command line, or
+ * render itself. Nothing it calls calls it back: the engines get what they need as arguments.
  */
 #ifndef SFSIM_RUN_RUN_H
 #define SFSIM_RUN_RUN_H
@@ -22,24 +23,13 @@
 #include "../../scenes/scene.h"
 #include "../config.h"
 #include "../core.h"
-#include "../functional.h"
 #include "../raybatch.h"
 #include "../sampling.h"
 #include "../stats.h"
 #include "../timing.h"
 #include "accel.h"
-
-/* The modes: the golden model, the kernel on the functional core, the kernel timed on the
- * machine, and a sample of the kernel's (tile, pass) units timed (docs/sampling.md). */
-typedef enum RunMode { RUN_REFERENCE, RUN_FUNCTIONAL, RUN_DETAILED, RUN_SAMPLED, RUN_MODE_COUNT } RunMode;
-extern const char *const run_mode_names[RUN_MODE_COUNT]; /* "reference", "functional", ... */
-
-/* name as a mode: 0, or -1 when it names none. */
-int run_mode_parse(const char *name, RunMode *mode);
-/* The kernel runs (every mode but the golden model's). */
-static inline int run_mode_kernel(RunMode m) { return m != RUN_REFERENCE; }
-/* The timing model runs (on every unit, or on the sample). */
-static inline int run_mode_timed(RunMode m) { return m == RUN_DETAILED || m == RUN_SAMPLED; }
+#include "engine.h"
+#include "spec.h"
 
 /* The render size a caller imposes over the scene file's [render]; -1 (or 0 for the sizes) keeps
  * the scene's value. */
@@ -54,7 +44,11 @@ typedef struct RunScene {
     PackedScene p;
     AccelInfo accel;           /* what was built, and its host time */
     double load_seconds;       /* reading the scene file */
-    CoreImage *image;          /* p's bytes, which the kernel modes' cores share (run_scene_image) */
+    /* p's bytes as one shared image (a sealed memfd, sim/core.h) that the kernel modes' cores map
+     * instead of each copying them (26 MB on the conference room); NULL for the golden model, or
+     * when the host has no memfd (the cores copy). The scene owns it: whoever starts cores on p is
+     * passed it (FuncParams.image, run_trace's image) and p's bytes must not change while it lives. */
+    CoreImage *image;
 } RunScene;
 
 /* Load path, print the scene's warnings on stderr as "<who>: warning: ..." (who NULL: not printed;
@@ -65,38 +59,6 @@ typedef struct RunScene {
 int run_scene_open(RunScene *sc, const char *path, const RunSize *size, const CfgMachine *cfg, RunMode mode,
                    const char *who, char *err, size_t errlen);
 void run_scene_close(RunScene *sc);
-/* The shared image of the packed bytes of an open scene (a RunScene's p, its bytes unchanged since
- * run_scene_open), for the kernel modes' cores to map instead of copying (sim/core.h); NULL for
- * any other PackedScene, whose bytes the cores copy. The bytes of an open scene must not change. */
-const CoreImage *run_scene_image(const PackedScene *p);
-
-/* How to run: the mode, the machine and the host. Zero-initialised fields take the defaults. */
-typedef struct RunSpec {
-    RunMode mode;
-    const CfgMachine *cfg;     /* NULL: the defaults of sim/config.def */
-    const char *kernel_path;   /* NULL: kernels/pathtrace.s beside the binary (sim/run/kernel.h) */
-    uint32_t seed;             /* the path tracer's random stream */
-    int threads;               /* host threads; 0: every core */
-    /* RUN_SAMPLED (docs/sampling.md): the fraction of the (tile, pass) units timed, (0, 1], or
-     * when target_error > 0 as many as the sequential rule needs for a 95 % interval of the cycles
-     * within +-target_error (a fraction, 0.01 = 1 %); sample_seed fixes which units. no_image: the
-     * golden model runs only a pilot (fr->rgb stays black). */
-    double sample;
-    double target_error;
-    uint32_t sample_seed;
-    int no_image;
-    void (*progress)(void *ctx, uint32_t tiles_done, uint32_t tiles_total);
-    /* A line on what a long run is doing (sampled mode's rounds); may be NULL. */
-    void (*note)(void *ctx, const char *line);
-    void *progress_ctx;
-} RunSpec;
-
-/* spec's machine: spec->cfg, or the defaults written into *defcfg. */
-const CfgMachine *run_spec_machine(const RunSpec *spec, CfgMachine *defcfg);
-/* spec's host threads: spec->threads, or every core. */
-int run_spec_threads(const RunSpec *spec);
-/* spec's kernel source: spec->kernel_path, or kernels/pathtrace.s beside the binary (kpath holds it). */
-const char *run_spec_kernel(const RunSpec *spec, char *kpath, size_t len);
 
 /* A rendered frame and its figures. */
 typedef struct RunFrame {
@@ -115,14 +77,12 @@ typedef struct RunFrame {
     double seconds;            /* host time rendering */
 } RunFrame;
 
-/* The settings run_frame refuses, checked before any work (a mode out of range; in RUN_SAMPLED a
- * target error outside [0, 1), a sample fraction outside (0, 1] when there is no target, or a
- * workload without a golden model; target_error or no_image in another mode; a stream size the
- * kernel has no tile for): 0, or -1 with a message naming the setting. */
-int run_spec_check(const RunSpec *spec, char *err, size_t errlen);
-
-/* Render sc's frame as spec says. 0; -1 with a message (bad settings, a kernel that does not
- * assemble, memories too small, too few tiles to estimate from); -2 when the simulated program
+/* Render sc's frame as spec says. spec must hold what the commands check once (sim/cli/runopts.c)
+ * and this asserts: a mode; RUN_REFERENCE and RUN_SAMPLED on a workload with a golden model
+ * (run_workload_golden); in RUN_SAMPLED a target error in [0, 1) and, without one, a sample
+ * fraction in (0, 1]; no target error and no no_image in the other modes. 0; -1 with a message
+ * (a kernel that does not assemble, memories too small, too few tiles to estimate from); -2 when
+ * the simulated program
  * failed in a tile: then fr->rgb holds the tiles that finished (fr->f.tiles_done of fr->f.ntiles)
  * and the rest black. fr must be freed with run_frame_free either way. */
 int run_frame(const RunScene *sc, const RunSpec *spec, RunFrame *fr, char *err, size_t errlen);
@@ -137,9 +97,12 @@ typedef struct RunTrace {
 } RunTrace;
 
 /* Trace batch b against p (a scene of needs) as spec says: RUN_REFERENCE (the golden model),
- * RUN_FUNCTIONAL or RUN_DETAILED (the kernel's traversal and intersection); hits[i] for ray i.
- * 0, -1 (input) or -2 (the kernel failed). out may be NULL. */
-int run_trace(const PackedScene *p, uint32_t needs, const RunSpec *spec, const RayBatch *b, BatchHit *hits,
-              RunTrace *out, char *err, size_t errlen);
+ * RUN_FUNCTIONAL or RUN_DETAILED (the kernel's traversal and intersection; asserted: a batch has
+ * no units to sample); hits[i] for ray i.
+ * image: p's shared image (an open scene's RunScene.image) for the kernel's cores to map, or NULL
+ * (they copy p's bytes; the results are the same). 0, -1 (input) or -2 (the kernel failed). out
+ * may be NULL. */
+int run_trace(const PackedScene *p, const CoreImage *image, uint32_t needs, const RunSpec *spec, const RayBatch *b,
+              BatchHit *hits, RunTrace *out, char *err, size_t errlen);
 
 #endif

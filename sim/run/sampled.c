@@ -4,11 +4,12 @@
  *
  * Owns: the auxiliary variables taken from the golden model's unit counts, the pilot of
  * --no-image, the rounds of the sequential rule and the figures sampled mode reports.
- * Must not: estimate anything itself (sim/sampling.c does), run the kernel (sim/functional.c) or
+ * Must not: estimate anything itself (sim/sampling.c does), run the kernel (sim/run/engine.c) or
  * write files.
  */
 #include "sampled.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -63,7 +64,7 @@ static int measure(void *ctx, const uint32_t *units, uint32_t count, double *ys)
 static int golden_units(const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg, RunFrame *fr,
                         RefUnitStats *units, RefStats *rs, char *err, size_t errlen)
 {
-    /* run_spec_check refused the workloads without a golden model */
+    assert(run_workload_golden(cfg)); /* the options' check refused the others (sim/cli/runopts.c) */
     RefParams rp = {.tile = fr->tile, .seed = spec->seed, .threads = fr->threads, .progress = spec->progress,
                     .progress_ctx = spec->progress_ctx, .bounces = cfg->workload_bounces,
                     .workload = cfg->workload_kind == CFG_WORKLOAD_PHONG ? REF_WORKLOAD_PHONG : REF_WORKLOAD_PATH,
@@ -264,7 +265,7 @@ int sampled_population(const RunScene *sc, const RunSpec *spec, SampledPopulatio
     const CfgMachine *cfg = run_spec_machine(spec, &defcfg);
     char kpath[4200];
     FuncParams fp = {.cfg = cfg,
-                     .kernel_path = run_spec_kernel(spec, kpath, sizeof kpath),
+                     .kernel_path = run_spec_kernel(spec, kpath, sizeof kpath), .image = sc->image,
                      .needs = sc->s.needs, .seed = spec->seed, .threads = spec->threads, .timed = 1};
     FuncSession *fs;
     if (func_open(&sc->p, &fp, &fs, err, errlen) != 0)

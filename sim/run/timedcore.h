@@ -1,6 +1,6 @@
 /* sim/run/timedcore.h -- one core of the configured machine with its program loaded and, when
  * timed, the timing model hooked to it: the one set-up of a simulated core, used by the kernel
- * modes' workers (sim/functional.c) and `sfsim exec` (sim/main.c).
+ * modes' workers (sim/run/engine.c) and `sfsim exec` (sim/main.c).
  *
  * Owns: turning the config into core and timing parameters and hooking them together.
  * Must not: run the program, or decide what is timed.

@@ -26,7 +26,7 @@
 #include <sys/types.h>
 
 #include "../../isa/isa.h"
-#include "../functional.h"
+#include "../run/engine.h"
 #include "../stats.h"
 #include "../timing.h"
 #include "../util.h"

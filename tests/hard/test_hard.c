@@ -10,7 +10,7 @@
 #include <string.h>
 
 #include "../../sim/config.h"
-#include "../../sim/functional.h"
+#include "../../sim/run/engine.h"
 #include "../../sim/reference.h"
 #include "../support/numerics.h"
 #include "../support/rng.h"

@@ -280,8 +280,8 @@ uint32_t trace_both(const PackedScene *p, uint32_t needs, const RayBatch *b, int
     static char err[65536];
     RunSpec kspec = {.mode = RUN_FUNCTIONAL, .cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .threads = 2};
     RunSpec rspec = {.mode = RUN_REFERENCE, .cfg = &cfg, .threads = 1};
-    cr_assert_eq(run_trace(p, needs, &kspec, b, *kh, NULL, err, sizeof err), 0, "%s", err);
-    cr_assert_eq(run_trace(p, needs, &rspec, b, *rh, NULL, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(run_trace(p, NULL, needs, &kspec, b, *kh, NULL, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(run_trace(p, NULL, needs, &rspec, b, *rh, NULL, err, sizeof err), 0, "%s", err);
     uint32_t differ = 0;
     for (uint32_t i = 0; i < b->count; i++)
         if (memcmp(&(*kh)[i], &(*rh)[i], sizeof(BatchHit)) != 0)

@@ -15,7 +15,7 @@
 #include "../../scenes/pack.h"
 #include "../../scenes/scene.h"
 #include "../../sim/config.h"
-#include "../../sim/functional.h"
+#include "../../sim/run/engine.h"
 #include "../../sim/timing.h"
 
 #include "../support/shared.h"

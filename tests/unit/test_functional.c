@@ -14,7 +14,7 @@
 #include "../../scenes/pack.h"
 #include "../../scenes/scene.h"
 #include "../../sim/config.h"
-#include "../../sim/functional.h"
+#include "../../sim/run/engine.h"
 #include "../../sim/ref_kd.h"
 #include "../../sim/run/accel.h"
 #include "../../sim/reference.h"
@@ -274,7 +274,7 @@ Test(functional, machines_too_small_for_the_kernel_are_refused_by_key)
     scene_free(&s);
 }
 
-/* A frame's (tile, pass) units (sim/functional.c, run_tile_pass): tests/unit/pass_trap.s adds 1.0
+/* A frame's (tile, pass) units (sim/run/engine.c, run_tile_pass): tests/unit/pass_trap.s adds 1.0
  * per pass to the first N floats of its tile's framebuffer, so after the division by spp those
  * pixels hold exactly 1.0 when every pass of the tile ran once and handed the framebuffer on, on
  * whichever threads; the rest of the frame stays 0. Tiles are 32 x 32 (M = 1024), N = 16. */

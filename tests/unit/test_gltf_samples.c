@@ -17,7 +17,7 @@
 #include "../../scenes/pack.h"
 #include "../../scenes/scene.h"
 #include "../../sim/config.h"
-#include "../../sim/functional.h"
+#include "../../sim/run/engine.h"
 #include "../../sim/reference.h"
 #include "../../sim/render.h"
 #include "../support/shared.h"

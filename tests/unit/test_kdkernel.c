@@ -14,7 +14,7 @@
 #include "../../scenes/pack.h"
 #include "../../scenes/scene.h"
 #include "../../sim/config.h"
-#include "../../sim/functional.h"
+#include "../../sim/run/engine.h"
 #include "../../sim/ref_kd.h"
 #include "../../sim/run/accel.h"
 #include "../../sim/ref_trace.h"

@@ -10,7 +10,7 @@
 #include <string.h>
 
 #include "../../sim/config.h"
-#include "../../sim/functional.h"
+#include "../../sim/run/engine.h"
 #include "../../sim/reference.h"
 #include "../../sim/ref_trace.h"
 #include "../../sim/run/accel.h"
@@ -400,7 +400,7 @@ Test(numerics, rays_leaving_a_large_triangle_do_not_hit_it, .timeout = 120)
     for (int v = 0; v < 5; v++) {
         cr_assert_eq(cfg_set(&cfg, trav[v], &ce), 0);
         RunSpec spec = {.mode = RUN_FUNCTIONAL, .cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .threads = 2};
-        cr_assert_eq(run_trace(&p, s.needs, &spec, &bt, kh, NULL, err, sizeof err), 0, "%s", err);
+        cr_assert_eq(run_trace(&p, NULL, s.needs, &spec, &bt, kh, NULL, err, sizeof err), 0, "%s", err);
         for (uint32_t i = 0; i < bt.count; i++)
             kdhits += bt.rays[i].query == RAY_ANY ? kh[i].prim == 1 : kh[i].prim != UINT32_MAX;
     }

@@ -272,7 +272,7 @@ Test(render, trace_of_zero_rays_in_every_mode, .timeout = 120)
             RunTrace rt;
             memset(&rt, 0xff, sizeof rt);
             RunSpec spec = {.mode = modes[m], .cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .threads = 2};
-            int rc = run_trace(&p, s.needs, &spec, &b, &hit, &rt, err, sizeof err);
+            int rc = run_trace(&p, NULL, s.needs, &spec, &b, &hit, &rt, err, sizeof err);
             const char *mn = run_mode_names[modes[m]];
             cr_expect_eq(rc, 0, "input %d, %s: %s", k, mn, err);
             cr_expect_eq(rt.instructions, 0u, "input %d, %s: %llu instructions", k, mn,

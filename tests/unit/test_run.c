@@ -2,8 +2,9 @@
  * the same scene-memory bytes as the by-hand set-up it replaced in tools/validation.c and bench/
  * (scene_load, the size imposed, pack_scene with bvh_default_params, and for the kd-tree kernels
  * accel_add_kd), so their tables and figures did not move when they switched to it; and the
- * entry point's own rules: mode names, the render settings it checks, and the settings run_frame
- * refuses before any work; and the open scene's shared image, whose batches are those of a copy.
+ * entry point's own rules: mode names and the render settings it checks (the options a command
+ * refuses are tests/unit/test_runopts.c's); and the open scene's shared image, whose batches are
+ * those of a copy.
  */
 #include <criterion/criterion.h>
 #include <math.h>
@@ -160,46 +161,6 @@ Test(run_scene, a_size_out_of_range_is_refused_by_name)
     run_scene_close(&sc);
 }
 
-/* Settings run_frame refuses before it renders anything: no image is left to free. */
-Test(run_frame, bad_settings_are_refused_before_any_work)
-{
-    char err[4096];
-    RunScene sc;
-    RunSize size = {8, 8, 1, 1};
-    cr_assert_eq(run_scene_open(&sc, "scenes/cornell/scene.ini", &size, NULL, RUN_FUNCTIONAL, NULL, err, sizeof err), 0,
-                 "%s", err);
-    CfgMachine spec_cfg;
-    cfg_defaults(&spec_cfg);
-    spec_cfg.workload_kind = CFG_WORKLOAD_SPECULAR;
-    static const struct {
-        RunMode mode;
-        double sample, target;
-        int cfg_specular, no_image;
-        const char *want;
-    } cases[] = {
-        {RUN_SAMPLED, 0.0, 0.0, 0, 0, "--sample 0: expected a fraction of the units in (0, 1]"},
-        {RUN_SAMPLED, 1.5, 0.0, 0, 0, "--sample 1.5: expected a fraction"},
-        {RUN_SAMPLED, 0.0, 1.0, 0, 0, "--target-error 1: expected a fraction in (0, 1)"},
-        {RUN_SAMPLED, 0.0, -0.5, 0, 0, "--target-error -0.5: expected a fraction in (0, 1)"},
-        {RUN_DETAILED, 0.0, 0.01, 0, 0, "belong to --mode sampled"},
-        {RUN_FUNCTIONAL, 0.0, 0.0, 0, 1, "belong to --mode sampled"},
-        {RUN_SAMPLED, 0.0, 0.01, 1, 0, "workload.kind = specular has no golden model"},
-        {RUN_REFERENCE, 0.0, 0.0, 1, 0, "workload.kind = specular has no golden model"},
-        {RUN_MODE_COUNT, 0.0, 0.0, 0, 0, "no such mode"},
-    };
-    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        RunSpec spec = {.mode = cases[i].mode, .cfg = cases[i].cfg_specular ? &spec_cfg : NULL, .seed = 1,
-                        .threads = 1, .sample = cases[i].sample, .target_error = cases[i].target,
-                        .no_image = cases[i].no_image};
-        RunFrame fr;
-        err[0] = 0;
-        cr_expect_eq(run_frame(&sc, &spec, &fr, err, sizeof err), -1, "case %zu", i);
-        cr_expect(strstr(err, cases[i].want) != NULL, "case %zu: %s", i, err);
-        run_frame_free(&fr);
-    }
-    run_scene_close(&sc);
-}
-
 /* The golden model's frame through the entry point: an image and its rays, the tile of the
  * machine's stream, and the same bits on 1 and 2 host threads. */
 Test(run_frame, golden_frame_is_the_same_on_any_thread_count)
@@ -225,18 +186,20 @@ Test(run_frame, golden_frame_is_the_same_on_any_thread_count)
     run_scene_close(&sc);
 }
 
-/* The kernel modes' cores map an open scene's image (run_scene_image) instead of copying the
- * packed bytes: a batch traced from it gives the same hits, instructions and cycles as from a
- * PackedScene the registry does not know (a struct copy: its cores copy the bytes). */
+/* The kernel modes' cores map the open scene's image (RunScene.image, passed to run_trace)
+ * instead of copying the packed bytes: a batch traced with it gives the same hits, instructions and
+ * cycles as without it (NULL: each core copies the bytes). The golden model's scene has none. */
 Test(run_scene, a_batch_from_the_shared_image_is_the_batch_from_the_copy)
 {
     RunScene sc;
     char err[4096];
+    cr_assert_eq(run_scene_open(&sc, "scenes/cornell/scene.ini", NULL, NULL, RUN_REFERENCE, NULL, err, sizeof err), 0,
+                 "%s", err);
+    cr_expect_null(sc.image, "the golden model starts no cores: no image");
+    run_scene_close(&sc);
     cr_assert_eq(run_scene_open(&sc, "scenes/cornell/scene.ini", NULL, NULL, RUN_DETAILED, NULL, err, sizeof err), 0,
                  "%s", err);
-    cr_assert_not_null(run_scene_image(&sc.p), "an open scene has a shared image (memfd)");
-    PackedScene copy = sc.p;
-    cr_assert_null(run_scene_image(&copy), "another PackedScene has no image");
+    cr_assert_not_null(sc.image, "an open scene of a kernel mode owns a shared image (memfd)");
     enum { N = 700 };
     RayBatch b = {calloc(N, sizeof(BatchRay)), N};
     BatchHit *h[2] = {calloc(N, sizeof(BatchHit)), calloc(N, sizeof(BatchHit))};
@@ -258,8 +221,9 @@ Test(run_scene, a_batch_from_the_shared_image_is_the_batch_from_the_copy)
         for (int threads = 1; threads <= 2; threads++) {
             RunTrace rt[2];
             RunSpec spec = {.mode = modes[m], .kernel_path = "kernels/pathtrace.s", .threads = threads};
-            cr_assert_eq(run_trace(&sc.p, sc.s.needs, &spec, &b, h[0], &rt[0], err, sizeof err), 0, "%s", err);
-            cr_assert_eq(run_trace(&copy, sc.s.needs, &spec, &b, h[1], &rt[1], err, sizeof err), 0, "%s", err);
+            cr_assert_eq(run_trace(&sc.p, sc.image, sc.s.needs, &spec, &b, h[0], &rt[0], err, sizeof err), 0, "%s",
+                         err);
+            cr_assert_eq(run_trace(&sc.p, NULL, sc.s.needs, &spec, &b, h[1], &rt[1], err, sizeof err), 0, "%s", err);
             const char *mn = run_mode_names[modes[m]];
             cr_expect(memcmp(h[0], h[1], N * sizeof(BatchHit)) == 0, "%s, %d threads: hits differ", mn, threads);
             cr_expect_eq(rt[0].instructions, rt[1].instructions, "%s: instructions differ", mn);
@@ -271,7 +235,7 @@ Test(run_scene, a_batch_from_the_shared_image_is_the_batch_from_the_copy)
         hits += b.rays[i].query == RAY_CLOSEST ? h[0][i].prim != UINT32_MAX : h[0][i].prim;
     cr_expect_gt(hits, N / 2, "the batch should hit the box (%u hits of %u)", hits, N);
     run_scene_close(&sc);
-    cr_expect_null(run_scene_image(&sc.p), "a closed scene has no image");
+    cr_expect_null(sc.image, "a closed scene has no image");
     free(b.rays);
     free(h[0]);
     free(h[1]);

@@ -1,4 +1,4 @@
-/* tests/unit/test_units.c -- sampled mode's units (sim/functional.h func_open / func_units /
+/* tests/unit/test_units.c -- sampled mode's units (sim/run/engine.h func_open / func_units /
  * func_close): a (tile, pass) unit run alone takes exactly the instructions and cycles it takes in
  * the full detailed run, so timing every unit reproduces detailed mode exactly, in any order and
  * on any thread count; bad unit numbers are refused.
@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../../sim/functional.h"
+#include "../../sim/run/engine.h"
 #include "../../sim/run/run.h"
 
 #define SCENE "scenes/cornell/scene.ini"
@@ -21,8 +21,8 @@ static void open_scene(RunScene *sc, int w, int h, int spp)
 
 static FuncParams timed_params(const CfgMachine *cfg, const RunScene *sc, int threads)
 {
-    FuncParams fp = {.cfg = cfg, .kernel_path = "kernels/pathtrace.s", .needs = sc->s.needs, .seed = 1,
-                     .threads = threads, .timed = 1};
+    FuncParams fp = {.cfg = cfg, .kernel_path = "kernels/pathtrace.s", .image = sc->image, .needs = sc->s.needs,
+                     .seed = 1, .threads = threads, .timed = 1};
     return fp;
 }
 

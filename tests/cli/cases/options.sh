@@ -68,6 +68,17 @@ run "$SFSIM" run --mode=fast
 want_rc 1; want_err "--mode fast"
 end
 
+begin "a mode the machine cannot run is bad input (1), said before the scene is read (sim/cli/runopts.c)"
+run "$SFSIM" run --mode sampled --set workload.kind=specular -s "$T/no_such_scene.ini" -o "$T/w"
+want_rc 1
+want_err "^sfsim run: --mode sampled: workload.kind = specular has no golden model to draw the units' auxiliary counts from \(path and phong do\); use --mode detailed$"
+run "$SFSIM" run --mode reference --set workload.kind=diffuse -s "$T/no_such_scene.ini" -o "$T/w"
+want_rc 1; want_err "^sfsim run: --mode reference: workload.kind = diffuse has no golden model \(path and phong do\)$"
+[ -e "$T/w" ] && no "a refused run made its output folder"
+run "$SFSIM" trace --mode sampled -s "$T/no_such_scene.ini" --rays tests/cli/cornell_rays.txt -o "$T/h"
+want_rc 1; want_err "^sfsim trace: --mode sampled: expected functional, detailed or reference$"
+end
+
 begin "sfsim exec takes its options after the program too"
 "$SFASM" tests/cli/ok.s -o "$T/ok.sfo" >/dev/null 2>&1 || no "cannot assemble tests/cli/ok.s"
 run "$SFSIM" exec "$T/ok.sfo" -q --width=8

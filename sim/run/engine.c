@@ -1,12 +1,13 @@
-/* sim/functional.c -- the functional mode: kernels/pathtrace.s on functional cores, one tile per
- * run, host threads over tiles.
+/* sim/run/engine.c -- the kernel engine (engine.h): kernels/pathtrace.s on functional cores, one
+ * (tile, pass) unit or ray batch per run, host threads over them (sim/run/tiles.c).
  *
- * Owns: the kernel's build symbols, its launch block and counters (by name from the object's
- * symbol table: kernels/lib/abi.inc is their only definition), copying tiles out of the
- * framebuffer. Must not: compute radiance, or make results depend on the thread count (each
- * tile's pixels come from its own run only).
+ * Owns: the kernel's launch block and counters (by name from the object's symbol table:
+ * kernels/lib/abi.inc is their only definition), copying tiles in and out of the framebuffer, the
+ * workers and their sums. Must not: compute radiance, make results depend on the thread count
+ * (each tile's pixels come from its own runs only), or call up into sim/run/run.c (its caller
+ * passes everything it needs in FuncParams, the scene's shared image included).
  */
-#include "functional.h"
+#include "engine.h"
 
 #include <limits.h>
 #include <math.h>
@@ -18,14 +19,9 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "run/kernel.h"
-#include "run/run.h"
-#include "run/tiles.h"
-#include "run/timedcore.h"
-
-const char *const func_kd_kind_keys[FUNC_KD_KINDS] = {"camera", "indirect", "shadow"};
-const char *const func_kd_counter_keys[FUNC_KD_COUNTERS] = {"nodes", "leaves", "prims", "restarts", "overflows",
-                                                            "underflows"};
+#include "kernel.h"
+#include "tiles.h"
+#include "timedcore.h"
 
 typedef struct Job {
     const PackedScene *p;
@@ -444,11 +440,10 @@ static int worker_begin(void *ctx, int index)
         fail(j, msg, 0);
         return -1;
     }
-    /* The packed scene into scene memory: mapped copy-on-write from the open scene's image
-     * (run_scene_image), or copied. */
-    const CoreImage *im = run_scene_image(j->p);
-    if (im) {
-        if (core_load_image(w->tc.core, im) != 0) {
+    /* The packed scene into scene memory: mapped copy-on-write from the image the caller passed
+     * (FuncParams.image, the open scene's), or copied. */
+    if (j->fp->image) {
+        if (core_load_image(w->tc.core, j->fp->image) != 0) {
             fail(j, "out of memory loading the scene into scene memory", 0);
             return -1;
         }

@@ -1,38 +1,40 @@
-/* sim/functional.h -- the functional mode: the path-tracing kernel (kernels/pathtrace.s)
- * assembled for the scene and the machine, run tile by tile on functional cores.
+/* sim/run/engine.h -- the kernel engine: the path-tracing kernel (kernels/pathtrace.s), built for
+ * the scene and the machine by sim/run/kernel.c, run on functional cores (and, in the detailed and
+ * sampled modes, a timing model hooked to each) over a frame's tiles, a sample's (tile, pass)
+ * units or a ray batch. The functional, detailed and sampled modes and `sfsim trace` run through it.
  *
- * Owns: running the kernel that sim/run/kernel.c built, tile by tile (sim/run/tiles.c hands the
- * tiles to host threads): the launch block of each run, copying the tile out of the framebuffer,
- * the statistics that need no timing, and (detailed mode) attaching a timing model to each core.
+ * Owns: the kernel's runs: the launch block of each (tile, pass) unit or batch, copying the tile
+ * in and out of the framebuffer, the ray batch in and the hits out, the kernel's counters read
+ * back from the scratchpad, the workers (one timed core per host thread, sim/run/timedcore.h)
+ * that sim/run/tiles.c hands the work to, and the figures (FuncStats, FuncTile, FuncUnit) that
+ * sim/stats.def reads. Its prefix stays func_ (the kernel on functional cores), the names the
+ * statistics registry and the tests know it by.
  * Must not: choose the kernel's symbols or assemble it (sim/run/kernel.c), build acceleration
- * structures (sim/run/accel.c), compute any pixel itself or model time (sim/timing.c does).
+ * structures (sim/run/accel.c), choose the mode or its defaults (sim/run/run.c calls it), compute
+ * any pixel itself, or model time (sim/timing.c does). It calls only down: kernel, tiles,
+ * timedcore, the core and the timing model; nothing in sim/run/run.h.
  */
-#ifndef SFSIM_FUNCTIONAL_H
-#define SFSIM_FUNCTIONAL_H
+#ifndef SFSIM_RUN_ENGINE_H
+#define SFSIM_RUN_ENGINE_H
 
 #include <stddef.h>
 #include <stdint.h>
 
-#include "../scenes/pack.h"
-#include "config.h"
-#include "core.h"
-#include "raybatch.h"
-#include "timing.h"
+#include "../../scenes/pack.h"
+#include "../config.h"
+#include "../core.h"
+#include "../raybatch.h"
+#include "../timing.h"
+#include "kernel.h"
 
-#define FUNC_MAX_GENERATIONS 64
 #define FUNC_STAGES 3          /* stream counters: traversal, intersection, shading */
-
-/* accel.structure = kd: the kernel's kd-tree counters (kernels/lib/abi.inc, KC_*), per ray kind. */
-enum { FUNC_KD_CAMERA, FUNC_KD_INDIRECT, FUNC_KD_SHADOW, FUNC_KD_KINDS };
-enum { FUNC_KD_NODES, FUNC_KD_LEAVES, FUNC_KD_PRIMS, FUNC_KD_RESTARTS, FUNC_KD_OVERFLOWS, FUNC_KD_UNDERFLOWS,
-       FUNC_KD_COUNTERS };
-extern const char *const func_kd_kind_keys[FUNC_KD_KINDS];       /* "camera", "indirect", "shadow" */
-extern const char *const func_kd_counter_keys[FUNC_KD_COUNTERS]; /* "nodes", "leaves", "prims", "restarts",
-                                                                    "overflows", "underflows" */
 
 typedef struct FuncParams {
     const CfgMachine *cfg;     /* SIMD width, stream size, memories, instruction limit */
     const char *kernel_path;   /* kernels/pathtrace.s */
+    /* p's bytes as a shared image (the opened scene's, RunScene.image: sim/run/run.h), which each
+     * core maps copy-on-write; NULL: each core copies p's bytes. It must hold p's bytes unchanged. */
+    const CoreImage *image;
     uint32_t needs;            /* SCENE_NEED_* of the scene */
     uint32_t seed;
     int threads;
