@@ -1,4 +1,5 @@
-/* scenes/bvh.c -- binned SAH BVH builder (its invariant checker and cost: scenes/bvh_check.c).
+/* scenes/bvh.c -- binned SAH BVH builder (the checks of its input and of a built tree, and its
+ * cost: scenes/bvh_check.c).
  *
  * Owns: BvhNode topology and prim_index order. Must not: look at primitive geometry beyond the
  * boxes it is given, or lay the tree out in simulated memory.
@@ -757,52 +758,6 @@ static void make_leaf(BvhNode *n, uint32_t begin, uint32_t end)
     n->axis = 0;
 }
 
-static int check_params(const BvhParams *p, char *err, size_t errlen)
-{
-    if (p->max_leaf_size < 1 || p->bins < 2 || p->bins > 256 || !(p->cost_traversal >= 0.0f) ||
-        !(p->cost_intersect > 0.0f)) {
-        snprintf(err, errlen, "bvh: bad parameters (leaf size %d, bins %d, costs %g/%g)",
-                 p->max_leaf_size, p->bins, (double)p->cost_traversal, (double)p->cost_intersect);
-        return -1;
-    }
-    return 0;
-}
-
-/* First one pass without a branch per value (finite and ordered: lo <= hi, |lo| and |hi| <= FLT_MAX,
- * each false for a NaN), then, only when it fails, the loop that names the first bad box. */
-static int check_boxes(const float *bmin, const float *bmax, uint32_t n, char *err, size_t errlen)
-{
-    int ok = 1;
-    size_t t = 0, nt = 3 * (size_t)n;
-#if defined(__SSE2__)
-    /* the same comparisons, four values at a time (cmple is false for a NaN too) */
-    __m128 all = _mm_castsi128_ps(_mm_set1_epi32(-1)), magnitude = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
-    __m128 big = _mm_set1_ps(FLT_MAX), good = all;
-    for (; t + 4 <= nt; t += 4) {
-        __m128 lo = _mm_loadu_ps(bmin + t), hi = _mm_loadu_ps(bmax + t);
-        good = _mm_and_ps(good, _mm_cmple_ps(lo, hi));
-        good = _mm_and_ps(good, _mm_cmple_ps(_mm_and_ps(lo, magnitude), big));
-        good = _mm_and_ps(good, _mm_cmple_ps(_mm_and_ps(hi, magnitude), big));
-    }
-    ok = _mm_movemask_ps(good) == 15;
-#endif
-    for (; t < nt; t++)
-        ok &= (bmin[t] <= bmax[t]) & (fabsf(bmin[t]) <= FLT_MAX) & (fabsf(bmax[t]) <= FLT_MAX);
-    if (ok)
-        return 0;
-    for (uint32_t i = 0; i < n; i++) {
-        for (int k = 0; k < 3; k++) {
-            float lo = bmin[3 * i + k], hi = bmax[3 * i + k];
-            if (!isfinite(lo) || !isfinite(hi) || lo > hi) {
-                snprintf(err, errlen, "bvh: primitive %u has a bad box on axis %d: [%g, %g]", i, k,
-                         (double)lo, (double)hi);
-                return -1;
-            }
-        }
-    }
-    return 0;
-}
-
 /* split_node of two primitives, without bins: what binning them would find. On an axis with a
  * split (bin_scale > 0: their centroids differ and the extent is finite, not denormal) the lower
  * centroid lands in bin 0 ((c - cmin) * scale = 0) and the other in the last bin (extent x
@@ -978,7 +933,7 @@ int bvh_build(const BvhParams *p, const float *bmin, const float *bmax, uint32_t
               char *err, size_t errlen)
 {
     memset(out, 0, sizeof *out);
-    if (check_params(p, err, errlen) != 0 || check_boxes(bmin, bmax, n, err, errlen) != 0)
+    if (bvh_check_input(p, bmin, bmax, n, err, errlen) != 0)
         return -1;
     out->nprims = n;
     if (n == 0)

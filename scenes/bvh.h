@@ -45,6 +45,9 @@ int bvh_build(const BvhParams *p, const float *bmin, const float *bmax, uint32_t
               char *err, size_t errlen);
 void bvh_free(Bvh *b);
 
+/* The build's input: parameters in range, every box finite with lo <= hi. 0, or -1 with a
+ * message naming the parameter or the first bad primitive (bvh_build calls it first). */
+int bvh_check_input(const BvhParams *p, const float *bmin, const float *bmax, uint32_t n, char *err, size_t errlen);
 /* Check the invariants: every primitive in exactly one leaf, every primitive's box inside its
  * leaf's box, children inside parents, no NaN boxes, leaf sizes > 0, every node reachable once.
  * 0, or -1 with the first violation described. */

@@ -1,13 +1,69 @@
-/* scenes/bvh_check.c -- a built BVH's invariants (bvh_check) and its SAH cost (bvh_sah_cost).
+/* scenes/bvh_check.c -- a build's input (bvh_check_input), a built BVH's invariants (bvh_check) and
+ * its SAH cost (bvh_sah_cost).
  *
  * Owns: what a correct tree is. Must not: build or change a tree (scenes/bvh.c builds them).
  */
 #include "bvh.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
+static int check_params(const BvhParams *p, char *err, size_t errlen)
+{
+    if (p->max_leaf_size < 1 || p->bins < 2 || p->bins > 256 || !(p->cost_traversal >= 0.0f) ||
+        !(p->cost_intersect > 0.0f)) {
+        snprintf(err, errlen, "bvh: bad parameters (leaf size %d, bins %d, costs %g/%g)",
+                 p->max_leaf_size, p->bins, (double)p->cost_traversal, (double)p->cost_intersect);
+        return -1;
+    }
+    return 0;
+}
+
+/* First one pass without a branch per value (finite and ordered: lo <= hi, |lo| and |hi| <= FLT_MAX,
+ * each false for a NaN), then, only when it fails, the loop that names the first bad box. */
+static int check_boxes(const float *bmin, const float *bmax, uint32_t n, char *err, size_t errlen)
+{
+    int ok = 1;
+    size_t t = 0, nt = 3 * (size_t)n;
+#if defined(__SSE2__)
+    /* the same comparisons, four values at a time (cmple is false for a NaN too) */
+    __m128 all = _mm_castsi128_ps(_mm_set1_epi32(-1)), magnitude = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    __m128 big = _mm_set1_ps(FLT_MAX), good = all;
+    for (; t + 4 <= nt; t += 4) {
+        __m128 lo = _mm_loadu_ps(bmin + t), hi = _mm_loadu_ps(bmax + t);
+        good = _mm_and_ps(good, _mm_cmple_ps(lo, hi));
+        good = _mm_and_ps(good, _mm_cmple_ps(_mm_and_ps(lo, magnitude), big));
+        good = _mm_and_ps(good, _mm_cmple_ps(_mm_and_ps(hi, magnitude), big));
+    }
+    ok = _mm_movemask_ps(good) == 15;
+#endif
+    for (; t < nt; t++)
+        ok &= (bmin[t] <= bmax[t]) & (fabsf(bmin[t]) <= FLT_MAX) & (fabsf(bmax[t]) <= FLT_MAX);
+    if (ok)
+        return 0;
+    for (uint32_t i = 0; i < n; i++) {
+        for (int k = 0; k < 3; k++) {
+            float lo = bmin[3 * i + k], hi = bmax[3 * i + k];
+            if (!isfinite(lo) || !isfinite(hi) || lo > hi) {
+                snprintf(err, errlen, "bvh: primitive %u has a bad box on axis %d: [%g, %g]", i, k,
+                         (double)lo, (double)hi);
+                return -1;
+            }
+        }
+    }
+    return 0;
+}
+
+int bvh_check_input(const BvhParams *p, const float *bmin, const float *bmax, uint32_t n, char *err, size_t errlen)
+{
+    return check_params(p, err, errlen) != 0 || check_boxes(bmin, bmax, n, err, errlen) != 0 ? -1 : 0;
+}
 
 /* Six comparisons, no branch between them (most boxes are inside). */
 static inline int inside(const float *lo, const float *hi, const float *plo, const float *phi)
