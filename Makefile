@@ -92,7 +92,7 @@ endif
 # and tests/unit (everything else, linked --as-needed so it starts fast). unit runs last.
 TEST_SRC := $(wildcard tests/unit/*.c) tests/support/numerics.c tests/support/shared.c tests/support/files.c \
             tests/support/isa_expect.c tests/support/core_prog.c tests/support/scene_fixture.c tests/support/fixed_level.c \
-            tests/support/asm_fixture.c tests/support/bvh_ref.c
+            tests/support/asm_fixture.c tests/support/bvh_ref.c tests/support/packed.c
 IO_TEST_SRC := $(wildcard tests/io/*.c) tests/support/xcheck.c tests/support/shared.c tests/support/files.c
 LDAS    := -Wl,--as-needed
 
@@ -349,6 +349,8 @@ $(BUILD)/fuzz/fuzz_rays: tests/fuzz/fuzz_rays.c sim/raybatch.c host/outfile.c ho
 
 # The timing model of one core: what fuzz_config builds from the config it fuzzes.
 TM_SRC := sim/timing.c sim/event.c $(wildcard sim/machine/*.c sim/timing/*.c) sim/mem/cache.c sim/mem/bus.c
+# ... and the chip's shared memory, whose keys the config's check asks about (sim/chip/chip.h)
+TM_SRC += sim/chip/chip.c sim/mem/dram.c sim/mem/dram_sched.c sim/mem/dram_level.c sim/mem/l2.c sim/mem/noc.c
 
 $(BUILD)/fuzz/fuzz_config: tests/fuzz/fuzz_config.c sim/config.c sim/ini.c host/infile.c $(TM_SRC) isa/isa.c
 	@mkdir -p $(dir $@)

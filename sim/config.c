@@ -6,6 +6,8 @@
  */
 #include "config.h"
 
+#include "chip/chip.h"
+
 #include <cjson/cJSON.h>
 #include <errno.h>
 #include <math.h>
@@ -32,6 +34,8 @@ static const struct { const char *section, *key; const char *names[CFG_ENUM_NAME
                          "ro,ra,bg,ba,ch,co", "ro,co,ra,ba,bg,ch"}},
     {"dram", "page_policy", {"open", "closed"}},
     {"kernel", "schedule", {"none", "list"}},
+    {"chip", "memory", {"bus", "shared"}},
+    {"l2", "write_policy", {"back", "through"}},
 };
 
 static const char *const *enum_of(const char *section, const char *key)
@@ -349,6 +353,9 @@ int cfg_check(const CfgMachine *cfg, CfgErrors *errs)
     for (size_t i = 0; i < sizeof pow2 / sizeof pow2[0]; i++)
         if (pow2[i].v & (pow2[i].v - 1))
             add_error(errs, "config: %s = %d is not a power of two", pow2[i].key, pow2[i].v);
+    char why[600];
+    if (chip_check(cfg, why, sizeof why))
+        add_error(errs, "config: %s", why);
     if (cfg->scene_cache_kb > 0) {
         int64_t set_bytes = (int64_t)cfg->scene_line_bytes * cfg->scene_cache_ways;
         if (((int64_t)cfg->scene_cache_kb * 1024) % set_bytes != 0)

@@ -911,6 +911,8 @@ CoreExit core_run_slice(Core *c, uint64_t max_instr, uint64_t limit)
     return c->hook ? run_loop_hooked(c, max_instr, limit) : run_loop_plain(c, max_instr, limit);
 }
 
+uint64_t core_slice_executed(const Core *c, uint64_t max_instr) { return max_instr - c->slice_left; }
+
 CoreExit core_run(Core *c, uint64_t max_instr)
 {
     return core_run_slice(c, max_instr, max_instr);

@@ -31,7 +31,12 @@ typedef struct CoreParams {
     uint32_t mem_bytes[CORE_MEM_COUNT]; /* RB0 and RB1 must be equal; each a multiple of 4 */
 } CoreParams;
 
-typedef enum CoreExit { CORE_EXIT_HALT = 0, CORE_EXIT_TRAP = 1, CORE_EXIT_LIMIT = 2 } CoreExit;
+/* CORE_EXIT_YIELD: the hook asked the core to stop after the instruction it was given
+ * (CoreFollow.yield: the timing model of a chip's core waits for an answer of the shared memory,
+ * docs/chip.md). That instruction has executed; its record stays in the core (core_record) for the
+ * hook's owner to take up again, and the next core_run goes on after it (on a halt: the core stays
+ * on it, and a core_run runs it again only after core_restart). */
+typedef enum CoreExit { CORE_EXIT_HALT = 0, CORE_EXIT_TRAP = 1, CORE_EXIT_LIMIT = 2, CORE_EXIT_YIELD = 3 } CoreExit;
 
 #define CORE_GENERATIONS 64   /* statistics generations kept apart (sgen) */
 
@@ -125,6 +130,8 @@ static inline void core_record_start(CoreRecord *r, uint64_t w)
 typedef struct CoreFollow {
     uint64_t where;
     uint32_t last;
+    /* Set by the hook: stop after this record (CORE_EXIT_YIELD); the hook's owner clears it. */
+    uint8_t yield;
 } CoreFollow;
 #define CORE_FOLLOW_NONE UINT64_MAX /* matches no record: core_record_where's top byte is CORE_MEM_COUNT */
 
@@ -160,6 +167,8 @@ CoreExit core_run(Core *c, uint64_t max_instr);
 /* core_run for one slice of a longer run: at most max_instr instructions; a CORE_EXIT_LIMIT trap
  * names `limit`, the whole run's limit, in its message. */
 CoreExit core_run_slice(Core *c, uint64_t max_instr, uint64_t limit);
+/* The instructions the last core_run_slice(c, max_instr, ...) executed (max_instr > 0). */
+uint64_t core_slice_executed(const Core *c, uint64_t max_instr);
 /* The trap message after CORE_EXIT_TRAP/CORE_EXIT_LIMIT:
  * "trap: <reason> at pc <n> (<disassembly>) <file>:<line>". */
 const char *core_trap_message(const Core *c);
@@ -172,6 +181,9 @@ void core_set_hook(Core *c, CoreHook hook, void *ctx);
 void core_set_op_hook(Core *c, int op, CoreHook hook);
 /* The hook's CoreFollow (see there), or NULL for none; core_set_hook clears it. */
 void core_set_follow(Core *c, CoreFollow *f);
+/* The record of the instruction the core last gave its hook (after CORE_EXIT_YIELD: the one the
+ * hook stopped at). */
+const CoreRecord *core_record(const Core *c);
 
 /* State access (for tests, the CLI and the renderer). */
 int core_lanes(const Core *c);

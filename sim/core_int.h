@@ -70,6 +70,7 @@ struct Core {
     CoreHook hook_op[ISA_OP_COUNT]; /* the hook each opcode's records go to (core_set_op_hook) */
     void *hook_ctx;
     CoreFollow *follow;           /* the hook's, or &no_follow */
+    uint64_t slice_left;          /* the instructions the last run slice had left (core_slice_executed) */
     CoreFollow no_follow;         /* where = CORE_FOLLOW_NONE */
     CoreRecord rec;
     char trap[1024];

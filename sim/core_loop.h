@@ -63,8 +63,10 @@ static __attribute__((noinline)) CoreExit CORE_LOOP_NAME(Core *c, uint64_t max_i
 #define ISA_OP(name, code, mnem, fmt, acc, unit, cat, flags, desc)                              \
     op_##name:                                                                                  \
         r = CORE_EXEC_##unit(c, &x, ISA_OP_##name);                                             \
-        if (r)                                                                                  \
+        if (r) {                                                                                \
+            c->slice_left = left;                                                               \
             return CORE_EXIT_TRAP;                                                              \
+        }                                                                                       \
         row[ISA_OP_##name]++;                                                                   \
         if ((flags) & ISA_FL_VEC)                                                               \
             row[ISA_OP_COUNT] += (uint64_t)popcount64(x.lanes);                                 \
@@ -76,6 +78,12 @@ static __attribute__((noinline)) CoreExit CORE_LOOP_NAME(Core *c, uint64_t max_i
             } else {                                                                            \
                 c->rec.next_pc = x.halt ? c->pc : x.next;                                       \
                 c->hook_op[ISA_OP_##name](c->hook_ctx, &c->rec);                                \
+                if (__builtin_expect(f_->yield, 0)) { /* the record stays for the hook's owner */ \
+                    if (!x.halt)                                                                \
+                        c->pc = x.next;                                                         \
+                    c->slice_left = left;                                                       \
+                    return CORE_EXIT_YIELD;                                                     \
+                }                                                                               \
             }                                                                                   \
             /* what record_reset leaves to the memory families: the addresses, and the count and \
              * base that only the AGU's and the partition unit's set */                          \
@@ -88,8 +96,10 @@ static __attribute__((noinline)) CoreExit CORE_LOOP_NAME(Core *c, uint64_t max_i
                 c->rec.base = 0;                                                                \
             }                                                                                   \
         }                                                                                       \
-        if (x.halt)                                                                             \
+        if (x.halt) {                                                                           \
+            c->slice_left = left;                                                               \
             return CORE_EXIT_HALT;                                                              \
+        }                                                                                       \
         c->pc = x.next;                                                                         \
         CORE_NEXT();
 #include "../isa/opcodes.def"
@@ -97,9 +107,11 @@ static __attribute__((noinline)) CoreExit CORE_LOOP_NAME(Core *c, uint64_t max_i
 #undef CORE_NEXT
 
 op_end:
+    c->slice_left = left;
     trap(c, "pc past the end of the program (%u instructions)", c->ncode);
     return CORE_EXIT_TRAP;
 limit:
+    c->slice_left = 0;
     trap(c, "instruction limit of %llu reached", (unsigned long long)limit);
     return CORE_EXIT_LIMIT;
 }

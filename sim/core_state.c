@@ -298,6 +298,8 @@ void core_set_op_hook(Core *c, int op, CoreHook hook)
         c->hook_op[op] = hook;
 }
 
+const CoreRecord *core_record(const Core *c) { return &c->rec; }
+
 void core_set_follow(Core *c, CoreFollow *f)
 {
     c->no_follow.where = CORE_FOLLOW_NONE;

@@ -118,7 +118,9 @@ static StatsCtx stats_ctx(const Report *r)
         [RUN_REFERENCE] = STATS_M_REF, [RUN_FUNCTIONAL] = STATS_M_FUNC, [RUN_DETAILED] = STATS_M_DET,
         [RUN_SAMPLED] = STATS_M_SAMP};
     int kernel = run_mode_kernel(r->mode);
-    StatsCtx c = {.mode = mode_bit[r->mode] | (kernel && r->fr->f.kd ? STATS_M_KD : 0),
+    StatsCtx c = {.mode = mode_bit[r->mode] | (kernel && r->fr->f.kd ? STATS_M_KD : 0) |
+                          (kernel && r->fr->f.chip_cores ? STATS_M_CHIP : 0) |
+                          (kernel && r->fr->f.chip_mem ? STATS_M_SHARED : 0),
                   .cfg = r->cfg, .run = &r->fr->run, .f = kernel ? &r->fr->f : NULL,
                   .t = run_mode_timed(r->mode) ? &r->fr->f.timing : NULL,
                   .est = r->fr->has_est ? &r->fr->est : NULL,

@@ -8,6 +8,8 @@
  * outside the table and its fig_* function, or write a non-statistics block (render.c does).
  */
 #include "stats.h"
+
+#include "chip/chip.h"
 #include "stats_walk.h"
 
 #include <cjson/cJSON.h>
@@ -60,6 +62,7 @@ int stats_dim_size(StatsDim d)
     case STATS_D_KIND: return FUNC_KD_KINDS;
     case STATS_D_COUNTER: return FUNC_KD_COUNTERS;
     case STATS_D_BOUND: return 2;
+    case STATS_D_CORE: return 0;
     case STATS_D_COUNT: break;
     }
     return 0;
@@ -77,7 +80,7 @@ const char *stats_dim_key(StatsDim d, int i)
     case STATS_D_KIND: return func_kd_kind_keys[i];
     case STATS_D_COUNTER: return func_kd_counter_keys[i];
     case STATS_D_BOUND: return bound_keys[i];
-    case STATS_D_GEN: case STATS_D_TILE: case STATS_D_COUNT: break;
+    case STATS_D_GEN: case STATS_D_TILE: case STATS_D_CORE: case STATS_D_COUNT: break;
     }
     return "";
 }
@@ -91,6 +94,8 @@ int stats_dim_len(const StatsCtx *c, StatsDim d)
     }
     if (d == STATS_D_TILE)
         return c->f ? (int)c->f->ntiles : 0;
+    if (d == STATS_D_CORE)
+        return c->f ? (int)c->f->chip_cores : 0;
     return stats_dim_size(d);
 }
 
@@ -230,7 +235,16 @@ StatsFrame stats_frame(const TimingStats *t, double instructions, double clock_m
 StatsFrame stats_frame_of(const StatsCtx *c)
 {
     double instructions = c->est_instructions ? c->est_instructions->total : c->f ? (double)c->f->instructions : 0.0;
-    return stats_frame(c->t, instructions, c->cfg ? c->cfg->core_clock_mhz : 0.0, c->est);
+    const double mhz = c->cfg ? c->cfg->core_clock_mhz : 0.0;
+    StatsFrame s = stats_frame(c->t, instructions, mhz, c->est);
+    if (c->f && c->f->chip_cores && !c->est) { /* a chip: the makespan; busy over the K cores */
+        const double hz = mhz * 1e6, k = (double)c->f->chip_cores;
+        s.cycles = s.cycles_lo = s.cycles_hi = (double)c->f->makespan;
+        s.busy = (double)c->t->busy / k;
+        s.fps = s.fps_lo = s.fps_hi = s.cycles > 0 ? hz / s.cycles : 0.0;
+        s.fps_no_stall = s.busy > 0 ? hz / s.busy : 0.0;
+    }
+    return s;
 }
 /* A ratio, and whether it has a meaning (its denominator is not 0). */
 static double defined_if(double v, int ok, int *na)
@@ -344,6 +358,101 @@ FIG(kd_total_per_ray)
     return defined_if(stats_ratio(counts[idx[0]], rays), rays > 0, na);
 }
 
+/* ---- a chip's figures (docs/chip.md) -------------------------------------------------------- */
+
+static const ChipMemStats *mem_of(const StatsCtx *c) { return c->f->chip_mem; }
+/* busy (0), stall (1), idle (2) cycles summed over the cores */
+static double chip_sum(const StatsCtx *c, int which)
+{
+    double s = 0;
+    for (uint32_t k = 0; k < c->f->chip_cores; k++)
+        s += (double)(which == 0 ? c->f->cores[k].busy : which == 1 ? c->f->cores[k].stall : c->f->cores[k].idle);
+    return s;
+}
+FIG(chip_cores) { UNUSED_FIG_ARGS; return c->f->chip_cores; }
+FIG(chip_busy) { UNUSED_FIG_ARGS; return chip_sum(c, 0); }
+FIG(chip_stall) { UNUSED_FIG_ARGS; return chip_sum(c, 1); }
+FIG(chip_idle) { UNUSED_FIG_ARGS; return chip_sum(c, 2); }
+FIG(chip_imbalance)
+{
+    (void)idx;
+    double most = 0, sum = 0;
+    for (uint32_t k = 0; k < c->f->chip_cores; k++) {
+        const double a = (double)(c->f->cores[k].busy + c->f->cores[k].stall);
+        sum += a;
+        if (a > most)
+            most = a;
+    }
+    return defined_if(sum > 0 ? most * c->f->chip_cores / sum : 0.0, sum > 0, na);
+}
+FIG(chip_unused)
+{
+    UNUSED_FIG_ARGS;
+    double n = 0;
+    for (uint32_t k = 0; k < c->f->chip_cores; k++)
+        n += c->f->cores[k].tiles == 0;
+    return n;
+}
+FIG(mem_read_latency)
+{
+    (void)idx;
+    return defined_if(stats_ratio(mem_of(c)->read_latency, mem_of(c)->requests), mem_of(c)->requests > 0, na);
+}
+FIG(l2_present) { UNUSED_FIG_ARGS; return mem_of(c)->has_l2; }
+FIG(noc_present) { UNUSED_FIG_ARGS; return mem_of(c)->has_noc; }
+FIG(l2_hit_rate)
+{
+    (void)idx;
+    const L2Stats *l = &mem_of(c)->l2;
+    return defined_if(stats_ratio(l->hits, l->reads + l->writes), l->reads + l->writes > 0, na);
+}
+FIG(l2_mpki)
+{
+    (void)idx;
+    return defined_if(1000.0 * stats_ratio(mem_of(c)->l2.misses, c->f->instructions), c->f->instructions > 0, na);
+}
+FIG(l2_read_latency)
+{
+    (void)idx;
+    const L2Stats *l = &mem_of(c)->l2;
+    return defined_if(stats_ratio(l->read_latency, l->reads), l->reads > 0, na);
+}
+/* The frame's seconds: the makespan at the cores' clock. */
+static double frame_seconds(const StatsCtx *c) { return (double)c->f->makespan / (c->cfg->core_clock_mhz * 1e6); }
+FIG(dram_bandwidth)
+{
+    (void)idx;
+    const double s = frame_seconds(c);
+    return defined_if(s > 0 ? (double)mem_of(c)->dram.bytes / s / 1e9 : 0.0, s > 0, na);
+}
+FIG(dram_peak) { UNUSED_FIG_ARGS; return mem_of(c)->dram_peak_gbs; }
+FIG(dram_utilization)
+{
+    const double s = frame_seconds(c), peak = mem_of(c)->dram_peak_gbs;
+    (void)idx;
+    return defined_if(s > 0 && peak > 0 ? (double)mem_of(c)->dram.bytes / s / 1e9 / peak : 0.0, s > 0 && peak > 0, na);
+}
+FIG(dram_read_latency_ns)
+{
+    (void)idx;
+    const DramChanStats *d = &mem_of(c)->dram;
+    return defined_if(stats_ratio(d->read_latency, d->reads) * 1000.0 / mem_of(c)->dram_clock_mhz, d->reads > 0, na);
+}
+FIG(dram_row_hit_rate)
+{
+    (void)idx;
+    const DramChanStats *d = &mem_of(c)->dram;
+    const uint64_t all = d->row_hits + d->row_misses + d->row_conflicts;
+    return defined_if(stats_ratio(d->row_hits, all), all > 0, na);
+}
+FIG(dram_queue_avg)
+{
+    (void)idx;
+    const DramChanStats *d = &mem_of(c)->dram;
+    return defined_if(stats_ratio(d->occupancy_sum, d->cycles) / (mem_of(c)->dram_channels ? mem_of(c)->dram_channels : 1),
+                      d->cycles > 0, na);
+}
+
 /* ---- the table ------------------------------------------------------------------------------ */
 
 #define RUN(f) STATS_SRC_RUN, offsetof(StatsRun, f), NULL, 0
@@ -352,6 +461,8 @@ FIG(kd_total_per_ray)
 #define TIMING(f) STATS_SRC_TIMING, offsetof(TimingStats, f), NULL, 0
 #define TILE(f) STATS_SRC_TILE, offsetof(FuncTile, f), NULL, 0
 #define TILE32(f) STATS_SRC_TILE, offsetof(FuncTile, f), NULL, 1
+#define CHIPCORE(f) STATS_SRC_CHIPCORE, offsetof(FuncCore, f), NULL, 0
+#define CHIPMEM(f) STATS_SRC_CHIPMEM, offsetof(ChipMemStats, f), NULL, 0
 #define FN(name) STATS_SRC_FN, 0, fig_##name, 0
 #define EXTERNAL STATS_SRC_EXTERNAL, 0, NULL, 0
 #define D0 0, {0}
@@ -378,6 +489,8 @@ _Static_assert(sizeof stats_rows / sizeof stats_rows[0] <= STATS_MAX_ROWS, "stat
 #undef TIMING
 #undef TILE
 #undef TILE32
+#undef CHIPCORE
+#undef CHIPMEM
 #undef FN
 #undef EXTERNAL
 #undef D0
@@ -403,6 +516,8 @@ double stats_row_value(const StatsCtx *c, const StatsRow *r, const int *idx, int
     case STATS_SRC_FUNC: base = (const unsigned char *)c->f; break;
     case STATS_SRC_TIMING: base = (const unsigned char *)c->t; break;
     case STATS_SRC_TILE: base = (const unsigned char *)&c->f->tiles[idx[0]]; d0 = 1; break;
+    case STATS_SRC_CHIPCORE: base = (const unsigned char *)&c->f->cores[idx[0]]; d0 = 1; break;
+    case STATS_SRC_CHIPMEM: base = (const unsigned char *)c->f->chip_mem; break;
     case STATS_SRC_EXTERNAL: default: return 0.0;
     }
     size_t el = 0;   /* row-major over the dimensions' static sizes: the C array's layout */
@@ -420,9 +535,9 @@ double stats_row_value(const StatsCtx *c, const StatsRow *r, const int *idx, int
 
 int stats_row_present(const StatsRow *r, unsigned mode)
 {
-    if (!(r->modes & mode & ~(unsigned)STATS_M_KD))
+    if (!(r->modes & mode & ~(unsigned)STATS_M_QUALIFIERS))
         return 0;
-    return !(r->modes & STATS_M_KD) || (mode & STATS_M_KD);
+    return (r->modes & STATS_M_QUALIFIERS & ~mode) == 0; /* each qualifier the row has, the run has */
 }
 
 /* Every mode has the key: null where the row is not (cycles in functional mode). */
@@ -649,7 +764,8 @@ int stats_json(cJSON *root, const StatsCtx *c)
 static size_t src_size(StatsSrc s)
 {
     return s == STATS_SRC_RUN ? sizeof(StatsRun) : s == STATS_SRC_CORE ? sizeof(CoreStats) : s == STATS_SRC_FUNC ? sizeof(FuncStats)
-         : s == STATS_SRC_TIMING ? sizeof(TimingStats) : s == STATS_SRC_TILE ? sizeof(FuncTile) : 0;
+         : s == STATS_SRC_TIMING ? sizeof(TimingStats) : s == STATS_SRC_TILE ? sizeof(FuncTile)
+         : s == STATS_SRC_CHIPCORE ? sizeof(FuncCore) : s == STATS_SRC_CHIPMEM ? sizeof(ChipMemStats) : 0;
 }
 
 int stats_row_check(const StatsRow *r, char *err, size_t errlen)
@@ -667,6 +783,10 @@ int stats_row_check(const StatsRow *r, char *err, size_t errlen)
         what = "a TILE field's first dimension is the tile";
     else if (r->src != STATS_SRC_TILE && r->ndims && r->dims[0] == STATS_D_TILE)
         what = "the tile dimension indexes FuncTile fields";
+    else if ((r->src == STATS_SRC_CHIPCORE) != (r->ndims && r->dims[0] == STATS_D_CORE) && r->src != STATS_SRC_FN)
+        what = "a CHIPCORE field's first dimension is the core, and the core dimension indexes FuncCore fields";
+    else if ((r->src == STATS_SRC_CHIPCORE || r->src == STATS_SRC_CHIPMEM) && !(r->modes & STATS_M_CHIP))
+        what = "a chip's field is in a chip's run only (M(CHIP))";
     else if (list && (r->ndims != 1 || r->text == STATS_T_MORE))
         what = "a list has one dimension";
     else if ((r->text == STATS_T_MORE && r->ndims) || (r->text == STATS_T_LINE && r->ndims > 1 && !list))
@@ -681,7 +801,7 @@ int stats_row_check(const StatsRow *r, char *err, size_t errlen)
         what = "the row appears in no mode";
     if (!what && src_size(r->src)) {
         size_t n = r->u32 ? 4 : 8;
-        for (int k = r->src == STATS_SRC_TILE; k < r->ndims; k++)
+        for (int k = r->src == STATS_SRC_TILE || r->src == STATS_SRC_CHIPCORE; k < r->ndims; k++)
             n *= (size_t)stats_dim_size(r->dims[k]);
         if (r->offset + n > src_size(r->src))
             what = "its field and dimensions reach past the end of the struct";
@@ -690,7 +810,8 @@ int stats_row_check(const StatsRow *r, char *err, size_t errlen)
         for (int k = 0; k < r->ndims && !what; k++) {
             char ph[32];
             snprintf(ph, sizeof ph, "{%s}", stats_dim_names[r->dims[k]]);
-            if (!strstr(r->csv, ph) || r->dims[k] == STATS_D_GEN || r->dims[k] == STATS_D_TILE)
+            if (!strstr(r->csv, ph) || r->dims[k] == STATS_D_GEN || r->dims[k] == STATS_D_TILE ||
+                r->dims[k] == STATS_D_CORE)
                 what = "its CSV name does not name each (static) dimension";
         }
     }

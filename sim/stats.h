@@ -55,6 +55,9 @@ enum {
     STATS_M_SAMP = 1 << 3,   /* --mode sampled */
     STATS_M_EXEC = 1 << 4,   /* sfsim exec --timing, sfsim trace --mode detailed: TimingStats only */
     STATS_M_KD = 1 << 5,     /* with accel.structure = kd (a row's modes: only then) */
+    STATS_M_CHIP = 1 << 6,   /* a chip's run: chip.cores > 1 or chip.memory = shared (only then) */
+    STATS_M_SHARED = 1 << 7, /* with chip.memory = shared (only then) */
+    STATS_M_QUALIFIERS = STATS_M_KD | STATS_M_CHIP | STATS_M_SHARED,
     STATS_M_KERNEL = STATS_M_FUNC | STATS_M_DET | STATS_M_SAMP,
     STATS_M_TIMED = STATS_M_DET | STATS_M_SAMP,
     STATS_M_ALL = STATS_M_REF | STATS_M_KERNEL,
@@ -67,6 +70,8 @@ typedef enum StatsSrc {
     STATS_SRC_FUNC,      /* a uint64 field of FuncStats */
     STATS_SRC_TIMING,    /* a uint64 field of TimingStats */
     STATS_SRC_TILE,      /* a field of FuncTile (first dimension: the tile) */
+    STATS_SRC_CHIPCORE,  /* a uint64 field of FuncCore, the core's (FuncStats.cores[core]) */
+    STATS_SRC_CHIPMEM,   /* a uint64 field of ChipMemStats (FuncStats.chip_mem) */
     STATS_SRC_FN,        /* a derived figure computed in stats.c */
     STATS_SRC_EXTERNAL,  /* written by its owner (render.c's host block); read back by the CSV */
 } StatsSrc;
@@ -82,7 +87,8 @@ typedef enum StatsSrc {
     X(UNIT,     "unit",     "functional-unit class (isa.h ISA_UNITS)") \
     X(KIND,     "kind",     "ray kind: camera, indirect, shadow") \
     X(COUNTER,  "counter",  "kd-tree counter of the kernel (KC_* in kernels/lib/abi.inc)") \
-    X(BOUND,    "bound",    "a 95 % interval's bound: lo, hi (array)")
+    X(BOUND,    "bound",    "a 95 % interval's bound: lo, hi (array)") \
+    X(CORE,     "core",     "a core of the chip (array, chip.cores)")
 
 typedef enum StatsDim {
 #define STATS_DIM_ENUM(name, key, desc) STATS_D_##name,

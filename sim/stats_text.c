@@ -98,6 +98,11 @@ static void headline(TextW *w, const StatsRow *r)
             "sample       the shares and unit lines below are those of the %u sampled units (docs/sampling.md)\n",
             r->label, s.cycles, s.cycles_lo, s.cycles_hi, s.busy, s.cycles - s.busy, c->est->n, c->est->N, s.fps,
             s.fps_lo, s.fps_hi, mhz, s.fps_no_stall, c->est->n);
+    else if (c->f && c->f->chip_cores)
+        out(w, "%-12s %llu, the makespan of %u cores (core-cycles: %llu busy + %llu stalled + %llu idle); %.2f fps "
+            "at %g MHz (%.2f fps with no stalls and even load)\n", r->label, (unsigned long long)c->f->makespan,
+            c->f->chip_cores, (unsigned long long)t->busy, (unsigned long long)(t->cycles - t->busy),
+            (unsigned long long)((uint64_t)c->f->chip_cores * c->f->makespan - t->cycles), s.fps, mhz, s.fps_no_stall);
     else
         out(w, "%-12s %llu = %llu busy + %llu stalled; %.2f fps at %g MHz (%.2f fps with no stalls)\n", r->label,
             (unsigned long long)t->cycles, (unsigned long long)t->busy, (unsigned long long)(t->cycles - t->busy),
@@ -217,6 +222,7 @@ static int dim_sums(StatsDim d)
     switch (d) {
     case STATS_D_STAGE: case STATS_D_FILTER: case STATS_D_CAUSE: case STATS_D_CATEGORY: case STATS_D_GEN:
     case STATS_D_TILE: case STATS_D_OPCODE: case STATS_D_UNIT: case STATS_D_KIND: return 1;
+    case STATS_D_CORE: return 1;
     case STATS_D_COUNTER: case STATS_D_BOUND: case STATS_D_COUNT: break;
     }
     return 0;

@@ -67,6 +67,7 @@ void timing_free(Timing *t)
     if (!t)
         return;
     evq_free(&t->q);
+    tm_pend_free(t);
     for (uint32_t i = 0; i < t->desc_cap; i++)
         free(t->desc[i].memo);
     free(t->desc);
@@ -78,15 +79,40 @@ void timing_free(Timing *t)
 
 
 
-void timing_reset(Timing *t)
+/* Cold units from cycle `at` (the scoreboard, the queues, the units and the L1). */
+static void units_cold(Timing *t, uint64_t at)
 {
     evq_clear(&t->q);
-    t->now = 0;
+    t->now = t->base = at;
 #define TM_UNIT(field, Type, Params, Stats, params_fn, prefix) prefix##_reset(&t->field);
 #include "machine/units.def"
 #undef TM_UNIT
     t->halted = 0;
+    t->follow.yield = 0;
     memo_none(t);
+}
+
+void timing_continue(Timing *t, int cold)
+{
+    if (t->mmode == MM_REPLAY)
+        memo_retime(t, 0, NULL, 0);
+    memo_none(t);
+    if (cold) {
+        units_cold(t, t->now);
+        return;
+    }
+    t->base = t->now; /* (what is still in flight, an issue interval, goes on as it would) */
+    t->halted = 0;
+    t->follow.yield = 0;
+}
+
+uint64_t timing_now(const Timing *t) { return t->now; }
+
+void timing_set_fb_base(Timing *t, uint64_t base) { t->mem.fb_base = base; }
+
+void timing_reset(Timing *t)
+{
+    units_cold(t, 0);
     if (++t->run == 0) { /* wrapped: no entry may look current */
         memo_fold_all(t);
         for (uint32_t i = 0; i < t->desc_cap; i++)
@@ -150,7 +176,7 @@ void timing_end(Timing *t)
         memo_retime(t, 0, NULL, 0);
     memo_none(t);
     if (!t->halted) {
-        t->st.cycles += t->now;
+        t->st.cycles += t->now - t->base;
         t->st.runs++;
         t->halted = 1;
     }

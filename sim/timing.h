@@ -93,6 +93,32 @@ void timing_free(Timing *t);
 /* A cold machine for the next program run (empty queues, idle units, empty cache, time 0);
  * statistics keep accumulating. */
 void timing_reset(Timing *t);
+/* The next program run on the same core from the cycle the last one ended in (a chip's core,
+ * docs/chip.md): the same program; cold: its units idle and its L1 empty as after timing_reset,
+ * else everything as the last run left it. The cycles of the run count from there. */
+void timing_continue(Timing *t, int cold);
+/* Where the core's framebuffer starts in the framebuffer's physical space (a chip: its tile's
+ * place in the frame's framebuffer, so that two tiles' lines never meet below the L1s). */
+void timing_set_fb_base(Timing *t, uint64_t base);
+/* The cycle the next instruction may issue in. */
+uint64_t timing_now(const Timing *t);
+
+/* ---- a chip's core (docs/chip.md, sim/timing/pend.c) ----
+ * The L1's misses and write-backs leave through out(ctx, line address, write, cycle, fill): a read
+ * names its fill (a write UINT32_MAX), whose answer the chip gives back with timing_answer. Until
+ * then the data are pending: an instruction that needs them yields (the core stops with
+ * CORE_EXIT_YIELD, timing_yielded), and is timed with timing_resume once timing_blocked says its
+ * answers are in. 0; -1 on out of memory. */
+typedef void (*TimingOut)(void *ctx, uint64_t addr, int write, uint64_t cycle, uint32_t fill);
+int timing_chip(Timing *t, TimingOut out, void *ctx);
+void timing_answer(Timing *t, uint32_t fill, uint64_t cycle);
+int timing_yielded(const Timing *t);
+/* Whether rec, the record the core yielded at, still waits for an answer. */
+int timing_blocked(Timing *t, const CoreRecord *rec);
+void timing_resume(Timing *t, const CoreRecord *rec);
+/* Fills sent and not answered yet. */
+uint32_t timing_fills_out(const Timing *t);
+
 /* The CoreHook: one executed instruction. */
 void timing_hook(void *ctx, const CoreRecord *rec);
 /* The hook for the records of opcode op: timing_hook's work specialized to the op's kind of

@@ -47,13 +47,15 @@ static char *slurp(const char *path)
 }
 
 /* The sections, by the modes a row appears in. */
-enum { SEC_EVERY, SEC_REF, SEC_KERNEL, SEC_TIMED, SEC_KD, SEC_TEXT, SEC_COUNT };
+enum { SEC_EVERY, SEC_REF, SEC_KERNEL, SEC_TIMED, SEC_KD, SEC_CHIP, SEC_SHARED, SEC_TEXT, SEC_COUNT };
 static const char *const sec_titles[SEC_COUNT] = {
     "Every mode (the timing figures are `null` unless detailed or sampled)",
     "Reference mode (the golden model)",
     "Kernel modes (`functional`, `detailed`, `sampled`)",
     "Detailed and sampled modes (sampled: the frame figures are estimates, the breakdowns the sampled units', docs/sampling.md)",
     "Kernel modes with `accel.structure = kd` (the `kd` object)",
+    "Detailed mode on a chip: `chip.cores` > 1 or `chip.memory = shared` (the `chip` and `cores` objects; docs/chip.md)",
+    "Detailed mode with `chip.memory = shared` (the `memory`, `l2`, `noc` and `dram` objects; docs/chip.md)",
     "report.txt only (no report.json key)",
 };
 
@@ -64,6 +66,10 @@ static int section(const StatsRow *r)
         return SEC_TEXT;
     if (r->modes & STATS_M_KD)
         return SEC_KD;
+    if (r->modes & STATS_M_SHARED)
+        return SEC_SHARED;
+    if (r->modes & STATS_M_CHIP)
+        return SEC_CHIP;
     if ((m & STATS_M_ALL) == STATS_M_ALL || (r->flags & STATS_F_NULLED))
         return SEC_EVERY;
     if (m == STATS_M_REF)
@@ -123,6 +129,8 @@ static void print_dims(void)
             printf("0 .. generations reached - 1");
         else if (d == STATS_D_TILE)
             printf("every tile");
+        else if (d == STATS_D_CORE)
+            printf("every core, 0 .. chip.cores - 1");
         else if (d == STATS_D_OPCODE)
             printf("the mnemonics of docs/isa.md");
         else

@@ -42,7 +42,7 @@ static __attribute__((noinline)) uint64_t mem_issue_lanes(SceneMem *m, Cache *l1
 {
     uint64_t lines[ISA_MAX_LANES], d[ISA_MAX_LANES];
     for (int i = 0; i < naddr; i++)
-        lines[i] = cache_line(l1, mem_phys(flags, addr[i]));
+        lines[i] = cache_line(l1, mem_phys(m, flags, addr[i]));
     int k = lines_distinct(lines, naddr, d);
     *ready = 0;
     uint64_t slot = at;
@@ -52,9 +52,7 @@ static __attribute__((noinline)) uint64_t mem_issue_lanes(SceneMem *m, Cache *l1
             in_slot = 0;
         }
         in_slot++;
-        uint64_t r = cache_access(l1, d[i] << l1->line_shift, slot, write);
-        if (r > *ready)
-            *ready = r;
+        *ready = cache_join(l1, *ready, cache_access(l1, d[i] << l1->line_shift, slot, write));
     }
     m->st.instructions++;
     return ((uint64_t)k + (uint64_t)m->p.ports - 1) / (uint64_t)m->p.ports;
@@ -67,7 +65,7 @@ uint64_t mem_issue(SceneMem *m, Cache *l1, uint32_t flags, const uint32_t *addr,
     if (naddr != 1)
         return mem_issue_lanes(m, l1, flags, write, addr, naddr, at, ready);
     /* a scalar access: one line, no search for distinct lines */
-    *ready = cache_access(l1, mem_phys(flags, addr[0]), at, write);
+    *ready = cache_access(l1, mem_phys(m, flags, addr[0]), at, write);
     m->st.instructions++;
     return 1;
 }

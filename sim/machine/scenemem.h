@@ -32,6 +32,8 @@ typedef struct SceneMemStats {    /* uint64_t only (timing_stats_add) */
 
 typedef struct SceneMem {
     SceneMemParams p;
+    uint64_t fb_base;          /* where the core's framebuffer starts in the framebuffer space (a
+                                  chip: its tile's place in the frame's; else 0) */
     SceneMemStats st;
 } SceneMem;
 
@@ -41,9 +43,9 @@ void mem_free(SceneMem *m);
 
 /* The physical address (sim/mem/port.h) of byte addr of an instruction with ISA flags `flags`:
  * ISA_FL_FB picks the framebuffer's space. */
-static inline uint64_t mem_phys(uint32_t flags, uint32_t addr)
+static inline uint64_t mem_phys(const SceneMem *m, uint32_t flags, uint32_t addr)
 {
-    return (flags & ISA_FL_FB) ? (uint64_t)1 << MEM_SPACE_SHIFT | addr : addr;
+    return (flags & ISA_FL_FB) ? ((uint64_t)1 << MEM_SPACE_SHIFT) + m->fb_base + addr : addr;
 }
 
 /* One scene-memory or framebuffer instruction (flags: its ISA flags; ISA_FL_FB picks the

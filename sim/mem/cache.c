@@ -22,6 +22,12 @@ int cache_init(Cache *c, const CacheParams *p)
 
 void cache_connect(Cache *c, MemPort below) { c->below = below; }
 
+void cache_set_join(Cache *c, MemJoin join, void *ctx)
+{
+    c->join = join;
+    c->jctx = ctx;
+}
+
 void cache_free(Cache *c)
 {
     free(c->tag);
@@ -121,7 +127,16 @@ uint64_t cache_access(Cache *c, uint64_t addr, uint64_t t, int write)
     if (write) /* a load leaves the line as it was */
         c->dirty[k] = 1;
     const uint64_t r = t + (uint64_t)c->p.hit_latency;
+    if (__builtin_expect(c->join != NULL, 0))
+        return cache_join(c, r, c->ready[k]);
     return r > c->ready[k] ? r : c->ready[k];
+}
+
+void cache_fill_done(Cache *c, uint64_t addr, uint64_t pending, uint64_t x)
+{
+    size_t k;
+    if (cache_peek(c, addr, &k) && c->ready[k] == pending)
+        c->ready[k] = x;
 }
 
 int cache_peek(const Cache *c, uint64_t addr, size_t *way)

@@ -43,6 +43,8 @@ typedef struct Cache {
     size_t last_way;              /* the way of the last hit or fill (tag index), tried first */
     int instantiated;
     MemPort below;
+    MemJoin join;                 /* NULL unless the port answers later (port.h, MEM_PENDING) */
+    void *jctx;
     CacheStats st;
 } Cache;
 
@@ -52,6 +54,19 @@ void cache_free(Cache *c);
 void cache_reset(Cache *c);
 /* The level below (before the first access). */
 void cache_connect(Cache *c, MemPort below);
+/* A port that may answer later (port.h, MEM_PENDING): a hit on a line whose fill is pending is
+ * ready at join(its hit cycle, the fill's pending value). */
+void cache_set_join(Cache *c, MemJoin join, void *ctx);
+/* The fill of the line holding addr, pending as `pending`, came at cycle x: the line, if it is
+ * still there waiting for that fill, is ready at x. */
+void cache_fill_done(Cache *c, uint64_t addr, uint64_t pending, uint64_t x);
+/* The later of two ready cycles, either maybe pending (MemJoin; the plain maximum without one). */
+static inline uint64_t cache_join(const Cache *c, uint64_t a, uint64_t b)
+{
+    if (__builtin_expect(c->join != NULL, 0) && (mem_pending(a) || mem_pending(b)))
+        return c->join(c->jctx, a, b);
+    return a > b ? a : b;
+}
 /* The line of a physical byte address (port.h). */
 static inline uint64_t cache_line(const Cache *c, uint64_t addr)
 {

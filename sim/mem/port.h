@@ -28,6 +28,18 @@ typedef struct MemPort {
     void *below;
 } MemPort;
 
+/* A ready cycle not known yet (a chip's core: the answer of a shared level below its L1 comes
+ * later, docs/chip.md): bit 63 set and bit 62 clear, the low 32 bits naming what it waits for, an
+ * outstanding line fill or (MEM_PENDING_GROUP) a group of them (sim/timing/pend.c). Such a value
+ * compares above every cycle, so a wait on it is seen as a wait; it never ends up in a statistic.
+ * UINT64_MAX (a level out of memory) is not one. */
+#define MEM_PENDING ((uint64_t)1 << 63)
+#define MEM_PENDING_GROUP ((uint64_t)1 << 61)
+static inline int mem_pending(uint64_t v) { return (v >> 62) == 2; }
+/* The later of two ready cycles when one may be pending: the maximum of two known cycles, or a
+ * pending value standing for both (the joiner's). */
+typedef uint64_t (*MemJoin)(void *ctx, uint64_t a, uint64_t b);
+
 static inline uint64_t port_request(const MemPort *p, uint64_t addr, int write, uint64_t at)
 {
     const MemReq r = {addr, at, (uint8_t)(write != 0)};

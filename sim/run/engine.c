@@ -19,37 +19,12 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "chiprun.h"
+#include "engine_int.h"
 #include "kernel.h"
 #include "tiles.h"
 #include "timedcore.h"
 
-typedef struct Job {
-    const PackedScene *p;
-    const FuncParams *fp;
-    const Kernel *k;
-    float *rgb;
-    uint32_t width, height, tiles_x, ntiles;
-    FuncTile *tiles;
-    uint32_t spp;
-    const uint32_t *units;     /* sampled mode: the round's (tile, pass) units, NULL for whole tiles */
-    uint32_t *passes_done;     /* func_render, when not NULL: the launch's items are (tile, pass)
-                                  units in pass order, each pass after the tile's one before
-                                  (run_tile_pass); each tile's passes finished */
-    atomic_uint tiles_done;    /* ... and the tiles with every pass finished */
-    FuncUnit *unit_out;        /* ... and their figures */
-    struct Worker *workers;    /* one per host thread (sim/run/tiles.h) */
-    int nworkers;
-    atomic_int failed;
-    int trapped;               /* the failure was the kernel's (trap, limit, error code) */
-    pthread_mutex_t lock;
-    char err[1024];
-} Job;
-
-typedef struct Worker {
-    Job *job;
-    TimedCore tc;              /* the core; its timing model in the timed modes */
-    FuncStats st;
-} Worker;
 
 
 static uint32_t spad_u32(Core *c, uint32_t addr)
@@ -78,7 +53,7 @@ static void kd_counts_add(Core *c, const KernelAbi *a, int lanes, FuncStats *st)
         }
 }
 
-static void fail(Job *j, const char *msg, int trapped)
+void eng_fail(Job *j, const char *msg, int trapped)
 {
     pthread_mutex_lock(&j->lock);
     if (!atomic_load(&j->failed)) {
@@ -111,7 +86,7 @@ static int timing_close(Worker *w, const TimingStats *before, FuncUnit *fu)
     for (int c = 0; c < TM_CAUSE_COUNT; c++)
         fu->stalls[c] += s->stalls[c] - before->stalls[c];
     if (timing_error(w->tc.tm)) {
-        fail(w->job, timing_error(w->tc.tm), 0);
+        eng_fail(w->job, timing_error(w->tc.tm), 0);
         return -1;
     }
     return 0;
@@ -184,13 +159,13 @@ static int trace_batch(Worker *w, Core *c, uint32_t t, FuncStats *st)
     if (ex != CORE_EXIT_HALT) {
         snprintf(msg, sizeof msg, "kernel, rays %u..%u: %s%s", first, first + n - 1, core_trap_message(c),
                  ex == CORE_EXIT_LIMIT ? " (sim.max_instructions)" : "");
-        fail(j, msg, 1);
+        eng_fail(j, msg, 1);
         return -1;
     }
     if (spad_u32(c, a->l_error)) {
         snprintf(msg, sizeof msg, "kernel, rays %u..%u: traversal stack overflow (raise spad.size_kb)", first,
                  first + n - 1);
-        fail(j, msg, 1);
+        eng_fail(j, msg, 1);
         return -1;
     }
     for (uint32_t i = 0; i < n; i++) {
@@ -231,7 +206,7 @@ static void tile_place(const Job *j, uint32_t t, FuncTile *ft)
 /* A pass's launch block on a restarted core: the scratchpad's counters cleared (a pass starts
  * from nothing an earlier pass left, so it runs alone exactly as inside its tile), and for a
  * tile's first pass the framebuffer zeroed (the passes add to it). */
-static void pass_launch(Job *j, Core *c, const FuncTile *ft, int zero_fb)
+void eng_pass_launch(Job *j, Core *c, const FuncTile *ft, int zero_fb)
 {
     const KernelAbi *a = &j->k->abi;
     core_restart(c);
@@ -248,24 +223,20 @@ static void pass_launch(Job *j, Core *c, const FuncTile *ft, int zero_fb)
         memset(fb, 0, (size_t)ft->w * ft->h * 12);
 }
 
-/* One kernel run: pass `pass` of the launched tile, on a cold machine when timed (fu gets its
- * timed figures). 0, or -1 after fail(). */
-static int run_pass(Worker *w, Core *c, const FuncTile *ft, uint32_t pass, FuncUnit *fu)
+void eng_pass_set(Job *j, Core *c, uint32_t pass)
 {
-    Job *j = w->job;
+    spad_set(c, j->k->abi.l_pass0, pass);
+    spad_set(c, j->k->abi.l_pass1, pass + 1);
+}
+
+int eng_pass_end(Job *j, Core *c, const FuncTile *ft, uint32_t pass, CoreExit ex)
+{
     const KernelAbi *a = &j->k->abi;
-    spad_set(c, a->l_pass0, pass);
-    spad_set(c, a->l_pass1, pass + 1);
-    TimingStats tbefore;
-    timing_begin(w, c, &tbefore);
-    CoreExit ex = core_run(c, (uint64_t)j->fp->cfg->sim_max_instructions);
-    if (timing_close(w, &tbefore, fu))
-        return -1;
     char msg[1400];
     if (ex != CORE_EXIT_HALT) {
         snprintf(msg, sizeof msg, "kernel, tile at (%u, %u), pass %u: %s%s", ft->x0, ft->y0, pass,
                  core_trap_message(c), ex == CORE_EXIT_LIMIT ? " (sim.max_instructions)" : "");
-        fail(j, msg, 1);
+        eng_fail(j, msg, 1);
         return -1;
     }
     uint32_t kerr = spad_u32(c, a->l_error);
@@ -274,15 +245,29 @@ static int run_pass(Worker *w, Core *c, const FuncTile *ft, uint32_t pass, FuncU
                  kerr == a->err_stack         ? "traversal stack overflow (raise spad.size_kb)"
                  : kerr == a->err_generations ? "more generations than the kernel counts (64)"
                                              : "error code set");
-        fail(j, msg, 1);
+        eng_fail(j, msg, 1);
         return -1;
     }
     return 0;
 }
 
+/* One kernel run: pass `pass` of the launched tile, on a cold machine when timed (fu gets its
+ * timed figures). 0, or -1 after eng_fail(). */
+static int run_pass(Worker *w, Core *c, const FuncTile *ft, uint32_t pass, FuncUnit *fu)
+{
+    Job *j = w->job;
+    eng_pass_set(j, c, pass);
+    TimingStats tbefore;
+    timing_begin(w, c, &tbefore);
+    CoreExit ex = core_run(c, (uint64_t)j->fp->cfg->sim_max_instructions);
+    if (timing_close(w, &tbefore, fu))
+        return -1;
+    return eng_pass_end(j, c, ft, pass, ex);
+}
+
 /* The kernel's counters in the scratchpad, from the pass just run, added to st; the rays traced
  * returned. */
-static uint64_t counters_add(Job *j, Core *c, FuncStats *st)
+uint64_t eng_counters_add(Job *j, Core *c, FuncStats *st)
 {
     const KernelAbi *a = &j->k->abi;
     st->dropped += spad_u32(c, a->st_dropped);
@@ -307,21 +292,21 @@ static uint64_t counters_add(Job *j, Core *c, FuncStats *st)
 }
 
 /* Pass `pass` of the tile ft (placed) on core c: its kernel run, with its timed figures, rays,
- * instructions and active lanes added to ft's. 0, or -1 after fail(). */
+ * instructions and active lanes added to ft's. 0, or -1 after eng_fail(). */
 static int tile_pass(Worker *w, Core *c, FuncTile *ft, uint32_t pass, FuncStats *st)
 {
     Job *j = w->job;
     uint64_t before = core_instructions(c), lanes_before[ISA_STAGE_COUNT];
     for (int k = 0; k < ISA_STAGE_COUNT; k++)
         lanes_before[k] = core_stats(c)->active_lanes[k];
-    pass_launch(j, c, ft, pass == 0);
+    eng_pass_launch(j, c, ft, pass == 0);
     FuncUnit fu = {0};
     int rc = run_pass(w, c, ft, pass, &fu);
     if (w->tc.tm)
         tile_add_timed(ft, &fu);
     if (rc)
         return -1;
-    ft->rays += counters_add(j, c, st);
+    ft->rays += eng_counters_add(j, c, st);
     ft->instructions += core_instructions(c) - before;
     for (int k = 0; k < ISA_STAGE_COUNT; k++)
         ft->active_lanes[k] += core_stats(c)->active_lanes[k] - lanes_before[k];
@@ -329,7 +314,7 @@ static int tile_pass(Worker *w, Core *c, FuncTile *ft, uint32_t pass, FuncStats 
 }
 
 /* Tile t placed, its counts zeroed (before its first pass). */
-static FuncTile *tile_start(Job *j, uint32_t t)
+FuncTile *eng_tile_start(Job *j, uint32_t t)
 {
     FuncTile *ft = &j->tiles[t];
     tile_place(j, t, ft);
@@ -347,7 +332,7 @@ static float *tile_row(const Job *j, const FuncTile *ft, uint32_t y)
 
 /* The pixels of the tile ft between the framebuffer's first w x h pixels and the frame's rgb
  * (to_fb: into the framebuffer). */
-static void tile_pixels(Job *j, Core *c, const FuncTile *ft, int to_fb)
+void eng_tile_pixels(Job *j, Core *c, const FuncTile *ft, int to_fb)
 {
     uint32_t size;
     uint8_t *fb = core_mem(c, CORE_MEM_FB, &size);
@@ -368,11 +353,11 @@ static int run_tile(Worker *w, Core *c, uint32_t t, FuncStats *st)
     Job *j = w->job;
     if (j->fp->batch)
         return trace_batch(w, c, t, st);
-    FuncTile *ft = tile_start(j, t);
+    FuncTile *ft = eng_tile_start(j, t);
     for (uint32_t pass = 0; pass < j->spp; pass++)
         if (tile_pass(w, c, ft, pass, st))
             return -1;
-    tile_pixels(j, c, ft, 0);
+    eng_tile_pixels(j, c, ft, 0);
     return 0;
 }
 
@@ -384,12 +369,12 @@ static int run_tile_pass(Worker *w, Core *c, uint32_t i, FuncStats *st)
 {
     Job *j = w->job;
     const uint32_t t = i % j->ntiles, pass = i / j->ntiles;
-    FuncTile *ft = pass ? &j->tiles[t] : tile_start(j, t);
+    FuncTile *ft = pass ? &j->tiles[t] : eng_tile_start(j, t);
     if (pass > 0)
-        tile_pixels(j, c, ft, 1);
+        eng_tile_pixels(j, c, ft, 1);
     if (tile_pass(w, c, ft, pass, st))
         return -1;
-    tile_pixels(j, c, ft, 0);
+    eng_tile_pixels(j, c, ft, 0);
     j->passes_done[t] = pass + 1;
     if (pass + 1 == j->spp) {
         uint32_t done = atomic_fetch_add(&j->tiles_done, 1u) + 1u;
@@ -410,7 +395,7 @@ static int run_unit(Worker *w, Core *c, uint32_t i, FuncStats *st)
     fu->unit = j->units[i];
     FuncTile place;
     tile_place(j, fu->unit / j->spp, &place);
-    pass_launch(j, c, &place, 1);
+    eng_pass_launch(j, c, &place, 1);
     uint64_t before = core_instructions(c), lanes_before[ISA_STAGE_COUNT];
     for (int k = 0; k < ISA_STAGE_COUNT; k++)
         lanes_before[k] = core_stats(c)->active_lanes[k];
@@ -419,14 +404,14 @@ static int run_unit(Worker *w, Core *c, uint32_t i, FuncStats *st)
     fu->instructions = core_instructions(c) - before;
     for (int k = 0; k < ISA_STAGE_COUNT; k++)
         fu->active_lanes[k] = core_stats(c)->active_lanes[k] - lanes_before[k];
-    fu->rays = counters_add(j, c, st);
+    fu->rays = eng_counters_add(j, c, st);
     return 0;
 }
 
 /* sim/run/tiles.h: a core (and in the timed modes a timing model) per host thread, with the scene
  * loaded once and kept until workers_close (sampled mode runs several launches on the same cores);
  * each tile or unit restarts the core. */
-static int worker_begin(void *ctx, int index)
+int eng_worker_begin(void *ctx, int index)
 {
     Job *j = ctx;
     Worker *w = &j->workers[index];
@@ -437,14 +422,14 @@ static int worker_begin(void *ctx, int index)
     int rc = timedcore_open(&w->tc, j->fp->cfg, &j->k->obj, j->fp->timed, err, sizeof err);
     if (rc != 0) {
         snprintf(msg, sizeof msg, "%s: %s", rc == -2 ? "timing model" : "kernel", err);
-        fail(j, msg, 0);
+        eng_fail(j, msg, 0);
         return -1;
     }
     /* The packed scene into scene memory: mapped copy-on-write from the image the caller passed
      * (FuncParams.image, the open scene's), or copied. */
     if (j->fp->image) {
         if (core_load_image(w->tc.core, j->fp->image) != 0) {
-            fail(j, "out of memory loading the scene into scene memory", 0);
+            eng_fail(j, "out of memory loading the scene into scene memory", 0);
             return -1;
         }
     } else {
@@ -481,7 +466,7 @@ static void workers_close(Job *j)
 
 /* The workers' counters, summed in worker order (the totals do not depend on which thread ran
  * which tile). */
-static void stats_sum(FuncStats *st, const Worker *ws, int nthreads)
+void eng_stats_sum(FuncStats *st, const Worker *ws, int nthreads)
 {
     for (int i = 0; i < nthreads; i++) {
         const FuncStats *s = &ws[i].st;
@@ -566,6 +551,8 @@ static void session_free(FuncSession *s)
     workers_close(&s->job);
     free(s->job.tiles);
     free(s->job.workers);
+    free(s->job.cores);
+    free(s->job.chip_mem);
     pthread_mutex_destroy(&s->job.lock);
     if (s->built)
         kernel_free(&s->k);
@@ -602,7 +589,8 @@ int func_open(const PackedScene *p, const FuncParams *fp, FuncSession **out, cha
         session_free(s);
         return -1;
     }
-    job->nworkers = tiles_threads(fp->threads, fp->batch ? job->ntiles : job->ntiles * job->spp);
+    job->nworkers = chip_run_wanted(fp) ? fp->cfg->chip_cores /* a worker per core */
+                                        : tiles_threads(fp->threads, fp->batch ? job->ntiles : job->ntiles * job->spp);
     job->workers = calloc((size_t)job->nworkers, sizeof *job->workers);
     if (!job->workers) {
         snprintf(err, errlen, "out of memory");
@@ -633,7 +621,7 @@ int func_units(FuncSession *s, const uint32_t *units, uint32_t n, FuncUnit *out,
         }
     job->units = units;
     job->unit_out = out;
-    TileLaunch launch = {n, job->nworkers, worker_begin, worker_tile, NULL, job, job->fp->progress,
+    TileLaunch launch = {n, job->nworkers, eng_worker_begin, worker_tile, NULL, job, job->fp->progress,
                          job->fp->progress_ctx, 0};
     tiles_run(&launch);
     job->units = NULL;
@@ -660,7 +648,7 @@ static int session_finish(FuncSession *s, FuncStats *st, char *err, size_t errle
     Job *job = &s->job;
     *st = s->head;
     workers_close(job);
-    stats_sum(st, job->workers, job->nworkers);
+    eng_stats_sum(st, job->workers, job->nworkers);
     int rc = 0;
     if (job->fp->timed) {
         st->timed = 1;
@@ -674,6 +662,12 @@ static int session_finish(FuncSession *s, FuncStats *st, char *err, size_t errle
     st->ntiles = job->ntiles;
     st->tiles_done = job->ntiles;
     job->tiles = NULL;
+    st->chip_cores = job->ncores;
+    st->cores = job->cores;
+    st->makespan = job->makespan;
+    st->chip_mem = job->chip_mem;
+    job->cores = NULL;
+    job->chip_mem = NULL;
     session_free(s);
     return rc;
 }
@@ -706,11 +700,11 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
      * framebuffer the one before left (run_tile_pass). Without an image (rgb NULL), a pass table,
      * or with more units than a launch counts (2^32), whole tiles. */
     uint32_t done;
-    const int by_pass = rgb && !fp->batch && (uint64_t)job->ntiles * job->spp <= UINT32_MAX;
+    const int by_pass = !chip_run_wanted(fp) && rgb && !fp->batch && (uint64_t)job->ntiles * job->spp <= UINT32_MAX;
     job->passes_done = by_pass ? calloc(job->ntiles ? job->ntiles : 1, sizeof *job->passes_done) : NULL;
     if (job->passes_done) {
         atomic_init(&job->tiles_done, 0u);
-        TileLaunch launch = {job->ntiles * job->spp, job->nworkers, worker_begin, worker_tile, NULL, job, NULL, NULL,
+        TileLaunch launch = {job->ntiles * job->spp, job->nworkers, eng_worker_begin, worker_tile, NULL, job, NULL, NULL,
                              job->ntiles};
         tiles_run(&launch);
         done = 0;
@@ -724,8 +718,10 @@ int func_render(const PackedScene *p, const FuncParams *fp, float *rgb, FuncStat
         }
         free(job->passes_done);
         job->passes_done = NULL;
+    } else if (chip_run_wanted(fp)) {
+        done = chip_run_frame(job);
     } else {
-        TileLaunch launch = {job->ntiles, job->nworkers, worker_begin, worker_tile, NULL, job, fp->progress,
+        TileLaunch launch = {job->ntiles, job->nworkers, eng_worker_begin, worker_tile, NULL, job, fp->progress,
                              fp->progress_ctx, 0};
         done = tiles_run(&launch);
     }
@@ -756,4 +752,8 @@ void func_stats_free(FuncStats *st)
 {
     free(st->tiles);
     st->tiles = NULL;
+    free(st->cores);
+    st->cores = NULL;
+    free(st->chip_mem);
+    st->chip_mem = NULL;
 }

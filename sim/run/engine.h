@@ -59,6 +59,7 @@ typedef struct FuncTile {
     uint8_t sampled;           /* timed: every tile in detailed mode; sampled mode: a unit of it was sampled */
     uint32_t units_timed;      /* sampled mode: the tile's units timed */
     uint64_t active_lanes[ISA_STAGE_COUNT]; /* per stage (for sampled mode's utilization) */
+    uint32_t core;             /* a chip's run: the core that rendered it */
 } FuncTile;
 
 /* Sampled mode's unit: one pass of one tile (unit = tile * spp + pass), run alone from a cleared
@@ -71,6 +72,16 @@ typedef struct FuncUnit {
     uint64_t stalls[TM_CAUSE_COUNT];
     uint64_t active_lanes[ISA_STAGE_COUNT];
 } FuncUnit;
+
+/* A chip's core over the frame (docs/chip.md): busy + stall + idle = the makespan. */
+typedef struct FuncCore {
+    uint64_t tiles, instructions;
+    uint64_t busy, stall, idle;
+    uint64_t finish;            /* the cycle its last tile ended (0: it got none) */
+    uint64_t stalls[TM_CAUSE_COUNT];
+} FuncCore;
+
+struct ChipMemStats;
 
 typedef struct FuncStats {
     CoreStats core;                                 /* summed over all tiles */
@@ -96,6 +107,12 @@ typedef struct FuncStats {
     int kd;
     uint32_t kd_stack_depth;
     uint64_t kd_counts[FUNC_KD_KINDS][FUNC_KD_COUNTERS];
+    /* A chip run (chip.cores > 1 or chip.memory = shared, detailed mode): its cores, the frame's
+     * cycles (the makespan) and the shared memory's counters (NULL without one). */
+    uint32_t chip_cores;                            /* 0: not a chip run */
+    FuncCore *cores;
+    uint64_t makespan;
+    struct ChipMemStats *chip_mem;
 } FuncStats;
 
 /* Render the whole image through the kernel: rgb (width * height * 3 floats, zeroed by the

@@ -68,6 +68,11 @@ static int report_problems(const cJSON *j, unsigned mode, const char *path, char
     const cJSON *kd = cJSON_GetObjectItemCaseSensitive(j, "kd");
     if (cJSON_IsObject(kd) && cJSON_IsString(cJSON_GetObjectItemCaseSensitive(kd, "structure")))
         mode |= STATS_M_KD;
+    /* ... and a chip block exactly for a chip's run, a memory block with shared memory */
+    if (cJSON_IsObject(cJSON_GetObjectItemCaseSensitive(j, "chip")))
+        mode |= STATS_M_CHIP;
+    if (cJSON_IsObject(cJSON_GetObjectItemCaseSensitive(j, "memory")))
+        mode |= STATS_M_SHARED;
     int n = stats_csv_check(j, mode, p, SWEEP_REPORT_PROBLEMS);
     if (n == 0)
         return 0;

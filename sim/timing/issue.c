@@ -80,6 +80,10 @@ static inline int hazard(const Timing *t, const TmDesc *d, const CoreRecord *rec
 static __attribute__((noinline)) uint64_t wait_hazards(Timing *t, const TmDesc *d, const CoreRecord *rec,
                                                        uint64_t at, int cause)
 {
+    /* A chip's core: a register waiting for an answer of the shared memory stops the core here,
+     * before anything is charged (sim/timing/pend.c). */
+    if (__builtin_expect(t->pend != NULL, 0) && tm_yield_if_pending(t, d))
+        return TM_YIELDED;
     /* The registers first, in one pass, when no taken-branch bubble is pending (the only hazard
      * above them; no event can start one during a wait): while one waits, the interval goes to the
      * first register in order still waiting, which is where the event-to-event walk below would
@@ -335,7 +339,7 @@ static inline __attribute__((always_inline)) void complete_as(Timing *t, const T
     }
     t->now = end;
     if (flow && __builtin_expect(d->is_halt, 0)) {
-        t->st.cycles += end;
+        t->st.cycles += end - t->base;
         t->st.runs++;
         t->halted = 1;
     }
@@ -392,7 +396,10 @@ static inline __attribute__((always_inline)) uint64_t hazards_cleared(Timing *t,
  * gather's hazards do not read them: part_blocks only asks the ID-stream memory's). */
 static void time_gather_c(Timing *t, const TmDesc *d, const CoreRecord *rec, int c)
 {
-    issue_rb_c(t, d, rec, hazards_cleared(t, d, rec, TM_NO_FLOW), c);
+    const uint64_t at = hazards_cleared(t, d, rec, TM_NO_FLOW);
+    if (__builtin_expect(at == TM_YIELDED, 0))
+        return;
+    issue_rb_c(t, d, rec, at, c);
 }
 
 /* A scalar scene load that hits the line in `way` (its access counted apart: mem_hits): time_kind's
@@ -401,6 +408,8 @@ static void time_gather_c(Timing *t, const TmDesc *d, const CoreRecord *rec, int
 static void time_scene_hit(Timing *t, const TmDesc *d, const CoreRecord *rec, size_t way)
 {
     const uint64_t at = hazards_cleared(t, d, rec, TM_NO_FLOW);
+    if (__builtin_expect(at == TM_YIELDED, 0))
+        return;
     const uint64_t r = at + (uint64_t)t->l1.p.hit_latency, line = t->l1.ready[way];
     count_issue(t, d, rec->stage, rec->gen);
     complete_as(t, d, rec, at, at + 1, r > line ? r : line, TM_SCENE_MEMORY, TM_NO_FLOW);
@@ -469,6 +478,8 @@ static inline __attribute__((always_inline)) void time_kind(Timing *t, const TmD
 {
     const int flow = kind < 0 || kind == TK_PLAIN ? 1 : TM_NO_FLOW; /* (a plain instruction may branch) */
     const uint64_t at = hazards_cleared(t, d, rec, flow);
+    if (__builtin_expect(at == TM_YIELDED, 0))
+        return;
     switch (kind) {
     case TK_PLAIN: /* neither a memory unit nor a special result time (the common case below) */
         break;

@@ -79,6 +79,8 @@ typedef struct TmDesc {
 
 #include "memo.h"
 
+typedef struct Pend Pend;
+
 struct Timing {
     EvQueue q;
     uint64_t now;                  /* the cycle the next instruction may issue in */
@@ -120,6 +122,8 @@ struct Timing {
      * generation (busy + stalls). */
     uint64_t issues[ISA_STAGE_COUNT][CORE_GENERATIONS][2];
     int halted;
+    uint64_t base;                 /* the cycle the program run started in (timing_continue) */
+    Pend *pend;                    /* a chip's core: answers that come later (pend.c); else NULL */
     char err[256];
     TimingStats st;
 };
@@ -173,6 +177,15 @@ static inline void drain(Timing *t, uint64_t at)
         simd_fetch_resumed(&t->simd);
 }
 
+
+/* ---- a chip's core (sim/timing/pend.c) ---------------------------------------------------- */
+
+/* What wait_hazards returns when the instruction yielded (nothing of it timed). */
+#define TM_YIELDED UINT64_MAX
+/* 1 when one of d's registers waits for an answer of the shared memory: the core is told to
+ * yield (CoreFollow.yield) and a recording of a block is dropped. */
+int tm_yield_if_pending(Timing *t, const TmDesc *d);
+void tm_pend_free(Timing *t);
 
 /* ---- what the memo asks of the model (sim/timing/issue.c) --------------------------------- */
 

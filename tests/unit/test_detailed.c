@@ -18,29 +18,15 @@
 #include "../../sim/run/engine.h"
 #include "../../sim/timing.h"
 
+#include "../support/packed.h"
 #include "../support/shared.h"
 
 static Scene scene;
 static PackedScene packed;
 
-static void load(const char *path, int w, int h, int spp)
-{
-    NEEDS_SCENE(path);
-    char err[1024];
-    cr_assert_eq(scene_load(path, &scene, err, sizeof err), 0, "%s: %s", path, err);
-    scene.render.width = w;
-    scene.render.height = h;
-    scene.render.spp = spp;
-    BvhParams bp;
-    bvh_default_params(&bp);
-    cr_assert_eq(pack_scene(&scene, &bp, 0, &packed, err, sizeof err), 0, "%s", err);
-}
+static void load(const char *path, int w, int h, int spp) { packed_load(path, w, h, spp, &scene, &packed); }
 
-static void unload(void)
-{
-    pack_free(&packed);
-    scene_free(&scene);
-}
+static void unload(void) { packed_free(&scene, &packed); }
 
 static float *render(const CfgMachine *cfg, int threads, int timed, FuncStats *st)
 {

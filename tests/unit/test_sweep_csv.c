@@ -181,8 +181,15 @@ Test(sweep_columns, names_in_the_documented_order)
     cr_expect_str_eq(name_of(rays + 7), "kd_underflows_per_ray");
     cr_expect_str_eq(name_of(rays + 8), "kd_camera_nodes_per_ray");
     cr_expect_str_eq(name_of(rays + 8 + 6), "kd_indirect_nodes_per_ray");
-    cr_expect_str_eq(name_of(stats_csv_count() - 1), "kd_shadow_underflows_per_ray");
-    cr_expect_eq(stats_csv_count(), rays + 2 + 6 + 3 * 6);
+    const int chip = rays + 2 + 6 + 3 * 6; /* a chip's, after the kd counters (docs/chip.md) */
+    cr_expect_str_eq(name_of(chip - 1), "kd_shadow_underflows_per_ray");
+    cr_expect_str_eq(name_of(chip), "chip_cores");
+    cr_expect_str_eq(name_of(chip + 1), "load_imbalance");
+    cr_expect_str_eq(name_of(chip + 2), "memory_latency");
+    cr_expect_str_eq(name_of(chip + 3), "l2_hit_rate");
+    cr_expect_str_eq(name_of(chip + 4), "dram_gbs");
+    cr_expect_str_eq(name_of(stats_csv_count() - 1), "dram_bandwidth_share");
+    cr_expect_eq(stats_csv_count(), chip + 6);
 }
 
 /* The plots find their columns by name, once; each group's columns follow its first. */

@@ -1,0 +1,68 @@
+/* sim/chip/chip.h -- the memory the chip's cores share (docs/chip.md): the on-chip network, the
+ * L2 and DRAM, each optional, joined as levels (sim/mem/level.h), with the cores' scene caches
+ * above them, stepped in one global time order.
+ *
+ * Owns: building the shared levels from the config (chip.*, noc.*, l2.*, dram.*), the cores'
+ * requests on their way in (ordered by cycle, then core, then the order a core sent them),
+ * stepping the levels one cycle of theirs at a time, and handing each answer to its core's
+ * timing model (timing_answer). Must not: run a core, hand out work, or decide when a cycle may
+ * be stepped (its caller, the chip's run in sim/run/chiprun.c, keeps the rule of docs/chip.md).
+ *
+ * A request a core's L1 makes in cycle c enters the shared memory in cycle c + 1 (the cycle it
+ * takes to leave the core); so once the memory has done cycle e, a core that goes on from cycle
+ * e can still send anything it has to, and nothing the memory did in cycle e could have changed.
+ */
+#ifndef SFSIM_CHIP_CHIP_H
+#define SFSIM_CHIP_CHIP_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../config.h"
+#include "../mem/dram.h"
+#include "../mem/l2.h"
+#include "../mem/noc.h"
+#include "../timing.h"
+
+typedef struct Chip Chip;
+
+/* Whether cfg's chip has shared memory below its cores' L1s (chip.memory = shared). */
+int chip_shared(const CfgMachine *cfg);
+/* The shared memory's keys checked together: 0, or -1 with the keys named in err. */
+int chip_check(const CfgMachine *cfg, char *err, size_t errlen);
+/* The shared memory of cfg's chip for `cores` cores. NULL with err on a bad config or out of
+ * memory. */
+Chip *chip_new(const CfgMachine *cfg, int cores, char *err, size_t errlen);
+void chip_free(Chip *c);
+/* Core k's timing model sends its L1's misses and write-backs here from now on. 0, or -1 on out
+ * of memory. */
+int chip_attach(Chip *c, int k, Timing *t);
+/* The requests the cores sent while they ran (each into a list of its own, so that cores may run
+ * on any host threads) taken in: before chip_next, with no core running. */
+void chip_collect(Chip *c);
+/* The next cycle in which the shared memory has something to do (a request entering, an event of
+ * a level); UINT64_MAX: nothing. */
+uint64_t chip_next(const Chip *c);
+/* Does cycle e (e = chip_next): the requests entering then, then every level's events of it. Each
+ * read answered is given to its core's timing model, and woke(ctx, core, cycle) is called after. */
+typedef void (*ChipWoke)(void *ctx, int core, uint64_t cycle);
+void chip_step(Chip *c, uint64_t e, ChipWoke woke, void *ctx);
+/* Internal errors (out of memory in a queue); NULL when none. */
+const char *chip_error(const Chip *c);
+
+/* The shared levels' counters: which levels there are, and theirs. */
+typedef struct ChipMemStats {
+    int has_noc, has_l2;
+    NocStats noc;
+    L2Stats l2;
+    DramChanStats dram;              /* summed over channels */
+    int dram_channels;
+    uint64_t requests, writes;       /* from the cores */
+    uint64_t read_latency;           /* sum over reads of answer - the cycle the L1 sent it */
+    uint64_t read_latency_max;
+    double dram_clock_mhz;           /* its command clock */
+    double dram_peak_gbs;            /* channels x bus width x data rate, GB/s (10^9 bytes) */
+} ChipMemStats;
+void chip_stats(const Chip *c, ChipMemStats *s);
+
+#endif

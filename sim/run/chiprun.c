@@ -1,0 +1,452 @@
+/* sim/run/chiprun.c -- a frame on the chip (chiprun.h; docs/chip.md): K cores, the tiles handed
+ * out in simulated time, and the shared memory stepped in one global time order.
+ *
+ * Owns: each core's place in its work (tile, pass, waiting for memory or for a tile), the
+ * distributor, the rule of when the shared memory may do a cycle and when a tile may be handed
+ * out, and the per-core figures. Must not: model a memory level (sim/chip/chip.c and sim/mem/ do),
+ * time an instruction (sim/timing*), or make a result depend on the host.
+ *
+ * The rule (docs/chip.md, "Exact and deterministic"): every core runs until it must wait, for an
+ * answer of the shared memory (it yielded) or for a tile (it finished one at cycle T). Then, with
+ * no core running, the memory does its next cycle e only if no core woken since could still send
+ * a request entering at or before e (a core woken at X sends from X on; its requests enter from
+ * X + 1), and a core waiting since T gets the next tile only when no other core can still finish
+ * before T (or at T with a lower number): T < the memory's next cycle (a core waiting for memory
+ * is woken at that cycle at the earliest) and T < every woken core's cycle.
+ */
+#include "chiprun.h"
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../chip/chip.h"
+
+enum { CS_RUN, CS_MEM, CS_TILE, CS_DONE };
+
+typedef struct CoreRun {
+    int state;
+    int resume;                  /* it yielded: its record is timed again first */
+    uint32_t tile, pass;
+    FuncTile *ft;
+    uint64_t wake;               /* CS_RUN: the cycle it goes on from */
+    uint64_t done_at;            /* CS_TILE: the cycle its tile ended */
+    uint64_t instr0, lanes0[ISA_STAGE_COUNT];
+    uint64_t done;               /* the pass's instructions so far */
+    FuncUnit fu;                 /* the pass's timed figures so far */
+    TimingStats before;
+} CoreRun;
+
+/* Host threads over the cores that can run in a step: each takes the next core of the list until
+ * none is left; the step ends when every thread has (a core runs on whichever thread takes it:
+ * nothing of a core's run depends on that). */
+typedef struct Pool {
+    pthread_t *th;
+    int nth;                     /* threads besides the caller's */
+    pthread_mutex_t mu;
+    pthread_cond_t go, done;
+    uint64_t gen;                /* steps begun */
+    int running;                 /* threads still in this step */
+    int quit;
+    const int *list;
+    int nlist;
+    atomic_int next;
+    atomic_int failed;
+    struct ChipRun *r;
+} Pool;
+
+typedef struct ChipRun {
+    Job *job;
+    Chip *chip;
+    CoreRun *cr;
+    Pool pool;
+    int *runnable;
+    int k;
+    uint32_t next_tile;
+    atomic_uint tiles_done;
+    uint64_t xmin;               /* the earliest cycle a core woken in this step goes on from */
+    uint64_t fb_tile;            /* bytes of a tile's framebuffer, in whole lines */
+    int cold;
+} ChipRun;
+
+int chip_run_wanted(const FuncParams *fp)
+{
+    return fp->timed && !fp->batch && (fp->cfg->chip_cores > 1 || chip_shared(fp->cfg));
+}
+
+static Timing *tm_of(const ChipRun *r, int k) { return r->job->workers[k].tc.tm; }
+static Core *core_of(const ChipRun *r, int k) { return r->job->workers[k].tc.core; }
+
+/* Pass cr->pass of the core's tile, from the cycle the core is at. */
+static void pass_begin(ChipRun *r, int k)
+{
+    CoreRun *cr = &r->cr[k];
+    Core *c = core_of(r, k);
+    Timing *t = tm_of(r, k);
+    eng_pass_launch(r->job, c, cr->ft, cr->pass == 0);
+    eng_pass_set(r->job, c, cr->pass);
+    timing_continue(t, r->cold);
+    cr->before = *timing_stats(t);
+    cr->instr0 = core_instructions(c);
+    cr->done = 0;
+    for (int s = 0; s < ISA_STAGE_COUNT; s++)
+        cr->lanes0[s] = core_stats(c)->active_lanes[s];
+}
+
+static void tile_begin(ChipRun *r, int k, uint32_t tile)
+{
+    CoreRun *cr = &r->cr[k];
+    cr->tile = tile;
+    cr->pass = 0;
+    cr->ft = eng_tile_start(r->job, tile);
+    cr->ft->core = (uint32_t)k;
+    r->job->cores[k].tiles++;
+    timing_set_fb_base(tm_of(r, k), (uint64_t)tile * r->fb_tile);
+    cr->state = CS_RUN;
+    pass_begin(r, k);
+}
+
+/* The pass ended (ex): its figures to the tile and the worker. 0, or -1 after eng_fail. */
+static int pass_finish(ChipRun *r, int k, CoreExit ex)
+{
+    CoreRun *cr = &r->cr[k];
+    Worker *w = &r->job->workers[k];
+    Core *c = w->tc.core;
+    Timing *t = w->tc.tm;
+    timing_end(t);
+    const TimingStats *s = timing_stats(t);
+    FuncTile *ft = cr->ft;
+    ft->sampled = 1;
+    ft->cycles += s->cycles - cr->before.cycles;
+    ft->busy += s->busy - cr->before.busy;
+    for (int i = 0; i < TM_CAUSE_COUNT; i++)
+        ft->stalls[i] += s->stalls[i] - cr->before.stalls[i];
+    if (timing_error(t)) {
+        eng_fail(r->job, timing_error(t), 0);
+        return -1;
+    }
+    if (eng_pass_end(r->job, c, ft, cr->pass, ex))
+        return -1;
+    ft->rays += eng_counters_add(r->job, c, &w->st);
+    ft->instructions += core_instructions(c) - cr->instr0;
+    for (int i = 0; i < ISA_STAGE_COUNT; i++)
+        ft->active_lanes[i] += core_stats(c)->active_lanes[i] - cr->lanes0[i];
+    return 0;
+}
+
+/* Core k's run up to the instruction limit of a pass (cr->done: the pass's instructions so far). */
+static CoreExit run_slice(ChipRun *r, int k)
+{
+    Core *c = core_of(r, k);
+    CoreRun *cr = &r->cr[k];
+    const uint64_t max = (uint64_t)r->job->fp->cfg->sim_max_instructions;
+    if (cr->done >= max) /* (a yield at the limit's last instruction: the next one would trap) */
+        return CORE_EXIT_LIMIT;
+    const CoreExit ex = core_run_slice(c, max - cr->done, max);
+    cr->done += core_slice_executed(c, max - cr->done);
+    return ex;
+}
+
+/* Core k runs until it must wait: for memory (CS_MEM), for a tile (CS_TILE). 0, or -1 after
+ * eng_fail. */
+static int core_go(ChipRun *r, int k)
+{
+    CoreRun *cr = &r->cr[k];
+    Core *c = core_of(r, k);
+    Timing *t = tm_of(r, k);
+    for (;;) {
+        CoreExit ex;
+        if (cr->resume) {
+            cr->resume = 0;
+            const CoreRecord *rec = core_record(c);
+            timing_resume(t, rec);
+            if (timing_yielded(t)) {
+                eng_fail(r->job, "chip: internal error: a core went on before its answers were in", 0);
+                return -1;
+            }
+            ex = (isa_ops[rec->in->op].flags & ISA_FL_END) ? CORE_EXIT_HALT : run_slice(r, k);
+        } else {
+            ex = run_slice(r, k);
+        }
+        if (ex == CORE_EXIT_YIELD) {
+            cr->state = CS_MEM;
+            cr->resume = 1;
+            return 0;
+        }
+        if (ex == CORE_EXIT_LIMIT && !core_trap_message(c)[0]) {
+            char msg[300];
+            snprintf(msg, sizeof msg, "kernel, tile at (%u, %u), pass %u: instruction limit of %llu reached "
+                     "(sim.max_instructions)", cr->ft->x0, cr->ft->y0, cr->pass,
+                     (unsigned long long)r->job->fp->cfg->sim_max_instructions);
+            eng_fail(r->job, msg, 1);
+            return -1;
+        }
+        if (pass_finish(r, k, ex))
+            return -1;
+        if (++cr->pass < r->job->spp) {
+            pass_begin(r, k);
+            continue;
+        }
+        eng_tile_pixels(r->job, c, cr->ft, 0);
+        atomic_fetch_add(&r->tiles_done, 1u);
+        cr->state = CS_TILE;
+        cr->done_at = timing_now(t);
+        return 0;
+    }
+}
+
+/* ---- host threads ---------------------------------------------------------------------------- */
+
+/* Takes cores off the step's list and runs them. */
+static void pool_work(Pool *p)
+{
+    int i;
+    while ((i = atomic_fetch_add(&p->next, 1)) < p->nlist)
+        if (core_go(p->r, p->list[i]))
+            atomic_store(&p->failed, 1);
+}
+
+static void *pool_thread(void *arg)
+{
+    Pool *p = arg;
+    uint64_t seen = 0;
+    pthread_mutex_lock(&p->mu);
+    for (;;) {
+        while (p->gen == seen && !p->quit)
+            pthread_cond_wait(&p->go, &p->mu);
+        if (p->quit)
+            break;
+        seen = p->gen;
+        pthread_mutex_unlock(&p->mu);
+        pool_work(p);
+        pthread_mutex_lock(&p->mu);
+        if (--p->running == 0)
+            pthread_cond_signal(&p->done);
+    }
+    pthread_mutex_unlock(&p->mu);
+    return NULL;
+}
+
+/* nth threads besides the caller's (fewer if they cannot be made: the same results, slower). */
+static void pool_open(Pool *p, ChipRun *r, int nth)
+{
+    memset(p, 0, sizeof *p);
+    p->r = r;
+    pthread_mutex_init(&p->mu, NULL);
+    pthread_cond_init(&p->go, NULL);
+    pthread_cond_init(&p->done, NULL);
+    p->th = nth > 0 ? calloc((size_t)nth, sizeof *p->th) : NULL;
+    for (int i = 0; p->th && i < nth; i++) {
+        if (pthread_create(&p->th[i], NULL, pool_thread, p) != 0)
+            break;
+        p->nth++;
+    }
+}
+
+static void pool_close(Pool *p)
+{
+    pthread_mutex_lock(&p->mu);
+    p->quit = 1;
+    pthread_cond_broadcast(&p->go);
+    pthread_mutex_unlock(&p->mu);
+    for (int i = 0; i < p->nth; i++)
+        pthread_join(p->th[i], NULL);
+    free(p->th);
+    pthread_mutex_destroy(&p->mu);
+    pthread_cond_destroy(&p->go);
+    pthread_cond_destroy(&p->done);
+}
+
+/* Runs the cores of list (n of them) to their next wait, on the pool's threads and the caller's.
+ * 0, or -1 when one failed. */
+static int pool_step(Pool *p, const int *list, int n)
+{
+    p->list = list;
+    p->nlist = n;
+    atomic_store(&p->next, 0);
+    atomic_store(&p->failed, 0);
+    const int helpers = n > 1 ? (p->nth < n - 1 ? p->nth : n - 1) : 0;
+    if (helpers) {
+        pthread_mutex_lock(&p->mu);
+        p->running = p->nth;
+        p->gen++;
+        pthread_cond_broadcast(&p->go);
+        pthread_mutex_unlock(&p->mu);
+    }
+    pool_work(p);
+    if (helpers) {
+        pthread_mutex_lock(&p->mu);
+        while (p->running > 0)
+            pthread_cond_wait(&p->done, &p->mu);
+        pthread_mutex_unlock(&p->mu);
+    }
+    return atomic_load(&p->failed) ? -1 : 0;
+}
+
+/* ChipWoke: core k has an answer at cycle x; it goes on once its yielded record needs no other. */
+static void woke(void *ctx, int k, uint64_t x)
+{
+    ChipRun *r = ctx;
+    CoreRun *cr = &r->cr[k];
+    if (cr->state != CS_MEM || timing_blocked(tm_of(r, k), core_record(core_of(r, k))))
+        return;
+    cr->state = CS_RUN;
+    cr->wake = x;
+    if (x < r->xmin)
+        r->xmin = x;
+}
+
+/* The core waiting longest for a tile (the earliest cycle, then the lowest number); -1: none. */
+static int first_waiting(const ChipRun *r)
+{
+    int best = -1;
+    for (int k = 0; k < r->k; k++)
+        if (r->cr[k].state == CS_TILE && (best < 0 || r->cr[k].done_at < r->cr[best].done_at))
+            best = k;
+    return best;
+}
+
+/* With no core running: hand out tiles and step the shared memory until a core can go on, by the
+ * rule above. 1 when one can, 0 when every core is done, -1 on a failure. */
+static int shared_step(ChipRun *r)
+{
+    r->xmin = UINT64_MAX;
+    if (r->chip)
+        chip_collect(r->chip);
+    for (;;) {
+        const uint64_t e = r->chip ? chip_next(r->chip) : UINT64_MAX;
+        const int w = first_waiting(r);
+        if (w >= 0 && r->cr[w].done_at < e && r->cr[w].done_at < r->xmin) {
+            if (r->next_tile < r->job->ntiles) {
+                const uint64_t at = r->cr[w].done_at;
+                tile_begin(r, w, r->next_tile++);
+                r->cr[w].wake = at;
+                if (at < r->xmin)
+                    r->xmin = at;
+            } else {
+                r->cr[w].state = CS_DONE;
+            }
+            continue;
+        }
+        int waiting_mem = 0;
+        for (int k = 0; k < r->k && !waiting_mem; k++)
+            waiting_mem = r->cr[k].state == CS_MEM;
+        if (e != UINT64_MAX && e <= r->xmin && (waiting_mem || w >= 0)) {
+            chip_step(r->chip, e, woke, r);
+            if (chip_error(r->chip)) {
+                eng_fail(r->job, chip_error(r->chip), 0);
+                return -1;
+            }
+            continue;
+        }
+        if (r->xmin != UINT64_MAX)
+            return 1;
+        if (waiting_mem || w >= 0) {
+            eng_fail(r->job, "chip: internal error: cores wait for memory that has nothing in flight", 0);
+            return -1;
+        }
+        return 0;
+    }
+}
+
+/* The per-core figures and the makespan into the job. */
+static void figures(ChipRun *r)
+{
+    Job *j = r->job;
+    uint64_t makespan = 0;
+    for (int k = 0; k < r->k; k++)
+        if (r->cr[k].done_at > makespan)
+            makespan = r->cr[k].done_at;
+    for (int k = 0; k < r->k; k++) {
+        FuncCore *fc = &j->cores[k];
+        const TimingStats *s = timing_stats(tm_of(r, k));
+        fc->busy = s->busy;
+        fc->stall = s->cycles - s->busy;
+        memcpy(fc->stalls, s->stalls, sizeof fc->stalls);
+        fc->finish = r->cr[k].done_at;
+        fc->idle = makespan - (fc->busy + fc->stall);
+        fc->instructions = core_instructions(core_of(r, k));
+    }
+    j->makespan = makespan;
+    if (r->chip) {
+        j->chip_mem = calloc(1, sizeof *j->chip_mem);
+        if (j->chip_mem)
+            chip_stats(r->chip, j->chip_mem);
+    }
+}
+
+/* The cores opened, the scene loaded in each, and each joined to the shared memory. */
+static int cores_open(ChipRun *r)
+{
+    Job *j = r->job;
+    for (int k = 0; k < r->k; k++) {
+        if (eng_worker_begin(j, k))
+            return -1;
+        if (r->chip && chip_attach(r->chip, k, tm_of(r, k))) {
+            eng_fail(j, "out of memory for the chip", 0);
+            return -1;
+        }
+        timing_reset(tm_of(r, k));
+    }
+    return 0;
+}
+
+uint32_t chip_run_frame(Job *j)
+{
+    const CfgMachine *cfg = j->fp->cfg;
+    ChipRun r = {.job = j, .k = cfg->chip_cores, .cold = cfg->chip_cold_units};
+    const uint64_t line = (uint64_t)cfg->scene_line_bytes;
+    r.fb_tile = ((uint64_t)j->k->tile_w * j->k->tile_h * 12 + line - 1) / line * line;
+    char err[600];
+    r.cr = calloc((size_t)r.k, sizeof *r.cr);
+    r.runnable = calloc((size_t)r.k, sizeof *r.runnable);
+    j->cores = calloc((size_t)r.k, sizeof *j->cores);
+    if (!r.cr || !r.runnable || !j->cores) {
+        eng_fail(j, "out of memory for the chip's cores", 0);
+        free(r.cr);
+        free(r.runnable);
+        return 0;
+    }
+    atomic_init(&r.tiles_done, 0u);
+    j->ncores = (uint32_t)r.k;
+    if (chip_shared(cfg) && !(r.chip = chip_new(cfg, r.k, err, sizeof err))) {
+        eng_fail(j, err, 0);
+        free(r.cr);
+        free(r.runnable);
+        return 0;
+    }
+    const int threads = j->fp->threads < 1 ? 1 : j->fp->threads > r.k ? r.k : j->fp->threads;
+    pool_open(&r.pool, &r, threads - 1);
+    if (cores_open(&r) == 0) {
+        for (int k = 0; k < r.k; k++) {
+            if (r.next_tile < j->ntiles)
+                tile_begin(&r, k, r.next_tile++);
+            else
+                r.cr[k].state = CS_DONE;
+        }
+        int go = 1;
+        while (go > 0 && !atomic_load(&j->failed)) {
+            int n = 0;
+            for (int k = 0; k < r.k; k++)
+                if (r.cr[k].state == CS_RUN)
+                    r.runnable[n++] = k;
+            const uint32_t before = atomic_load(&r.tiles_done);
+            if (pool_step(&r.pool, r.runnable, n))
+                go = -1;
+            const uint32_t done = atomic_load(&r.tiles_done);
+            if (done != before && j->fp->progress)
+                j->fp->progress(j->fp->progress_ctx, done, j->ntiles);
+            if (go > 0)
+                go = shared_step(&r);
+        }
+        if (!atomic_load(&j->failed))
+            figures(&r);
+    }
+    pool_close(&r.pool);
+    chip_free(r.chip);
+    free(r.cr);
+    free(r.runnable);
+    return atomic_load(&r.tiles_done);
+}

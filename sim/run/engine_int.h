@@ -1,0 +1,69 @@
+/* sim/run/engine_int.h -- the kernel engine's inside (sim/run/engine.c), shared with the chip's
+ * run of it (sim/run/chiprun.c): the job of a launch, its workers (one core each), and the steps
+ * of a (tile, pass) unit that both take.
+ *
+ * Owns: nothing of its own (engine.c's types and steps). Must not: be included outside sim/run/.
+ */
+#ifndef SFSIM_RUN_ENGINE_INT_H
+#define SFSIM_RUN_ENGINE_INT_H
+
+#include <pthread.h>
+#include <stdatomic.h>
+
+#include "engine.h"
+#include "timedcore.h"
+
+typedef struct Job {
+    const PackedScene *p;
+    const FuncParams *fp;
+    const Kernel *k;
+    float *rgb;
+    uint32_t width, height, tiles_x, ntiles;
+    FuncTile *tiles;
+    uint32_t spp;
+    const uint32_t *units;     /* sampled mode: the round's (tile, pass) units, NULL for whole tiles */
+    uint32_t *passes_done;     /* func_render, when not NULL: the launch's items are (tile, pass)
+                                  units in pass order, each pass after the tile's one before
+                                  (run_tile_pass); each tile's passes finished */
+    atomic_uint tiles_done;    /* ... and the tiles with every pass finished */
+    FuncUnit *unit_out;        /* ... and their figures */
+    struct Worker *workers;    /* one per host thread (sim/run/tiles.h) */
+    int nworkers;
+    atomic_int failed;
+    int trapped;               /* the failure was the kernel's (trap, limit, error code) */
+    pthread_mutex_t lock;
+    char err[1024];
+    /* a chip's run (sim/run/chiprun.c): its cores' figures, the makespan, the shared memory's */
+    FuncCore *cores;
+    uint32_t ncores;
+    uint64_t makespan;
+    struct ChipMemStats *chip_mem;
+} Job;
+
+typedef struct Worker {
+    Job *job;
+    TimedCore tc;              /* the core; its timing model in the timed modes */
+    FuncStats st;
+} Worker;
+
+/* The job's failure: the first message is kept (trapped: the kernel's own failure). */
+void eng_fail(Job *j, const char *msg, int trapped);
+/* Tile t placed, its counts zeroed (before its first pass). */
+FuncTile *eng_tile_start(Job *j, uint32_t t);
+/* A pass's launch block on a restarted core (the framebuffer zeroed for a tile's first pass), and
+ * the pass's number in it. */
+void eng_pass_launch(Job *j, Core *c, const FuncTile *ft, int zero_fb);
+void eng_pass_set(Job *j, Core *c, uint32_t pass);
+/* After the pass's run stopped with ex: 0 if it halted without an error code, else -1 after
+ * eng_fail() with the tile, the pass and the reason. */
+int eng_pass_end(Job *j, Core *c, const FuncTile *ft, uint32_t pass, CoreExit ex);
+/* The kernel's counters of the pass just run added to st; its rays returned. */
+uint64_t eng_counters_add(Job *j, Core *c, FuncStats *st);
+/* The tile's pixels between the core's framebuffer and the frame (to_fb: into the framebuffer). */
+void eng_tile_pixels(Job *j, Core *c, const FuncTile *ft, int to_fb);
+/* Worker `index`'s core opened and the scene loaded (sim/run/tiles.h's begin). */
+int eng_worker_begin(void *ctx, int index);
+/* The workers' counters into st, in worker order. */
+void eng_stats_sum(FuncStats *st, const Worker *ws, int nworkers);
+
+#endif

@@ -1,0 +1,258 @@
+/* tests/unit/test_chip.c -- detailed mode on a chip of K cores (docs/chip.md, sim/run/chiprun.c).
+ *
+ * What must hold: the picture is the one core's (timing never changes a pixel); every core's
+ * cycles are busy + stall + idle = the makespan, so the chip's are K x makespan; the distributor
+ * hands the next tile to the core that became idle first (ties to the lowest number); with cold
+ * units and a bus of its own per core, each tile takes exactly the cycles it takes on the one
+ * core of today's machine; and a run gives the same figures every time.
+ */
+#include <criterion/criterion.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../../scenes/pack.h"
+#include "../../scenes/scene.h"
+#include "../../sim/chip/chip.h"
+#include "../../sim/config.h"
+#include "../../sim/run/engine.h"
+#include "../../sim/timing.h"
+
+#include "../support/packed.h"
+#include "../support/shared.h"
+
+static Scene scene;
+static PackedScene packed;
+
+static void load(const char *path, int w, int h, int spp) { packed_load(path, w, h, spp, &scene, &packed); }
+
+static void unload(void) { packed_free(&scene, &packed); }
+
+static float *render_on(const CfgMachine *cfg, int threads, FuncStats *st)
+{
+    size_t n = 3 * (size_t)scene.render.width * scene.render.height;
+    float *rgb = calloc(n, sizeof *rgb);
+    static char err[65536];
+    FuncParams fp = {.cfg = cfg, .kernel_path = "kernels/pathtrace.s", .needs = scene.needs, .seed = 1,
+                     .threads = threads, .timed = 1};
+    cr_assert_eq(func_render(&packed, &fp, rgb, st, err, sizeof err), 0, "%s", err);
+    return rgb;
+}
+
+static float *render(const CfgMachine *cfg, FuncStats *st) { return render_on(cfg, 2, st); }
+
+/* 128 x 128 pixels in 32 x 32 tiles: 16 tiles. */
+static void small_frame(CfgMachine *cfg)
+{
+    cfg_defaults(cfg);
+    cfg->stream_rays = 1024;
+}
+
+static void shared_memory(CfgMachine *cfg, int cores)
+{
+    cfg->chip_cores = cores;
+    cfg->chip_memory = CFG_CHIP_MEMORY_SHARED;
+    cfg->chip_cold_units = 0;
+    cfg->l2_size_kb = 256;
+    cfg->l2_banks = 4;
+    cfg->noc_latency = 4;
+}
+
+/* Every core: busy + stall + idle = the makespan, the makespan the latest finish; the chip's
+ * timing totals the cores' sums. */
+static void check_chip_accounting(const FuncStats *st, uint32_t k)
+{
+    cr_assert_eq(st->chip_cores, k);
+    char err[256];
+    cr_assert_eq(timing_check(&st->timing, err, sizeof err), 0, "%s", err);
+    uint64_t latest = 0, busy = 0, stall = 0, idle = 0, tiles = 0;
+    for (uint32_t c = 0; c < k; c++) {
+        const FuncCore *fc = &st->cores[c];
+        cr_expect_eq(fc->busy + fc->stall + fc->idle, st->makespan, "core %u: %llu + %llu + %llu != %llu", c,
+                     (unsigned long long)fc->busy, (unsigned long long)fc->stall, (unsigned long long)fc->idle,
+                     (unsigned long long)st->makespan);
+        cr_expect_eq(fc->busy + fc->stall, fc->finish, "core %u works from cycle 0 to its finish, no gap", c);
+        if (fc->finish > latest)
+            latest = fc->finish;
+        busy += fc->busy;
+        stall += fc->stall;
+        idle += fc->idle;
+        tiles += fc->tiles;
+    }
+    cr_expect_eq(latest, st->makespan);
+    cr_expect_eq(busy + stall + idle, (uint64_t)k * st->makespan);
+    cr_expect_eq(busy, st->timing.busy);
+    cr_expect_eq(busy + stall, st->timing.cycles);
+    cr_expect_eq(tiles, st->ntiles);
+}
+
+/* The tiles go to the cores in the order the cores became idle: tile t (t >= K) to the core whose
+ * earlier tile ended first among those still to be given one. Replays the distributor from the
+ * tiles' own cycles and cores. */
+static void check_distribution(const FuncStats *st, uint32_t k)
+{
+    uint64_t free_at[64] = {0};
+    cr_assert(k <= 64);
+    for (uint32_t t = 0; t < st->ntiles; t++) {
+        uint32_t best = 0;
+        for (uint32_t c = 1; c < k; c++)
+            if (free_at[c] < free_at[best])
+                best = c;
+        cr_expect_eq(st->tiles[t].core, best, "tile %u went to core %u, the first idle was core %u", t,
+                     st->tiles[t].core, best);
+        free_at[st->tiles[t].core] += st->tiles[t].cycles;
+    }
+}
+
+Test(chip, own_bus_cold_units_time_each_tile_as_one_core)
+{
+    load("scenes/cornell/scene.ini", 128, 128, 2);
+    CfgMachine one, chip;
+    small_frame(&one);
+    small_frame(&chip);
+    chip.chip_cores = 4; /* chip.memory = bus, chip.cold_units = 1: the defaults */
+    FuncStats a, b;
+    float *ra = render(&one, &a), *rb = render(&chip, &b);
+    cr_assert_eq(a.chip_cores, 0, "K = 1 on the paper's bus is today's run");
+    cr_assert_eq(memcmp(ra, rb, 3 * sizeof(float) * 128 * 128), 0, "the picture does not depend on the chip");
+    cr_assert_eq(a.ntiles, b.ntiles);
+    for (uint32_t t = 0; t < a.ntiles; t++)
+        cr_expect_eq(a.tiles[t].cycles, b.tiles[t].cycles, "tile %u: %llu cycles alone, %llu on the chip", t,
+                     (unsigned long long)a.tiles[t].cycles, (unsigned long long)b.tiles[t].cycles);
+    cr_expect_eq(a.timing.cycles, b.timing.cycles);
+    check_chip_accounting(&b, 4);
+    check_distribution(&b, 4);
+    free(ra);
+    free(rb);
+    func_stats_free(&a);
+    func_stats_free(&b);
+    unload();
+}
+
+Test(chip, shared_memory_accounts_for_every_cycle)
+{
+    load("scenes/cornell/scene.ini", 128, 128, 1);
+    CfgMachine one, chip;
+    small_frame(&one);
+    small_frame(&chip);
+    shared_memory(&chip, 4);
+    FuncStats a, b;
+    float *ra = render(&one, &a), *rb = render(&chip, &b);
+    cr_assert_eq(memcmp(ra, rb, 3 * sizeof(float) * 128 * 128), 0, "the picture does not depend on the chip");
+    cr_expect_eq(a.instructions, b.instructions);
+    check_chip_accounting(&b, 4);
+    check_distribution(&b, 4);
+    cr_assert_not_null(b.chip_mem);
+    const ChipMemStats *m = b.chip_mem;
+    cr_expect_eq(m->requests, b.timing.l1.misses, "every L1 miss is one read below it");
+    cr_expect_eq(m->writes, b.timing.l1.writebacks, "every write-back one write");
+    cr_expect_eq(m->l2.reads, m->requests, "the network delivers every read to the L2");
+    cr_expect_eq(m->l2.hits + m->l2.misses + m->l2.merged, m->l2.reads + m->l2.writes);
+    cr_expect(m->l2.misses > 0 && m->dram.reads > 0, "a cold L2 misses to DRAM");
+    cr_expect(m->read_latency > 0);
+    free(ra);
+    free(rb);
+    func_stats_free(&a);
+    func_stats_free(&b);
+    unload();
+}
+
+Test(chip, same_figures_every_run)
+{
+    load("scenes/cornell/scene.ini", 128, 128, 1);
+    CfgMachine chip;
+    small_frame(&chip);
+    shared_memory(&chip, 3);
+    FuncStats a, b;
+    float *ra = render(&chip, &a), *rb = render(&chip, &b);
+    cr_expect_eq(a.makespan, b.makespan);
+    cr_expect_eq(memcmp(&a.timing, &b.timing, sizeof a.timing), 0);
+    cr_expect_eq(memcmp(a.cores, b.cores, 3 * sizeof *a.cores), 0);
+    cr_expect_eq(memcmp(a.chip_mem, b.chip_mem, sizeof *a.chip_mem), 0);
+    for (uint32_t t = 0; t < a.ntiles; t++)
+        cr_expect_eq(a.tiles[t].core, b.tiles[t].core);
+    free(ra);
+    free(rb);
+    func_stats_free(&a);
+    func_stats_free(&b);
+    unload();
+}
+
+Test(chip, more_cores_than_tiles_leaves_cores_idle)
+{
+    load("scenes/cornell/scene.ini", 64, 64, 1); /* 4 tiles */
+    CfgMachine chip;
+    small_frame(&chip);
+    shared_memory(&chip, 6);
+    FuncStats st;
+    float *rgb = render(&chip, &st);
+    check_chip_accounting(&st, 6);
+    for (uint32_t c = 0; c < 6; c++) {
+        cr_expect_eq(st.cores[c].tiles, c < 4 ? 1u : 0u, "core %u", c);
+        if (c >= 4)
+            cr_expect_eq(st.cores[c].idle, st.makespan);
+    }
+    free(rgb);
+    func_stats_free(&st);
+    unload();
+}
+
+/* With a network slower than the L1's own bus would be, the scene-memory stalls grow: the chip's
+ * memory reaches the timing. */
+Test(chip, a_slower_network_stalls_more)
+{
+    load("scenes/cornell/scene.ini", 64, 64, 1);
+    CfgMachine fast, slow;
+    small_frame(&fast);
+    shared_memory(&fast, 2);
+    slow = fast;
+    slow.noc_latency = 200;
+    FuncStats a, b;
+    float *ra = render(&fast, &a), *rb = render(&slow, &b);
+    cr_expect(b.timing.stalls[TM_SCENE_MEMORY] > a.timing.stalls[TM_SCENE_MEMORY],
+              "network latency 200: %llu scene-memory stall cycles, latency 4: %llu",
+              (unsigned long long)b.timing.stalls[TM_SCENE_MEMORY], (unsigned long long)a.timing.stalls[TM_SCENE_MEMORY]);
+    cr_expect(b.makespan > a.makespan);
+    cr_expect_eq(a.instructions, b.instructions);
+    free(ra);
+    free(rb);
+    func_stats_free(&a);
+    func_stats_free(&b);
+    unload();
+}
+
+/* The figures do not depend on the host threads (docs/chip.md): 16 cores on 1 and on 2 threads,
+ * with the shared memory and with a bus per core (where every core runs in every step). */
+static void same_on_threads(CfgMachine *chip)
+{
+    FuncStats a, b;
+    float *ra = render_on(chip, 1, &a), *rb = render_on(chip, 2, &b);
+    cr_assert_eq(memcmp(ra, rb, 3 * sizeof(float) * 128 * 128), 0);
+    cr_expect_eq(a.makespan, b.makespan, "1 thread: %llu cycles, 2 threads: %llu", (unsigned long long)a.makespan,
+                 (unsigned long long)b.makespan);
+    cr_expect_eq(memcmp(&a.timing, &b.timing, sizeof a.timing), 0);
+    cr_expect_eq(memcmp(a.cores, b.cores, 16 * sizeof *a.cores), 0);
+    cr_expect((a.chip_mem == NULL) == (b.chip_mem == NULL));
+    if (a.chip_mem)
+        cr_expect_eq(memcmp(a.chip_mem, b.chip_mem, sizeof *a.chip_mem), 0);
+    for (uint32_t t = 0; t < a.ntiles; t++)
+        cr_expect_eq(a.tiles[t].core, b.tiles[t].core);
+    free(ra);
+    free(rb);
+    func_stats_free(&a);
+    func_stats_free(&b);
+}
+
+Test(chip, same_figures_on_one_and_two_host_threads)
+{
+    load("scenes/cornell/scene.ini", 128, 128, 1);
+    CfgMachine chip;
+    small_frame(&chip);
+    shared_memory(&chip, 16);
+    same_on_threads(&chip);
+    small_frame(&chip);
+    chip.chip_cores = 16;
+    chip.chip_cold_units = 0;
+    same_on_threads(&chip);
+    unload();
+}
