@@ -24,6 +24,7 @@
 #include "heatmap.h"
 #include "img.h"
 #include "../host/outfile.h"
+#include "mem/memtrace.h"
 #include "provenance.h"
 #include "reference.h"
 #include "report.h"
@@ -302,6 +303,25 @@ static void keep_partial(const RenderOptions *o, const RunScene *sc, const RunFr
     snprintf(err, errlen, "%s", text);
 }
 
+/* The L1s' requests of a detailed run (FuncStats.trace) in sfsim's trace format (docs/dram.md),
+ * each with its core as the source, written whole or not at all. 0, or -1 with a message. */
+static int write_mem_trace(const char *path, const CfgMachine *cfg, const FuncStats *f, char *err, size_t errlen)
+{
+    MtrWriter *w = mtr_create(path, cfg->core_clock_mhz, err, errlen);
+    if (!w)
+        return -1;
+    char src[32];
+    for (size_t i = 0; i < f->ntrace; i++) {
+        const FuncMemRec *m = &f->trace[i];
+        snprintf(src, sizeof src, "core%u", m->core);
+        if (mtr_write(w, m->cycle, m->write, m->addr, src, err, errlen) != 0) {
+            mtr_discard(w);
+            return -1;
+        }
+    }
+    return mtr_finish(w, err, errlen);
+}
+
 int render_run(const RenderOptions *o, char *err, size_t errlen)
 {
     CfgMachine defcfg;
@@ -316,6 +336,7 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         spec.target_error = o->target_error;
         spec.no_image = o->no_image;
     }
+    spec.mem_trace = o->mem_trace != NULL;
     /* Before any work: an output folder that cannot be made would fail the run only at its end. */
     if (outfile_check_dir(o->out_dir, err, errlen) != 0)
         return -3;
@@ -337,6 +358,10 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
         if (write_outputs(&rep, err, errlen) != 0) {
             size_t n = strlen(err);
             snprintf(err + n, errlen - n, " (no output of this run was kept in %s)", o->out_dir);
+            rc = -3;
+        } else if (o->mem_trace && write_mem_trace(o->mem_trace, cfg, &fr.f, err, errlen) != 0) {
+            size_t n = strlen(err);
+            snprintf(err + n, errlen - n, " (the run's other outputs are in %s)", o->out_dir);
             rc = -3;
         }
     }

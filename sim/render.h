@@ -28,6 +28,7 @@ typedef struct RenderOptions {
     double target_error;       /* ... target_error is 0; else the 95 % half-width wanted (0.01 = 1 %) */
     uint32_t sample_seed;      /* sampled mode: which units */
     int no_image;              /* sampled mode: no image, a pilot of the golden model for the counts */
+    const char *mem_trace;     /* detailed mode: write the L1s' requests below here (docs/chip.md), or NULL */
 } RenderOptions;
 
 /* The render keys `--set` takes beside the machine keys (sfsim run, sfsim sweep), with their

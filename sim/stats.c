@@ -398,6 +398,11 @@ FIG(mem_read_latency)
     (void)idx;
     return defined_if(stats_ratio(mem_of(c)->read_latency, mem_of(c)->requests), mem_of(c)->requests > 0, na);
 }
+FIG(scene_stall_l1)
+{
+    UNUSED_FIG_ARGS;
+    return (double)(c->t->stalls[TM_SCENE_MEMORY] - c->t->scene_from[0] - c->t->scene_from[1]);
+}
 FIG(l2_present) { UNUSED_FIG_ARGS; return mem_of(c)->has_l2; }
 FIG(noc_present) { UNUSED_FIG_ARGS; return mem_of(c)->has_noc; }
 FIG(l2_hit_rate)

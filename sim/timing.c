@@ -110,6 +110,21 @@ uint64_t timing_now(const Timing *t) { return t->now; }
 
 void timing_set_fb_base(Timing *t, uint64_t base) { t->mem.fb_base = base; }
 
+static uint64_t tap_request(void *below, const MemReq *r)
+{
+    Timing *t = below;
+    t->tap(t->tap_ctx, r->addr, r->write, r->at);
+    return t->tap_below.request(t->tap_below.below, r);
+}
+
+void timing_tap(Timing *t, TimingTap tap, void *ctx)
+{
+    t->tap_below = t->l1.below;
+    t->tap = tap;
+    t->tap_ctx = ctx;
+    cache_connect(&t->l1, (MemPort){tap_request, t});
+}
+
 void timing_reset(Timing *t)
 {
     units_cold(t, 0);

@@ -80,6 +80,9 @@ typedef struct TimingStats {
     uint64_t gen_cycles[CORE_GENERATIONS], gen_busy[CORE_GENERATIONS];
     uint64_t gen_stalls[CORE_GENERATIONS][TM_CAUSE_COUNT];
     uint64_t runs;                                          /* programs timed (passes of tiles; trace batches) */
+    /* A chip's core: of the scene_memory stall cycles, those spent waiting for lines the shared L2
+     * supplied, and for lines from DRAM (the rest: the L1's own, its ports and hits). */
+    uint64_t scene_from[2];
     /* each unit's counters, under its field name (machine/units.def) */
 #define TM_UNIT(field, Type, Params, Stats, params_fn, prefix) Stats field;
 #include "machine/units.def"
@@ -111,11 +114,18 @@ uint64_t timing_now(const Timing *t);
  * answers are in. 0; -1 on out of memory. */
 typedef void (*TimingOut)(void *ctx, uint64_t addr, int write, uint64_t cycle, uint32_t fill);
 int timing_chip(Timing *t, TimingOut out, void *ctx);
-void timing_answer(Timing *t, uint32_t fill, uint64_t cycle);
+/* from: where the line came from, TIMING_FROM_L2 or TIMING_FROM_DRAM (TimingStats.scene_from). */
+enum { TIMING_FROM_L2 = 0, TIMING_FROM_DRAM = 1 };
+void timing_answer(Timing *t, uint32_t fill, uint64_t cycle, int from);
 int timing_yielded(const Timing *t);
 /* Whether rec, the record the core yielded at, still waits for an answer. */
 int timing_blocked(Timing *t, const CoreRecord *rec);
 void timing_resume(Timing *t, const CoreRecord *rec);
+/* Every request the L1 sends below (misses' reads, write-backs, and with no cache every access)
+ * is given to tap as it leaves, before the level below takes it: `sfsim run --mem-trace`. Install
+ * after timing_chip. */
+typedef void (*TimingTap)(void *ctx, uint64_t addr, int write, uint64_t cycle);
+void timing_tap(Timing *t, TimingTap tap, void *ctx);
 /* Fills sent and not answered yet. */
 uint32_t timing_fills_out(const Timing *t);
 

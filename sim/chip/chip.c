@@ -287,6 +287,8 @@ static void answered(void *ctx, uint64_t id, uint64_t cycle)
         return;
     const int k = (int)MEM_ID_CORE(id);
     const uint32_t fill = (uint32_t)id;
+    /* where the line came from: DRAM when there is no L2, or the L2 got it from below */
+    const int source = !c->l2 || (id & MEM_FROM_BELOW) ? TIMING_FROM_DRAM : TIMING_FROM_L2;
     ChipPort *p = &c->port[k];
     if (k >= c->cores || fill >= p->nsent) {
         snprintf(c->err, sizeof c->err, "chip: an answer for no request (core %d, fill %u)", k, fill);
@@ -296,7 +298,7 @@ static void answered(void *ctx, uint64_t id, uint64_t cycle)
     c->lat_sum += lat;
     if (lat > c->lat_max)
         c->lat_max = lat;
-    timing_answer(p->t, fill, cycle);
+    timing_answer(p->t, fill, cycle, source);
     if (c->woke)
         c->woke(c->wctx, k, cycle);
 }

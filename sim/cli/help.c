@@ -156,12 +156,17 @@ void help_run(FILE *out)
             "                           tile for the units' counts (the estimate alone, fastest)\n"
             "  --kernel FILE            kernel modes: the kernel source (default:\n"
             "                           kernels/pathtrace.s in the data folder, or $SFSIM_KERNEL)\n"
+            "  --mem-trace FILE         detailed mode: every line the scene caches ask of the memory below\n"
+            "                           them (misses, write-backs), in sfsim's trace format with the core\n"
+            "                           as source, for `sfsim mem --trace FILE` (docs/chip.md)\n"
             "\n"
             "examples:\n"
             "  sfsim run -o out                                        the Cornell box, detailed mode\n"
             "  sfsim run -s scene.gltf --set render.spp=4 --set=core.simd_width=8 -j2 -o n8\n"
             "  sfsim run --mode sampled --target-error 0.005 -o samp   cycles and fps to +-0.5%% (95%%)\n"
-            "  sfsim run --mode reference -o ref && sfsim compare ref/frame.exr out/frame.exr\n");
+            "  sfsim run --mode reference -o ref && sfsim compare ref/frame.exr out/frame.exr\n"
+            "  sfsim run -c configs/chip16-ddr4.ini -s scenes/conference/scene.ini -o chip   16 cores, L2, DDR4\n"
+            "  sfsim run --mem-trace out.trc -o out && sfsim mem --trace out.trc   its misses through DRAM\n");
 }
 
 void help_compare(FILE *out)

@@ -18,7 +18,7 @@
 
 /* ---- run --------------------------------------------------------------------------------------- */
 
-enum { R_MODE = CLI_LONG, R_SET, R_EXPOSURE, R_SAMPLE, R_TARGET, R_NO_IMAGE, R_SEED, R_NOPROG, R_KERNEL };
+enum { R_MODE = CLI_LONG, R_SET, R_EXPOSURE, R_SAMPLE, R_TARGET, R_NO_IMAGE, R_SEED, R_NOPROG, R_KERNEL, R_MEMTRACE };
 static const struct option run_longs[] = {
     {"scene", required_argument, NULL, 's'},         {"out", required_argument, NULL, 'o'},
     {"config", required_argument, NULL, 'c'},        {"mode", required_argument, NULL, R_MODE},
@@ -26,7 +26,8 @@ static const struct option run_longs[] = {
     {"exposure", required_argument, NULL, R_EXPOSURE}, {"sample", required_argument, NULL, R_SAMPLE},
     {"target-error", required_argument, NULL, R_TARGET}, {"no-image", no_argument, NULL, R_NO_IMAGE},
     {"sample-seed", required_argument, NULL, R_SEED}, {"no-progress", no_argument, NULL, R_NOPROG},
-    {"kernel", required_argument, NULL, R_KERNEL},   {"help", no_argument, NULL, CLI_HELP},
+    {"kernel", required_argument, NULL, R_KERNEL},   {"mem-trace", required_argument, NULL, R_MEMTRACE},
+    {"help", no_argument, NULL, CLI_HELP},
     {"version", no_argument, NULL, CLI_VERSION},     {NULL, 0, NULL, 0}};
 
 /* Which of the sampled mode's sizes the command line gave (their values alone do not say). */
@@ -115,6 +116,7 @@ static int run_option(const CliParse *p, RunCmd *c, RunGiven *g, int code, const
         break;
     case R_NOPROG: o->progress = 0; break;
     case R_KERNEL: o->kernel_path = v; break;
+    case R_MEMTRACE: o->mem_trace = v; break;
     case R_SET: {
         int r = run_render_key(p, o, v);
         if (r < 0)
@@ -134,6 +136,10 @@ static int run_together(RenderOptions *o, const RunGiven *g)
     if ((g->sample || g->target || o->no_image) && o->mode != RUN_SAMPLED) {
         fprintf(stderr, "sfsim run: --sample, --target-error and --no-image apply to --mode sampled only "
                         "(sfsim help run)\n");
+        return EXIT_USAGE;
+    }
+    if (o->mem_trace && o->mode != RUN_DETAILED) {
+        fprintf(stderr, "sfsim run: --mem-trace FILE writes the timed requests of --mode detailed only (sfsim help run)\n");
         return EXIT_USAGE;
     }
     if (g->sample && g->target) {

@@ -348,7 +348,7 @@ static void fill(void *ctx, uint64_t id, uint64_t cycle)
     b->dirty[k] = m->dirty;
     for (uint32_t i = 0; i < m->nwait; i++) {
         l->st.read_latency += cycle - m->wait[i].cycle;
-        answer(l, m->wait[i].id, cycle);
+        answer(l, m->wait[i].id | MEM_FROM_BELOW, cycle);
     }
     m->busy = 0;
     m->nwait = 0;

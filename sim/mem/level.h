@@ -16,6 +16,10 @@
 
 #include <stdint.h>
 
+/* Set in an answer's id by a level that got the read's line from the level below it (an L2 miss
+ * filled from DRAM); a level in front (the network) passes it on. Ids leave it clear. */
+#define MEM_FROM_BELOW ((uint64_t)1 << 46)
+
 /* A request done: its id as pushed, the cycle it is done (a read's data delivered, a write taken). */
 typedef void (*MemAnswer)(void *ctx, uint64_t id, uint64_t cycle);
 

@@ -244,8 +244,10 @@ static void from_behind(void *ctx, uint64_t id, uint64_t x)
     Noc *n = ctx;
     if (id & NOC_WRITE)
         return;
+    const uint64_t below = id & MEM_FROM_BELOW;
+    id &= ~MEM_FROM_BELOW;
     Slot *s = &n->slot[id];
-    put(n, (Msg){x, 0, s->addr, s->id, s->core, s->bank, n->xfer, AT_BANK_OUT, 0});
+    put(n, (Msg){x, 0, s->addr, s->id | below, s->core, s->bank, n->xfer, AT_BANK_OUT, 0});
     s->next_free = n->free_slot;
     n->free_slot = (uint32_t)id;
 }

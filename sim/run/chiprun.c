@@ -35,6 +35,10 @@ typedef struct CoreRun {
     uint64_t done_at;            /* CS_TILE: the cycle its tile ended */
     uint64_t instr0, lanes0[ISA_STAGE_COUNT];
     uint64_t done;               /* the pass's instructions so far */
+    int id;                      /* its number */
+    FuncMemRec *tr;              /* FuncParams.mem_trace: its requests below, in order */
+    size_t ntr, captr;
+    int tr_oom;
     FuncUnit fu;                 /* the pass's timed figures so far */
     TimingStats before;
 } CoreRun;
@@ -73,7 +77,7 @@ typedef struct ChipRun {
 
 int chip_run_wanted(const FuncParams *fp)
 {
-    return fp->timed && !fp->batch && (fp->cfg->chip_cores > 1 || chip_shared(fp->cfg));
+    return fp->timed && !fp->batch && (fp->cfg->chip_cores > 1 || chip_shared(fp->cfg) || fp->mem_trace);
 }
 
 static Timing *tm_of(const ChipRun *r, int k) { return r->job->workers[k].tc.tm; }
@@ -195,6 +199,63 @@ static int core_go(ChipRun *r, int k)
         cr->done_at = timing_now(t);
         return 0;
     }
+}
+
+/* ---- the trace of the L1s' requests (--mem-trace) ------------------------------------------- */
+
+/* TimingTap: core cr->id's L1 sends a request. */
+static void trace_tap(void *ctx, uint64_t addr, int write, uint64_t cycle)
+{
+    CoreRun *cr = ctx;
+    if (cr->ntr == cr->captr) {
+        size_t cap = cr->captr ? 2 * cr->captr : 1024;
+        FuncMemRec *g = realloc(cr->tr, cap * sizeof *g);
+        if (!g) {
+            cr->tr_oom = 1;
+            return;
+        }
+        cr->tr = g;
+        cr->captr = cap;
+    }
+    cr->tr[cr->ntr] = (FuncMemRec){cycle, addr, (uint32_t)cr->id, (uint8_t)(write != 0), cr->ntr};
+    cr->ntr++;
+}
+
+static int trace_order(const void *pa, const void *pb)
+{
+    const FuncMemRec *a = pa, *b = pb;
+    if (a->cycle != b->cycle)
+        return a->cycle < b->cycle ? -1 : 1;
+    if (a->core != b->core)
+        return a->core < b->core ? -1 : 1;
+    return a->seq < b->seq ? -1 : a->seq > b->seq;
+}
+
+/* The cores' requests into the job, in (cycle, core, order sent) order. 0, or -1 after eng_fail. */
+static int trace_gather(ChipRun *r)
+{
+    size_t n = 0;
+    for (int k = 0; k < r->k; k++) {
+        if (r->cr[k].tr_oom) {
+            eng_fail(r->job, "out of memory for the memory trace (--mem-trace)", 0);
+            return -1;
+        }
+        n += r->cr[k].ntr;
+    }
+    FuncMemRec *all = malloc((n ? n : 1) * sizeof *all);
+    if (!all) {
+        eng_fail(r->job, "out of memory for the memory trace (--mem-trace)", 0);
+        return -1;
+    }
+    size_t o = 0;
+    for (int k = 0; k < r->k; k++) {
+        memcpy(all + o, r->cr[k].tr, r->cr[k].ntr * sizeof *all);
+        o += r->cr[k].ntr;
+    }
+    qsort(all, n, sizeof *all, trace_order);
+    r->job->trace = all;
+    r->job->ntrace = n;
+    return 0;
 }
 
 /* ---- host threads ---------------------------------------------------------------------------- */
@@ -388,6 +449,9 @@ static int cores_open(ChipRun *r)
             eng_fail(j, "out of memory for the chip", 0);
             return -1;
         }
+        r->cr[k].id = k;
+        if (j->fp->mem_trace)
+            timing_tap(tm_of(r, k), trace_tap, &r->cr[k]);
         timing_reset(tm_of(r, k));
     }
     return 0;
@@ -443,9 +507,15 @@ uint32_t chip_run_frame(Job *j)
         }
         if (!atomic_load(&j->failed))
             figures(&r);
+        if (!atomic_load(&j->failed) && j->fp->mem_trace)
+            trace_gather(&r);
+        if (r.k == 1 && !r.chip) /* the paper's machine, run here for its trace: reported as ever */
+            j->ncores = 0;
     }
     pool_close(&r.pool);
     chip_free(r.chip);
+    for (int k = 0; k < r.k; k++)
+        free(r.cr[k].tr);
     free(r.cr);
     free(r.runnable);
     return atomic_load(&r.tiles_done);

@@ -553,6 +553,7 @@ static void session_free(FuncSession *s)
     free(s->job.workers);
     free(s->job.cores);
     free(s->job.chip_mem);
+    free(s->job.trace);
     pthread_mutex_destroy(&s->job.lock);
     if (s->built)
         kernel_free(&s->k);
@@ -666,6 +667,9 @@ static int session_finish(FuncSession *s, FuncStats *st, char *err, size_t errle
     st->cores = job->cores;
     st->makespan = job->makespan;
     st->chip_mem = job->chip_mem;
+    st->trace = job->trace;
+    st->ntrace = job->ntrace;
+    job->trace = NULL;
     job->cores = NULL;
     job->chip_mem = NULL;
     session_free(s);
@@ -756,4 +760,7 @@ void func_stats_free(FuncStats *st)
     st->cores = NULL;
     free(st->chip_mem);
     st->chip_mem = NULL;
+    free(st->trace);
+    st->trace = NULL;
+    st->ntrace = 0;
 }

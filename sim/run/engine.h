@@ -48,6 +48,9 @@ typedef struct FuncParams {
     /* Detailed mode: time every instruction on the machine of cfg (sim/timing.h). Each tile (or
      * trace batch) starts on a cold machine, so the cycles do not depend on the host threads. */
     int timed;
+    /* Detailed mode: keep every request the L1s send below (FuncStats.trace; the frame then runs
+     * on the chip's run, sim/run/chiprun.c, in one continuous time per core). */
+    int mem_trace;
 } FuncParams;
 
 typedef struct FuncTile {
@@ -81,6 +84,14 @@ typedef struct FuncCore {
     uint64_t stalls[TM_CAUSE_COUNT];
 } FuncCore;
 
+/* A request an L1 sent below (FuncParams.mem_trace): in (cycle, core, order sent) order. */
+typedef struct FuncMemRec {
+    uint64_t cycle, addr;       /* the cycle it left the core; a physical line address (port.h) */
+    uint32_t core;
+    uint8_t write;
+    uint64_t seq;               /* the core's requests so far */
+} FuncMemRec;
+
 struct ChipMemStats;
 
 typedef struct FuncStats {
@@ -113,6 +124,8 @@ typedef struct FuncStats {
     FuncCore *cores;
     uint64_t makespan;
     struct ChipMemStats *chip_mem;
+    FuncMemRec *trace;                              /* FuncParams.mem_trace */
+    size_t ntrace;
 } FuncStats;
 
 /* Render the whole image through the kernel: rgb (width * height * 3 floats, zeroed by the

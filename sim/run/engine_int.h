@@ -38,6 +38,8 @@ typedef struct Job {
     uint32_t ncores;
     uint64_t makespan;
     struct ChipMemStats *chip_mem;
+    FuncMemRec *trace;
+    size_t ntrace;
 } Job;
 
 typedef struct Worker {

@@ -49,6 +49,7 @@ typedef struct RunSpec {
     double target_error;
     uint32_t sample_seed;
     int no_image;
+    int mem_trace;             /* RUN_DETAILED: keep the L1s' requests below (RunFrame.f.trace) */
     void (*progress)(void *ctx, uint32_t tiles_done, uint32_t tiles_total);
     /* A line on what a long run is doing (sampled mode's rounds); may be NULL. */
     void (*note)(void *ctx, const char *line);

@@ -280,7 +280,8 @@ static void memo_record_start(Timing *t, const MemoEv *ev, int nev)
     memcpy(m->ev_in, ev, sizeof *ev * (size_t)nev);
     t->m_ok = 1;
     t->m_written[0] = t->m_written[1] = t->m_seen[0] = t->m_seen[1] = 0;
-    memcpy(t->m_stalls0, t->st.stalls, sizeof t->m_stalls0);
+    for (int c = 0; c < TM_CHARGE_SLOTS; c++)
+        t->m_stalls0[c] = tm_slot(&t->st, c);
     t->mmode = MM_RECORD;
 }
 
@@ -377,8 +378,8 @@ __attribute__((noinline)) void memo_store(Timing *t)
     m->end_rel = (uint32_t)(t->now - t->m_t0);
     uint64_t stalls = 0;
     m->ncharge = 0;
-    for (int c = 0; c < TM_CAUSE_COUNT; c++) {
-        uint64_t v = t->st.stalls[c] - t->m_stalls0[c];
+    for (int c = 0; c < TM_CHARGE_SLOTS; c++) {
+        uint64_t v = tm_slot(&t->st, c) - t->m_stalls0[c];
         if (v > UINT32_MAX)
             return;
         if (v) {

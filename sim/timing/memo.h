@@ -64,6 +64,8 @@ enum { MEMO_LEN = 40, MEMO_REGS = 40, MEMO_EVENTS = 6, MEMO_WAYS = 8 };
  * (relative to the start, 0 if by its hit latency), and nothing else touches the cache inside a
  * block, so every later load hits the same way; the core counts them like plain records, and
  * their accesses are counted at the block's end (mem_hits). */
+/* A block's charges are noted by slot: the stall causes and two more (sim/timing/tm.h). */
+enum { MEMO_CHARGE_SLOTS = TM_CAUSE_COUNT + 2 };
 enum { MEMO_NO_LANES = 255 }; /* MemoEntry.gc of a gather with no lanes (no access, no transfer) */
 enum { MEMO_SCENE = 254 };    /* MemoEntry.gc of a scene load */
 
@@ -107,8 +109,8 @@ typedef struct MemoEntry {
                                        a destination being a hazard too) */
     MemoEv ev_out[MEMO_EVENTS];     /* events it left pending after end_rel */
     uint8_t ncharge;                /* stall causes it charged, with their cycles */
-    uint8_t ch_cause[TM_CAUSE_COUNT];
-    uint32_t ch_cycles[TM_CAUSE_COUNT];
+    uint8_t ch_cause[MEMO_CHARGE_SLOTS];
+    uint32_t ch_cycles[MEMO_CHARGE_SLOTS];
     uint16_t issues[2];             /* scalar, vector */
     uint16_t nspad;                 /* scalar scratchpad accesses (TmDesc.spad) */
     uint8_t unit[MEMO_LEN], unit_n[MEMO_LEN];

@@ -22,6 +22,7 @@
 
 typedef struct PendGroup {
     uint64_t known;                  /* the latest known part */
+    int cause;                       /* of the answer that came latest (0 before one) */
     uint32_t n;                      /* fills still out */
     uint32_t fill[ISA_MAX_LANES + 1];
 } PendGroup;
@@ -86,6 +87,7 @@ static uint32_t group_new(Pend *p)
         g = p->ngrp++;
     }
     p->grp[g].known = 0;
+    p->grp[g].cause = TM_SCENE_MEMORY;
     p->grp[g].n = 0;
     p->grp_live[g] = 1;
     return g;
@@ -197,21 +199,25 @@ void tm_pend_free(Timing *t)
     t->pend = NULL;
 }
 
-/* Every register standing at v gets x; the scoreboard's horizon again the latest ready cycle. */
-static void regs_resolve(Timing *t, uint64_t v, uint64_t x)
+/* Every register standing at v gets x, a wait for it charged to cause; the scoreboard's horizon
+ * again the latest ready cycle. */
+static void regs_resolve(Timing *t, uint64_t v, uint64_t x, int cause)
 {
     uint64_t hz = 0;
     for (int r = 0; r < SIMD_NREGS; r++) {
-        if (t->simd.ready[r] == v)
+        if (t->simd.ready[r] == v) {
             t->simd.ready[r] = x;
+            t->simd.rcause[r] = (uint8_t)cause;
+        }
         if (t->simd.ready[r] > hz)
             hz = t->simd.ready[r];
     }
     t->simd.horizon = hz;
 }
 
-void timing_answer(Timing *t, uint32_t fill, uint64_t x)
+void timing_answer(Timing *t, uint32_t fill, uint64_t x, int from)
 {
+    const int cause = from == TIMING_FROM_L2 ? TM_FROM_L2 : TM_FROM_DRAM;
     Pend *p = t->pend;
     if (!p || fill >= p->nfill || p->line[fill] == UINT64_MAX) {
         internal_error(t, "an answer for no outstanding fill");
@@ -219,7 +225,7 @@ void timing_answer(Timing *t, uint32_t fill, uint64_t x)
     }
     const uint64_t v = MEM_PENDING | fill;
     cache_fill_done(&t->l1, p->line[fill], v, x);
-    regs_resolve(t, v, x);
+    regs_resolve(t, v, x, cause);
     for (uint32_t g = 0; g < p->ngrp; g++) {
         if (!p->grp_live[g])
             continue;
@@ -227,12 +233,14 @@ void timing_answer(Timing *t, uint32_t fill, uint64_t x)
         for (uint32_t i = 0; i < gr->n; i++)
             if (gr->fill[i] == fill) {
                 gr->fill[i] = gr->fill[--gr->n];
-                if (x > gr->known)
+                if (x >= gr->known) { /* the latest answer's level (the known part: the L1's) */
                     gr->known = x;
+                    gr->cause = cause;
+                }
                 break;
             }
         if (gr->n == 0) {
-            regs_resolve(t, MEM_PENDING | MEM_PENDING_GROUP | g, gr->known);
+            regs_resolve(t, MEM_PENDING | MEM_PENDING_GROUP | g, gr->known, gr->cause);
             group_free(p, g);
         }
     }

@@ -115,7 +115,7 @@ struct Timing {
     uint32_t m_glines;             /* replay of a block with gathers: the first one's lines */
     size_t m_sway;                 /* replay or record of a block of scene loads: their way */
     uint64_t m_written[2], m_seen[2]; /* record: registers written, live-ins noted */
-    uint64_t m_stalls0[TM_CAUSE_COUNT];
+    uint64_t m_stalls0[MEMO_CHARGE_SLOTS]; /* record: tm_slot at the block's start */
     uint32_t m_bound[MEMO_REGS];   /* record: each live-in's first check, relative to m_t0 */
     /* Issue cycles by stage, statistics generation and vector flag: one count per instruction;
      * timing_stats() folds them into TimingStats' busy counters and the cycles per stage and
@@ -123,6 +123,9 @@ struct Timing {
     uint64_t issues[ISA_STAGE_COUNT][CORE_GENERATIONS][2];
     int halted;
     uint64_t base;                 /* the cycle the program run started in (timing_continue) */
+    MemPort tap_below;             /* timing_tap: the L1's port before the tap, and the tap */
+    TimingTap tap;
+    void *tap_ctx;
     Pend *pend;                    /* a chip's core: answers that come later (pend.c); else NULL */
     char err[256];
     TimingStats st;
@@ -130,13 +133,31 @@ struct Timing {
 
 /* ---- accounting --------------------------------------------------------------------------- */
 
+/* Beside the causes, what a register's wait may be charged to (SimdUnit.rcause) on a chip's core:
+ * scene_memory, counted as well in TimingStats.scene_from by where the line came from. The memo
+ * notes a block's charges by slot: the causes (scene_memory without those) and these two. */
+enum { TM_FROM_L2 = TM_CAUSE_COUNT, TM_FROM_DRAM, TM_CHARGE_SLOTS };
+_Static_assert((int)TM_CHARGE_SLOTS == (int)MEMO_CHARGE_SLOTS, "memo.h sizes a block's charges by slot");
+
 static inline void charge(Timing *t, int cause, uint64_t cycles, int stage, int gen)
 {
     if (!cycles)
         return;
+    if (__builtin_expect(cause >= TM_CAUSE_COUNT, 0)) {
+        t->st.scene_from[cause - TM_CAUSE_COUNT] += cycles;
+        cause = TM_SCENE_MEMORY;
+    }
     t->st.stalls[cause] += cycles;
     t->st.stage_stalls[stage][cause] += cycles;
     t->st.gen_stalls[gen][cause] += cycles;
+}
+
+/* A charge slot's cycles so far (see TM_CHARGE_SLOTS). */
+static inline uint64_t tm_slot(const TimingStats *s, int slot)
+{
+    if (slot >= TM_CAUSE_COUNT)
+        return s->scene_from[slot - TM_CAUSE_COUNT];
+    return slot == TM_SCENE_MEMORY ? s->stalls[slot] - s->scene_from[0] - s->scene_from[1] : s->stalls[slot];
 }
 
 /* One issue cycle of the instruction d (the cycles per stage and generation are folded in

@@ -150,6 +150,12 @@ Test(chip, shared_memory_accounts_for_every_cycle)
     cr_expect_eq(m->l2.hits + m->l2.misses + m->l2.merged, m->l2.reads + m->l2.writes);
     cr_expect(m->l2.misses > 0 && m->dram.reads > 0, "a cold L2 misses to DRAM");
     cr_expect(m->read_latency > 0);
+    /* the scene-memory stalls by where the line came from: part of scene_memory, some of each */
+    const TimingStats *t = &b.timing;
+    cr_expect(t->scene_from[0] + t->scene_from[1] <= t->stalls[TM_SCENE_MEMORY]);
+    cr_expect(t->scene_from[0] > 0 && t->scene_from[1] > 0, "L2: %llu, DRAM: %llu stall cycles",
+              (unsigned long long)t->scene_from[0], (unsigned long long)t->scene_from[1]);
+    cr_expect_eq(a.timing.scene_from[0] + a.timing.scene_from[1], 0, "the paper's machine has no L2 and no DRAM");
     free(ra);
     free(rb);
     func_stats_free(&a);
@@ -254,5 +260,25 @@ Test(chip, same_figures_on_one_and_two_host_threads)
     chip.chip_cores = 16;
     chip.chip_cold_units = 0;
     same_on_threads(&chip);
+    unload();
+}
+
+/* Without an L2 every line a scene cache misses comes from DRAM: its waits are DRAM's. */
+Test(chip, without_an_l2_every_miss_is_drams)
+{
+    load("scenes/cornell/scene.ini", 64, 64, 1);
+    CfgMachine chip;
+    small_frame(&chip);
+    shared_memory(&chip, 2);
+    chip.l2_size_kb = 0;
+    FuncStats st;
+    float *rgb = render(&chip, &st);
+    cr_expect_eq(st.timing.scene_from[0], 0);
+    cr_expect(st.timing.scene_from[1] > 0);
+    cr_expect_eq(st.chip_mem->l2.reads, 0);
+    cr_expect_eq(st.chip_mem->dram.reads, st.chip_mem->requests, "one DDR4 burst of 64 bytes a line");
+    check_chip_accounting(&st, 2);
+    free(rgb);
+    func_stats_free(&st);
     unload();
 }

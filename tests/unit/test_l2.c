@@ -15,13 +15,17 @@ typedef struct Fix {
     FixedLevel below;
     L2 *l2;
     uint64_t ans[1024]; /* answer cycle by request id, 0 = none yet */
+    uint8_t from_below[1024]; /* the answer said its line came from below (MEM_FROM_BELOW) */
     int nans;
 } Fix;
 
 static void on_answer(void *ctx, uint64_t id, uint64_t cycle)
 {
     Fix *f = ctx;
+    const int from_below = (id & MEM_FROM_BELOW) != 0;
+    id &= ~MEM_FROM_BELOW;
     cr_assert_lt(id, 1024u);
+    f->from_below[id] = (uint8_t)from_below;
     cr_assert_eq(f->ans[id], 0u, "request %llu answered twice", (unsigned long long)id);
     f->ans[id] = cycle;
     f->nans++;
@@ -56,6 +60,7 @@ Test(l2, read_miss_then_hit)
     l2_push(f.l2, L(0) + 8, 0, 40, 2);
     run_all(&f);
     cr_expect_eq(f.ans[2], 43);
+    cr_expect(f.from_below[1] && !f.from_below[2], "the miss's line came from below, the hit's did not");
     const L2Stats *s = l2_stats(f.l2);
     cr_expect_eq(s->reads, 2);
     cr_expect_eq(s->hits, 1);

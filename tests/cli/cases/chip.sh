@@ -1,0 +1,77 @@
+#!/usr/bin/env bash
+# tests/cli/cases/chip.sh -- `sfsim run` on a chip (docs/chip.md): the chip's report (per-core
+# busy + stall + idle = cores x cycles, the memory sections, stalls by level) and `--mem-trace`
+# (one line per request the scene caches sent below, the count the report gives, replayable by
+# `sfsim mem`), and the misuses: --mem-trace outside detailed mode, a chip in sampled mode or in
+# `sfsim trace`, an L2 that does not divide into sets.
+set -u
+cd "$(dirname "$0")/../../.." || exit 2
+SFSIM=${SFSIM:-bin/sfsim}
+T=$(mktemp -d "${TMPDIR:-/tmp}/sfsim-cli-chip.XXXXXX") || exit 2
+trap 'rm -rf "$T"' EXIT
+. tests/cli/lib.sh
+
+small=(--set render.width=64 --set render.height=64 --set render.spp=1 --set stream.rays=1024)
+
+# A value of report.json: json FILE python-expression-on-j
+json() { python3 -c "import json,sys; j=json.load(open(sys.argv[1])); print($2)" "$1"; }
+
+begin "chip: 4 cores with an L2 and DDR4 account for every core-cycle, and trace their misses"
+run "$SFSIM" run -c configs/chip16-ddr4.ini --set chip.cores=4 "${small[@]}" --mem-trace "$T/c4.trc" -o "$T/c4"
+want_rc 0
+want_out "wrote .*report.json.*; $T/c4.trc"
+[ "$(json "$T/c4/report.json" "sum(c['busy'] + c['stall'] + c['idle'] for c in j['cores']) == 4 * j['cycles']")" = True ] ||
+    no "busy + stall + idle over the cores is not 4 x cycles"
+[ "$(json "$T/c4/report.json" "j['chip']['cores']")" = 4 ] || no "chip.cores is not 4"
+[ "$(json "$T/c4/report.json" "sum(j['scene_memory_stalls'].values()) == j['stalls']['scene_memory']")" = True ] ||
+    no "the scene-memory stalls by level do not add up to scene_memory's"
+grep -q '^memory ' "$T/c4/report.txt" && grep -q '^l2 ' "$T/c4/report.txt" && grep -q '^dram ' "$T/c4/report.txt" ||
+    no "report.txt lacks the memory, l2 or dram line"
+lines=$(($(wc -l <"$T/c4.trc") - 1))
+want=$(json "$T/c4/report.json" "j['memory']['reads'] + j['memory']['writes']")
+[ "$lines" = "$want" ] || no "the trace has $lines requests, the report $want"
+head -1 "$T/c4.trc" | grep -q '^sfsim-memtrace 1 clock_mhz=500$' || no "no sfsim-memtrace header"
+end
+
+begin "chip: sfsim mem replays a run's trace"
+run "$SFSIM" mem --trace "$T/c4.trc"
+want_rc 0
+want_out "^total"
+end
+
+begin "chip: one core on its bus traces as many lines as its cache missed and wrote back, and reports as ever"
+run "$SFSIM" run "${small[@]}" --mem-trace "$T/c1.trc" -o "$T/c1"
+want_rc 0
+lines=$(($(wc -l <"$T/c1.trc") - 1))
+want=$(json "$T/c1/report.json" "j['units']['scene_memory']['misses'] + j['units']['scene_memory']['writebacks']")
+[ "$lines" = "$want" ] || no "the trace has $lines requests, the cache $want misses and write-backs"
+[ "$(json "$T/c1/report.json" "'chip' in j")" = False ] || no "the paper's machine reports a chip"
+end
+
+begin "chip: --mem-trace outside detailed mode is a usage error"
+run "$SFSIM" run --mode functional "${small[@]}" --mem-trace "$T/x.trc" -o "$T/x"
+want_rc 2
+want_err "--mem-trace"
+[ ! -e "$T/x.trc" ] || no "a trace was written"
+end
+
+begin "chip: sampled mode on a chip says it is not built yet"
+run "$SFSIM" run --mode sampled --sample 0.5 --set chip.cores=2 "${small[@]}" -o "$T/s"
+want_rc 1
+want_err "detailed mode only"
+end
+
+begin "chip: an L2 that does not divide into sets names its keys"
+run "$SFSIM" run --set chip.memory=shared --set l2.size_kb=100 "${small[@]}" -o "$T/b"
+want_rc 1
+want_err "l2.size_kb = 100"
+end
+
+begin "chip: --mem-trace into a folder fails with exit 4 and keeps the run's other outputs"
+mkdir -p "$T/dir.trc"
+run "$SFSIM" run "${small[@]}" --mem-trace "$T/dir.trc" -o "$T/d"
+want_rc 4
+[ -e "$T/d/report.json" ] || no "the run's report was not kept"
+end
+
+cli_summary "cli chip"
