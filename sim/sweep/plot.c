@@ -440,7 +440,7 @@ static void gp_xaxis(const Plotter *p, UtilBuf *gp, const char *xkey)
         sweep_strs_free(&seen);
         util_buf_puts(gp, ")\n");
     }
-    util_buf_puts(gp, "set offsets graph 0.03, graph 0.03, 0, 0\n");
+    util_buf_puts(gp, "set autoscale xfix\nset offsets graph 0.03, graph 0.03, 0, 0\n");
 }
 
 /* fps (lines, with the confidence interval as error bars when every point has one), SIMD
