@@ -379,6 +379,10 @@ static int group_cols(const char *prefix, const char *const *keys, int n, int *f
 
 int sweep_plot_cols(SweepPlotCols *cols, char *err, size_t errlen)
 {
+    /* A chip's figures (docs/chip.md): a point has some of them when it ran a chip. */
+    static const char *const chip_keys[] = {"load_imbalance", "memory_latency", "l2_hit_rate", "dram_gbs",
+                                            "dram_bandwidth_share"};
+    cols->chip_n = (int)(sizeof chip_keys / sizeof chip_keys[0]);
     const char *stages[3];
     for (int s = 0; s < 3; s++)
         stages[s] = isa_stage_keys[plot_stages[s]];
@@ -390,7 +394,8 @@ int sweep_plot_cols(SweepPlotCols *cols, char *err, size_t errlen)
         return -1;
     if (group_cols("utilization_", stages, 3, &cols->util, err, errlen) ||
         group_cols("stall_share_", tm_cause_keys, TM_CAUSE_COUNT, &cols->stall, err, errlen) ||
-        group_cols("ops_share_", isa_category_keys, ISA_C_COUNT, &cols->ops, err, errlen))
+        group_cols("ops_share_", isa_category_keys, ISA_C_COUNT, &cols->ops, err, errlen) ||
+        group_cols("", chip_keys, cols->chip_n, &cols->chip, err, errlen))
         return -1;
     return 0;
 }
@@ -401,6 +406,41 @@ static void dat_heads(UtilBuf *b, int m0, int n)
     char name[128];
     for (int m = m0; m < m0 + n; m++)
         util_buf_printf(b, " %s", stats_csv_name(m, name, sizeof name));
+}
+
+/* The x axis of lines against a numeric key: its label, its values as ticks (up to 16), a log
+ * scale when they span a factor of 100 or more, and a margin either side. */
+static void gp_xaxis(const Plotter *p, UtilBuf *gp, const char *xkey)
+{
+    util_buf_puts(gp, "set xlabel ");
+    axis_label(gp, xkey);
+    util_buf_puts(gp, "\n");
+    int numeric, nv = key_values(p->pl, xkey, &numeric);
+    double lo = INFINITY, hi = -INFINITY;
+    for (int r = 0; r < p->pl->npoints; r++) {
+        double x;
+        if (sweep_is_number(sweep_plan_value(p->pl, r, xkey), &x))
+            lo = fmin(lo, x), hi = fmax(hi, x);
+    }
+    if (lo > 0 && hi / lo >= 100)
+        util_buf_puts(gp, "set logscale x\n");
+    if (nv <= 16) {
+        util_buf_puts(gp, "set xtics (");
+        SweepStrs seen = {0};
+        for (int r = 0; r < p->pl->npoints; r++) {
+            const char *v = sweep_plan_value(p->pl, r, xkey);
+            int dup = 0;
+            for (int i = 0; i < seen.n && !dup; i++)
+                dup = !strcmp(seen.v[i], v);
+            if (!dup) {
+                util_buf_printf(gp, "%s%s", seen.n ? ", " : "", v);
+                sweep_strs_push(&seen, xstrdup(v));
+            }
+        }
+        sweep_strs_free(&seen);
+        util_buf_puts(gp, ")\n");
+    }
+    util_buf_puts(gp, "set autoscale xfix\nset offsets graph 0.03, graph 0.03, 0, 0\n");
 }
 
 /* fps (lines, with the confidence interval as error bars when every point has one), SIMD
@@ -455,35 +495,7 @@ static void plot_lines(Plotter *p, const char *xkey, int what)
     }
     gp_head(p, &gp, base, util ? 1500 : 960, util ? 560 : 620,
             util ? "SIMD utilization per stage" : kd ? "kd-tree nodes visited per ray" : "frames per second", xkey);
-    util_buf_puts(&gp, "set xlabel ");
-    axis_label(&gp, xkey);
-    util_buf_puts(&gp, "\n");
-    int numeric, nv = key_values(p->pl, xkey, &numeric);
-    double lo = INFINITY, hi = -INFINITY;
-    for (int r = 0; r < p->pl->npoints; r++) {
-        double x;
-        if (sweep_is_number(sweep_plan_value(p->pl, r, xkey), &x))
-            lo = fmin(lo, x), hi = fmax(hi, x);
-    }
-    if (lo > 0 && hi / lo >= 100)
-        util_buf_puts(&gp, "set logscale x\n");
-    if (nv <= 16) {
-        util_buf_puts(&gp, "set xtics (");
-        SweepStrs seen = {0};
-        for (int r = 0; r < p->pl->npoints; r++) {
-            const char *v = sweep_plan_value(p->pl, r, xkey);
-            int dup = 0;
-            for (int i = 0; i < seen.n && !dup; i++)
-                dup = !strcmp(seen.v[i], v);
-            if (!dup) {
-                util_buf_printf(&gp, "%s%s", seen.n ? ", " : "", v);
-                sweep_strs_push(&seen, xstrdup(v));
-            }
-        }
-        sweep_strs_free(&seen);
-        util_buf_puts(&gp, ")\n");
-    }
-    util_buf_puts(&gp, "set offsets graph 0.03, graph 0.03, 0, 0\n");
+    gp_xaxis(p, &gp, xkey);
     util_buf_puts(&gp, ng > 1 || kd ? "set key outside below center horizontal\n" : "unset key\n");
     if (util) {
         util_buf_puts(&gp, "set yrange [0:1]\nset ylabel \"SIMD utilization (active lanes / N)\"\n");
@@ -521,6 +533,73 @@ static void plot_lines(Plotter *p, const char *xkey, int what)
         util_buf_puts(&gp, "\n");
     }
     plot_finish(p, base, &gp, &dat, util);
+    free(base);
+    groups_free(g, ng);
+}
+
+/* A chip's memory figures against a numeric key (memory_K.png), a panel each, a line per
+ * combination of the other keys: only for sweeps some of whose points ran a chip (docs/chip.md). A
+ * figure a point does not have (the L2's hit rate with no L2) is a gap in its line. */
+static const struct {
+    const char *col, *title, *ylabel;
+    int unit_range;
+} chip_panels[] = {
+    {"dram_gbs", "DRAM bandwidth used", "GB/s (10^9 bytes) over the frame", 0},
+    {"dram_bandwidth_share", "DRAM bandwidth, share of peak", "bandwidth used / peak", 0},
+    {"memory_latency", "average memory latency", "cycles from a miss leaving its core to its line", 0},
+    {"l2_hit_rate", "L2 hit rate", "L2 hits / requests", 1},
+    {"stall_share_scene_memory", "scene-memory stalls", "share of the cores' busy + stall cycles", 0},
+    {"load_imbalance", "load imbalance", "most busy + stall cycles of a core / mean", 0},
+};
+#define N_CHIP_PANELS (int)(sizeof chip_panels / sizeof chip_panels[0])
+
+static void plot_chip(Plotter *p, const char *xkey)
+{
+    int m[N_CHIP_PANELS];
+    char err[256];
+    for (int c = 0; c < N_CHIP_PANELS; c++)
+        if ((m[c] = sweep_col(chip_panels[c].col, err, sizeof err)) < 0)
+            return; /* sweep_plot_cols found every one of them */
+    Group *g;
+    int ng = groups_make(p, xkey, p->c.chip, p->c.chip_n, &g);
+    if (!ng) {
+        groups_free(g, ng);
+        return;
+    }
+    char *base = xasprintf("memory_%s", xkey);
+    UtilBuf gp = {0}, dat = {0};
+    for (int i = 0; i < ng; i++) {
+        util_buf_printf(&dat, "%s# %s\n# %s", i ? "\n\n" : "", g[i].label[0] ? g[i].label : "all points", xkey);
+        for (int c = 0; c < N_CHIP_PANELS; c++)
+            util_buf_printf(&dat, " %s", chip_panels[c].col);
+        util_buf_puts(&dat, "\n");
+        for (int j = 0; j < g[i].n; j++) {
+            util_buf_printf(&dat, "%s", sweep_plan_value(p->pl, g[i].rows[j], xkey));
+            for (int c = 0; c < N_CHIP_PANELS; c++)
+                dat_num(&dat, &p->rows[g[i].rows[j]], m[c]);
+            util_buf_puts(&dat, "\n");
+        }
+    }
+    gp_head(p, &gp, base, 1500, 1020, "the chip's memory", xkey);
+    gp_xaxis(p, &gp, xkey);
+    util_buf_puts(&gp, ng > 1 ? "set key outside below center horizontal\n" : "unset key\n");
+    util_buf_puts(&gp, "set multiplot layout 2,3 title ");
+    UtilBuf t = {0};
+    util_buf_printf(&t, "the chip's memory against %s", xkey);
+    gp_str(&gp, sweep_buf_text(&t));
+    util_buf_free(&t);
+    util_buf_printf(&gp, " . \"\\n\" . %s\n", p->subtitle);
+    for (int c = 0; c < N_CHIP_PANELS; c++) {
+        util_buf_printf(&gp, "set title \"%s\"\nset ylabel \"%s\"\nset yrange [0:%s]\nplot ", chip_panels[c].title,
+                        chip_panels[c].ylabel, chip_panels[c].unit_range ? "1" : "*");
+        for (int i = 0; i < ng; i++) {
+            util_buf_printf(&gp, "%s\"%s.dat\" index %d using 1:%d with linespoints lw 2 pt 7 ps 1.2 title ",
+                            i ? ", \\\n     " : "", base, i, 2 + c);
+            gp_str(&gp, g[i].label[0] ? g[i].label : "all points");
+        }
+        util_buf_puts(&gp, "\n");
+    }
+    plot_finish(p, base, &gp, &dat, 1);
     free(base);
     groups_free(g, ng);
 }
@@ -769,6 +848,7 @@ int sweep_plots_make(const SweepPlan *pl, const SweepRow *rows, const char *dir,
         plot_lines(&p, pl->keys[k], 2); /* only when some point ran on a kd-tree */
         plot_stacked(&p, pl->keys[k], &p.stall);
         plot_stacked(&p, pl->keys[k], &p.ops);
+        plot_chip(&p, pl->keys[k]); /* only when some point ran a chip */
     }
     if (!lines)
         for (int kind = 0; kind < 5; kind++)

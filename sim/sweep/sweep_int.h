@@ -286,6 +286,7 @@ typedef struct SweepPlotCols {
     int util;          /* utilization_traversal, then _intersection and _shading */
     int kd, kd_camera; /* kd_nodes_per_ray, kd_camera_nodes_per_ray */
     int stall, ops;    /* stall_share_<first cause>, ops_share_<first category> */
+    int chip, chip_n;  /* load_imbalance, then memory_latency, l2_hit_rate, dram_gbs, dram_bandwidth_share */
 } SweepPlotCols;
 /* 0, or -1 with the column that is missing or out of its group's order in err. */
 int sweep_plot_cols(SweepPlotCols *cols, char *err, size_t errlen);
