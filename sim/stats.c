@@ -409,12 +409,13 @@ FIG(l2_hit_rate)
 {
     (void)idx;
     const L2Stats *l = &mem_of(c)->l2;
-    return defined_if(stats_ratio(l->hits, l->reads + l->writes), l->reads + l->writes > 0, na);
+    return defined_if(stats_ratio(l->hits, l->reads + l->writes), mem_of(c)->has_l2 && l->reads + l->writes > 0, na);
 }
 FIG(l2_mpki)
 {
     (void)idx;
-    return defined_if(1000.0 * stats_ratio(mem_of(c)->l2.misses, c->f->instructions), c->f->instructions > 0, na);
+    return defined_if(1000.0 * stats_ratio(mem_of(c)->l2.misses, c->f->instructions),
+                      mem_of(c)->has_l2 && c->f->instructions > 0, na);
 }
 FIG(l2_read_latency)
 {

@@ -252,14 +252,14 @@ static void chip_out(void *ctx, uint64_t addr, int write, uint64_t at, uint32_t 
     p->out[p->nout++] = (InReq){at + 1, addr, (uint32_t)p->core, write ? UINT32_MAX : fill, p->seq++};
 }
 
-void chip_collect(Chip *c)
+void chip_collect(Chip *c, const int *cores, int n)
 {
-    for (int k = 0; k < c->cores; k++) {
-        ChipPort *p = &c->port[k];
+    for (int i = 0; i < n; i++) {
+        ChipPort *p = &c->port[cores[i]];
         if (p->oom)
             snprintf(c->err, sizeof c->err, "chip: out of memory for requests");
-        for (size_t i = 0; i < p->nout; i++)
-            in_push(c, p->out[i]);
+        for (size_t q = 0; q < p->nout; q++)
+            in_push(c, p->out[q]);
         p->nout = 0;
     }
 }

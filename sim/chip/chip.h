@@ -38,8 +38,9 @@ void chip_free(Chip *c);
  * of memory. */
 int chip_attach(Chip *c, int k, Timing *t);
 /* The requests the cores sent while they ran (each into a list of its own, so that cores may run
- * on any host threads) taken in: before chip_next, with no core running. */
-void chip_collect(Chip *c);
+ * on any host threads) taken in: those of the n cores listed (every core that ran since the last
+ * call), before chip_next, with no core running. */
+void chip_collect(Chip *c, const int *cores, int n);
 /* The next cycle in which the shared memory has something to do (a request entering, an event of
  * a level); UINT64_MAX: nothing. */
 uint64_t chip_next(const Chip *c);

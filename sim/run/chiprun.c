@@ -66,7 +66,9 @@ typedef struct ChipRun {
     Chip *chip;
     CoreRun *cr;
     Pool pool;
-    int *runnable;
+    int *runnable;               /* the cores woken or given a tile since the last step */
+    int nrunnable;
+    int nmem, ntile;             /* cores waiting for memory, for a tile */
     int k;
     uint32_t next_tile;
     atomic_uint tiles_done;
@@ -175,7 +177,7 @@ static int core_go(ChipRun *r, int k)
             ex = run_slice(r, k);
         }
         if (ex == CORE_EXIT_YIELD) {
-            cr->state = CS_MEM;
+            cr->state = CS_MEM; /* (counted by the caller, after the step: threads run cores) */
             cr->resume = 1;
             return 0;
         }
@@ -256,6 +258,12 @@ static int trace_gather(ChipRun *r)
     r->job->trace = all;
     r->job->ntrace = n;
     return 0;
+}
+
+static int int_order(const void *a, const void *b)
+{
+    const int x = *(const int *)a, y = *(const int *)b;
+    return (x > y) - (x < y);
 }
 
 /* ---- host threads ---------------------------------------------------------------------------- */
@@ -355,6 +363,8 @@ static void woke(void *ctx, int k, uint64_t x)
         return;
     cr->state = CS_RUN;
     cr->wake = x;
+    r->nmem--;
+    r->runnable[r->nrunnable++] = k;
     if (x < r->xmin)
         r->xmin = x;
 }
@@ -363,6 +373,8 @@ static void woke(void *ctx, int k, uint64_t x)
 static int first_waiting(const ChipRun *r)
 {
     int best = -1;
+    if (r->ntile == 0)
+        return -1;
     for (int k = 0; k < r->k; k++)
         if (r->cr[k].state == CS_TILE && (best < 0 || r->cr[k].done_at < r->cr[best].done_at))
             best = k;
@@ -375,15 +387,24 @@ static int shared_step(ChipRun *r)
 {
     r->xmin = UINT64_MAX;
     if (r->chip)
-        chip_collect(r->chip);
+        chip_collect(r->chip, r->runnable, r->nrunnable);
+    /* the cores just run now wait: count them by what for */
+    for (int i = 0; i < r->nrunnable; i++) {
+        const int s = r->cr[r->runnable[i]].state;
+        r->nmem += s == CS_MEM;
+        r->ntile += s == CS_TILE;
+    }
+    r->nrunnable = 0;
     for (;;) {
         const uint64_t e = r->chip ? chip_next(r->chip) : UINT64_MAX;
         const int w = first_waiting(r);
         if (w >= 0 && r->cr[w].done_at < e && r->cr[w].done_at < r->xmin) {
+            r->ntile--;
             if (r->next_tile < r->job->ntiles) {
                 const uint64_t at = r->cr[w].done_at;
                 tile_begin(r, w, r->next_tile++);
                 r->cr[w].wake = at;
+                r->runnable[r->nrunnable++] = w;
                 if (at < r->xmin)
                     r->xmin = at;
             } else {
@@ -391,9 +412,7 @@ static int shared_step(ChipRun *r)
             }
             continue;
         }
-        int waiting_mem = 0;
-        for (int k = 0; k < r->k && !waiting_mem; k++)
-            waiting_mem = r->cr[k].state == CS_MEM;
+        const int waiting_mem = r->nmem > 0;
         if (e != UINT64_MAX && e <= r->xmin && (waiting_mem || w >= 0)) {
             chip_step(r->chip, e, woke, r);
             if (chip_error(r->chip)) {
@@ -485,19 +504,20 @@ uint32_t chip_run_frame(Job *j)
     pool_open(&r.pool, &r, threads - 1);
     if (cores_open(&r) == 0) {
         for (int k = 0; k < r.k; k++) {
-            if (r.next_tile < j->ntiles)
+            if (r.next_tile < j->ntiles) {
                 tile_begin(&r, k, r.next_tile++);
-            else
+                r.runnable[r.nrunnable++] = k;
+            } else {
                 r.cr[k].state = CS_DONE;
+            }
         }
         int go = 1;
         while (go > 0 && !atomic_load(&j->failed)) {
-            int n = 0;
-            for (int k = 0; k < r.k; k++)
-                if (r.cr[k].state == CS_RUN)
-                    r.runnable[n++] = k;
+            /* the cores woken or given a tile, in core order (the order does not change a result:
+                 * it only keeps the host's work the same from run to run) */
+            qsort(r.runnable, (size_t)r.nrunnable, sizeof *r.runnable, int_order);
             const uint32_t before = atomic_load(&r.tiles_done);
-            if (pool_step(&r.pool, r.runnable, n))
+            if (pool_step(&r.pool, r.runnable, r.nrunnable))
                 go = -1;
             const uint32_t done = atomic_load(&r.tiles_done);
             if (done != before && j->fp->progress)
