@@ -285,7 +285,8 @@ TEST_ENV = SFSIM_BUILD=$(BUILD) SFSIM_GEN_ISADOC=$(BUILD)/gen_isadoc SFSIM_TEST_
 
 # The tools the test suite does not run are still built (-Werror), so they cannot rot.
 test-built: all $(BUILD)/tests/unit $(BUILD)/tests/io $(BUILD)/gen_cornell $(BUILD)/outputs_digest \
-		$(BUILD)/validation $(BUILD)/paper $(BUILD)/bench/speed_vs_error $(BUILD)/bench/per_ray
+		$(BUILD)/validation $(BUILD)/paper $(BUILD)/bench/speed_vs_error $(BUILD)/bench/per_ray \
+		$(BUILD)/bench/chip_speed
 	@bash tests/outputs/check.sh
 	@bash tests/cli/run.sh
 	@bash tests/cli/sweep.sh
@@ -392,6 +393,10 @@ $(BUILD)/bench/detailed_speed: bench/detailed_speed.c tests/support/shared.c $(B
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(LTO_LINK) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
 
+$(BUILD)/bench/chip_speed: bench/chip_speed.c tests/support/shared.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(LTO_LINK) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
+
 $(BUILD)/bench/speed_vs_error: bench/speed_vs_error.c tests/support/shared.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(LTO_LINK) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
@@ -425,7 +430,8 @@ paper: deps
 
 bench: deps
 	@$(MAKE) --no-print-directory $(BUILD)/bench/core_speed $(BUILD)/bench/embree_xcheck $(BUILD)/bench/functional_speed \
-		$(BUILD)/bench/detailed_speed $(BUILD)/bench/speed_vs_error $(BUILD)/bench/per_ray $(BUILD)/bench/sched_speed
+		$(BUILD)/bench/detailed_speed $(BUILD)/bench/speed_vs_error $(BUILD)/bench/per_ray $(BUILD)/bench/sched_speed \
+		$(BUILD)/bench/chip_speed
 	$(BUILD)/bench/core_speed
 	$(BUILD)/bench/embree_xcheck
 	$(BUILD)/bench/functional_speed
@@ -433,6 +439,7 @@ bench: deps
 	$(BUILD)/bench/speed_vs_error out/bench
 	$(BUILD)/bench/per_ray
 	$(BUILD)/bench/sched_speed
+	$(BUILD)/bench/chip_speed
 
 # ---- the example `make run` executes --------------------------------------------------------
 # The default scene on the default machine in detailed mode, sized to take one to two minutes

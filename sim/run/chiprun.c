@@ -336,7 +336,10 @@ static int pool_step(Pool *p, const int *list, int n)
     p->nlist = n;
     atomic_store(&p->next, 0);
     atomic_store(&p->failed, 0);
-    const int helpers = n > 1 ? (p->nth < n - 1 ? p->nth : n - 1) : 0;
+    /* With shared memory a step wakes about one core (docs/chip.md, "Host threads"): waking the
+     * threads for it cost more than it gave (bench/chip_speed: 0.81x on 2 threads), so they take
+     * the steps of cores on their own buses only, where every core runs its whole tile. */
+    const int helpers = n > 1 && !p->r->chip ? (p->nth < n - 1 ? p->nth : n - 1) : 0;
     if (helpers) {
         pthread_mutex_lock(&p->mu);
         p->running = p->nth;
