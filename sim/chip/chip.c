@@ -27,7 +27,7 @@ typedef struct ChipPort {        /* what core k's timing model sends through (ti
     Timing *t;
     uint64_t seq;
     uint64_t *sent;              /* by fill: the cycle the L1 sent it */
-    uint32_t nsent;
+    size_t nsent;
     InReq *out;                  /* sent while the core ran (its host thread's only), not yet in */
     size_t nout, capout;
     int oom;
@@ -168,6 +168,23 @@ Chip *chip_new(const CfgMachine *cfg, int cores, char *err, size_t errlen)
 
 /* ---- requests on their way in ----------------------------------------------------------------- */
 
+/* *a holds at least need elements of size bytes (its capacity *cap doubled as needed); -1 on out
+ * of memory, *a unchanged. */
+static int grow(void **a, size_t *cap, size_t need, size_t size)
+{
+    if (need <= *cap)
+        return 0;
+    size_t n = *cap ? 2 * *cap : 64;
+    while (n < need)
+        n *= 2;
+    void *g = realloc(*a, n * size);
+    if (!g)
+        return -1;
+    *a = g;
+    *cap = n;
+    return 0;
+}
+
 static int in_before(const InReq *a, const InReq *b)
 {
     if (a->at != b->at)
@@ -179,15 +196,9 @@ static int in_before(const InReq *a, const InReq *b)
 
 static void in_push(Chip *c, InReq r)
 {
-    if (c->n == c->cap) {
-        size_t cap = c->cap ? 2 * c->cap : 256;
-        InReq *h = realloc(c->h, cap * sizeof *h);
-        if (!h) {
-            snprintf(c->err, sizeof c->err, "chip: out of memory for requests");
-            return;
-        }
-        c->h = h;
-        c->cap = cap;
+    if (grow((void **)&c->h, &c->cap, c->n + 1, sizeof *c->h)) {
+        snprintf(c->err, sizeof c->err, "chip: out of memory for requests");
+        return;
     }
     size_t i = c->n++;
     while (i > 0 && in_before(&r, &c->h[(i - 1) / 2])) {
@@ -225,27 +236,10 @@ static InReq in_pop(Chip *c)
 static void chip_out(void *ctx, uint64_t addr, int write, uint64_t at, uint32_t fill)
 {
     ChipPort *p = ctx;
-    if (!write && fill >= p->nsent) {
-        uint32_t n = p->nsent ? 2 * p->nsent : 64;
-        while (n <= fill)
-            n *= 2;
-        uint64_t *s = realloc(p->sent, n * sizeof *s);
-        if (!s) {
-            p->oom = 1;
-            return;
-        }
-        p->sent = s;
-        p->nsent = n;
-    }
-    if (p->nout == p->capout) {
-        size_t cap = p->capout ? 2 * p->capout : 64;
-        InReq *o = realloc(p->out, cap * sizeof *o);
-        if (!o) {
-            p->oom = 1;
-            return;
-        }
-        p->out = o;
-        p->capout = cap;
+    if ((!write && grow((void **)&p->sent, &p->nsent, (size_t)fill + 1, sizeof *p->sent)) ||
+        grow((void **)&p->out, &p->capout, p->nout + 1, sizeof *p->out)) {
+        p->oom = 1;
+        return;
     }
     if (!write)
         p->sent[fill] = at;

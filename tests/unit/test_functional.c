@@ -19,25 +19,13 @@
 #include "../../sim/run/accel.h"
 #include "../../sim/reference.h"
 
+#include "../support/packed.h"
 #include "../support/shared.h"
 
 typedef struct Img {
     float *rgb;
     int w, h;
 } Img;
-
-static void load_packed(const char *path, int w, int h, int spp, Scene *s, PackedScene *p)
-{
-    NEEDS_SCENE(path);
-    char err[1024];
-    cr_assert_eq(scene_load(path, s, err, sizeof err), 0, "%s: %s", path, err);
-    s->render.width = w;
-    s->render.height = h;
-    s->render.spp = spp;
-    BvhParams bp;
-    bvh_default_params(&bp);
-    cr_assert_eq(pack_scene(s, &bp, 0, p, err, sizeof err), 0, "%s", err);
-}
 
 static Img golden(const PackedScene *p, int w, int h, int tile)
 {
@@ -100,7 +88,7 @@ static void matches_golden(const char *path, int w, int h, int spp)
 {
     Scene s;
     PackedScene p;
-    load_packed(path, w, h, spp, &s, &p);
+    packed_load(path, w, h, spp, &s, &p);
     Img g = golden(&p, w, h, 64);
     FuncStats st;
     Img k = kernel(&p, s.needs, w, h, 16, 4096, 2, &st);
@@ -180,7 +168,7 @@ Test(functional, same_image_for_every_simd_width_stream_size_and_thread_count, .
     Scene s;
     PackedScene p;
     int w = 72, h = 40;
-    load_packed("scenes/cornell/spheres.ini", w, h, 2, &s, &p);
+    packed_load("scenes/cornell/spheres.ini", w, h, 2, &s, &p);
     FuncStats st;
     Img base = kernel(&p, s.needs, w, h, 16, 4096, 1, &st);
     func_stats_free(&st);
@@ -207,7 +195,7 @@ Test(functional, utilization_falls_with_n_and_streams_grow_with_m, .timeout = 30
     Scene s;
     PackedScene p;
     int w = 64, h = 64;
-    load_packed("scenes/cornell/scene.ini", w, h, 1, &s, &p);
+    packed_load("scenes/cornell/scene.ini", w, h, 1, &s, &p);
     double util[2];
     double len[2][3];
     int ns[2] = {8, 64};
@@ -242,7 +230,7 @@ Test(functional, machines_too_small_for_the_kernel_are_refused_by_key)
 {
     Scene s;
     PackedScene p;
-    load_packed("scenes/cornell/scene.ini", 16, 16, 1, &s, &p);
+    packed_load("scenes/cornell/scene.ini", 16, 16, 1, &s, &p);
     struct { const char *key; int value; const char *want; } cases[] = {
         {"raybuf", 64, "raybuf.size_kb"}, {"idm", 8, "idm.size_kb"}, {"fb", 4, "fb.size_kb"},
         {"spad", 1, "spad.size_kb"}, {"scene", 0, "scene.size_mb"}};
@@ -283,7 +271,7 @@ static void pass_trap_frame(int w, int h, int spp, int threads, float **rgb, Fun
 {
     Scene s;
     PackedScene p;
-    load_packed("scenes/cornell/scene.ini", w, h, spp, &s, &p);
+    packed_load("scenes/cornell/scene.ini", w, h, spp, &s, &p);
     CfgMachine cfg;
     cfg_defaults(&cfg);
     cfg.stream_rays = 1024;
@@ -365,7 +353,7 @@ Test(functional, a_missing_kernel_is_an_error_naming_it)
 {
     Scene s;
     PackedScene p;
-    load_packed("scenes/cornell/scene.ini", 16, 16, 1, &s, &p);
+    packed_load("scenes/cornell/scene.ini", 16, 16, 1, &s, &p);
     CfgMachine cfg;
     cfg_defaults(&cfg);
     float *rgb = calloc(3 * 16 * 16, sizeof(float));
@@ -386,7 +374,7 @@ Test(functional, packet_tracing_same_image_lower_utilization, .timeout = 300)
     Scene s;
     PackedScene p;
     int w = 64, h = 48;
-    load_packed("scenes/cornell/glossy.ini", w, h, 2, &s, &p);
+    packed_load("scenes/cornell/glossy.ini", w, h, 2, &s, &p);
     Img g = golden(&p, w, h, 64);
     static const int lanes[] = {4, 8, 12, 16};
     for (size_t i = 0; i < sizeof lanes / sizeof lanes[0]; i++) {
@@ -423,7 +411,7 @@ Test(functional, forced_specular_workload_bounces_every_ray, .timeout = 300)
     Scene s;
     PackedScene p;
     int w = 48, h = 40;
-    load_packed("scenes/cornell/scene.ini", w, h, 1, &s, &p);
+    packed_load("scenes/cornell/scene.ini", w, h, 1, &s, &p);
     CfgMachine cfg;
     cfg_defaults(&cfg);
     cfg.workload_kind = CFG_WORKLOAD_SPECULAR;
@@ -453,7 +441,7 @@ Test(functional, one_bounce_diffuse_workload_has_two_generations, .timeout = 300
     Scene s;
     PackedScene p;
     int w = 48, h = 40;
-    load_packed("scenes/cornell/scene.ini", w, h, 4, &s, &p);
+    packed_load("scenes/cornell/scene.ini", w, h, 4, &s, &p);
     CfgMachine cfg;
     cfg_defaults(&cfg);
     cfg.workload_kind = CFG_WORKLOAD_DIFFUSE;
@@ -489,7 +477,7 @@ static void phong_matches_golden(const char *path, int w, int h, int spp)
 {
     Scene s;
     PackedScene p;
-    load_packed(path, w, h, spp, &s, &p);
+    packed_load(path, w, h, spp, &s, &p);
     uint32_t nlights = sm_u32(&p, sm_hdr(&p, SM_HDR_NLIGHTS));
     static const int bounces[] = {0, 1, 3};
     for (size_t b = 0; b < sizeof bounces / sizeof bounces[0]; b++) {
@@ -587,7 +575,7 @@ Test(functional, first_ray_order_differs_only_in_rare_ties, .timeout = 300)
     Scene s;
     PackedScene p;
     int w = 64, h = 48;
-    load_packed("scenes/conference/scene.ini", w, h, 1, &s, &p);
+    packed_load("scenes/conference/scene.ini", w, h, 1, &s, &p);
     Img g = golden(&p, w, h, 64);
     CfgMachine cfg;
     cfg_defaults(&cfg);
@@ -636,7 +624,7 @@ Test(functional, kd_tree_from_the_kd_keys_is_packed)
 {
     Scene s;
     PackedScene p;
-    load_packed("scenes/cornell/scene.ini", 16, 16, 1, &s, &p);
+    packed_load("scenes/cornell/scene.ini", 16, 16, 1, &s, &p);
     CfgMachine cfg;
     cfg_defaults(&cfg);
     AccelKdInfo info;
@@ -684,7 +672,7 @@ Test(functional, kd_counters_and_build_symbols)
     Scene s;
     PackedScene p;
     int w = 128, h = 64;           /* 8 tiles of 32 x 32 */
-    load_packed("scenes/cornell/scene.ini", w, h, 1, &s, &p);
+    packed_load("scenes/cornell/scene.ini", w, h, 1, &s, &p);
     CfgMachine cfg;
     kd_cfg(&cfg, CFG_KD_STACK);
     AccelKdInfo info;
@@ -726,7 +714,7 @@ Test(functional, kd_memory_checks_name_the_keys)
 {
     Scene s;
     PackedScene p;
-    load_packed("scenes/cornell/scene.ini", 16, 16, 1, &s, &p);
+    packed_load("scenes/cornell/scene.ini", 16, 16, 1, &s, &p);
     CfgMachine cfg;
     kd_cfg(&cfg, CFG_KD_STACK);
     AccelKdInfo info;
