@@ -211,9 +211,13 @@ static int cmd_run(int argc, char **argv)
     }
     size_t n = strlen(o->out_dir);
     const char *sep = n && o->out_dir[n - 1] == '/' ? "" : "/";
-    printf("sfsim run: wrote %s%s%sreport.txt, report.json, stats.txt%s%s%s\n", o->out_dir, sep,
+    printf("sfsim run: wrote %s%s%sreport.txt, report.json, stats.txt%s%s%s%s%s\n", o->out_dir, sep,
            o->no_image ? "" : "frame.png, frame.exr, ", run_mode_timed(o->mode) ? ", cost.png" : "",
-           o->mem_trace ? "; " : "", o->mem_trace ? o->mem_trace : "");
+           o->mem_trace ? "; " : "", o->mem_trace ? o->mem_trace : "", o->timeline ? "; " : "",
+           o->timeline ? o->timeline : "");
+    if (o->timeline)
+        printf("sfsim run: the timeline holds cycles %llu to %llu (--timeline-window FROM:TO chooses them)\n",
+               (unsigned long long)o->timeline_from, (unsigned long long)o->timeline_to);
     rc = EXIT_OK;
 out:
     cli_config_free(&c.ca);

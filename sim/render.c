@@ -25,6 +25,7 @@
 #include "img.h"
 #include "../host/outfile.h"
 #include "mem/memtrace.h"
+#include "timeline.h"
 #include "provenance.h"
 #include "reference.h"
 #include "report.h"
@@ -51,6 +52,7 @@ void render_default_options(RenderOptions *o)
     o->sample = 0.05;        /* used only when target_error is 0 (sfsim run --sample) */
     o->target_error = 0.01;
     o->sample_seed = 1;
+    o->timeline_to = TIMELINE_DEFAULT_CYCLES;
 }
 
 typedef struct Progress {
@@ -340,6 +342,14 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     /* Before any work: an output folder that cannot be made would fail the run only at its end. */
     if (outfile_check_dir(o->out_dir, err, errlen) != 0)
         return -3;
+    if (o->timeline && spec.mode == RUN_DETAILED) {
+        if (outfile_check_file(o->timeline, err, errlen) != 0)
+            return -3;
+        if (!(spec.timeline = timeline_new(o->timeline_from, o->timeline_to, cfg->chip_cores, cfg->core_clock_mhz, 0))) {
+            snprintf(err, errlen, "out of memory for the timeline");
+            return -1;
+        }
+    }
     RunScene sc;
     RunFrame fr;
     memset(&fr, 0, sizeof fr);
@@ -359,12 +369,14 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
             size_t n = strlen(err);
             snprintf(err + n, errlen - n, " (no output of this run was kept in %s)", o->out_dir);
             rc = -3;
-        } else if (o->mem_trace && write_mem_trace(o->mem_trace, cfg, &fr.f, err, errlen) != 0) {
+        } else if ((o->mem_trace && write_mem_trace(o->mem_trace, cfg, &fr.f, err, errlen) != 0) ||
+                   (spec.timeline && timeline_write(spec.timeline, o->timeline, err, errlen) != 0)) {
             size_t n = strlen(err);
             snprintf(err + n, errlen - n, " (the run's other outputs are in %s)", o->out_dir);
             rc = -3;
         }
     }
+    timeline_free(spec.timeline);
     run_frame_free(&fr);
     run_scene_close(&sc);
     return rc;

@@ -29,6 +29,9 @@ typedef struct RenderOptions {
     uint32_t sample_seed;      /* sampled mode: which units */
     int no_image;              /* sampled mode: no image, a pilot of the golden model for the counts */
     const char *mem_trace;     /* detailed mode: write the L1s' requests below here (docs/chip.md), or NULL */
+    const char *timeline;      /* detailed mode: write the timeline of cycles [timeline_from, timeline_to)
+                                  here (docs/timeline.md), or NULL */
+    uint64_t timeline_from, timeline_to;
 } RenderOptions;
 
 /* The render keys `--set` takes beside the machine keys (sfsim run, sfsim sweep), with their

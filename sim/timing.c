@@ -180,7 +180,54 @@ CoreFollow *timing_follow(Timing *t) { return &t->follow; }
 
 void timing_set_memo(Timing *t, int on)
 {
-    t->memo_off = !on;
+    t->memo_user_off = !on;
+    t->memo_off = t->memo_user_off || t->watch.instr != NULL;
+}
+
+/* ---- the watch (a timeline) ------------------------------------------------------------------ */
+
+const char *const timing_unit_keys[TIMING_UNIT_COUNT] = {
+#define TIMING_UNIT_KEY(name, key, desc) key,
+    TIMING_UNITS(TIMING_UNIT_KEY)
+#undef TIMING_UNIT_KEY
+};
+
+void tm_watch_charge(Timing *t, int slot, uint64_t cycles)
+{
+    const int from = slot == TM_FROM_L2 ? TIMING_FROM_L2 : slot == TM_FROM_DRAM ? TIMING_FROM_DRAM : -1;
+    t->watch.charge(t->watch.ctx, from < 0 ? slot : TM_SCENE_MEMORY, from, cycles);
+}
+
+void tm_watch_instr(Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at, uint64_t end, uint64_t ready)
+{
+    const TimingInstr in = {rec->pc, d->op, rec->stage, rec->gen, t->now, at, end,
+                            mem_pending(ready) ? UINT64_MAX : ready};
+    t->watch.instr(t->watch.ctx, &in);
+}
+
+/* The L1's port below while watched: a request answered at once is told to the watch. */
+static uint64_t watch_request(void *below, const MemReq *r)
+{
+    Timing *t = below;
+    const uint64_t done = t->watch_below.request(t->watch_below.below, r);
+    if (t->watch.request && done != UINT64_MAX && !mem_pending(done))
+        t->watch.request(t->watch.ctx, r->addr, r->write, r->at, done);
+    return done;
+}
+
+void timing_watch(Timing *t, const TimingWatch *w)
+{
+    if (w && !t->watch.instr) {
+        t->watch_below = t->l1.below;
+        cache_connect(&t->l1, (MemPort){watch_request, t});
+    } else if (!w && t->watch.instr) {
+        cache_connect(&t->l1, t->watch_below);
+    }
+    if (w)
+        t->watch = *w;
+    else
+        memset(&t->watch, 0, sizeof t->watch);
+    t->memo_off = t->memo_user_off || t->watch.instr != NULL;
 }
 
 TimingMemoCounts timing_memo_counts(const Timing *t) { return t->mc; }

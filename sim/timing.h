@@ -129,6 +129,44 @@ void timing_tap(Timing *t, TimingTap tap, void *ctx);
 /* Fills sent and not answered yet. */
 uint32_t timing_fills_out(const Timing *t);
 
+/* ---- watching the model: a timeline (sim/timeline.h, docs/timeline.md) ----
+ * While a watch is set the memo is off (every instruction is timed as it runs; the same results),
+ * and the model tells the watch, as it times each instruction: every stall it charges (cause; from:
+ * -1, or TIMING_FROM_L2 / TIMING_FROM_DRAM for a scene_memory wait a shared level answers), then
+ * the instruction (the cycle it began waiting, the cycle it issued, the next issue slot: the
+ * charges fill [start, issue) in the order given, then the cycles after issue), and the units'
+ * busy spans it starts. Set or cleared between program runs only. */
+typedef struct TimingInstr {
+    uint32_t pc;
+    uint8_t op, stage, gen;
+    uint64_t start, issue, end;
+    uint64_t ready;            /* its results' cycle (the latest; UINT64_MAX when a shared level
+                                  has not answered yet, or it has none: then end) */
+} TimingInstr;
+#define TIMING_UNITS(X) \
+    X(RAYBUF,       "raybuf",       "a gather's or scatter's bank cycles") \
+    X(INTERCONNECT, "interconnect", "a data-path transfer on an interconnect port") \
+    X(PARTITION,    "partition",    "the partition unit partitioning a stream") \
+    X(SCRATCHPAD,   "scratchpad",   "a vector scratchpad access's line cycles") \
+    X(L1,           "l1",           "a scene-memory or framebuffer access on the L1's (or bus's) port")
+enum {
+#define TIMING_UNIT_ENUM(name, key, desc) TIMING_UNIT_##name,
+    TIMING_UNITS(TIMING_UNIT_ENUM)
+#undef TIMING_UNIT_ENUM
+    TIMING_UNIT_COUNT
+};
+extern const char *const timing_unit_keys[TIMING_UNIT_COUNT];
+typedef struct TimingWatch {
+    void (*charge)(void *ctx, int cause, int from, uint64_t cycles);
+    void (*instr)(void *ctx, const TimingInstr *in);
+    void (*unit)(void *ctx, int unit, uint64_t from, uint64_t to);
+    /* a request below the L1 answered at once (a bus of its own): [at, done) */
+    void (*request)(void *ctx, uint64_t addr, int write, uint64_t at, uint64_t done);
+    void *ctx;
+} TimingWatch;
+/* w (copied), or NULL: no watch, the memo as timing_set_memo left it. Install after timing_tap. */
+void timing_watch(Timing *t, const TimingWatch *w);
+
 /* The CoreHook: one executed instruction. */
 void timing_hook(void *ctx, const CoreRecord *rec);
 /* The hook for the records of opcode op: timing_hook's work specialized to the op's kind of

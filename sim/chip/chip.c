@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "../mem/dram_level.h"
+#include "../mem/monitor.h"
 
 /* A request id: the core (MEM_ID), then a write's flag and the fill a read answers. */
 #define CHIP_WRITE ((uint64_t)1 << 47)
@@ -40,6 +41,7 @@ struct Chip {
     L2 *l2;
     Noc *noc;
     MemLevel top;
+    MemMonitor *mon[CHIP_LEVELS];  /* chip_new's watch: one before each level, else NULL */
     ChipPort *port;
     InReq *h;                    /* the requests on their way in: a heap by (at, core, seq) */
     size_t n, cap;
@@ -114,6 +116,8 @@ void chip_free(Chip *c)
         return;
     noc_free(c->noc);
     l2_free(c->l2);
+    for (int i = 0; i < CHIP_LEVELS; i++)
+        monitor_free(c->mon[i]);
     dram_level_free(c->dl);
     dram_free(c->dram);
     for (int k = 0; c->port && k < c->cores; k++) {
@@ -125,7 +129,20 @@ void chip_free(Chip *c)
     free(c);
 }
 
-Chip *chip_new(const CfgMachine *cfg, int cores, char *err, size_t errlen)
+const char *const chip_level_keys[CHIP_LEVELS] = {"noc", "l2", "dram"};
+
+/* c->top, watched as level `level` when there is a watch. 0, or -1 on out of memory. */
+static int watch_top(Chip *c, int level, const MemWatch *w)
+{
+    if (!w)
+        return 0;
+    if (!(c->mon[level] = monitor_new(c->top, level, w)))
+        return -1;
+    c->top = monitor_level(c->mon[level]);
+    return 0;
+}
+
+Chip *chip_new(const CfgMachine *cfg, int cores, const MemWatch *watch, char *err, size_t errlen)
 {
     if (chip_check(cfg, err, errlen))
         return NULL;
@@ -145,6 +162,8 @@ Chip *chip_new(const CfgMachine *cfg, int cores, char *err, size_t errlen)
         return NULL;
     }
     c->top = dram_level(c->dl);
+    if (watch_top(c, CHIP_LEVEL_DRAM, watch))
+        goto oom;
     if (cfg->l2_size_kb > 0) {
         L2Params lp;
         l2_params_of(cfg, &lp);
@@ -153,6 +172,8 @@ Chip *chip_new(const CfgMachine *cfg, int cores, char *err, size_t errlen)
             return NULL;
         }
         c->top = l2_level(c->l2);
+        if (watch_top(c, CHIP_LEVEL_L2, watch))
+            goto oom;
     }
     if (cfg->noc_latency > 0) {
         NocParams np;
@@ -162,8 +183,14 @@ Chip *chip_new(const CfgMachine *cfg, int cores, char *err, size_t errlen)
             return NULL;
         }
         c->top = noc_level(c->noc);
+        if (watch_top(c, CHIP_LEVEL_NOC, watch))
+            goto oom;
     }
     return c;
+oom:
+    snprintf(err, errlen, "out of memory for the chip's timeline");
+    chip_free(c);
+    return NULL;
 }
 
 /* ---- requests on their way in ----------------------------------------------------------------- */

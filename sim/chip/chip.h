@@ -21,6 +21,7 @@
 #include "../config.h"
 #include "../mem/dram.h"
 #include "../mem/l2.h"
+#include "../mem/monitor.h"
 #include "../mem/noc.h"
 #include "../timing.h"
 
@@ -30,9 +31,13 @@ typedef struct Chip Chip;
 int chip_shared(const CfgMachine *cfg);
 /* The shared memory's keys checked together: 0, or -1 with the keys named in err. */
 int chip_check(const CfgMachine *cfg, char *err, size_t errlen);
-/* The shared memory of cfg's chip for `cores` cores. NULL with err on a bad config or out of
- * memory. */
-Chip *chip_new(const CfgMachine *cfg, int cores, char *err, size_t errlen);
+/* The shared levels, top to bottom, as a watch names them (chip_level_keys: "noc", "l2", "dram"). */
+enum { CHIP_LEVEL_NOC, CHIP_LEVEL_L2, CHIP_LEVEL_DRAM, CHIP_LEVELS };
+extern const char *const chip_level_keys[CHIP_LEVELS];
+/* The shared memory of cfg's chip for `cores` cores; with watch (NULL: none), every request into
+ * each level there is and its answer are told to it (sim/mem/monitor.h: a timeline). NULL with err
+ * on a bad config or out of memory. */
+Chip *chip_new(const CfgMachine *cfg, int cores, const MemWatch *watch, char *err, size_t errlen);
 void chip_free(Chip *c);
 /* Core k's timing model sends its L1's misses and write-backs here from now on. 0, or -1 on out
  * of memory. */

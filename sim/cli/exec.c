@@ -17,7 +17,9 @@
 #include "../exitcodes.h"
 #include "../run/timedcore.h"
 #include "../stats.h"
+#include "../timeline.h"
 #include "../timing.h"
+#include "../../host/outfile.h"
 #include "../util.h"
 #include "help.h"
 #include "opts.h"
@@ -197,12 +199,13 @@ int cli_print_timing(const TimingStats *s, const CfgMachine *cfg, const char *mo
 }
 
 /* exec's options: its getopt_long table. */
-enum { X_SET = CLI_LONG, X_WIDTH, X_MAXI, X_DUMP, X_NOPROG };
+enum { X_SET = CLI_LONG, X_WIDTH, X_MAXI, X_DUMP, X_NOPROG, X_TIMELINE, X_TLWIN };
 static const struct option exec_longs[] = {
     {"config", required_argument, NULL, 'c'},      {"set", required_argument, NULL, X_SET},
     {"width", required_argument, NULL, X_WIDTH},    {"max-instructions", required_argument, NULL, X_MAXI},
     {"dump-mem", required_argument, NULL, X_DUMP},  {"timing", no_argument, NULL, 't'},
     {"quiet", no_argument, NULL, 'q'},              {"no-progress", no_argument, NULL, X_NOPROG},
+    {"timeline", required_argument, NULL, X_TIMELINE}, {"timeline-window", required_argument, NULL, X_TLWIN},
     {"help", no_argument, NULL, CLI_HELP},          {"version", no_argument, NULL, CLI_VERSION},
     {NULL, 0, NULL, 0}};
 
@@ -211,6 +214,9 @@ typedef struct ExecArgs {
     const char *prog, *dumps[64];
     int ndumps, quiet, timed, progress;
     char setbuf[2][96];
+    const char *timeline;      /* --timeline FILE: the pipeline trace of cycles [tl_from, tl_to) */
+    uint64_t tl_from, tl_to;
+    int tl_window;
 } ExecArgs;
 
 /* EXIT_OK to go on, or the exit code (after printing what was wrong, or the help). -1: help done. */
@@ -220,6 +226,7 @@ static int exec_parse(int argc, char **argv, ExecArgs *a)
     const char *v;
     int code;
     a->progress = 1;
+    a->tl_to = TIMELINE_DEFAULT_CYCLES;
     while ((code = cli_next(&p, &v)) > 0) {
         if (cli_common(&p, code, help_exec))
             return -1;
@@ -247,11 +254,26 @@ static int exec_parse(int argc, char **argv, ExecArgs *a)
         case 'q': a->quiet = 1; break;
         case 't': a->timed = 1; break;
         case X_NOPROG: a->progress = 0; break;
+        case X_TIMELINE: a->timeline = v; a->timed = 1; break;
+        case X_TLWIN: {
+            char why[300];
+            if (timeline_parse_window(v, &a->tl_from, &a->tl_to, why, sizeof why)) {
+                fprintf(stderr, "sfsim exec: %s\n", why);
+                return EXIT_INPUT;
+            }
+            a->tl_window = 1;
+            break;
+        }
         default: return EXIT_USAGE;
         }
     }
     if (code < 0)
         return EXIT_USAGE;
+    if (a->tl_window && !a->timeline) {
+        fprintf(stderr, "sfsim exec: --timeline-window chooses the cycles of --timeline FILE, which is not given "
+                        "(sfsim help exec)\n");
+        return EXIT_USAGE;
+    }
     int first = cli_first_operand();
     if (first >= argc) {
         fprintf(stderr, "sfsim exec: no program given (sfsim help exec)\n");
@@ -286,6 +308,18 @@ static int exec_run(const ExecArgs *a, const CfgMachine *cfg, const MemDump *dd)
     }
     Core *c = tc.core;
     Timing *tm = tc.tm;
+    Timeline *tl = NULL;
+    if (a->timeline) {
+        const int bad = outfile_check_file(a->timeline, err, sizeof err) != 0;
+        if (bad || !(tl = timeline_new(a->tl_from, a->tl_to, 1, cfg->core_clock_mhz, 1))) {
+            fprintf(stderr, "sfsim exec: %s\n", bad ? err : "out of memory for the timeline");
+            timedcore_close(&tc);
+            asm_object_free(&obj);
+            return EXIT_IO;
+        }
+        const TimingWatch w = timeline_core_watch(tl, 0);
+        timing_watch(tm, &w);
+    }
     double t0 = util_now();
     CoreExit ex = run_with_progress(c, (uint64_t)cfg->sim_max_instructions, a->progress);
     double secs = util_now() - t0;
@@ -302,6 +336,17 @@ static int exec_run(const ExecArgs *a, const CfgMachine *cfg, const MemDump *dd)
         dump_print(c, &dd[i]);
     if (tm && cli_print_timing(timing_stats(tm), cfg, timing_error(tm)))
         rc = EXIT_PROGRAM;
+    if (tl) { /* the pipeline trace, also of a run that trapped (what led up to it) */
+        timeline_end(tl, timing_stats(tm)->cycles);
+        if (timeline_write(tl, a->timeline, err, sizeof err) != 0) {
+            fprintf(stderr, "sfsim exec: %s\n", err);
+            rc = EXIT_IO;
+        } else {
+            printf("sfsim exec: wrote %s (cycles %llu to %llu)\n", a->timeline, (unsigned long long)a->tl_from,
+                   (unsigned long long)a->tl_to);
+        }
+        timeline_free(tl);
+    }
     if (ex != CORE_EXIT_HALT) {
         fprintf(stderr, "sfsim exec: %s\n", core_trap_message(c));
         rc = EXIT_PROGRAM;

@@ -89,15 +89,21 @@ void help_exec(FILE *out)
             "  -q, --quiet              print only the summary line (and the timing, with --timing)\n"
             "  --no-progress            no progress line: a run still going after 2 s otherwise says on\n"
             "                           stderr, every 5 s, how many instructions it ran of the limit\n"
+            "  --timeline FILE          (implies --timing) a pipeline trace in the Chrome trace event\n"
+            "                           format (Perfetto, chrome://tracing): each instruction from issue\n"
+            "                           to its results with its stall cycles and cause, and the cycles\n"
+            "                           busy or stalled and why (docs/timeline.md)\n"
+            "  --timeline-window FROM:TO  the cycles it holds (default 0:1000000; FROM: = 1000000 from FROM)\n"
             "\n"
             "The --dump-mem specs are checked against the config's memory sizes before the program runs.\n"
             "Exit codes: 0 halted, 1 bad input (config, object, --dump-mem spec), 2 usage, 3 trap or the\n"
-            "instruction limit (sfsim help exit-codes).\n"
+            "instruction limit, 4 the timeline could not be written (sfsim help exit-codes).\n"
             "\n"
             "examples:\n"
             "  sfasm prog.s -o prog.sfo && sfsim exec prog.sfo\n"
             "  sfsim exec prog.sfo --timing --width 8           cycles and stalls on an 8-lane machine\n"
-            "  sfsim exec prog.sfo --dump-mem spad:0:16 -q      16 words of the scratchpad after the run\n");
+            "  sfsim exec prog.sfo --dump-mem spad:0:16 -q      16 words of the scratchpad after the run\n"
+            "  sfsim exec prog.sfo --timeline pipe.json -q      open pipe.json in https://ui.perfetto.dev\n");
 }
 
 void help_config(FILE *out)
@@ -159,6 +165,12 @@ void help_run(FILE *out)
             "  --mem-trace FILE         detailed mode: every line the scene caches ask of the memory below\n"
             "                           them (misses, write-backs), in sfsim's trace format with the core\n"
             "                           as source, for `sfsim mem --trace FILE` (docs/chip.md)\n"
+            "  --timeline FILE          detailed mode: what each core, unit and memory level did, cycle by\n"
+            "                           cycle (busy, stalled and why, idle; requests in flight), in the\n"
+            "                           Chrome trace event format for Perfetto or chrome://tracing\n"
+            "                           (docs/timeline.md); the memo of blocks is off while it records\n"
+            "  --timeline-window FROM:TO  the cycles the timeline holds (default 0:1000000; FROM: for\n"
+            "                           1000000 cycles from FROM; 0:18446744073709551615 for all)\n"
             "\n"
             "examples:\n"
             "  sfsim run -o out                                        the Cornell box, detailed mode\n"
@@ -166,7 +178,8 @@ void help_run(FILE *out)
             "  sfsim run --mode sampled --target-error 0.005 -o samp   cycles and fps to +-0.5%% (95%%)\n"
             "  sfsim run --mode reference -o ref && sfsim compare ref/frame.exr out/frame.exr\n"
             "  sfsim run -c configs/chip16-ddr4.ini -s scenes/conference/scene.ini -o chip   16 cores, L2, DDR4\n"
-            "  sfsim run --mem-trace out.trc -o out && sfsim mem --trace out.trc   its misses through DRAM\n");
+            "  sfsim run --mem-trace out.trc -o out && sfsim mem --trace out.trc   its misses through DRAM\n"
+            "  sfsim run -c configs/chip16-ddr4.ini --timeline tl.json --timeline-window 200000:300000 -o c\n");
 }
 
 void help_compare(FILE *out)

@@ -14,11 +14,12 @@
 #include "../datadir.h"
 #include "../exitcodes.h"
 #include "../run/spec.h"
+#include "../timeline.h"
 #include "help.h"
 
 /* ---- run --------------------------------------------------------------------------------------- */
 
-enum { R_MODE = CLI_LONG, R_SET, R_EXPOSURE, R_SAMPLE, R_TARGET, R_NO_IMAGE, R_SEED, R_NOPROG, R_KERNEL, R_MEMTRACE };
+enum { R_MODE = CLI_LONG, R_SET, R_EXPOSURE, R_SAMPLE, R_TARGET, R_NO_IMAGE, R_SEED, R_NOPROG, R_KERNEL, R_MEMTRACE, R_TIMELINE, R_TLWIN };
 static const struct option run_longs[] = {
     {"scene", required_argument, NULL, 's'},         {"out", required_argument, NULL, 'o'},
     {"config", required_argument, NULL, 'c'},        {"mode", required_argument, NULL, R_MODE},
@@ -27,12 +28,13 @@ static const struct option run_longs[] = {
     {"target-error", required_argument, NULL, R_TARGET}, {"no-image", no_argument, NULL, R_NO_IMAGE},
     {"sample-seed", required_argument, NULL, R_SEED}, {"no-progress", no_argument, NULL, R_NOPROG},
     {"kernel", required_argument, NULL, R_KERNEL},   {"mem-trace", required_argument, NULL, R_MEMTRACE},
+    {"timeline", required_argument, NULL, R_TIMELINE}, {"timeline-window", required_argument, NULL, R_TLWIN},
     {"help", no_argument, NULL, CLI_HELP},
     {"version", no_argument, NULL, CLI_VERSION},     {NULL, 0, NULL, 0}};
 
 /* Which of the sampled mode's sizes the command line gave (their values alone do not say). */
 typedef struct RunGiven {
-    int sample, target;
+    int sample, target, window;
 } RunGiven;
 
 /* A render key (render.width=..., sim/render.h's table) into o: 1 taken, 0 not a render key, -1 a
@@ -117,6 +119,16 @@ static int run_option(const CliParse *p, RunCmd *c, RunGiven *g, int code, const
     case R_NOPROG: o->progress = 0; break;
     case R_KERNEL: o->kernel_path = v; break;
     case R_MEMTRACE: o->mem_trace = v; break;
+    case R_TIMELINE: o->timeline = v; break;
+    case R_TLWIN: {
+        char why[300];
+        if (timeline_parse_window(v, &o->timeline_from, &o->timeline_to, why, sizeof why)) {
+            fprintf(stderr, "sfsim run: %s\n", why);
+            return EXIT_INPUT;
+        }
+        g->window = 1;
+        break;
+    }
     case R_SET: {
         int r = run_render_key(p, o, v);
         if (r < 0)
@@ -140,6 +152,15 @@ static int run_together(RenderOptions *o, const RunGiven *g)
     }
     if (o->mem_trace && o->mode != RUN_DETAILED) {
         fprintf(stderr, "sfsim run: --mem-trace FILE writes the timed requests of --mode detailed only (sfsim help run)\n");
+        return EXIT_USAGE;
+    }
+    if ((o->timeline || g->window) && o->mode != RUN_DETAILED) {
+        fprintf(stderr, "sfsim run: --timeline FILE shows the cycles of --mode detailed only (sfsim help run)\n");
+        return EXIT_USAGE;
+    }
+    if (g->window && !o->timeline) {
+        fprintf(stderr, "sfsim run: --timeline-window chooses the cycles of --timeline FILE, which is not given "
+                        "(sfsim help run)\n");
         return EXIT_USAGE;
     }
     if (g->sample && g->target) {

@@ -23,6 +23,7 @@
 #include <string.h>
 
 #include "../chip/chip.h"
+#include "../timeline.h"
 
 enum { CS_RUN, CS_MEM, CS_TILE, CS_DONE };
 
@@ -34,6 +35,7 @@ typedef struct CoreRun {
     uint64_t wake;               /* CS_RUN: the cycle it goes on from */
     uint64_t done_at;            /* CS_TILE: the cycle its tile ended */
     uint64_t instr0, lanes0[ISA_STAGE_COUNT];
+    uint64_t pass_at;            /* the cycle its pass began (a timeline's) */
     uint64_t done;               /* the pass's instructions so far */
     int id;                      /* its number */
     FuncMemRec *tr;              /* FuncParams.mem_trace: its requests below, in order */
@@ -79,7 +81,8 @@ typedef struct ChipRun {
 
 int chip_run_wanted(const FuncParams *fp)
 {
-    return fp->timed && !fp->batch && (fp->cfg->chip_cores > 1 || chip_shared(fp->cfg) || fp->mem_trace);
+    return fp->timed && !fp->batch &&
+           (fp->cfg->chip_cores > 1 || chip_shared(fp->cfg) || fp->mem_trace || fp->timeline);
 }
 
 static Timing *tm_of(const ChipRun *r, int k) { return r->job->workers[k].tc.tm; }
@@ -94,6 +97,7 @@ static void pass_begin(ChipRun *r, int k)
     eng_pass_launch(r->job, c, cr->ft, cr->pass == 0);
     eng_pass_set(r->job, c, cr->pass);
     timing_continue(t, r->cold);
+    cr->pass_at = timing_now(t);
     cr->before = *timing_stats(t);
     cr->instr0 = core_instructions(c);
     cr->done = 0;
@@ -122,6 +126,12 @@ static int pass_finish(ChipRun *r, int k, CoreExit ex)
     Core *c = w->tc.core;
     Timing *t = w->tc.tm;
     timing_end(t);
+    Timeline *tl = r->job->fp->timeline;
+    if (tl) { /* the pass on the timeline; past its window, the core is not watched any more */
+        timeline_pass(tl, k, cr->tile, cr->pass, cr->pass_at, timing_now(t));
+        if (timeline_past(tl, timing_now(t)))
+            timing_watch(t, NULL);
+    }
     const TimingStats *s = timing_stats(t);
     FuncTile *ft = cr->ft;
     ft->sampled = 1;
@@ -453,6 +463,8 @@ static void figures(ChipRun *r)
         fc->instructions = core_instructions(core_of(r, k));
     }
     j->makespan = makespan;
+    if (j->fp->timeline)
+        timeline_end(j->fp->timeline, makespan);
     if (r->chip) {
         j->chip_mem = calloc(1, sizeof *j->chip_mem);
         if (j->chip_mem)
@@ -474,6 +486,10 @@ static int cores_open(ChipRun *r)
         r->cr[k].id = k;
         if (j->fp->mem_trace)
             timing_tap(tm_of(r, k), trace_tap, &r->cr[k]);
+        if (j->fp->timeline) { /* (after the tap: the watch sees what the tap passes on) */
+            const TimingWatch w = timeline_core_watch(j->fp->timeline, k);
+            timing_watch(tm_of(r, k), &w);
+        }
         timing_reset(tm_of(r, k));
     }
     return 0;
@@ -497,7 +513,8 @@ uint32_t chip_run_frame(Job *j)
     }
     atomic_init(&r.tiles_done, 0u);
     j->ncores = (uint32_t)r.k;
-    if (chip_shared(cfg) && !(r.chip = chip_new(cfg, r.k, err, sizeof err))) {
+    const MemWatch mw = j->fp->timeline ? timeline_mem_watch(j->fp->timeline) : (MemWatch){0};
+    if (chip_shared(cfg) && !(r.chip = chip_new(cfg, r.k, j->fp->timeline ? &mw : NULL, err, sizeof err))) {
         eng_fail(j, err, 0);
         free(r.cr);
         free(r.runnable);

@@ -51,6 +51,9 @@ typedef struct FuncParams {
     /* Detailed mode: keep every request the L1s send below (FuncStats.trace; the frame then runs
      * on the chip's run, sim/run/chiprun.c, in one continuous time per core). */
     int mem_trace;
+    /* Detailed mode: record the run's timeline here (sim/timeline.h; the frame then runs on the
+     * chip's run too), or NULL. */
+    struct Timeline *timeline;
 } FuncParams;
 
 typedef struct FuncTile {

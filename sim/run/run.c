@@ -119,7 +119,8 @@ static int kernel_frame(const RunScene *sc, const RunSpec *spec, const CfgMachin
                      .progress = spec->progress,
                      .progress_ctx = spec->progress_ctx,
                      .timed = run_mode_timed(spec->mode),
-                     .mem_trace = spec->mode == RUN_DETAILED && spec->mem_trace};
+                     .mem_trace = spec->mode == RUN_DETAILED && spec->mem_trace,
+                     .timeline = spec->mode == RUN_DETAILED ? spec->timeline : NULL};
     if (spec->mode == RUN_SAMPLED)
         return sampled_frame(sc, spec, cfg, &fp, fr, err, errlen);
     int rc = func_render(&sc->p, &fp, fr->rgb, &fr->f, err, errlen);

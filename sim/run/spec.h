@@ -50,6 +50,7 @@ typedef struct RunSpec {
     uint32_t sample_seed;
     int no_image;
     int mem_trace;             /* RUN_DETAILED: keep the L1s' requests below (RunFrame.f.trace) */
+    struct Timeline *timeline; /* RUN_DETAILED: record the run's timeline here (sim/timeline.h), or NULL */
     void (*progress)(void *ctx, uint32_t tiles_done, uint32_t tiles_total);
     /* A line on what a long run is doing (sampled mode's rounds); may be NULL. */
     void (*note)(void *ctx, const char *line);

@@ -252,6 +252,7 @@ static inline uint64_t dp_transfer(Timing *t, uint64_t at, uint64_t len, int sta
 {
     uint64_t s = xbar_transfer(&t->xbar, XBAR_DP, at, len, t->now);
     charge(t, TM_INTERCONNECT, s - at, stage, gen);
+    tm_watch_unit(t, TIMING_UNIT_INTERCONNECT, s, s + len);
     return s;
 }
 
@@ -304,6 +305,7 @@ static uint64_t result_time(Timing *t, const IsaOpInfo *oi, const CoreRecord *re
     case ISA_U_PART:
         if (fl & ISA_FL_IDM) { /* part: the unit runs on beside the data path */
             uint64_t e = part_start(&t->part, &t->xbar, rec->base, rec->count, is->at, t->now);
+            tm_watch_unit(t, TIMING_UNIT_PARTITION, is->at, e);
             if (part_hold(&t->part, end))
                 push(t, e, EV_PART, 0, 0, TM_PARTITION);
             agu_drop_range(&t->agu, t->part.lo, t->part.hi); /* IDs fetched ahead from there are stale */
@@ -325,6 +327,8 @@ static uint64_t result_time(Timing *t, const IsaOpInfo *oi, const CoreRecord *re
 static inline __attribute__((always_inline)) void complete_as(Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at, uint64_t end,
                                uint64_t ready, int res_cause, int flow)
 {
+    if (__builtin_expect(t->watch.instr != NULL, 0))
+        tm_watch_instr(t, d, rec, at, end, d->ndst ? ready : end);
     for (int i = 0; i < d->ndst; i++)
         simd_result(&t->simd, d->dsts[i], ready, res_cause);
     if (d->issue && at + d->issue > end) { /* the class is still inside its issue interval */
@@ -364,6 +368,7 @@ static inline void issue_rb_c(Timing *t, const TmDesc *d, const CoreRecord *rec,
     uint64_t ext = 0; /* extra issue cycles after at */
     if (c) { /* its bank cycles on one interconnect port */
         at = dp_transfer(t, at, (uint64_t)c, stage, gen);
+        tm_watch_unit(t, TIMING_UNIT_RAYBUF, at, at + (uint64_t)c);
         ext = (uint64_t)c - 1;
         charge(t, TM_BANK_CONFLICT, ext, stage, gen);
     }
@@ -411,6 +416,7 @@ static void time_scene_hit(Timing *t, const TmDesc *d, const CoreRecord *rec, si
     if (__builtin_expect(at == TM_YIELDED, 0))
         return;
     const uint64_t r = at + (uint64_t)t->l1.p.hit_latency, line = t->l1.ready[way];
+    tm_watch_unit(t, TIMING_UNIT_L1, at, at + 1);
     count_issue(t, d, rec->stage, rec->gen);
     complete_as(t, d, rec, at, at + 1, r > line ? r : line, TM_SCENE_MEMORY, TM_NO_FLOW);
 }
@@ -422,6 +428,7 @@ static __attribute__((noinline)) void issue_spad(Timing *t, const TmDesc *d, con
     if (rec->naddr) {
         ext = spad_access(&t->spad, rec->addr, rec->naddr) - 1;
         charge(t, TM_SCRATCHPAD, ext, stage, gen);
+        tm_watch_unit(t, TIMING_UNIT_SCRATCHPAD, at, at + ext + 1);
     }
     count_issue(t, d, stage, gen);
     complete_as(t, d, rec, at, at + ext + 1, d->kind == TK_SPAD_LOAD ? spad_load_ready(&t->spad, at + ext) : at + d->lat,
@@ -438,6 +445,7 @@ static __attribute__((noinline)) void issue_scene(Timing *t, const TmDesc *d, co
         if (ready == UINT64_MAX)
             internal_error(t, "out of memory for the scene cache");
         charge(t, TM_SCENE_MEMORY, ext, stage, gen);
+        tm_watch_unit(t, TIMING_UNIT_L1, at, at + ext + 1);
         cause = TM_SCENE_MEMORY;
     }
     count_issue(t, d, stage, gen);

@@ -127,6 +127,9 @@ struct Timing {
     TimingTap tap;
     void *tap_ctx;
     Pend *pend;                    /* a chip's core: answers that come later (pend.c); else NULL */
+    TimingWatch watch;             /* timing_watch: its callbacks, NULL when none */
+    int memo_user_off;             /* timing_set_memo(t, 0); memo_off also while watched */
+    MemPort watch_below;           /* timing_watch: the L1's port before the watch's */
     char err[256];
     TimingStats st;
 };
@@ -139,10 +142,21 @@ struct Timing {
 enum { TM_FROM_L2 = TM_CAUSE_COUNT, TM_FROM_DRAM, TM_CHARGE_SLOTS };
 _Static_assert((int)TM_CHARGE_SLOTS == (int)MEMO_CHARGE_SLOTS, "memo.h sizes a block's charges by slot");
 
+/* The watch's part of a charge, of an issue and of a unit's span (sim/timing.c). */
+void tm_watch_charge(Timing *t, int slot, uint64_t cycles);
+void tm_watch_instr(Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at, uint64_t end, uint64_t ready);
+static inline void tm_watch_unit(Timing *t, int unit, uint64_t from, uint64_t to)
+{
+    if (__builtin_expect(t->watch.unit != NULL, 0))
+        t->watch.unit(t->watch.ctx, unit, from, to);
+}
+
 static inline void charge(Timing *t, int cause, uint64_t cycles, int stage, int gen)
 {
     if (!cycles)
         return;
+    if (__builtin_expect(t->watch.charge != NULL, 0))
+        tm_watch_charge(t, cause, cycles);
     if (__builtin_expect(cause >= TM_CAUSE_COUNT, 0)) {
         t->st.scene_from[cause - TM_CAUSE_COUNT] += cycles;
         cause = TM_SCENE_MEMORY;
