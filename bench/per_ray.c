@@ -10,7 +10,9 @@
  *            triangle; a scene without lights: a random point inside its bounds.
  * Each batch goes through Embree 3 (rtcIntersect1 / rtcOccluded1, robust, the high-quality build,
  * one thread), the golden model, functional mode and detailed mode (the kernel's traversal and
- * intersection, `sfsim trace`'s path; N = 16, M = 4096), best of REPS runs each (the engines take
+ * intersection, `sfsim trace`'s path; N = 16, M = 4096), detailed mode with the memory hierarchy
+ * on (the 16-core chip of configs/chip16-ddr4.ini: L1s, a shared L2, a network and DDR4; the
+ * batches handed out to its cores), best of REPS runs each (the engines take
  * turns, one run each per round), and the bench prints ns per ray, the kernel's instructions per
  * ray and each engine's ratio to Embree.
  * The three engines of ours must return identical hits and Embree must agree with them (the rule
@@ -42,7 +44,13 @@
 #include "../tests/support/xcheck.h"
 #include "bench_scenes.h"
 
-enum { ENG_EMBREE, ENG_GOLDEN, ENG_FUNCTIONAL, ENG_DETAILED, ENG_COUNT };
+enum { ENG_EMBREE, ENG_GOLDEN, ENG_FUNCTIONAL, ENG_DETAILED, ENG_HIER, ENG_COUNT };
+
+/* ENG_HIER: detailed mode on the chip of configs/chip16-ddr4.ini (16 cores, each with its L1, a
+ * shared 4 MB L2, a network and DDR4-2400; the batches of M rays handed out to the cores in
+ * simulated time), the memory hierarchy on (docs/chip.md). */
+static const char *const hier_config = "configs/chip16-ddr4.ini";
+static CfgMachine hier_cfg;
 
 typedef struct Batch {
     const char *kind;          /* primary, diffuse, shadow */
@@ -258,11 +266,11 @@ static double embree_time(const RunScene *sc, const XcheckEmbree *e, const Batch
 }
 
 /* One of our engines over the batch, best of reps; its hits into hits. -1 after printing why. */
-static double ours_time(const RunScene *sc, RunMode mode, const Batch *bt, int reps, BatchHit *hits,
-                        uint64_t *instructions)
+static double ours_time(const RunScene *sc, RunMode mode, const CfgMachine *cfg, const Batch *bt, int reps,
+                        BatchHit *hits, uint64_t *instructions)
 {
     static char err[65536];
-    RunSpec spec = {.mode = mode, .kernel_path = "kernels/pathtrace.s", .seed = 1, .threads = 1};
+    RunSpec spec = {.mode = mode, .cfg = cfg, .kernel_path = "kernels/pathtrace.s", .seed = 1, .threads = 1};
     double best = INFINITY;
     for (int rep = 0; rep < reps; rep++) {
         RunTrace rt;
@@ -292,10 +300,10 @@ static int batch_time(const RunScene *sc, const XcheckEmbree *e, const Batch *bt
     }
     for (int k = 0; k < ENG_COUNT; k++)
         tm->seconds[k] = INFINITY;
-    static const RunMode kernel_modes[2] = {RUN_FUNCTIONAL, RUN_DETAILED};
+    static const RunMode kernel_modes[3] = {RUN_FUNCTIONAL, RUN_DETAILED, RUN_DETAILED};
     for (int rep = 0; rep < reps; rep++) {
         double s;
-        if ((s = ours_time(sc, RUN_REFERENCE, bt, 1, golden, NULL)) < 0)
+        if ((s = ours_time(sc, RUN_REFERENCE, NULL, bt, 1, golden, NULL)) < 0)
             goto out;
         tm->seconds[ENG_GOLDEN] = fmin(tm->seconds[ENG_GOLDEN], s);
         Timing agree = {0};
@@ -307,9 +315,9 @@ static int batch_time(const RunScene *sc, const XcheckEmbree *e, const Batch *bt
             tm->ties = agree.ties;
             tm->disagree = agree.disagree;
         }
-        for (int m = 0; m < 2; m++) {
+        for (int m = 0; m < 3; m++) {
             uint64_t instr = 0;
-            if ((s = ours_time(sc, kernel_modes[m], bt, 1, other, &instr)) < 0)
+            if ((s = ours_time(sc, kernel_modes[m], m == 2 ? &hier_cfg : NULL, bt, 1, other, &instr)) < 0)
                 goto out;
             tm->seconds[ENG_FUNCTIONAL + m] = fmin(tm->seconds[ENG_FUNCTIONAL + m], s);
             if (m == 0)
@@ -548,8 +556,18 @@ int main(int argc, char **argv)
     printf("per traced ray on 1 host thread, best of %d; %u x %u camera rays, then a diffuse and a shadow ray per hit; "
            "kernel modes N = 16, M = 4096\n",
            reps, side, side);
-    printf("%-12s %-8s %8s %9s %9s %9s %9s %8s %8s %8s %8s %8s\n", "scene", "rays", "count", "embree ns", "golden ns",
-           "func ns", "detail ns", "instr", "golden/E", "func/E", "detail/E", "agree");
+    CfgErrors ce = {0};
+    cfg_defaults(&hier_cfg);
+    if (cfg_load(&hier_cfg, hier_config, &ce) != 0) {
+        fprintf(stderr, "per_ray: %s: the chip for the hierarchy's row cannot be read\n", hier_config);
+        cfg_errors_free(&ce);
+        return 1;
+    }
+    cfg_errors_free(&ce);
+    printf("'hier': detailed mode with the memory hierarchy on, the chip of %s (%d cores, L2 %d KB, DRAM %s)\n",
+           hier_config, hier_cfg.chip_cores, hier_cfg.l2_size_kb, cfg_enum_name("dram", "preset", hier_cfg.dram_preset));
+    printf("%-12s %-8s %8s %9s %9s %9s %9s %9s %8s %8s %8s %8s %8s %8s\n", "scene", "rays", "count", "embree ns",
+           "golden ns", "func ns", "detail ns", "hier ns", "instr", "golden/E", "func/E", "detail/E", "hier/E", "agree");
     int rc = 0, skipped = 0;
     for (int i = 0; i < n; i++) {
         int ok = bench_scene_ok("per_ray", list[i], &skipped);

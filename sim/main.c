@@ -246,6 +246,9 @@ static int cmd_trace(int argc, char **argv)
     if (sum.sim_instructions)
         printf(", %llu simulated instructions", (unsigned long long)sum.sim_instructions);
     printf("; wrote %s\n", o.out_path);
+    if (sum.cores)
+        printf("sfsim trace: chip: %u cores, %u with a batch, makespan %llu cycles (the cycles below: the batches' "
+               "summed)\n", sum.cores, sum.cores_used, (unsigned long long)sum.makespan);
     if (sum.timed && cli_print_timing(&sum.timing, &c.cfg, NULL))
         return EXIT_PROGRAM;
     return EXIT_OK;

@@ -40,6 +40,9 @@ int trace_run(const TraceOptions *o, TraceSummary *sum, char *err, size_t errlen
     rc = run_trace(&sc.p, sc.image, sc.s.needs, &spec, &b, hits, &rt, err, errlen);
     sum->timed = rt.timed;
     sum->timing = rt.timing;
+    sum->cores = rt.cores;
+    sum->cores_used = rt.cores_used;
+    sum->makespan = rt.makespan;
     sum->sim_instructions = rt.instructions;
     sum->seconds = rt.seconds;
     if (rc != 0)

@@ -31,6 +31,8 @@ typedef struct TraceSummary {
     double seconds;
     int timed;                    /* detailed mode: timing holds the cycles of all batches */
     TimingStats timing;
+    uint32_t cores, cores_used;   /* a chip's: its cores, those that got a batch; else 0 */
+    uint64_t makespan;            /* a chip's: the cycle its last core finished */
 } TraceSummary;
 
 /* The whole command: 0, -1 with a message naming the file or key, -2 when the kernel failed, -3

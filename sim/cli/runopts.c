@@ -312,11 +312,5 @@ int runopts_trace(int argc, char **argv, TraceCmd *c)
     if (cli_config_build(&c->ca, &c->cfg))
         return EXIT_INPUT;
     o->cfg = &c->cfg;
-    if (o->mode == RUN_DETAILED && (c->cfg.chip_cores > 1 || c->cfg.chip_memory == CFG_CHIP_MEMORY_SHARED)) {
-        fprintf(stderr, "sfsim trace: --mode detailed times a batch on one core with its own bus; chip.cores = %d, "
-                        "chip.memory = %s is for sfsim run (docs/chip.md)\n", c->cfg.chip_cores,
-                cfg_enum_name("chip", "memory", c->cfg.chip_memory));
-        return EXIT_INPUT;
-    }
     return EXIT_OK;
 }

@@ -77,12 +77,12 @@ typedef struct ChipRun {
     uint64_t xmin;               /* the earliest cycle a core woken in this step goes on from */
     uint64_t fb_tile;            /* bytes of a tile's framebuffer, in whole lines */
     int cold;
+    uint32_t passes;             /* a tile's passes (spp); a ray batch of `sfsim trace`: 1 */
 } ChipRun;
 
 int chip_run_wanted(const FuncParams *fp)
 {
-    return fp->timed && !fp->batch &&
-           (fp->cfg->chip_cores > 1 || chip_shared(fp->cfg) || fp->mem_trace || fp->timeline);
+    return fp->timed && (fp->cfg->chip_cores > 1 || chip_shared(fp->cfg) || fp->mem_trace || fp->timeline);
 }
 
 static Timing *tm_of(const ChipRun *r, int k) { return r->job->workers[k].tc.tm; }
@@ -94,8 +94,12 @@ static void pass_begin(ChipRun *r, int k)
     CoreRun *cr = &r->cr[k];
     Core *c = core_of(r, k);
     Timing *t = tm_of(r, k);
-    eng_pass_launch(r->job, c, cr->ft, cr->pass == 0);
-    eng_pass_set(r->job, c, cr->pass);
+    if (r->job->fp->batch) {
+        eng_batch_launch(r->job, c, cr->tile);
+    } else {
+        eng_pass_launch(r->job, c, cr->ft, cr->pass == 0);
+        eng_pass_set(r->job, c, cr->pass);
+    }
     timing_continue(t, r->cold);
     cr->pass_at = timing_now(t);
     cr->before = *timing_stats(t);
@@ -110,7 +114,7 @@ static void tile_begin(ChipRun *r, int k, uint32_t tile)
     CoreRun *cr = &r->cr[k];
     cr->tile = tile;
     cr->pass = 0;
-    cr->ft = eng_tile_start(r->job, tile);
+    cr->ft = r->job->fp->batch ? &r->job->tiles[tile] : eng_tile_start(r->job, tile);
     cr->ft->core = (uint32_t)k;
     r->job->cores[k].tiles++;
     timing_set_fb_base(tm_of(r, k), (uint64_t)tile * r->fb_tile);
@@ -143,6 +147,8 @@ static int pass_finish(ChipRun *r, int k, CoreExit ex)
         eng_fail(r->job, timing_error(t), 0);
         return -1;
     }
+    if (r->job->fp->batch) /* a ray batch: its hits out */
+        return eng_batch_end(r->job, c, cr->tile, ex, &w->st);
     if (eng_pass_end(r->job, c, ft, cr->pass, ex))
         return -1;
     ft->rays += eng_counters_add(r->job, c, &w->st);
@@ -192,20 +198,24 @@ static int core_go(ChipRun *r, int k)
             return 0;
         }
         if (ex == CORE_EXIT_LIMIT && !core_trap_message(c)[0]) {
-            char msg[300];
-            snprintf(msg, sizeof msg, "kernel, tile at (%u, %u), pass %u: instruction limit of %llu reached "
-                     "(sim.max_instructions)", cr->ft->x0, cr->ft->y0, cr->pass,
+            char msg[300], where[80];
+            if (r->job->fp->batch)
+                snprintf(where, sizeof where, "rays %u..%u", cr->ft->x0, cr->ft->x0 + cr->ft->w - 1);
+            else
+                snprintf(where, sizeof where, "tile at (%u, %u), pass %u", cr->ft->x0, cr->ft->y0, cr->pass);
+            snprintf(msg, sizeof msg, "kernel, %s: instruction limit of %llu reached (sim.max_instructions)", where,
                      (unsigned long long)r->job->fp->cfg->sim_max_instructions);
             eng_fail(r->job, msg, 1);
             return -1;
         }
         if (pass_finish(r, k, ex))
             return -1;
-        if (++cr->pass < r->job->spp) {
+        if (++cr->pass < r->passes) {
             pass_begin(r, k);
             continue;
         }
-        eng_tile_pixels(r->job, c, cr->ft, 0);
+        if (!r->job->fp->batch)
+            eng_tile_pixels(r->job, c, cr->ft, 0);
         atomic_fetch_add(&r->tiles_done, 1u);
         cr->state = CS_TILE;
         cr->done_at = timing_now(t);
@@ -498,7 +508,7 @@ static int cores_open(ChipRun *r)
 uint32_t chip_run_frame(Job *j)
 {
     const CfgMachine *cfg = j->fp->cfg;
-    ChipRun r = {.job = j, .k = cfg->chip_cores, .cold = cfg->chip_cold_units};
+    ChipRun r = {.job = j, .k = cfg->chip_cores, .cold = cfg->chip_cold_units, .passes = j->fp->batch ? 1 : j->spp};
     const uint64_t line = (uint64_t)cfg->scene_line_bytes;
     r.fb_tile = ((uint64_t)j->k->tile_w * j->k->tile_h * 12 + line - 1) / line * line;
     char err[600];

@@ -110,13 +110,23 @@ static uint32_t rb_get(const uint8_t *rb, uint32_t addr)
     return v;
 }
 
-/* One batch of `sfsim trace`: rays [t * M, ...) into RB0, run, hits out. */
-static int trace_batch(Worker *w, Core *c, uint32_t t, FuncStats *st)
+/* Batch t's rays, [t * M, ...): the first and how many. */
+static uint32_t batch_rays(const Job *j, uint32_t t, uint32_t *first)
 {
-    Job *j = w->job;
+    const uint32_t rays = j->k->rays, count = j->fp->batch->count;
+    *first = t * rays;
+    return count - *first < rays ? count - *first : rays;
+}
+
+void eng_batch_launch(Job *j, Core *c, uint32_t t)
+{
     const KernelAbi *a = &j->k->abi;
     const RayBatch *b = j->fp->batch;
-    uint32_t rays = j->k->rays, first = t * rays, n = b->count - first < rays ? b->count - first : rays;
+    uint32_t first, n = batch_rays(j, t, &first);
+    FuncTile *ft = &j->tiles[t];
+    ft->x0 = first;
+    ft->w = n;
+    ft->h = 1;
     core_restart(c);
     uint32_t size;
     uint8_t *sp = core_mem(c, CORE_MEM_SPAD, &size);
@@ -142,19 +152,15 @@ static int trace_batch(Worker *w, Core *c, uint32_t t, FuncStats *st)
         rb_set(rb, a->f_kind + 4 * i, r->query == RAY_ANY ? 2u : 0u);
         rb_set(rb, a->f_prim + 4 * i, UINT32_MAX);
     }
-    TimingStats before;
-    timing_begin(w, c, &before);
-    CoreExit ex = core_run(c, (uint64_t)j->fp->cfg->sim_max_instructions);
-    FuncTile *ft = &j->tiles[t];
-    ft->x0 = first;
-    ft->w = n;
-    ft->h = 1;
-    FuncUnit fu = {0};
-    int trc = timing_close(w, &before, &fu);
-    if (w->tc.tm)
-        tile_add_timed(ft, &fu);
-    if (trc)
-        return -1;
+}
+
+int eng_batch_end(Job *j, Core *c, uint32_t t, CoreExit ex, FuncStats *st)
+{
+    const KernelAbi *a = &j->k->abi;
+    const RayBatch *b = j->fp->batch;
+    uint32_t first, n = batch_rays(j, t, &first);
+    uint32_t size;
+    const uint8_t *rb = core_mem(c, CORE_MEM_RB0, &size);
     char msg[1400];
     if (ex != CORE_EXIT_HALT) {
         snprintf(msg, sizeof msg, "kernel, rays %u..%u: %s%s", first, first + n - 1, core_trap_message(c),
@@ -191,6 +197,23 @@ static int trace_batch(Worker *w, Core *c, uint32_t t, FuncStats *st)
     if (j->fp->cfg->accel_structure == CFG_ACCEL_KD)
         kd_counts_add(c, a, j->k->cp.lanes, st);
     return 0;
+}
+
+/* One batch of `sfsim trace`: rays [t * M, ...) into RB0, run, hits out. */
+static int trace_batch(Worker *w, Core *c, uint32_t t, FuncStats *st)
+{
+    Job *j = w->job;
+    eng_batch_launch(j, c, t);
+    TimingStats before;
+    timing_begin(w, c, &before);
+    CoreExit ex = core_run(c, (uint64_t)j->fp->cfg->sim_max_instructions);
+    FuncUnit fu = {0};
+    int trc = timing_close(w, &before, &fu);
+    if (w->tc.tm)
+        tile_add_timed(&j->tiles[t], &fu);
+    if (trc)
+        return -1;
+    return eng_batch_end(j, c, t, ex, st);
 }
 
 /* Tile t's place in the frame. */

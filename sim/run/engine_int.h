@@ -61,6 +61,10 @@ void eng_pass_set(Job *j, Core *c, uint32_t pass);
 int eng_pass_end(Job *j, Core *c, const FuncTile *ft, uint32_t pass, CoreExit ex);
 /* The kernel's counters of the pass just run added to st; its rays returned. */
 uint64_t eng_counters_add(Job *j, Core *c, FuncStats *st);
+/* `sfsim trace`'s batch t (its rays into a restarted core's RB0; its FuncTile placed), and after
+ * the run stopped with ex its hits out and its rays counted into st: 0, or -1 after eng_fail. */
+void eng_batch_launch(Job *j, Core *c, uint32_t t);
+int eng_batch_end(Job *j, Core *c, uint32_t t, CoreExit ex, FuncStats *st);
 /* The tile's pixels between the core's framebuffer and the frame (to_fb: into the framebuffer). */
 void eng_tile_pixels(Job *j, Core *c, const FuncTile *ft, int to_fb);
 /* Worker `index`'s core opened and the scene loaded (sim/run/tiles.h's begin). */

@@ -234,6 +234,10 @@ int run_trace(const PackedScene *p, const CoreImage *image, uint32_t needs, cons
         out->instructions = st.instructions;
         out->timed = fp.timed;
         out->timing = st.timing;
+        out->cores = st.chip_cores;
+        out->makespan = st.makespan;
+        for (uint32_t k = 0; k < st.chip_cores; k++)
+            out->cores_used += st.cores[k].tiles > 0;
     }
     func_stats_free(&st);
     return rc;

@@ -93,6 +93,8 @@ typedef struct RunTrace {
     uint64_t instructions;     /* simulated (the kernel modes) */
     int timed;                 /* RUN_DETAILED: timing holds the cycles of every batch */
     TimingStats timing;
+    uint32_t cores, cores_used; /* RUN_DETAILED on a chip: its cores, those that got a batch; else 0 */
+    uint64_t makespan;         /* ... the cycle its last core finished (timing: the batches' cycles summed) */
     double seconds;            /* host time tracing */
 } RunTrace;
 

@@ -61,6 +61,19 @@ want_rc 1
 want_err "detailed mode only"
 end
 
+begin "chip: sfsim trace on 4 cores with an L2 and DDR4 gives functional mode's hits"
+awk 'BEGIN { print "# ox oy oz dx dy dz"; for (i = 0; i < 9000; i++) printf "278 273 -800 %.4f %.4f 1\n", (i % 97) / 200.0 - 0.24, int(i / 97) / 200.0 - 0.24 }' \
+    >"$T/rays.txt"
+run "$SFSIM" trace -s scenes/cornell/scene.ini --rays "$T/rays.txt" -o "$T/hits-f.txt" --mode functional
+want_rc 0
+run "$SFSIM" trace -s scenes/cornell/scene.ini --rays "$T/rays.txt" -o "$T/hits-c.txt" --mode detailed \
+    -c configs/chip16-ddr4.ini --set chip.cores=4
+want_rc 0
+want_out "9000 rays"
+want_out "chip: 4 cores, 3 with a batch, makespan [0-9]+ cycles"
+cmp -s "$T/hits-f.txt" "$T/hits-c.txt" || no "the chip's hits differ from functional mode's"
+end
+
 begin "chip: an L2 that does not divide into sets names its keys"
 run "$SFSIM" run --set chip.memory=shared --set l2.size_kb=100 "${small[@]}" -o "$T/b"
 want_rc 1
