@@ -21,6 +21,10 @@ struct DramLevel {
     uint32_t nline, capline, free_line; /* free list through next_free; UINT32_MAX: empty */
     MemAnswer answer;           /* during a run */
     void *actx;
+    /* lv_next's answer, kept until a push or a run changes the DRAM (only this level reaches it):
+     * the level above asks it once per cycle it steps (host speed only). */
+    uint64_t next_at;
+    int next_ok, running;       /* (nothing is kept while a run changes the DRAM) */
 };
 
 /* ceil(a x b / c) without overflow for any cycle a simulation reaches. */
@@ -68,6 +72,7 @@ void dram_level_free(DramLevel *l)
 
 void dram_level_reset(DramLevel *l)
 {
+    l->next_ok = 0;
     l->nline = 0;
     l->free_line = UINT32_MAX;
 }
@@ -95,6 +100,7 @@ static uint32_t line_new(DramLevel *l, uint64_t id)
 static void lv_push(void *self, uint64_t addr, int write, uint64_t cycle, uint64_t id)
 {
     DramLevel *l = self;
+    l->next_ok = 0;
     const uint32_t k = line_new(l, id);
     const uint64_t at = dram_level_to_dram(l, cycle);
     for (uint32_t b = 0; b < l->bursts; b++)
@@ -103,8 +109,12 @@ static void lv_push(void *self, uint64_t addr, int write, uint64_t cycle, uint64
 
 static uint64_t lv_next(const void *self)
 {
-    const DramLevel *l = self;
-    return dram_level_to_core(l, dram_next(l->d));
+    DramLevel *l = (DramLevel *)self; /* (the kept answer: not the level's state) */
+    if (!l->next_ok) {
+        l->next_at = dram_level_to_core(l, dram_next(l->d));
+        l->next_ok = !l->running;
+    }
+    return l->next_at;
 }
 
 /* A burst done at DRAM cycle d: its line is done with its last burst. */
@@ -123,9 +133,13 @@ static void burst_done(void *ctx, uint64_t k, int write, uint64_t d)
 static void lv_run(void *self, uint64_t until, MemAnswer answer, void *ctx)
 {
     DramLevel *l = self;
+    l->next_ok = 0;
+    l->running = 1;
     l->answer = answer;
     l->actx = ctx;
     dram_run(l->d, dram_level_to_dram(l, until), burst_done, l);
+    l->running = 0;
+    l->next_ok = 0;
 }
 
 MemLevel dram_level(DramLevel *l) { return (MemLevel){l, lv_push, lv_next, lv_run}; }

@@ -53,6 +53,10 @@ struct L2 {
     uint64_t stamp;
     MemAnswer answer;           /* during l2_run */
     void *actx;
+    /* l2_next's answer, kept until a push or a run changes the banks or the level below (nothing
+     * else reaches them): the network asks it once per message it steps (host speed only). */
+    uint64_t next_at;
+    int next_ok, running;       /* (nothing is kept while l2_run changes the banks) */
     L2Stats st;
 };
 
@@ -132,6 +136,7 @@ void l2_free(L2 *l)
 
 void l2_reset(L2 *l)
 {
+    l->next_ok = 0;
     const size_t n = (size_t)l->sets * (size_t)l->p.ways;
     for (int i = 0; i < l->p.banks; i++) {
         L2Bank *b = &l->bank[i];
@@ -157,6 +162,7 @@ const L2Stats *l2_stats(const L2 *l) { return &l->st; }
 
 void l2_push(L2 *l, uint64_t addr, int write, uint64_t cycle, uint64_t id)
 {
+    l->next_ok = 0;
     const uint64_t line = addr >> l->shift;
     L2Bank *b = &l->bank[line % (uint64_t)l->p.banks];
     if (b->n == b->capq) { /* grow the ring, keeping its order */
@@ -190,12 +196,17 @@ static uint64_t head_start(const L2 *l, const L2Bank *b)
 
 uint64_t l2_next(const L2 *l)
 {
+    if (l->next_ok)
+        return l->next_at;
     uint64_t t = l->below.next(l->below.self);
     for (int i = 0; i < l->p.banks; i++) {
         const uint64_t s = head_start(l, &l->bank[i]);
         if (s < t)
             t = s;
     }
+    L2 *m = (L2 *)l; /* (the kept answer: not the level's state) */
+    m->next_at = t;
+    m->next_ok = !l->running;
     return t;
 }
 
@@ -388,11 +399,14 @@ static void start_at(L2 *l, uint64_t t)
 
 void l2_run(L2 *l, uint64_t until, MemAnswer ans, void *ctx)
 {
+    l->next_ok = 0;
+    l->running = 1;
     l->answer = ans;
     l->actx = ctx;
+    uint64_t t;
     for (;;) {
         const uint64_t tb = l->below.next(l->below.self);
-        uint64_t t = tb;
+        t = tb;
         for (int i = 0; i < l->p.banks; i++) {
             const uint64_t s = head_start(l, &l->bank[i]);
             if (s < t)
@@ -404,6 +418,9 @@ void l2_run(L2 *l, uint64_t until, MemAnswer ans, void *ctx)
             l->below.run(l->below.self, t + 1, fill, l);
         start_at(l, t);
     }
+    l->running = 0;
+    l->next_at = t; /* what l2_next would say now */
+    l->next_ok = 1;
 }
 
 static void lv_push(void *self, uint64_t addr, int write, uint64_t cycle, uint64_t id)

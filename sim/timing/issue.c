@@ -419,6 +419,8 @@ static void time_scene_hit(Timing *t, const TmDesc *d, const CoreRecord *rec, si
     tm_watch_unit(t, TIMING_UNIT_L1, at, at + 1);
     count_issue(t, d, rec->stage, rec->gen);
     complete_as(t, d, rec, at, at + 1, r > line ? r : line, TM_SCENE_MEMORY, TM_NO_FLOW);
+    if (__builtin_expect(mem_pending(line), 0))
+        tm_pend_note(t, d);
 }
 
 static __attribute__((noinline)) void issue_spad(Timing *t, const TmDesc *d, const CoreRecord *rec, uint64_t at)
@@ -450,6 +452,8 @@ static __attribute__((noinline)) void issue_scene(Timing *t, const TmDesc *d, co
     }
     count_issue(t, d, stage, gen);
     complete_as(t, d, rec, at, at + ext + 1, ready ? ready : at + d->lat, cause, TM_NO_FLOW);
+    if (__builtin_expect(mem_pending(ready), 0))
+        tm_pend_note(t, d);
 }
 
 static __attribute__((noinline)) void issue_units_other(Timing *t, const TmDesc *d, const CoreRecord *rec,

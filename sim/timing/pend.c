@@ -37,7 +37,12 @@ struct Pend {
     uint8_t *grp_live;
     uint32_t ngrp, capgrp;
     uint32_t *free_grp, nfree_grp;
+    uint32_t *live_grp, nlive_grp;   /* the live groups, in no order; grp_pos: each one's place */
+    uint32_t *grp_pos;
     uint32_t live_fills;
+    /* Registers given a pending value since they were last looked at (tm_pend_note): the only ones
+     * an answer can stand in (a superset: one may have been written since). */
+    uint64_t cand[(SIMD_NREGS + 63) / 64];
 };
 
 /* *p resized to cap elements of size bytes; -1 on out of memory (*p unchanged). */
@@ -80,7 +85,9 @@ static uint32_t group_new(Pend *p)
         if (p->ngrp == p->capgrp) {
             const uint32_t cap = p->capgrp ? 2 * p->capgrp : 16;
             if (resize((void **)&p->grp, cap, sizeof *p->grp) || resize((void **)&p->grp_live, cap, 1) ||
-                resize((void **)&p->free_grp, cap, sizeof *p->free_grp))
+                resize((void **)&p->free_grp, cap, sizeof *p->free_grp) ||
+                resize((void **)&p->live_grp, cap, sizeof *p->live_grp) ||
+                resize((void **)&p->grp_pos, cap, sizeof *p->grp_pos))
                 return UINT32_MAX;
             p->capgrp = cap;
         }
@@ -90,6 +97,8 @@ static uint32_t group_new(Pend *p)
     p->grp[g].cause = TM_SCENE_MEMORY;
     p->grp[g].n = 0;
     p->grp_live[g] = 1;
+    p->grp_pos[g] = p->nlive_grp;
+    p->live_grp[p->nlive_grp++] = g;
     return g;
 }
 
@@ -132,6 +141,9 @@ static void group_free(Pend *p, uint32_t g)
 {
     p->grp_live[g] = 0;
     p->free_grp[p->nfree_grp++] = g;
+    const uint32_t last = p->live_grp[--p->nlive_grp]; /* the last live one takes its place */
+    p->live_grp[p->grp_pos[g]] = last;
+    p->grp_pos[last] = p->grp_pos[g];
 }
 
 /* MemJoin: the later of a and b, either pending. A group value is one made for this access (lines
@@ -195,22 +207,52 @@ void tm_pend_free(Timing *t)
     free(p->grp);
     free(p->grp_live);
     free(p->free_grp);
+    free(p->live_grp);
+    free(p->grp_pos);
     free(p);
     t->pend = NULL;
 }
 
+void tm_pend_note(Timing *t, const TmDesc *d)
+{
+    for (int i = 0; i < d->ndst; i++)
+        t->pend->cand[d->dsts[i] >> 6] |= (uint64_t)1 << (d->dsts[i] & 63);
+}
+
 /* Every register standing at v gets x, a wait for it charged to cause; the scoreboard's horizon
- * again the latest ready cycle. */
+ * again the latest ready cycle. Only the registers given a pending value can stand at v; while one
+ * still waits, the horizon is the latest of theirs (a pending value is above every cycle), else the
+ * latest of all. */
 static void regs_resolve(Timing *t, uint64_t v, uint64_t x, int cause)
 {
+    Pend *p = t->pend;
     uint64_t hz = 0;
-    for (int r = 0; r < SIMD_NREGS; r++) {
-        if (t->simd.ready[r] == v) {
-            t->simd.ready[r] = x;
-            t->simd.rcause[r] = (uint8_t)cause;
+    int left = 0;
+    for (int w = 0; w < (int)(sizeof p->cand / sizeof p->cand[0]); w++) {
+        for (uint64_t m = p->cand[w]; m; m &= m - 1) {
+            const int r = 64 * w + __builtin_ctzll(m);
+            if (t->simd.ready[r] == v) {
+                t->simd.ready[r] = x;
+                t->simd.rcause[r] = (uint8_t)cause;
+            }
+            if (!mem_pending(t->simd.ready[r])) {
+                p->cand[w] &= ~((uint64_t)1 << (r & 63));
+            } else {
+                left = 1;
+                if (t->simd.ready[r] > hz)
+                    hz = t->simd.ready[r];
+            }
         }
-        if (t->simd.ready[r] > hz)
-            hz = t->simd.ready[r];
+    }
+    if (!left) { /* (one pass a compiler can vectorize) */
+        uint64_t pend = 0; /* bit 63: a pending value no path noted (tm_pend_note), a model error */
+        for (int r = 0; r < SIMD_NREGS; r++) {
+            const uint64_t rd = t->simd.ready[r];
+            hz = rd > hz ? rd : hz;
+            pend |= rd & ~(rd << 1); /* bit 63 set and bit 62 clear: mem_pending */
+        }
+        if (pend >> 63)
+            internal_error(t, "a pending register not noted");
     }
     t->simd.horizon = hz;
 }
@@ -226,13 +268,12 @@ void timing_answer(Timing *t, uint32_t fill, uint64_t x, int from)
     const uint64_t v = MEM_PENDING | fill;
     cache_fill_done(&t->l1, p->line[fill], v, x);
     regs_resolve(t, v, x, cause);
-    for (uint32_t g = 0; g < p->ngrp; g++) {
-        if (!p->grp_live[g])
-            continue;
+    for (uint32_t i = p->nlive_grp; i-- > 0;) { /* (backwards: group_free moves the last one here) */
+        const uint32_t g = p->live_grp[i];
         PendGroup *gr = &p->grp[g];
-        for (uint32_t i = 0; i < gr->n; i++)
-            if (gr->fill[i] == fill) {
-                gr->fill[i] = gr->fill[--gr->n];
+        for (uint32_t k = 0; k < gr->n; k++)
+            if (gr->fill[k] == fill) {
+                gr->fill[k] = gr->fill[--gr->n];
                 if (x >= gr->known) { /* the latest answer's level (the known part: the L1's) */
                     gr->known = x;
                     gr->cause = cause;

@@ -220,6 +220,9 @@ static inline void drain(Timing *t, uint64_t at)
 /* 1 when one of d's registers waits for an answer of the shared memory: the core is told to
  * yield (CoreFollow.yield) and a recording of a block is dropped. */
 int tm_yield_if_pending(Timing *t, const TmDesc *d);
+/* d's destinations were given a pending value (a scene load's: the only kind whose result can be
+ * one); an answer looks at such registers only. */
+void tm_pend_note(Timing *t, const TmDesc *d);
 void tm_pend_free(Timing *t);
 
 /* ---- what the memo asks of the model (sim/timing/issue.c) --------------------------------- */
