@@ -68,9 +68,12 @@ void timing_free(Timing *t)
         return;
     evq_free(&t->q);
     tm_pend_free(t);
-    for (uint32_t i = 0; i < t->desc_cap; i++)
-        free(t->desc[i].memo);
-    free(t->desc);
+    if (!t->share_owner) { /* (an owner is freed after the models that share its blocks) */
+        for (uint32_t i = 0; i < t->desc_cap; i++)
+            free(t->desc[i].memo);
+        free(t->desc);
+    }
+    free(t->touched);
 #define TM_UNIT(field, Type, Params, Stats, params_fn, prefix) prefix##_free(&t->field);
 #include "machine/units.def"
 #undef TM_UNIT
@@ -127,6 +130,10 @@ void timing_tap(Timing *t, TimingTap tap, void *ctx)
 
 void timing_reset(Timing *t)
 {
+    if (t->memo_shared) { /* (a new run would make the shared blocks look stale to the others) */
+        internal_error(t, "a timing model sharing its memo was reset");
+        return;
+    }
     units_cold(t, 0);
     if (++t->run == 0) { /* wrapped: no entry may look current */
         memo_fold_all(t);
@@ -177,6 +184,42 @@ const char *timing_error(const Timing *t)
 }
 
 CoreFollow *timing_follow(Timing *t) { return &t->follow; }
+
+int timing_share_memo(Timing *t, Timing *owner, uint32_t ninstr)
+{
+    if (t == owner || t->share_owner || owner->share_owner || t->run != owner->run || t->mmode != MM_NONE ||
+        owner->mmode != MM_NONE)
+        return -1;
+    /* the owner's table at the program's size: a sharer never grows it (its pointer would go stale) */
+    if (owner->desc_cap < ninstr) {
+        TmDesc *g = realloc(owner->desc, sizeof *g * ninstr);
+        if (!g)
+            return -1;
+        memset(g + owner->desc_cap, 0, sizeof *g * (ninstr - owner->desc_cap));
+        owner->desc = g;
+        owner->desc_cap = ninstr;
+    }
+    if (!t->touched && !(t->touched = malloc(sizeof *t->touched * TM_TOUCHED)))
+        return -1;
+    if (!owner->touched && !(owner->touched = malloc(sizeof *owner->touched * TM_TOUCHED)))
+        return -1;
+    memo_fold_all(t);
+    memo_fold_all(owner);
+    for (uint32_t i = 0; i < t->desc_cap; i++)
+        free(t->desc[i].memo);
+    free(t->desc);
+    t->desc = owner->desc;
+    t->desc_cap = owner->desc_cap;
+    t->share_owner = owner;
+    t->memo_shared = owner->memo_shared = 1;
+    return 0;
+}
+
+void timing_fold_shared(Timing *t)
+{
+    if (t->memo_shared)
+        memo_fold_all(t);
+}
 
 void timing_set_memo(Timing *t, int on)
 {

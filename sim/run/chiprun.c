@@ -171,9 +171,19 @@ static CoreExit run_slice(ChipRun *r, int k)
     return ex;
 }
 
+static int core_go_run(ChipRun *r, int k);
+
 /* Core k runs until it must wait: for memory (CS_MEM), for a tile (CS_TILE). 0, or -1 after
- * eng_fail. */
+ * eng_fail. Its replays of stored blocks it shares with the other cores are then counted as its
+ * own (timing_fold_shared), before another core runs. */
 static int core_go(ChipRun *r, int k)
+{
+    const int rc = core_go_run(r, k);
+    timing_fold_shared(tm_of(r, k));
+    return rc;
+}
+
+static int core_go_run(ChipRun *r, int k)
 {
     CoreRun *cr = &r->cr[k];
     Core *c = core_of(r, k);
@@ -502,6 +512,11 @@ static int cores_open(ChipRun *r)
         }
         timing_reset(tm_of(r, k));
     }
+    /* With shared memory the cores run one at a time on one host thread: they share core 0's memo
+     * of blocks (one program, one machine), which keeps one memo in the host's caches instead of K
+     * (docs/chip.md, "Host speed"); a core that cannot share keeps its own (the same results). */
+    for (int k = 1; r->chip && k < r->k; k++)
+        (void)timing_share_memo(tm_of(r, k), tm_of(r, 0), j->k->obj.ntext);
     return 0;
 }
 

@@ -203,6 +203,8 @@ static __attribute__((noinline)) const TmDesc *describe_slow(Timing *t, const Co
     TmDesc *d;
     if (rec->pc < t->desc_cap) {
         d = &t->desc[rec->pc];
+    } else if (t->memo_shared) { /* (the shared table is the program's size: never here) */
+        d = &t->spare;
     } else {
         uint32_t cap = t->desc_cap ? t->desc_cap : 256;
         while (cap <= rec->pc && cap < UINT32_MAX / 2)

@@ -121,9 +121,31 @@ static __attribute__((noinline)) void memo_fold(Timing *t, MemoEntry *e)
     e->lz_n = 0;
 }
 
-/* Every stored block's replays into the statistics (memo_fold). */
+/* A shared stored block e this model starts to leave replays of uncounted: noted, so that they are
+ * folded into this model's statistics (memo_fold_all); a full list is folded at once. */
+static __attribute__((noinline)) void memo_touched(Timing *t, MemoEntry *e)
+{
+    if (t->ntouched == TM_TOUCHED) {
+        for (uint32_t i = 0; i < t->ntouched; i++)
+            if (t->touched[i]->lz_n)
+                memo_fold(t, t->touched[i]);
+        t->ntouched = 0;
+    }
+    t->touched[t->ntouched++] = e;
+}
+
+/* Every stored block's replays into the statistics (memo_fold). A model that shares its stored
+ * blocks (timing_share_memo) folds those it replayed since it last did: only the running model
+ * has replays uncounted (timing_fold_shared after each of its runs). */
 void memo_fold_all(Timing *t)
 {
+    if (t->memo_shared) {
+        for (uint32_t i = 0; i < t->ntouched; i++)
+            if (t->touched[i]->lz_n)
+                memo_fold(t, t->touched[i]);
+        t->ntouched = 0;
+        return;
+    }
     for (uint32_t i = 0; i < t->desc_cap; i++)
         if (t->desc[i].memo)
             for (int w = 0; w < MEMO_WAYS; w++)
@@ -173,6 +195,8 @@ void memo_apply(Timing *t, MemoEntry *e, int flip)
         e->lz_stage = (uint8_t)stage;
         e->lz_gen = (uint8_t)gen;
     }
+    if (__builtin_expect(t->memo_shared, 0) && e->lz_n == 0)
+        memo_touched(t, e);
     e->lz_n++;
     for (int i = 0; i < e->nwrite; i++) {
         t->simd.ready[e->write[i].reg] = t0 + e->write[i].rel;

@@ -81,6 +81,9 @@ typedef struct TmDesc {
 
 typedef struct Pend Pend;
 
+/* A sharing model's list of stored blocks it left replays of uncounted (Timing.touched). */
+enum { TM_TOUCHED = 512 };
+
 struct Timing {
     EvQueue q;
     uint64_t now;                  /* the cycle the next instruction may issue in */
@@ -129,6 +132,13 @@ struct Timing {
     Pend *pend;                    /* a chip's core: answers that come later (pend.c); else NULL */
     TimingWatch watch;             /* timing_watch: its callbacks, NULL when none */
     int memo_user_off;             /* timing_set_memo(t, 0); memo_off also while watched */
+    /* timing_share_memo: the descriptions and stored blocks are another core's (share_owner, or
+     * this one's when others use them); the stored blocks' replays this model left uncounted
+     * (MemoEntry.lz_n), to be folded into its statistics before another model replays them. */
+    Timing *share_owner;
+    int memo_shared;
+    MemoEntry **touched;
+    uint32_t ntouched;
     MemPort watch_below;           /* timing_watch: the L1's port before the watch's */
     char err[256];
     TimingStats st;
