@@ -45,6 +45,7 @@ static __attribute__((noinline)) uint64_t mem_issue_lanes(SceneMem *m, Cache *l1
         lines[i] = cache_line(l1, mem_phys(m, flags, addr[i]));
     int k = lines_distinct(lines, naddr, d);
     *ready = 0;
+    m->last_from = 0;
     uint64_t slot = at;
     for (int i = 0, in_slot = 0; i < k; i++) { /* one line per port-slot: slot = at + i / ports */
         if (in_slot == m->p.ports) {
@@ -52,7 +53,10 @@ static __attribute__((noinline)) uint64_t mem_issue_lanes(SceneMem *m, Cache *l1
             in_slot = 0;
         }
         in_slot++;
-        *ready = cache_join(l1, *ready, cache_access(l1, d[i] << l1->line_shift, slot, write));
+        const uint64_t r = cache_access(l1, d[i] << l1->line_shift, slot, write);
+        if (r > *ready) /* (the first line of the latest ready cycle, in lane order, says where from) */
+            m->last_from = l1->last_from;
+        *ready = cache_join(l1, *ready, r);
     }
     m->st.instructions++;
     return ((uint64_t)k + (uint64_t)m->p.ports - 1) / (uint64_t)m->p.ports;
@@ -66,6 +70,7 @@ uint64_t mem_issue(SceneMem *m, Cache *l1, uint32_t flags, const uint32_t *addr,
         return mem_issue_lanes(m, l1, flags, write, addr, naddr, at, ready);
     /* a scalar access: one line, no search for distinct lines */
     *ready = cache_access(l1, mem_phys(m, flags, addr[0]), at, write);
+    m->last_from = l1->last_from;
     m->st.instructions++;
     return 1;
 }

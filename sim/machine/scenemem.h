@@ -34,6 +34,8 @@ typedef struct SceneMem {
     SceneMemParams p;
     uint64_t fb_base;          /* where the core's framebuffer starts in the framebuffer space (a
                                   chip: its tile's place in the frame's; else 0) */
+    int last_from;             /* mem_issue's: where its latest line's fill came from (Cache.from),
+                                  when the access waited for it; else 0 */
     SceneMemStats st;
 } SceneMem;
 

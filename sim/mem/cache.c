@@ -34,8 +34,9 @@ void cache_free(Cache *c)
     free(c->ready);
     free(c->lru);
     free(c->dirty);
+    free(c->from);
     c->tag = c->ready = c->lru = NULL;
-    c->dirty = NULL;
+    c->dirty = c->from = NULL;
     c->instantiated = 0;
 }
 
@@ -47,8 +48,10 @@ void cache_reset(Cache *c)
         memset(c->ready, 0, n * sizeof *c->ready);
         memset(c->lru, 0, n * sizeof *c->lru);
         memset(c->dirty, 0, n);
+        memset(c->from, 0, n);
     }
     c->stamp = 0;
+    c->last_from = 0;
     c->last_way = 0;
 }
 
@@ -59,7 +62,8 @@ static int instantiate(Cache *c)
     c->ready = calloc(n, sizeof *c->ready);
     c->lru = calloc(n, sizeof *c->lru);
     c->dirty = calloc(n, 1);
-    if (!c->tag || !c->ready || !c->lru || !c->dirty) {
+    c->from = calloc(n, 1);
+    if (!c->tag || !c->ready || !c->lru || !c->dirty || !c->from) {
         cache_free(c);
         return -1;
     }
@@ -90,6 +94,8 @@ static uint64_t miss(Cache *c, uint64_t line, size_t set, uint64_t t, int write)
     tag[victim] = line + 1;
     c->lru[k] = c->stamp;
     c->dirty[k] = (uint8_t)(write != 0);
+    c->from[k] = 0;
+    c->last_from = 0;
     c->ready[k] = port_request(&c->below, line << c->line_shift, 0, t);
     c->last_way = k;
     return c->ready[k];
@@ -100,6 +106,7 @@ uint64_t cache_access(Cache *c, uint64_t addr, uint64_t t, int write)
     c->st.accesses++;
     if (c->sets == 0) { /* no cache: every access is a request below */
         c->st.misses++;
+        c->last_from = 0;
         return port_request(&c->below, addr & ~(((uint64_t)1 << c->line_shift) - 1), write, t);
     }
     if (!c->instantiated && instantiate(c))
@@ -127,16 +134,19 @@ uint64_t cache_access(Cache *c, uint64_t addr, uint64_t t, int write)
     if (write) /* a load leaves the line as it was */
         c->dirty[k] = 1;
     const uint64_t r = t + (uint64_t)c->p.hit_latency;
+    c->last_from = c->ready[k] > r ? c->from[k] : 0; /* (a pending fill's: its answer says) */
     if (__builtin_expect(c->join != NULL, 0))
         return cache_join(c, r, c->ready[k]);
     return r > c->ready[k] ? r : c->ready[k];
 }
 
-void cache_fill_done(Cache *c, uint64_t addr, uint64_t pending, uint64_t x)
+void cache_fill_done(Cache *c, uint64_t addr, uint64_t pending, uint64_t x, int from)
 {
     size_t k;
-    if (cache_peek(c, addr, &k) && c->ready[k] == pending)
+    if (cache_peek(c, addr, &k) && c->ready[k] == pending) {
         c->ready[k] = x;
+        c->from[k] = (uint8_t)(from + 1);
+    }
 }
 
 int cache_peek(const Cache *c, uint64_t addr, size_t *way)

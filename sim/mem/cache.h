@@ -39,6 +39,10 @@ typedef struct Cache {
     uint64_t *ready;              /* fill completion time per way */
     uint64_t *lru;                /* last-use stamp per way */
     uint8_t *dirty;
+    uint8_t *from;                /* per way: where a chip's fill came from (cache_fill_done's
+                                     from + 1), 0 for a line of the level's own (the bus's) */
+    int last_from;                /* the last access's: its line's from when the access waited
+                                     for the fill beyond its hit latency, else 0 */
     uint64_t stamp;
     size_t last_way;              /* the way of the last hit or fill (tag index), tried first */
     int instantiated;
@@ -57,9 +61,11 @@ void cache_connect(Cache *c, MemPort below);
 /* A port that may answer later (port.h, MEM_PENDING): a hit on a line whose fill is pending is
  * ready at join(its hit cycle, the fill's pending value). */
 void cache_set_join(Cache *c, MemJoin join, void *ctx);
-/* The fill of the line holding addr, pending as `pending`, came at cycle x: the line, if it is
- * still there waiting for that fill, is ready at x. */
-void cache_fill_done(Cache *c, uint64_t addr, uint64_t pending, uint64_t x);
+/* The fill of the line holding addr, pending as `pending`, came at cycle x from `from` (a chip's
+ * TIMING_FROM_L2 or TIMING_FROM_DRAM): the line, if it is still there waiting for that fill, is
+ * ready at x, and an access that waits for it past its hit latency says where the fill came from
+ * (last_from: from + 1). */
+void cache_fill_done(Cache *c, uint64_t addr, uint64_t pending, uint64_t x, int from);
 /* The later of two ready cycles, either maybe pending (MemJoin; the plain maximum without one). */
 static inline uint64_t cache_join(const Cache *c, uint64_t a, uint64_t b)
 {

@@ -420,7 +420,8 @@ static void time_scene_hit(Timing *t, const TmDesc *d, const CoreRecord *rec, si
     const uint64_t r = at + (uint64_t)t->l1.p.hit_latency, line = t->l1.ready[way];
     tm_watch_unit(t, TIMING_UNIT_L1, at, at + 1);
     count_issue(t, d, rec->stage, rec->gen);
-    complete_as(t, d, rec, at, at + 1, r > line ? r : line, TM_SCENE_MEMORY, TM_NO_FLOW);
+    complete_as(t, d, rec, at, at + 1, r > line ? r : line, line > r ? tm_from_slot(t->l1.from[way]) : TM_SCENE_MEMORY,
+                TM_NO_FLOW);
     if (__builtin_expect(mem_pending(line), 0))
         tm_pend_note(t, d);
 }
@@ -450,7 +451,7 @@ static __attribute__((noinline)) void issue_scene(Timing *t, const TmDesc *d, co
             internal_error(t, "out of memory for the scene cache");
         charge(t, TM_SCENE_MEMORY, ext, stage, gen);
         tm_watch_unit(t, TIMING_UNIT_L1, at, at + ext + 1);
-        cause = TM_SCENE_MEMORY;
+        cause = tm_from_slot(t->mem.last_from);
     }
     count_issue(t, d, stage, gen);
     complete_as(t, d, rec, at, at + ext + 1, ready ? ready : at + d->lat, cause, TM_NO_FLOW);

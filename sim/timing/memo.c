@@ -665,10 +665,12 @@ __attribute__((noinline)) int memo_scene(Timing *t, TmDesc *d, const CoreRecord 
     if (!load || d->short_block || t->memo_off || !cache_peek(&t->l1, rec->addr[0], &way))
         return 0;
     const uint64_t line = t->l1.ready[way], hit = t->now + (uint64_t)t->l1.p.hit_latency;
-    if (line > hit && line - t->now > UINT32_MAX)
+    if (line > hit && line - t->now > (UINT32_MAX >> 2))
         return 0;
+    /* the key: when the line's data are there, and where its fill came from (what a wait for
+     * them is charged to: tm_from_slot) */
     const MemoFirst f = {MEMO_SCENE, rec->addr[0] & (uint32_t)(t->l1.p.line_bytes - 1),
-                         line > hit ? (uint32_t)(line - t->now) : 0u};
+                         line > hit ? (uint32_t)(line - t->now) << 2 | t->l1.from[way] : 0u};
     t->m_sway = way;
     if (memo_begin(t, d, rec, &f)) {
         cache_hits(&t->l1, way, 1); /* the first load's access */

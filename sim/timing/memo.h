@@ -71,7 +71,8 @@ enum { MEMO_SCENE = 254 };    /* MemoEntry.gc of a scene load */
 
 /* What a block's key asks of its first record beyond the start state: a gather's bank cycles
  * (c0, as MemoEntry.gc; 0 for a plain instruction), or for a scene load (c0 MEMO_SCENE) its
- * address's place in its line and when its line's data are there. */
+ * address's place in its line and when its line's data are there (rel: the cycles from the
+ * start, times 4, plus where a chip's fill came from, Cache.from; 0 if by its hit latency). */
 typedef struct MemoFirst {
     int c0;
     uint32_t off, rel;

@@ -266,7 +266,7 @@ void timing_answer(Timing *t, uint32_t fill, uint64_t x, int from)
         return;
     }
     const uint64_t v = MEM_PENDING | fill;
-    cache_fill_done(&t->l1, p->line[fill], v, x);
+    cache_fill_done(&t->l1, p->line[fill], v, x, from);
     regs_resolve(t, v, x, cause);
     for (uint32_t i = p->nlive_grp; i-- > 0;) { /* (backwards: group_free moves the last one here) */
         const uint32_t g = p->live_grp[i];

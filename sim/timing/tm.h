@@ -176,6 +176,13 @@ static inline void charge(Timing *t, int cause, uint64_t cycles, int stage, int 
     t->st.gen_stalls[gen][cause] += cycles;
 }
 
+/* What a wait for a scene load's data is charged to: the L1's own scene_memory, or on a chip's
+ * core the slot of the level its line's fill came from (Cache.from: 1 the L2, 2 DRAM). */
+static inline int tm_from_slot(int from)
+{
+    return from == 0 ? TM_SCENE_MEMORY : from == 1 ? TM_FROM_L2 : TM_FROM_DRAM;
+}
+
 /* A charge slot's cycles so far (see TM_CHARGE_SLOTS). */
 static inline uint64_t tm_slot(const TimingStats *s, int slot)
 {

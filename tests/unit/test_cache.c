@@ -183,3 +183,50 @@ Test(cache, scene_cache_matches_a_plain_lru_cache_on_random_accesses)
     }
 }
 
+
+/* A level below that answers later (a chip's, sim/mem/port.h): every read gets a pending value. */
+static uint64_t later_request(void *below, const MemReq *r)
+{
+    uint32_t *n = below;
+    return r->write ? r->at : MEM_PENDING | (*n)++;
+}
+
+Test(cache, a_fill_says_where_it_came_from)
+{
+    /* Line A misses at 0 (pending); its answer comes from DRAM at 100 (cache_fill_done, from 1 =
+     * TIMING_FROM_DRAM). A hit on A at 10 waits for the fill (hit latency 2: 12 < 100): the access
+     * says DRAM (from + 1 = 2). A hit at 200 waits for nothing of the fill: 0. A miss: 0. Through
+     * the scene-memory ports: a two-line access whose latest line is A's (ready 300, from the L2)
+     * says the L2 (1); the other line, B, is the bus's own. */
+    Cache c;
+    cr_assert_eq(cache_init(&c, &(CacheParams){64 * 4 * 64, 4, 64, 2}), 0);
+    uint32_t fills = 0;
+    cache_connect(&c, (MemPort){later_request, &fills});
+    const uint64_t p = cache_access(&c, 0x40, 0, 0);
+    cr_assert(mem_pending(p));
+    cr_assert_eq(c.last_from, 0);
+    cache_fill_done(&c, 0x40, p, 100, 1);
+    cr_assert_eq(cache_access(&c, 0x44, 10, 0), 100);
+    cr_assert_eq(c.last_from, 2, "a hit waiting for a fill DRAM answered");
+    cr_assert_eq(cache_access(&c, 0x48, 200, 0), 202);
+    cr_assert_eq(c.last_from, 0, "a hit after the fill waits for its hit latency only");
+    const uint64_t q = cache_access(&c, 0x1000, 210, 0);
+    cr_assert(mem_pending(q));
+    cr_assert_eq(c.last_from, 0);
+    cache_fill_done(&c, 0x1000, q, 250, -1); /* (-1: a fill of the level's own: from 0) */
+    const uint64_t p2 = cache_access(&c, 0x2040, 260, 0); /* a third line, then A's again in flight */
+    cache_fill_done(&c, 0x2040, p2, 300, 0);
+    SceneMem m;
+    mem_init(&m, &(SceneMemParams){2});
+    uint64_t ready;
+    const uint32_t two[2] = {0x1000, 0x2040};
+    cr_assert_eq(mem_issue(&m, &c, 0, two, 2, 270, &ready), 1);
+    cr_assert_eq(ready, 300);
+    cr_assert_eq(m.last_from, 1, "the latest line's fill came from the L2");
+    const uint32_t own[1] = {0x1000};
+    mem_issue(&m, &c, 0, own, 1, 280, &ready);
+    cr_assert_eq(ready, 282);
+    cr_assert_eq(m.last_from, 0);
+    mem_free(&m);
+    cache_free(&c);
+}
