@@ -364,8 +364,11 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     if (rc == 0) {
         Report rep = {.o = o, .mode = spec.mode, .cfg = cfg, .sc = &sc, .fr = &fr};
         image_figures(fr.rgb, 3 * (size_t)sc.s.render.width * (size_t)sc.s.render.height, &rep.mean, &rep.nonfinite);
+        /* Energy and area: once, from the finished run's counters (sim/energy/energy.h). */
+        if (report_energy(&rep, err, errlen) != 0) {
+            rc = -1;
         /* From here on a failure is an output that could not be written (EXIT_IO). */
-        if (write_outputs(&rep, err, errlen) != 0) {
+        } else if (write_outputs(&rep, err, errlen) != 0) {
             size_t n = strlen(err);
             snprintf(err + n, errlen - n, " (no output of this run was kept in %s)", o->out_dir);
             rc = -3;

@@ -111,6 +111,8 @@ static void add_sample_json(cJSON *root, const RenderOptions *o, const RunFrame 
     cJSON_AddNumberToObject(sm, "golden_seconds", fr->golden_seconds);
 }
 
+static uint64_t report_rays(const Report *r) { return r->fr->run.primary + r->fr->run.shadow + r->fr->run.indirect; }
+
 /* The statistics walk's view of the run (sim/stats.h). */
 static StatsCtx stats_ctx(const Report *r)
 {
@@ -124,11 +126,36 @@ static StatsCtx stats_ctx(const Report *r)
                   .cfg = r->cfg, .run = &r->fr->run, .f = kernel ? &r->fr->f : NULL,
                   .t = run_mode_timed(r->mode) ? &r->fr->f.timing : NULL,
                   .est = r->fr->has_est ? &r->fr->est : NULL,
-                  .est_instructions = r->fr->has_est ? &r->fr->est_instructions : NULL, .rounds = r->fr->rounds};
+                  .est_instructions = r->fr->has_est ? &r->fr->est_instructions : NULL, .rounds = r->fr->rounds,
+                  .energy = r->has_energy ? &r->energy : NULL};
     return c;
 }
 
-static uint64_t report_rays(const Report *r) { return r->fr->run.primary + r->fr->run.shadow + r->fr->run.indirect; }
+int report_energy(Report *r, char *err, size_t errlen)
+{
+    r->has_energy = 0;
+    if (!run_mode_timed(r->mode))
+        return 0;
+    StatsCtx sx = stats_ctx(r);
+    const StatsFrame fr = stats_frame_of(&sx);
+    const double hz = r->cfg->core_clock_mhz * 1e6;
+    const FuncStats *f = &r->fr->f;
+    EnergyInput in = {.cfg = r->cfg, .f = f, .seconds = fr.cycles / hz, .scale = 1, .rays = (double)report_rays(r)};
+    if (sx.est_instructions && f->instructions > 0) {
+        /* Sampled mode: the counted events are the sampled units'; the frame's are estimated as its
+         * instructions are (docs/energy.md, "Sampled mode"). */
+        const double k = (double)f->instructions;
+        in.scale = sx.est_instructions->total / k;
+        in.scale_lo = sx.est_instructions->lo / k;
+        in.scale_hi = sx.est_instructions->hi / k;
+        in.seconds_lo = fr.cycles_lo / hz;
+        in.seconds_hi = fr.cycles_hi / hz;
+    }
+    if (energy_compute(&in, &r->energy, err, errlen) != 0)
+        return -1;
+    r->has_energy = 1;
+    return 0;
+}
 
 /* report.json (docs/report.md); NULL when out of memory. */
 cJSON *report_json(const Report *r)

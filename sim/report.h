@@ -8,6 +8,7 @@
 #include <stddef.h>
 
 #include "config.h"
+#include "energy/energy.h"
 #include "render.h"
 #include "run/run.h"
 
@@ -22,7 +23,13 @@ typedef struct Report {
     const RunFrame *fr;
     double mean;               /* of the image's finite values */
     long nonfinite;
+    EnergyReport energy;       /* timed modes: report_energy's (sim/energy/energy.h) */
+    int has_energy;
 } Report;
+
+/* The run's energy, power and area into r->energy, once after the run (timed modes; others: none).
+ * 0, or -1 with the reason in err. */
+int report_energy(Report *r, char *err, size_t errlen);
 
 /* report.json; NULL when out of memory. */
 struct cJSON *report_json(const Report *r);

@@ -10,6 +10,7 @@
 #include "stats.h"
 
 #include "chip/chip.h"
+#include "energy/energy.h"
 #include "stats_walk.h"
 
 #include <cjson/cJSON.h>
@@ -63,6 +64,10 @@ int stats_dim_size(StatsDim d)
     case STATS_D_COUNTER: return FUNC_KD_COUNTERS;
     case STATS_D_BOUND: return 2;
     case STATS_D_CORE: return 0;
+    case STATS_D_PART: return EN_P_COUNT;
+    case STATS_D_LEVEL: return EN_L_COUNT;
+    case STATS_D_DRAMPART: return EN_D_COUNT;
+    case STATS_D_AREA: return EN_A_COUNT;
     case STATS_D_COUNT: break;
     }
     return 0;
@@ -80,6 +85,10 @@ const char *stats_dim_key(StatsDim d, int i)
     case STATS_D_KIND: return func_kd_kind_keys[i];
     case STATS_D_COUNTER: return func_kd_counter_keys[i];
     case STATS_D_BOUND: return bound_keys[i];
+    case STATS_D_PART: return energy_part_keys[i];
+    case STATS_D_LEVEL: return energy_level_keys[i];
+    case STATS_D_DRAMPART: return energy_dram_keys[i];
+    case STATS_D_AREA: return energy_area_keys[i];
     case STATS_D_GEN: case STATS_D_TILE: case STATS_D_CORE: case STATS_D_COUNT: break;
     }
     return "";
@@ -458,6 +467,31 @@ FIG(dram_queue_avg)
     return defined_if(stats_ratio(d->occupancy_sum, d->cycles) / (mem_of(c)->dram_channels ? mem_of(c)->dram_channels : 1),
                       d->cycles > 0, na);
 }
+
+/* ---- energy, power and area (sim/energy/energy.h computes them once after the run) ---------- */
+
+/* A view with no energy computed (a report built without report_energy) reads zeros. */
+static const EnergyReport *en(const StatsCtx *c)
+{
+    static const EnergyReport none;
+    return c->energy ? c->energy : &none;
+}
+FIG(energy_total) { UNUSED_FIG_ARGS; return en(c)->total_j; }
+FIG(energy_events) { UNUSED_FIG_ARGS; return en(c)->events_j; }
+FIG(energy_leakage) { UNUSED_FIG_ARGS; return en(c)->leakage_j; }
+FIG(energy_ci95) { UNUSED_FIG_ARGS; return idx[0] ? en(c)->total_hi : en(c)->total_lo; }
+FIG(energy_part_events) { UNUSED_FIG_ARGS; return en(c)->events[idx[0]]; }
+FIG(energy_part_leakage) { UNUSED_FIG_ARGS; return en(c)->leakage[idx[0]]; }
+FIG(energy_level) { UNUSED_FIG_ARGS; return en(c)->level[idx[0]]; }
+FIG(energy_dram) { return defined_if(en(c)->dram[idx[0]], en(c)->dram_known || idx[0] == EN_D_IO, na); }
+FIG(energy_dram_pj_bit) { (void)idx; return defined_if(en(c)->dram_pj_per_bit, en(c)->dram_known, na); }
+FIG(power_average) { UNUSED_FIG_ARGS; return en(c)->average_w; }
+FIG(power_leakage) { UNUSED_FIG_ARGS; return en(c)->leakage_w; }
+FIG(mrays_per_j) { (void)idx; return defined_if(en(c)->mrays_per_j, en(c)->total_j > 0, na); }
+FIG(fps_per_w) { (void)idx; return defined_if(en(c)->fps_per_w, en(c)->total_j > 0, na); }
+FIG(area) { UNUSED_FIG_ARGS; return en(c)->area[idx[0]]; }
+FIG(fps_per_mm2) { (void)idx; return defined_if(en(c)->fps_per_mm2, en(c)->fps_per_mm2 > 0, na); }
+FIG(energy_node) { UNUSED_FIG_ARGS; return en(c)->node_nm; }
 
 /* ---- the table ------------------------------------------------------------------------------ */
 

@@ -29,6 +29,7 @@
 #include "timing.h"
 
 struct cJSON;
+struct EnergyReport;
 
 #define STATS_GENERATIONS 64   /* generations kept apart: CORE_, FUNC_MAX_ and REF_MAX_GENERATIONS */
 #define STATS_MAX_DIMS 3
@@ -88,7 +89,11 @@ typedef enum StatsSrc {
     X(KIND,     "kind",     "ray kind: camera, indirect, shadow") \
     X(COUNTER,  "counter",  "kd-tree counter of the kernel (KC_* in kernels/lib/abi.inc)") \
     X(BOUND,    "bound",    "a 95 % interval's bound: lo, hi (array)") \
-    X(CORE,     "core",     "a core of the chip (array, chip.cores)")
+    X(CORE,     "core",     "a core of the chip (array, chip.cores)") \
+    X(PART,     "part",     "a part of the machine with energy (sim/energy/energy.h ENERGY_PARTS)") \
+    X(LEVEL,    "level",    "a level of the machine: datapath, registers, local memories, L1, L2, network, DRAM") \
+    X(DRAMPART, "dram_part", "what the DRAM's energy went to: commands, standby states, I/O") \
+    X(AREA,     "structure", "a structure with an area (sim/energy/energy.h ENERGY_AREAS)")
 
 typedef enum StatsDim {
 #define STATS_DIM_ENUM(name, key, desc) STATS_D_##name,
@@ -122,6 +127,9 @@ typedef enum StatsDim {
     X(BYTES,        "bytes") \
     X(SECONDS,      "seconds") \
     X(FLAG,         "true/false") \
+    X(JOULES,       "J") \
+    X(WATTS,        "W") \
+    X(MM2,          "mm^2") \
     X(NAMES,        "names")
 
 typedef enum StatsUnit {
@@ -195,6 +203,7 @@ struct StatsCtx {
     const SampleEstimate *est;   /* sampled mode: the cycles */
     const SampleEstimate *est_instructions; /* ... the instructions */
     uint32_t rounds;             /* ... rounds of the sequential rule */
+    const struct EnergyReport *energy; /* timed modes: the run's energy and area (sim/energy/energy.h) */
 };
 
 /* The statistics of report.json, added to root (objects the walk creates may be shared with the
@@ -237,6 +246,8 @@ typedef struct StatsFrame {
     double cycles_lo, cycles_hi, fps_lo, fps_hi;   /* sampled mode: the 95 % intervals */
 } StatsFrame;
 StatsFrame stats_frame(const TimingStats *t, double instructions, double clock_mhz, const SampleEstimate *est);
+/* The frame's timing of c: stats_frame, or a chip's makespan (the report's cycles and fps). */
+StatsFrame stats_frame_of(const StatsCtx *c);
 
 /* The table's rules for one row (path names the dimensions, sources and text styles fit, fields
  * inside their struct): 0, or -1 with the row and the rule in err. */

@@ -47,6 +47,7 @@ static const char *fmt_value(const StatsRow *r, double v, int na, char *buf, siz
     case STATS_U_RAYS_PER_STREAM: snprintf(buf, len, "%.1f", v); break;
     case STATS_U_FPS: snprintf(buf, len, "%.2f", v); break;
     case STATS_U_MHZ: case STATS_U_NUMBER: snprintf(buf, len, "%g", v); break;
+    case STATS_U_JOULES: case STATS_U_WATTS: case STATS_U_MM2: snprintf(buf, len, "%.4g", v); break;
     case STATS_U_FLAG: snprintf(buf, len, "%s", v != 0 ? "yes" : "no"); break;
     default: snprintf(buf, len, "%.0f", v); break;
     }
@@ -222,8 +223,8 @@ static int dim_sums(StatsDim d)
     switch (d) {
     case STATS_D_STAGE: case STATS_D_FILTER: case STATS_D_CAUSE: case STATS_D_CATEGORY: case STATS_D_GEN:
     case STATS_D_TILE: case STATS_D_OPCODE: case STATS_D_UNIT: case STATS_D_KIND: return 1;
-    case STATS_D_CORE: return 1;
-    case STATS_D_COUNTER: case STATS_D_BOUND: case STATS_D_COUNT: break;
+    case STATS_D_CORE: case STATS_D_PART: case STATS_D_LEVEL: case STATS_D_DRAMPART: return 1;
+    case STATS_D_COUNTER: case STATS_D_BOUND: case STATS_D_AREA: case STATS_D_COUNT: break;
     }
     return 0;
 }
@@ -234,10 +235,10 @@ static int unit_sums(StatsUnit u)
     switch (u) {
     case STATS_U_CYCLES: case STATS_U_INSTRUCTIONS: case STATS_U_RAYS: case STATS_U_STREAMS: case STATS_U_EVENTS:
     case STATS_U_TILES: case STATS_U_UNITS: case STATS_U_ACCESSES: case STATS_U_LINES: case STATS_U_IDS:
-    case STATS_U_VECTORS: case STATS_U_TRANSFERS: case STATS_U_PARTITIONS: case STATS_U_BYTES: return 1;
+    case STATS_U_VECTORS: case STATS_U_TRANSFERS: case STATS_U_PARTITIONS: case STATS_U_BYTES: case STATS_U_JOULES: return 1;
     case STATS_U_RAYS_PER_STREAM: case STATS_U_PER_RAY: case STATS_U_RATIO: case STATS_U_FPS: case STATS_U_MHZ:
     case STATS_U_CPI: case STATS_U_NUMBER: case STATS_U_PIXELS: case STATS_U_SECONDS: case STATS_U_FLAG:
-    case STATS_U_NAMES: case STATS_U_COUNT: break;
+    case STATS_U_NAMES: case STATS_U_WATTS: case STATS_U_MM2: case STATS_U_COUNT: break;
     }
     return 0;
 }

@@ -38,7 +38,5 @@ const char *stats_seg_key(const Seg *g, const StatsRow *r, const int *idx, char 
 const char *stats_leaf_name(const StatsRow *r, char *buf, size_t len);
 /* Every row of c's mode (and the rows null in it), in table order. */
 void stats_walk(const StatsCtx *c, void (*visit)(void *w, const StatsRow *r), void *w);
-/* The frame's timing of c (stats_frame). */
-StatsFrame stats_frame_of(const StatsCtx *c);
 
 #endif

@@ -15,6 +15,7 @@
 
 #include "../../host/outfile.h"
 #include "../exitcodes.h"
+#include "../energy/dramenergy.h"
 #include "../mem/dram.h"
 #include "../mem/memtrace.h"
 #include "help.h"
@@ -223,8 +224,52 @@ static cJSON *json_block(const DramChanStats *s, const Figures *f)
     return o;
 }
 
+/* The DRAM's energy over the replay, cycles 0 to the last (sim/energy/dramenergy.h, docs/energy.md):
+ * report.txt's lines and report.json's "energy". */
+static cJSON *energy_block(FILE *o, const DramParams *p, const DramChanStats *s, double io_pj_bit)
+{
+    DramEnergy e;
+    const double rank_cycles = (double)p->channels * p->ranks * (double)s->cycles;
+    dram_energy(p, s, rank_cycles, io_pj_bit, &e);
+    const DramPower *w = &p->power;
+    cJSON *j = cJSON_CreateObject();
+    cJSON_AddBoolToObject(j, "known", e.known);
+    cJSON_AddStringToObject(j, "source", w->source ? w->source : "");
+    cJSON_AddNumberToObject(j, "io_pj_per_bit", e.io_pj_per_bit);
+    cJSON_AddNumberToObject(j, "io_j", e.io);
+    if (!e.known) {
+        fprintf(o, "energy\n  not computed: the preset gives no IDD currents (%s)\n", w->source ? w->source : "-");
+        fprintf(o, "  I/O                 %.4g nJ (%g pJ/bit)\n", e.io * 1e9, e.io_pj_per_bit);
+        return j;
+    }
+    const double dev = (double)p->bus_bits / p->device_width;
+    fprintf(o, "energy (IDD method, docs/energy.md): VDD %g V; IDD0 %g, IDD2N %g, IDD3N %g, IDD4R %g, IDD4W %g, IDD5B %g mA "
+               "a device, %g devices a rank\n", w->vdd, w->idd0, w->idd2n, w->idd3n, w->idd4r, w->idd4w, w->idd5b, dev);
+    fprintf(o, "  per command         ACT+PRE %.2f pJ, RD burst %.2f pJ, WR burst %.2f pJ, REF %.2f pJ\n", e.act_pj,
+            e.rd_pj, e.wr_pj, e.ref_pj);
+    fprintf(o, "  commands            activate %.4g nJ, read %.4g nJ, write %.4g nJ, refresh %.4g nJ\n", e.activate * 1e9,
+            e.read * 1e9, e.write * 1e9, e.refresh * 1e9);
+    fprintf(o, "  background          active standby %.4g nJ (%llu rank-cycles with a bank open, %llu refreshing), "
+               "precharged standby %.4g nJ, of %.0f rank-cycles\n", e.background_active * 1e9,
+            (unsigned long long)s->active_cycles, (unsigned long long)s->refresh_cycles, e.background_precharged * 1e9,
+            rank_cycles);
+    fprintf(o, "  total               %.4g nJ, %.3f pJ/bit; I/O apart: %.4g nJ (%g pJ/bit)\n", e.core * 1e9, e.pj_per_bit,
+            e.io * 1e9, e.io_pj_per_bit);
+    const struct { const char *k; double v; } f[] = {
+        {"vdd", w->vdd}, {"idd0", w->idd0}, {"idd2n", w->idd2n}, {"idd3n", w->idd3n}, {"idd4r", w->idd4r},
+        {"idd4w", w->idd4w}, {"idd5b", w->idd5b}, {"devices_per_rank", dev}, {"act_pre_pj", e.act_pj},
+        {"read_burst_pj", e.rd_pj}, {"write_burst_pj", e.wr_pj}, {"refresh_pj", e.ref_pj}, {"activate_j", e.activate},
+        {"read_j", e.read}, {"write_j", e.write}, {"refresh_j", e.refresh}, {"background_active_j", e.background_active},
+        {"background_precharged_j", e.background_precharged}, {"rank_cycles", rank_cycles}, {"total_j", e.core},
+        {"pj_per_bit", e.pj_per_bit}};
+    for (size_t i = 0; i < sizeof f / sizeof f[0]; i++)
+        cJSON_AddNumberToObject(j, f[i].k, f[i].v);
+    return j;
+}
+
 /* report.txt and report.json as text (malloc'ed), or -1. */
-static int build_reports(const Dram *d, const Replay *r, const char *trace, MtrFormat fmt, char **txt, char **json)
+static int build_reports(const Dram *d, const Replay *r, const char *trace, MtrFormat fmt, double io_pj_bit, char **txt,
+                         char **json)
 {
     const DramParams *p = dram_get_params(d);
     const DramStats *s = dram_stats(d);
@@ -267,6 +312,7 @@ static int build_reports(const Dram *d, const Replay *r, const char *trace, MtrF
     text_block(o, "total", &s->total, &f);
     cJSON_AddItemToObject(root, "channels", chans);
     cJSON_AddItemToObject(root, "total", json_block(&s->total, &f));
+    cJSON_AddItemToObject(root, "energy", energy_block(o, p, &s->total, io_pj_bit));
     int bad = fclose(o) != 0;
     char *j = cJSON_Print(root);
     cJSON_Delete(root);
@@ -359,12 +405,13 @@ static int parse(int argc, char **argv, MemOpts *m)
     return EXIT_OK;
 }
 
-static Dram *open_dram(const MemOpts *m, DramParams *dp)
+static Dram *open_dram(const MemOpts *m, DramParams *dp, double *io_pj_bit)
 {
     CfgMachine cfg;
     char err[512];
     if (cli_config_build(&m->cfg, &cfg))
         return NULL;
+    *io_pj_bit = cfg.energy_dram_io_pj_bit;
     if (dram_params(&cfg, dp, err, sizeof err)) {
         fprintf(stderr, "sfsim mem: %s\n", err);
         return NULL;
@@ -403,7 +450,8 @@ int cmd_mem(int argc, char **argv)
         return EXIT_IO;
     }
     DramParams dp;
-    Dram *d = open_dram(&m, &dp);
+    double io_pj_bit = 0;
+    Dram *d = open_dram(&m, &dp, &io_pj_bit);
     MtrReader *t = d ? mtr_open(m.trace, m.fmt, err, sizeof err) : NULL;
     Replay r = {.p = d ? dram_get_params(d) : NULL};
     char *txt = NULL, *json = NULL;
@@ -416,7 +464,7 @@ int cmd_mem(int argc, char **argv)
         fprintf(stderr, "sfsim mem: %s\n", r.lat ? err : "out of memory");
         goto out;
     }
-    if (build_reports(d, &r, m.trace, mtr_format(t), &txt, &json)) {
+    if (build_reports(d, &r, m.trace, mtr_format(t), io_pj_bit, &txt, &json)) {
         fprintf(stderr, "sfsim mem: out of memory writing the report\n");
         goto out;
     }

@@ -16,10 +16,12 @@ typedef struct PresetRow {
 
 static const PresetRow presets[DRAM_NPRESETS] = {
 #define DRAM_PRESET(nm, mhz, bt, ch, ra, bg, ba, ro, co, wd, bus, bl, cl, cwl, trcd, trp, tras, trc, ccds, ccdl, \
-                    rrds, rrdl, faw, twr, wtrs, wtrl, rtp, trefi, trfc, rtrs, rtw, map, src)                     \
+                    rrds, rrdl, faw, twr, wtrs, wtrl, rtp, trefi, trfc, rtrs, rtw, map, src, vdd, idd0, idd2n,  \
+                    idd3n, idd4r, idd4w, idd5b, psrc)                                                          \
     {#nm, src,                                                                                                   \
      {#nm, mhz, bt, ch, ra, bg, ba, ro, co, wd, bus, bl, cl, cwl, trcd, trp, tras, trc, ccds, ccdl, rrds, rrdl,   \
-      faw, twr, wtrs, wtrl, rtp, trefi, trfc, rtrs, rtw, map, 0, 0, 0, 0, 0, 0, 0, {0}, {0}, 0, 0}},
+      faw, twr, wtrs, wtrl, rtp, trefi, trfc, rtrs, rtw, map, 0, 0, 0, 0, 0, 0, 0, {0}, {0}, 0, 0,               \
+      {vdd, idd0, idd2n, idd3n, idd4r, idd4w, idd5b, psrc}}},
 #include "dram_presets.def"
 #undef DRAM_PRESET
 };
@@ -205,6 +207,11 @@ int dram_params(const CfgMachine *c, DramParams *p, char *err, size_t errlen)
     OVR(cl) OVR(cwl) OVR(trcd) OVR(trp) OVR(tras) OVR(trc) OVR(tccd_s) OVR(tccd_l) OVR(trrd_s) OVR(trrd_l)
     OVR(tfaw) OVR(twr) OVR(twtr_s) OVR(twtr_l) OVR(trtp) OVR(trefi) OVR(trfc) OVR(trtrs) OVR(trtw)
 #undef OVR
+#define OVRF(field) \
+    if (c->dram_##field > 0) \
+        p->power.field = c->dram_##field;
+    OVRF(vdd) OVRF(idd0) OVRF(idd2n) OVRF(idd3n) OVRF(idd4r) OVRF(idd4w) OVRF(idd5b)
+#undef OVRF
     if (c->dram_mapping > 0) {
         const char *m = cfg_enum_name("dram", "mapping", c->dram_mapping);
         if (!m) {

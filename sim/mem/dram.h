@@ -31,6 +31,13 @@ typedef enum DramField { DRAM_F_CH, DRAM_F_RA, DRAM_F_BG, DRAM_F_BA, DRAM_F_RO, 
 
 enum { DRAM_PAGE_OPEN = 0, DRAM_PAGE_CLOSED = 1 };
 
+/* The devices' supply and currents (dram_presets.def's power columns, docs/energy.md): V, and mA of
+ * one device; 0: not given. Read only by the energy model (sim/energy/dramenergy.h). */
+typedef struct DramPower {
+    double vdd, idd0, idd2n, idd3n, idd4r, idd4w, idd5b;
+    const char *source;             /* the data sheet, or why there is none */
+} DramPower;
+
 typedef struct DramParams {
     const char *name;               /* the preset's name ("ddr4_2400") */
     int clock_mhz;                  /* CK; tCK = 1000 / clock_mhz ns */
@@ -48,6 +55,7 @@ typedef struct DramParams {
     int burst_bytes;                /* bus_bits / 8 * bl: the bytes of one request */
     int field_shift[DRAM_NFIELDS], field_bits[DRAM_NFIELDS];
     int offset_bits, addr_bits;     /* bits below the fields; bits of the whole capacity */
+    DramPower power;                /* the energy model's figures (no timing decision reads them) */
 } DramParams;
 
 /* The preset's values with the controller defaults of sim/config.def; checked. 0 or -1. */
@@ -86,7 +94,8 @@ DramAddr dram_decode(const DramParams *p, uint64_t addr);
     X(occupancy_max,  "entries",  "most read + write queue entries at once")                                     \
     X(backpressure,   "cycles",   "sum over requests of cycles waited for a queue slot")                         \
     X(backpressured,  "requests", "requests that found their queue full")                                       \
-    X(cycles,         "cycles",   "cycles simulated (the time of the last dram_run)")
+    X(cycles,         "cycles",   "cycles simulated (the time of the last dram_run)")                          \
+    X(active_cycles,  "cycles",   "rank-cycles with a bank open (active standby, IDD3N: the energy model's background)")
 
 /* Latency histogram: exact below DRAM_HIST_EXACT cycles, then 32 buckets per power of two
  * (a bucket's values differ by less than 1/32). */

@@ -37,6 +37,10 @@ typedef struct Rank {
     int faw_n, faw_i;
     uint64_t ref_due;
     int ref_pending;
+    /* Its banks open, and since when (counted into active_cycles up to each dram_run's end); an
+     * auto-precharge closes its bank at closed_at, maybe after the command that caused it. */
+    int nopen;
+    uint64_t open_since, closed_at;
 } Rank;
 
 typedef struct Queue {
@@ -275,15 +279,28 @@ static void issue_act(const Dram *d, Chan *c, Req *r, uint64_t t)
         k->faw[k->faw_i] = t;
         k->faw_i = (k->faw_i + 1) % 4;
     }
+    if (k->nopen++ == 0)
+        k->open_since = max64(t, k->closed_at);
     c->cmd_ok = t + 1;
     c->st->activates++;
     if (r->outcome == OUT_HIT)
         r->outcome = OUT_MISS;
 }
 
+/* A bank of rank rk closes at t: the rank's active time ends with its last open bank. */
+static void rank_close(Chan *c, Rank *rk, uint64_t t)
+{
+    if (--rk->nopen == 0) {
+        if (t > rk->open_since)
+            c->st->active_cycles += t - rk->open_since;
+        rk->closed_at = t;
+    }
+}
+
 static void issue_pre(const Dram *d, Chan *c, int k, uint64_t t)
 {
     Bank *b = &c->bank[k];
+    rank_close(c, &c->rank[k / (d->p.bankgroups * d->p.banks)], t);
     b->open_row = -1;
     c->hits[0][k] = c->hits[1][k] = 0;
     b->t_act = max64(b->t_act, t + (uint64_t)d->p.trp);
@@ -357,6 +374,7 @@ static void issue_col(Dram *d, Chan *c, int i, uint64_t t)
         b->open_row = -1;
         b->t_act = max64(b->t_act, b->t_pre + (uint64_t)p->trp);
         c->st->precharges++;
+        rank_close(c, k, b->t_pre);
     }
 }
 
@@ -744,6 +762,13 @@ void dram_run(Dram *d, uint64_t until, DramDone done, void *ctx)
         c->st->occupancy_sum += (uint64_t)(c->q[0].n + c->q[1].n) * (until - c->occ_t);
         c->occ_t = until;
         c->st->cycles = until;
+        for (int k = 0; k < d->p.ranks; k++) { /* the open ranks' time so far */
+            Rank *rk = &c->rank[k];
+            if (rk->nopen && until > rk->open_since) {
+                c->st->active_cycles += until - rk->open_since;
+                rk->open_since = until;
+            }
+        }
     }
     d->now = until;
     while (d->nheap && d->heap[0].cycle < until) {

@@ -14,6 +14,7 @@
  * PNG's IEND chunk. pngcairo does not report a failed write (a full disk, a file-size limit).
  */
 #include "../../host/outfile.h"
+#include "../energy/energy.h"
 #include "sweep_int.h"
 
 #include <errno.h>
@@ -35,7 +36,7 @@ typedef struct Plotter {
     const SweepPlan *pl;
     const SweepRow *rows;
     SweepPlotCols c;
-    Series stall, ops;
+    Series stall, ops, energy;
     const char *dir; /* DIR/plots */
     char *subtitle;  /* scene, mode and fixed keys, gnuplot-escaped, lines joined by \n */
     int made;
@@ -353,16 +354,19 @@ static const Series stall_series = {-1, TM_CAUSE_COUNT, tm_cause_keys, "stall cy
                                     "share of all cycles", "stalls", 0};
 static const Series ops_series = {-1, ISA_C_COUNT, isa_category_keys, "operation mix",
                                   "share of executed instructions", "ops", 1};
+static const Series energy_series = {-1, EN_L_COUNT, energy_level_keys, "energy per frame by level (docs/energy.md)",
+                                     "J per frame", "energy", 0};
 
 /* The stages the utilization plots draw, in the order of their columns and panels. */
 static const int plot_stages[3] = {ISA_STAGE_TRAVERSAL, ISA_STAGE_INTERSECTION, ISA_STAGE_SHADING};
 
-/* The columns named prefix + keys[i], found by name; they must follow each other. */
-static int group_cols(const char *prefix, const char *const *keys, int n, int *first, char *err, size_t errlen)
+/* The columns named prefix + keys[i] + suffix, found by name; they must follow each other. */
+static int group_cols_sfx(const char *prefix, const char *const *keys, const char *suffix, int n, int *first, char *err,
+                          size_t errlen)
 {
     for (int i = 0; i < n; i++) {
         char name[128];
-        snprintf(name, sizeof name, "%s%s", prefix, keys[i]);
+        snprintf(name, sizeof name, "%s%s%s", prefix, keys[i], suffix);
         int m = sweep_col(name, err, errlen);
         if (m < 0)
             return -1;
@@ -375,6 +379,11 @@ static int group_cols(const char *prefix, const char *const *keys, int n, int *f
         }
     }
     return 0;
+}
+
+static int group_cols(const char *prefix, const char *const *keys, int n, int *first, char *err, size_t errlen)
+{
+    return group_cols_sfx(prefix, keys, "", n, first, err, errlen);
 }
 
 int sweep_plot_cols(SweepPlotCols *cols, char *err, size_t errlen)
@@ -390,7 +399,11 @@ int sweep_plot_cols(SweepPlotCols *cols, char *err, size_t errlen)
         (cols->fps_lo = sweep_col("fps_lo", err, errlen)) < 0 ||
         (cols->fps_hi = sweep_col("fps_hi", err, errlen)) < 0 ||
         (cols->kd = sweep_col("kd_nodes_per_ray", err, errlen)) < 0 ||
-        (cols->kd_camera = sweep_col("kd_camera_nodes_per_ray", err, errlen)) < 0)
+        (cols->kd_camera = sweep_col("kd_camera_nodes_per_ray", err, errlen)) < 0 ||
+        (cols->power = sweep_col("power_w", err, errlen)) < 0 ||
+        (cols->area = sweep_col("area_chip_mm2", err, errlen)) < 0)
+        return -1;
+    if (group_cols_sfx("energy_", energy_level_keys, "_j", EN_L_COUNT, &cols->energy, err, errlen))
         return -1;
     if (group_cols("utilization_", stages, 3, &cols->util, err, errlen) ||
         group_cols("stall_share_", tm_cause_keys, TM_CAUSE_COUNT, &cols->stall, err, errlen) ||
@@ -670,6 +683,59 @@ static void plot_stacked(Plotter *p, const char *xkey, const Series *se)
     groups_free(g, ng);
 }
 
+/* fps against x (power_w or area_chip_mm2) over every point with both, each point labelled with
+ * its swept values, and the Pareto front: the points no other point beats on both (more fps for
+ * no more x), joined in order of x. Drawn once a sweep, when two points or more have both. */
+static void plot_pareto(Plotter *p, int xcol, const char *xname, const char *base)
+{
+    const SweepPlan *pl = p->pl;
+    const int fps = p->c.fps;
+    int *idx = malloc((size_t)pl->npoints * sizeof *idx), n = 0;
+    for (int r = 0; idx && r < pl->npoints; r++)
+        if (row_usable(p, r, xcol, 1) && row_usable(p, r, fps, 1) && p->rows[r].has[xcol] && p->rows[r].has[fps])
+            idx[n++] = r;
+    if (n < 2) {
+        free(idx);
+        return;
+    }
+    UtilBuf gp = {0}, dat = {0};
+    util_buf_printf(&dat, "# every point: %s fps label\n", xname);
+    for (int i = 0; i < n; i++) {
+        const SweepRow *row = &p->rows[idx[i]];
+        util_buf_printf(&dat, "%.10g %.10g \"", row->m[xcol], row->m[fps]);
+        for (int k = 0; k < pl->nkeys; k++)
+            util_buf_printf(&dat, "%s%s", k ? " " : "", sweep_plan_value(pl, idx[i], pl->keys[k]));
+        util_buf_puts(&dat, "\"\n");
+    }
+    util_buf_printf(&dat, "\n\n# the Pareto front: %s fps, by %s\n", xname, xname);
+    for (double last = -1.0;;) { /* the next front point: the smallest x above last, most fps at it */
+        int best = -1;
+        for (int i = 0; i < n; i++) {
+            const SweepRow *a = &p->rows[idx[i]];
+            int beaten = 0;
+            for (int j = 0; j < n && !beaten; j++) {
+                const SweepRow *b = &p->rows[idx[j]];
+                beaten = b->m[xcol] <= a->m[xcol] && b->m[fps] >= a->m[fps] &&
+                         (b->m[xcol] < a->m[xcol] || b->m[fps] > a->m[fps]);
+            }
+            if (!beaten && a->m[xcol] > last && (best < 0 || a->m[xcol] < p->rows[idx[best]].m[xcol]))
+                best = i;
+        }
+        if (best < 0)
+            break;
+        last = p->rows[idx[best]].m[xcol];
+        util_buf_printf(&dat, "%.10g %.10g\n", last, p->rows[idx[best]].m[fps]);
+    }
+    gp_head(p, &gp, base, 900, 600, "fps", xname);
+    util_buf_printf(&gp, "set xlabel \"%s\"\nset ylabel \"frames/s\"\nset key top left\n", xname);
+    util_buf_printf(&gp, "plot \"%s.dat\" index 0 using 1:2 with points pt 7 ps 1.3 title \"points\", \\\n"
+                         "     \"%s.dat\" index 0 using 1:2:3 with labels offset 0.8,0.8 left notitle, \\\n"
+                         "     \"%s.dat\" index 1 using 1:2 with linespoints lw 2 title \"Pareto front\"\n",
+                    base, base, base);
+    plot_finish(p, base, &gp, &dat, 0);
+    free(idx);
+}
+
 /* Bar charts against the point (explicit points, or no numeric key swept). kind: 0 fps,
  * 1 utilization, 2 stalls, 3 ops. */
 static void plot_bars(Plotter *p, int kind)
@@ -826,6 +892,8 @@ int sweep_plots_make(const SweepPlan *pl, const SweepRow *rows, const char *dir,
     p.stall.m0 = p.c.stall;
     p.ops = ops_series;
     p.ops.m0 = p.c.ops;
+    p.energy = energy_series;
+    p.energy.m0 = p.c.energy;
     char *pdir = xasprintf("%s/plots", dir);
     p.dir = pdir;
     if (util_mkdir_p(pdir, err, sizeof err)) {
@@ -849,7 +917,10 @@ int sweep_plots_make(const SweepPlan *pl, const SweepRow *rows, const char *dir,
         plot_stacked(&p, pl->keys[k], &p.stall);
         plot_stacked(&p, pl->keys[k], &p.ops);
         plot_chip(&p, pl->keys[k]); /* only when some point ran a chip */
+        plot_stacked(&p, pl->keys[k], &p.energy); /* only when some point was timed */
     }
+    plot_pareto(&p, p.c.area, "area_chip_mm2", "pareto_fps_area");   /* timed points only */
+    plot_pareto(&p, p.c.power, "power_w", "pareto_fps_power");
     if (!lines)
         for (int kind = 0; kind < 5; kind++)
             plot_bars(&p, kind); /* (kd_nodes_point: only when some point ran on a kd-tree) */

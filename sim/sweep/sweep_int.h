@@ -287,6 +287,8 @@ typedef struct SweepPlotCols {
     int kd, kd_camera; /* kd_nodes_per_ray, kd_camera_nodes_per_ray */
     int stall, ops;    /* stall_share_<first cause>, ops_share_<first category> */
     int chip, chip_n;  /* load_imbalance, then memory_latency, l2_hit_rate, dram_gbs, dram_bandwidth_share */
+    int energy;        /* energy_<level>_j, a column per level of sim/energy/energy.h, in order */
+    int power, area;   /* power_w, area_chip_mm2 (the Pareto plots' x axes) */
 } SweepPlotCols;
 /* 0, or -1 with the column that is missing or out of its group's order in err. */
 int sweep_plot_cols(SweepPlotCols *cols, char *err, size_t errlen);

@@ -188,8 +188,18 @@ Test(sweep_columns, names_in_the_documented_order)
     cr_expect_str_eq(name_of(chip + 2), "memory_latency");
     cr_expect_str_eq(name_of(chip + 3), "l2_hit_rate");
     cr_expect_str_eq(name_of(chip + 4), "dram_gbs");
-    cr_expect_str_eq(name_of(stats_csv_count() - 1), "dram_bandwidth_share");
-    cr_expect_eq(stats_csv_count(), chip + 6);
+    cr_expect_str_eq(name_of(chip + 5), "dram_bandwidth_share");
+    const int energy = chip + 6; /* energy, power and area (docs/energy.md) */
+    cr_expect_str_eq(name_of(energy), "energy_j");
+    cr_expect_str_eq(name_of(energy + 1), "energy_datapath_j");
+    cr_expect_str_eq(name_of(energy + 7), "energy_dram_j");
+    cr_expect_str_eq(name_of(energy + 8), "power_w");
+    cr_expect_str_eq(name_of(energy + 9), "mrays_per_j");
+    cr_expect_str_eq(name_of(energy + 10), "fps_per_w");
+    cr_expect_str_eq(name_of(energy + 11), "area_simd_mm2");
+    cr_expect_str_eq(name_of(energy + 20), "area_chip_mm2");
+    cr_expect_str_eq(name_of(stats_csv_count() - 1), "fps_per_mm2");
+    cr_expect_eq(stats_csv_count(), energy + 22);
 }
 
 /* The plots find their columns by name, once; each group's columns follow its first. */

@@ -34,4 +34,24 @@ for f in "$T"/sw/plots/stalls_*.gp "$T"/sw/plots/ops_*.gp; do
 done
 end
 
+begin "energy by level is stacked against a swept key; the Pareto fronts are the points no other beats"
+[ -s "$T/sw/plots/energy_core.simd_width.png" ] || no "no energy plot"
+for f in pareto_fps_area pareto_fps_power; do
+    d="$T/sw/plots/$f.dat"
+    [ -s "$d" ] && [ -s "$T/sw/plots/$f.png" ] || { no "no $f plot"; continue; }
+    # block 0: every point (x fps label); block 1: the front (x fps). The front rises in x and fps;
+    # each point has a front point at no more x with no less fps; each front point is a point.
+    awk 'BEGIN { b = 0 } /^$/ { if (seen) b = 1; next } /^#/ { next }
+         { seen = 1; if (b == 0) { n++; x[n] = $1; y[n] = $2 } else { m++; fx[m] = $1; fy[m] = $2 } }
+         END {
+             if (m < 1 || n < 2) { print "empty: " n " points, " m " on the front"; exit 1 }
+             for (i = 2; i <= m; i++) if (!(fx[i] > fx[i-1] && fy[i] > fy[i-1])) { print "front not rising at " i; exit 1 }
+             for (i = 1; i <= n; i++) { ok = 0; for (j = 1; j <= m; j++) if (fx[j] <= x[i] && fy[j] >= y[i]) ok = 1
+                                       if (!ok) { print "point " x[i] " " y[i] " beats the front"; exit 1 } }
+             for (j = 1; j <= m; j++) { ok = 0; for (i = 1; i <= n; i++) if (x[i] == fx[j] && y[i] == fy[j]) ok = 1
+                                       if (!ok) { print "front point " fx[j] " is no point"; exit 1 } }
+         }' "$d" > "$T/why" || no "$f: $(cat "$T/why")"
+done
+end
+
 cli_summary "cli plots"
