@@ -92,7 +92,7 @@ endif
 # and tests/unit (everything else, linked --as-needed so it starts fast). unit runs last.
 TEST_SRC := $(wildcard tests/unit/*.c) tests/support/numerics.c tests/support/shared.c tests/support/files.c \
             tests/support/isa_expect.c tests/support/core_prog.c tests/support/scene_fixture.c tests/support/fixed_level.c \
-            tests/support/asm_fixture.c tests/support/bvh_ref.c tests/support/packed.c
+            tests/support/asm_fixture.c tests/support/bvh_ref.c tests/support/packed.c tests/support/report_run.c
 IO_TEST_SRC := $(wildcard tests/io/*.c) tests/support/xcheck.c tests/support/shared.c tests/support/files.c
 LDAS    := -Wl,--as-needed
 

@@ -24,6 +24,7 @@
 #include "../../sim/render.h"
 #include "../../sim/run/run.h"
 #include "../support/files.h"
+#include "../support/report_run.h"
 
 /* Equal to rounding: the same sum taken in another order. */
 #define EXPECT_SAME(a, b, what) \
@@ -46,26 +47,7 @@ static double num(const cJSON *root, const char *path)
 }
 
 /* render_run into a fresh folder; report.json parsed. */
-static cJSON *run_report(RenderOptions *o)
-{
-    char dir[] = "/tmp/sfsim-energy-XXXXXX";
-    cr_assert_not_null(mkdtemp(dir));
-    o->out_dir = dir;
-    char err[65536], path[256];
-    cr_assert_eq(render_run(o, err, sizeof err), 0, "%s", err);
-    snprintf(path, sizeof path, "%s/report.json", dir);
-    char *json = tu_slurp(path);
-    static const char *const files[] = {"report.json", "report.txt", "frame.exr", "frame.png", "cost.png", "stats.txt"};
-    for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
-        snprintf(path, sizeof path, "%s/%s", dir, files[i]);
-        unlink(path);
-    }
-    rmdir(dir);
-    cJSON *j = cJSON_Parse(json);
-    free(json);
-    cr_assert(cJSON_IsObject(j), "report.json does not parse");
-    return j;
-}
+static cJSON *run_report(RenderOptions *o) { return tu_run_report(o, "energy", NULL); }
 
 /* ==== energy_run =================================================================================== */
 

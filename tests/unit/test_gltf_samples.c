@@ -22,38 +22,20 @@
 #include "../../sim/render.h"
 #include "../support/shared.h"
 #include "../support/files.h"
+#include "../support/report_run.h"
 
 /* A golden-model run of `scene` at 8 x 8 into a fresh folder: report.json parsed, *txt receives
  * report.txt. */
 static cJSON *run_reference(const char *scene, char **txt)
 {
-    char dir[] = "/tmp/sfsim-gltf-XXXXXX";
-    cr_assert_not_null(mkdtemp(dir));
     RenderOptions o;
     render_default_options(&o);
     o.scene_path = scene;
-    o.out_dir = dir;
     o.mode = RUN_REFERENCE;
     o.width = o.height = 8;
     o.spp = 1;
     o.threads = 1;
-    char err[4096];
-    cr_assert_eq(render_run(&o, err, sizeof err), 0, "%s", err);
-    char path[256];
-    snprintf(path, sizeof path, "%s/report.json", dir);
-    char *json = tu_slurp(path);
-    snprintf(path, sizeof path, "%s/report.txt", dir);
-    *txt = tu_slurp(path);
-    static const char *const files[] = {"report.json", "report.txt", "frame.exr", "frame.png"};
-    for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
-        snprintf(path, sizeof path, "%s/%s", dir, files[i]);
-        unlink(path);
-    }
-    rmdir(dir);
-    cJSON *j = cJSON_Parse(json);
-    free(json);
-    cr_assert(cJSON_IsObject(j), "report.json does not parse");
-    return j;
+    return tu_run_report(&o, "gltf", txt);
 }
 
 /* stderr captured by Criterion, as one string. */

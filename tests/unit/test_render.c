@@ -21,32 +21,10 @@
 #include "../../sim/run/run.h"
 #include "../../sim/trace.h"
 #include "../support/files.h"
+#include "../support/report_run.h"
 
-/* render_run(o) into a fresh folder (o->out_dir is set here); returns report.json parsed, *txt
- * receives report.txt. */
-static cJSON *run_opts(RenderOptions *o, char **txt)
-{
-    char dir[] = "/tmp/sfsim-report-XXXXXX";
-    cr_assert_not_null(mkdtemp(dir));
-    o->out_dir = dir;
-    char err[65536];
-    cr_assert_eq(render_run(o, err, sizeof err), 0, "%s", err);
-    char path[256];
-    snprintf(path, sizeof path, "%s/report.json", dir);
-    char *json = tu_slurp(path);
-    snprintf(path, sizeof path, "%s/report.txt", dir);
-    *txt = tu_slurp(path);
-    static const char *const files[] = {"report.json", "report.txt", "frame.exr", "frame.png", "cost.png"};
-    for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
-        snprintf(path, sizeof path, "%s/%s", dir, files[i]);
-        unlink(path);
-    }
-    rmdir(dir);
-    cJSON *j = cJSON_Parse(json);
-    free(json);
-    cr_assert(cJSON_IsObject(j), "report.json does not parse");
-    return j;
-}
+/* render_run(o) into a fresh folder; returns report.json parsed, *txt receives report.txt. */
+static cJSON *run_opts(RenderOptions *o, char **txt) { return tu_run_report(o, "report", txt); }
 
 /* A functional run of the Cornell box, 128 x 64 pixels in 8 tiles of 32 x 32, into a fresh
  * folder; returns report.json parsed, *txt receives report.txt. */

@@ -15,6 +15,7 @@
 #include "../../sim/render.h"
 #include "../../sim/stats.h"
 #include "../support/files.h"
+#include "../support/report_run.h"
 
 /* docs/report.md's statistics tables are what tools/gen_reportdoc.c makes of the table today. */
 Test(stats, docs_report_md_is_current)
@@ -154,21 +155,7 @@ Test(stats, csv_reads_a_fixture_report)
 }
 
 /* render_run(o) into a fresh folder; report.json parsed. */
-static cJSON *run_report(RenderOptions *o)
-{
-    char dir[] = "/tmp/sfsim-stats-XXXXXX";
-    cr_assert_not_null(mkdtemp(dir));
-    o->out_dir = dir;
-    char err[65536], path[256];
-    cr_assert_eq(render_run(o, err, sizeof err), 0, "%s", err);
-    snprintf(path, sizeof path, "%s/report.json", dir);
-    char *json = tu_slurp(path);
-    tu_remove_tree(dir);
-    cJSON *j = cJSON_Parse(json);
-    free(json);
-    cr_assert(cJSON_IsObject(j), "report.json does not parse");
-    return j;
-}
+static cJSON *run_report(RenderOptions *o) { return tu_run_report(o, "stats", NULL); }
 
 static double at(const cJSON *j, const char *a, const char *b)
 {
