@@ -49,6 +49,9 @@ struct L2 {
     L2Params p;
     int sets, shift;
     L2Bank *bank;
+    uint64_t *live;             /* a bit per bank with requests queued (n > 0), so that a step
+                                   looks at those banks only, in bank order (host speed only) */
+    int nlive_words;
     MemLevel below;
     uint64_t stamp;
     MemAnswer answer;           /* during l2_run */
@@ -104,7 +107,9 @@ L2 *l2_new(const L2Params *p, MemLevel below, char *err, size_t errlen)
     while ((1 << l->shift) < p->line_bytes)
         l->shift++;
     l->bank = calloc((size_t)p->banks, sizeof *l->bank);
-    int bad = !l->bank;
+    l->nlive_words = (p->banks + 63) / 64;
+    l->live = calloc((size_t)l->nlive_words, sizeof *l->live);
+    int bad = !l->bank || !l->live;
     for (int i = 0; !bad && i < p->banks; i++)
         bad = bank_alloc(&l->bank[i], (size_t)l->sets * (size_t)p->ways, p->mshrs);
     if (bad) {
@@ -130,6 +135,7 @@ void l2_free(L2 *l)
         free(b->pending);
         free(b->mshr);
     }
+    free(l->live);
     free(l->bank);
     free(l);
 }
@@ -141,6 +147,7 @@ void l2_reset(L2 *l)
     for (int i = 0; i < l->p.banks; i++) {
         L2Bank *b = &l->bank[i];
         b->head = b->n = 0;
+        l->live[i >> 6] &= ~((uint64_t)1 << (i & 63));
         b->pcycle = 0;
         b->pused = 0;
         b->not_before = 0;
@@ -164,7 +171,9 @@ void l2_push(L2 *l, uint64_t addr, int write, uint64_t cycle, uint64_t id)
 {
     l->next_ok = 0;
     const uint64_t line = addr >> l->shift;
-    L2Bank *b = &l->bank[line % (uint64_t)l->p.banks];
+    const int bi = (int)(line % (uint64_t)l->p.banks);
+    L2Bank *b = &l->bank[bi];
+    l->live[bi >> 6] |= (uint64_t)1 << (bi & 63);
     if (b->n == b->capq) { /* grow the ring, keeping its order */
         uint32_t cap = b->capq ? 2 * b->capq : 16;
         L2Req *q = malloc(sizeof *q * cap);
@@ -194,16 +203,23 @@ static uint64_t head_start(const L2 *l, const L2Bank *b)
     return s;
 }
 
+/* The earliest of t and the cycles the banks' heads can start. */
+static uint64_t banks_next(const L2 *l, uint64_t t)
+{
+    for (int w = 0; w < l->nlive_words; w++)
+        for (uint64_t m = l->live[w]; m; m &= m - 1) {
+            const uint64_t s = head_start(l, &l->bank[64 * w + __builtin_ctzll(m)]);
+            if (s < t)
+                t = s;
+        }
+    return t;
+}
+
 uint64_t l2_next(const L2 *l)
 {
     if (l->next_ok)
         return l->next_at;
-    uint64_t t = l->below.next(l->below.self);
-    for (int i = 0; i < l->p.banks; i++) {
-        const uint64_t s = head_start(l, &l->bank[i]);
-        if (s < t)
-            t = s;
-    }
+    const uint64_t t = banks_next(l, l->below.next(l->below.self));
     L2 *m = (L2 *)l; /* (the kept answer: not the level's state) */
     m->next_at = t;
     m->next_ok = !l->running;
@@ -372,29 +388,36 @@ static void fill(void *ctx, uint64_t id, uint64_t cycle)
 }
 
 /* Every bank's requests that start at cycle t. */
+static void start_bank(L2 *l, int i, uint64_t t)
+{
+    L2Bank *b = &l->bank[i];
+    uint64_t s;
+    while ((s = head_start(l, b)) == t) {
+        const L2Req r = b->q[b->head];
+        if (!take(l, b, i, &r, s)) {
+            b->stopped = 1;
+            b->stopped_at = s;
+            break;
+        }
+        l->st.port_wait += s - (r.cycle > b->not_before ? r.cycle : b->not_before);
+        if (s == b->pcycle) {
+            b->pused++;
+        } else {
+            b->pcycle = s;
+            b->pused = 1;
+        }
+        b->head = (b->head + 1) % b->capq;
+        if (--b->n == 0)
+            l->live[i >> 6] &= ~((uint64_t)1 << (i & 63));
+    }
+}
+
+/* The banks whose heads start at t, in bank order (only those with requests queued). */
 static void start_at(L2 *l, uint64_t t)
 {
-    for (int i = 0; i < l->p.banks; i++) {
-        L2Bank *b = &l->bank[i];
-        uint64_t s;
-        while ((s = head_start(l, b)) == t) {
-            const L2Req r = b->q[b->head];
-            if (!take(l, b, i, &r, s)) {
-                b->stopped = 1;
-                b->stopped_at = s;
-                break;
-            }
-            l->st.port_wait += s - (r.cycle > b->not_before ? r.cycle : b->not_before);
-            if (s == b->pcycle) {
-                b->pused++;
-            } else {
-                b->pcycle = s;
-                b->pused = 1;
-            }
-            b->head = (b->head + 1) % b->capq;
-            b->n--;
-        }
-    }
+    for (int w = 0; w < l->nlive_words; w++)
+        for (uint64_t m = l->live[w]; m; m &= m - 1) /* (a copy: a bit start_bank clears stays in it) */
+            start_bank(l, 64 * w + __builtin_ctzll(m), t);
 }
 
 void l2_run(L2 *l, uint64_t until, MemAnswer ans, void *ctx)
@@ -406,12 +429,7 @@ void l2_run(L2 *l, uint64_t until, MemAnswer ans, void *ctx)
     uint64_t t;
     for (;;) {
         const uint64_t tb = l->below.next(l->below.self);
-        t = tb;
-        for (int i = 0; i < l->p.banks; i++) {
-            const uint64_t s = head_start(l, &l->bank[i]);
-            if (s < t)
-                t = s;
-        }
+        t = banks_next(l, tb);
         if (t >= until)
             break;
         if (tb == t) /* the level below's events of cycle t first: fills come before starts */
