@@ -215,12 +215,6 @@ int timing_share_memo(Timing *t, Timing *owner, uint32_t ninstr)
     return 0;
 }
 
-void timing_fold_shared(Timing *t)
-{
-    if (t->memo_shared)
-        memo_fold_all(t);
-}
-
 void timing_set_memo(Timing *t, int on)
 {
     t->memo_user_off = !on;

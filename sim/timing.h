@@ -188,12 +188,13 @@ static inline void timing_attach(Timing *t, Core *c)
 /* A chip's cores run one program on one machine: t uses owner's descriptions and stored blocks
  * from now on (docs/chip.md, "Host speed"), so that a block one core stored another replays, and
  * the cores' memos are one in the host's caches. Only for models run one at a time (the chip's
- * shared memory steps its cores on one host thread): after each run of t (or of owner), before
- * another model runs, timing_fold_shared(t) counts its replays into its own statistics. Both
- * after timing_reset, with the same run, neither reset after (timing_continue only); owner freed
- * last. ninstr: the program's instructions. 0, or -1 (refused, or out of memory: nothing shared). */
+ * shared memory steps its cores on one host thread). Each model's replays still count in its own
+ * statistics (a block holds one model's uncounted replays at a time, folded into it when another
+ * replays the block). Both after timing_reset, with the same run, neither reset after
+ * (timing_continue only); every model's statistics read (timing_stats) before the owner is freed,
+ * the owner freed last. ninstr: the program's instructions. 0, or -1 (refused, or out of memory:
+ * nothing shared). */
 int timing_share_memo(Timing *t, Timing *owner, uint32_t ninstr);
-void timing_fold_shared(Timing *t);
 /* Memoized blocks on (the default) or off: the same results either way (tests/unit/test_timing.c
  * compares them); off only to check that. */
 void timing_set_memo(Timing *t, int on);

@@ -171,19 +171,9 @@ static CoreExit run_slice(ChipRun *r, int k)
     return ex;
 }
 
-static int core_go_run(ChipRun *r, int k);
-
 /* Core k runs until it must wait: for memory (CS_MEM), for a tile (CS_TILE). 0, or -1 after
- * eng_fail. Its replays of stored blocks it shares with the other cores are then counted as its
- * own (timing_fold_shared), before another core runs. */
+ * eng_fail. */
 static int core_go(ChipRun *r, int k)
-{
-    const int rc = core_go_run(r, k);
-    timing_fold_shared(tm_of(r, k));
-    return rc;
-}
-
-static int core_go_run(ChipRun *r, int k)
 {
     CoreRun *cr = &r->cr[k];
     Core *c = core_of(r, k);
@@ -577,6 +567,11 @@ uint32_t chip_run_frame(Job *j)
         if (r.k == 1 && !r.chip) /* the paper's machine, run here for its trace: reported as ever */
             j->ncores = 0;
     }
+    /* Every core's replays of the blocks they share counted now, while core 0 (whose memo they
+     * share) is alive: the workers' statistics are read again as each is closed, in core order. */
+    for (int k = 0; r.chip && k < r.k; k++)
+        if (tm_of(&r, k))
+            (void)timing_stats(tm_of(&r, k));
     pool_close(&r.pool);
     chip_free(r.chip);
     for (int k = 0; k < r.k; k++)

@@ -123,27 +123,36 @@ static __attribute__((noinline)) void memo_fold(Timing *t, MemoEntry *e)
 
 /* A shared stored block e this model starts to leave replays of uncounted: noted, so that they are
  * folded into this model's statistics (memo_fold_all); a full list is folded at once. */
+static void memo_fold_touched(Timing *t)
+{
+    for (uint32_t i = 0; i < t->ntouched; i++)
+        if (t->touched[i]->lz_n && t->touched[i]->lz_owner == t)
+            memo_fold(t, t->touched[i]);
+    t->ntouched = 0;
+}
+
+/* A shared block e replayed by t: replays another model left uncounted in it folded into that
+ * one's statistics first; e noted in t's list when its count starts. */
 static __attribute__((noinline)) void memo_touched(Timing *t, MemoEntry *e)
 {
-    if (t->ntouched == TM_TOUCHED) {
-        for (uint32_t i = 0; i < t->ntouched; i++)
-            if (t->touched[i]->lz_n)
-                memo_fold(t, t->touched[i]);
-        t->ntouched = 0;
+    if (e->lz_n && e->lz_owner != t)
+        memo_fold(e->lz_owner, e);
+    if (e->lz_n == 0) {
+        if (t->ntouched == TM_TOUCHED)
+            memo_fold_touched(t);
+        t->touched[t->ntouched++] = e;
+        e->lz_owner = t;
     }
-    t->touched[t->ntouched++] = e;
 }
 
 /* Every stored block's replays into the statistics (memo_fold). A model that shares its stored
- * blocks (timing_share_memo) folds those it replayed since it last did: only the running model
- * has replays uncounted (timing_fold_shared after each of its runs). */
+ * blocks (timing_share_memo) folds the ones whose uncounted replays are its own (MemoEntry.lz_owner,
+ * noted in its list: memo_touched); another model's are folded into that one when this one replays
+ * the block, or by that one. */
 void memo_fold_all(Timing *t)
 {
     if (t->memo_shared) {
-        for (uint32_t i = 0; i < t->ntouched; i++)
-            if (t->touched[i]->lz_n)
-                memo_fold(t, t->touched[i]);
-        t->ntouched = 0;
+        memo_fold_touched(t);
         return;
     }
     for (uint32_t i = 0; i < t->desc_cap; i++)
@@ -189,14 +198,14 @@ void memo_apply(Timing *t, MemoEntry *e, int flip)
     const int stage = t->m_stage, gen = t->m_gen;
     drain(t, end); /* what the next record's drain would apply; the events left come after */
     t->now = end;
+    if (__builtin_expect(t->memo_shared, 0) && (e->lz_n == 0 || e->lz_owner != t))
+        memo_touched(t, e);
     if (__builtin_expect(e->lz_stage != stage || e->lz_gen != gen || e->lz_n == UINT32_MAX, 0)) {
         if (e->lz_n)
             memo_fold(t, e);
         e->lz_stage = (uint8_t)stage;
         e->lz_gen = (uint8_t)gen;
     }
-    if (__builtin_expect(t->memo_shared, 0) && e->lz_n == 0)
-        memo_touched(t, e);
     e->lz_n++;
     for (int i = 0; i < e->nwrite; i++) {
         t->simd.ready[e->write[i].reg] = t0 + e->write[i].rel;
@@ -473,9 +482,10 @@ __attribute__((noinline)) void memo_store(Timing *t)
     if (!d0->memo && !(d0->memo = calloc(1, sizeof *d0->memo)))
         return; /* no memory: the block is just not kept */
     MemoEntry *old = &d0->memo->e[d0->memo->next];
-    if (old->lz_n)
-        memo_fold(t, old);
+    if (old->lz_n) /* (a shared block's: into the model that replayed it) */
+        memo_fold(t->memo_shared && old->lz_owner ? old->lz_owner : t, old);
     m->lz_n = 0;
+    m->lz_owner = t;
     *old = *m;
     t->mc.stores++;
     d0->memo->next = (uint8_t)((d0->memo->next + 1) % MEMO_WAYS);

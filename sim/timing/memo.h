@@ -131,6 +131,8 @@ typedef struct MemoEntry {
      * when the statistics are read (timing_stats). A replay then only counts itself. */
     uint32_t lz_n;
     uint8_t lz_stage, lz_gen;
+    Timing *lz_owner;               /* a shared memo (timing_share_memo): the model whose replays
+                                       lz_n counts; another's replay folds them into it first */
 } MemoEntry;
 
 typedef struct MemoWays {
