@@ -117,7 +117,10 @@ static void tile_begin(ChipRun *r, int k, uint32_t tile)
     cr->ft = r->job->fp->batch ? &r->job->tiles[tile] : eng_tile_start(r->job, tile);
     cr->ft->core = (uint32_t)k;
     r->job->cores[k].tiles++;
-    timing_set_fb_base(tm_of(r, k), (uint64_t)tile * r->fb_tile);
+    /* The tile's framebuffer at its place in the frame's, so that two tiles' lines never meet in
+     * the shared levels; a core on its own bus keeps the paper's one framebuffer (whose place
+     * changes which L1 sets its lines meet), so that a tile there takes today's cycles. */
+    timing_set_fb_base(tm_of(r, k), r->chip ? (uint64_t)tile * r->fb_tile : 0);
     cr->state = CS_RUN;
     pass_begin(r, k);
 }

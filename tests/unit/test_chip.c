@@ -111,6 +111,11 @@ Test(chip, own_bus_cold_units_time_each_tile_as_one_core)
     small_frame(&one);
     small_frame(&chip);
     chip.chip_cores = 4; /* chip.memory = bus, chip.cold_units = 1: the defaults */
+    /* a direct-mapped scene cache of 256 sets, small enough that the framebuffer's lines and the
+     * scene's meet in its sets, and more sets than a tile's framebuffer has lines (192): where a
+     * tile's framebuffer lies would change which lines meet */
+    one.scene_cache_kb = chip.scene_cache_kb = 16;
+    one.scene_cache_ways = chip.scene_cache_ways = 1;
     FuncStats a, b;
     float *ra = render(&one, &a), *rb = render(&chip, &b);
     cr_assert_eq(a.chip_cores, 0, "K = 1 on the paper's bus is today's run");
