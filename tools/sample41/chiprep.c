@@ -1,7 +1,10 @@
 /* tools/sample41/chiprep.c -- issue 41's design study (docs/sampling.md, "Sampling a chip"):
  * the estimator of the chosen design replayed on measured cycles, over seeds.
  * Build (not part of make):  gcc -O2 -I. -o build/chiprep tools/sample41/chiprep.c build/libsfsim.a -lgsl -lgslcblas -lm
- * usage: chiprep UNITS.tsv TILES.txt K SPP TARGET N0 PILOT(0|1) SEEDS
+ * usage: chiprep UNITS.tsv TILES.txt K SPP TARGET N0 PILOT(0|1) SEEDS [TAIL [BC]]
+ *   BC 1: the tile-effect makespan bias-corrected by its draws (2 M - mean of the draws).
+ *   TAIL: up to 2 more units timed in each of the last TAIL tiles in frame order (a tail stratum for
+ *   the tile-effect estimate only).
  *   TARGET > 0: today's sequential rule from N0 units to +-TARGET on the total; TARGET = 0: N0 units.
  *   PILOT 1: the --no-image pilot's counts as auxiliaries.
  * UNITS.tsv: bench/speed_vs_error's dump (paper machine's per-unit cycles and aux).
@@ -58,6 +61,8 @@ int main(int argc, char **argv)
     if (argc < 9) { fprintf(stderr, "usage\n"); return 2; }
     K = atoi(argv[3]); SPP = atoi(argv[4]);
     double target = atof(argv[5]); uint32_t n0 = atoi(argv[6]); int pilot = atoi(argv[7]); int seeds = atoi(argv[8]);
+    uint32_t tail = argc > 9 ? (uint32_t)atoi(argv[9]) : 0, tail_units = 0; double tail_sum = 0;
+    int bias_correct = argc > 10 ? atoi(argv[10]) : 0;
     FILE *f = fopen(argv[2], "r");
     double pt[4096], ct[4096]; T = 0;
     while (fscanf(f, "%lf %lf", &pt[T], &ct[T]) == 2) T++;
@@ -126,12 +131,28 @@ int main(int argc, char **argv)
             static double Pt[4096], Mt[4096], Rt[4096], base[4096];
             for (uint32_t t = 0; t < T; t++) { Pt[t] = Mt[t] = Rt[t] = 0; }
             memset(meas, 0, N); for (uint32_t i = 0; i < n; i++) { meas[order[i]] = 1; Mt[tl[i]] += 1; Rt[tl[i]] += r[i]; }
+            /* the tail stratum: up to 2 more units in each of the last TAIL tiles (for the tiles'
+             * estimates and effects only; the total and the fit stay the simple random sample's) */
+            tail_units = 0;
+            for (uint32_t t = T > tail ? T - tail : 0; t < T; t++)
+                for (uint32_t q = 0, want = SPP < 2 ? SPP : 2, got = 0; q < SPP && got < want; q++) {
+                    uint32_t uu = t * SPP + (uint32_t)((q * 7u + (uint32_t)s * 3u + t) % SPP);
+                    if (meas[uu]) { got++; continue; }
+                    double pp = e.coef[0];
+                    for (uint32_t j = 0; j < KX; j++)
+                        pp += e.coef[j + 1] * x[(size_t)uu * KX + j];
+                    meas[uu] = 1; Mt[t] += 1; Rt[t] += (y[uu] - pp) / pp; got++; tail_units++;
+                }
             for (uint32_t uu = 0; uu < N; uu++) if (!meas[uu]) { double p = e.coef[0];
                 for (uint32_t j = 0; j < KX; j++)
                     p += e.coef[j + 1] * x[(size_t)uu * KX + j];
                 Pt[uu / SPP] += p; }
             double Mc;
-            { ms_from(e.coef, order, n, n, meas, tc);
+            { for (uint32_t t = 0; t < T; t++) tc[t] = 0;
+              for (uint32_t uu = 0; uu < N; uu++) { double p = e.coef[0];
+                  for (uint32_t j = 0; j < KX; j++)
+                      p += e.coef[j + 1] * x[(size_t)uu * KX + j];
+                  tc[uu / SPP] += meas[uu] ? y[uu] : p; }
               for (uint32_t t = 0; t < T; t++) { double sh = Mt[t] > 0 ? Mt[t] * sa2 / (Mt[t] * sa2 + se2 + 1e-300) : 0;
                 double ahat = Mt[t] > 0 ? sh * Rt[t] / Mt[t] : 0; base[t] = tc[t] + ahat * Pt[t];
                 Pt[t] = Pt[t] * sqrt(sa2 * (1 - sh)); }
@@ -146,14 +167,15 @@ int main(int argc, char **argv)
                 double mb = ls(tc); bs += mb / B; bs2 += mb * mb / B; }
             double vb = bs2 - bs * bs; if (vb < 0) vb = 0;
             double h2 = (n < N ? sample_t975(n - e.k - 1) : 0) * sqrt(v + vb);
-            double c2 = Mc; /* centre: tile-corrected LS */
+            double c2 = bias_correct ? 2 * Mc - bs : Mc; /* centre: tile-corrected LS (bootstrap bias-corrected with BC=1) */
             covC += c2 - h2 <= M && M <= c2 + h2; hwC += h2 / c2; errC += fabs(c2 / M - 1); sgnC += c2 / M - 1; sgnM += Mh / M - 1;
-            sa_mean += sqrt(sa2) / seeds; se_mean += sqrt(se2) / seeds;
+            tail_sum += tail_units; sa_mean += sqrt(sa2) / seeds; se_mean += sqrt(se2) / seeds;
         }
         nsum += n;
     }
     printf("N=%u tiles=%u K=%u Y=%.0f M=%.0f M/(Y/K)=%.4f seeds=%d pilot=%d target=%g n0=%u: mean units %.1f | total: cover %d, mean|err| %.3f %% | makespan: mean|err| %.3f %%, max %.3f %%, cover (total's rel. interval) %d (mean half-width %.2f %%), cover (jackknife) %d (mean half-width %.2f %%)\n",
            N, T, K, Y, M, M / (Y / K), seeds, pilot, target, n0, nsum / seeds, covT, 100 * errT / seeds, 100 * errM / seeds, 100 * maxM, covA, 100 * hwA / seeds, covB, 100 * hwB / seeds);
+    printf("  tail stratum: last %u tiles, %.1f more units (mean)\n", tail, tail_sum / seeds);
     printf("  makespan signed mean error %+.3f %%; tile-effect model: sigma_a %.2f %%, sigma_e %.2f %% (means); tile-corrected makespan mean|err| %.3f %% (signed %+.3f %%), interval (jackknife + tile-effect bootstrap) covers %d, mean half-width %.2f %%\n",
            100 * sgnM / seeds, 100 * sa_mean, 100 * se_mean, 100 * errC / seeds, 100 * sgnC / seeds, covC, 100 * hwC / seeds);
     return 0;

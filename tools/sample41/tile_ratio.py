@@ -6,7 +6,11 @@
                                   with the report's makespan, tiles[].core and cores[].finish
   tile_ratio.py ratio A B [WAVE]  per-tile ratio of A's cycles to B's (same frame): mean, spread, the
                                   totals' ratio; with WAVE, the first WAVE tiles and the rest apart
-RUN, A, B: output folders of `sfsim run --mode detailed` (report.json)."""
+  tile_ratio.py tiles UNITS.tsv SPP CHIP
+                                  chiprep's TILES.txt: per tile, its paper-machine cycles (the sum
+                                  of its units in bench/speed_vs_error's units-conference.tsv) and
+                                  its cycles in CHIP's run
+RUN, A, B, CHIP: output folders of `sfsim run --mode detailed` (report.json)."""
 import json, statistics as st, sys
 
 def load(d):
@@ -45,11 +49,22 @@ def ratio(a, b, wave=0):
         describe(f'first {wave} tiles', q[:wave])
         describe('the rest', q[wave:])
 
+def tiles(units, spp, chip):
+    u = {}
+    for line in open(units):
+        if not line.startswith('#'):
+            f = line.split()
+            u[int(f[0])] = float(f[1])
+    for t, tile in enumerate(load(chip)['tiles']):
+        print('%d %d' % (sum(u[t * spp + q] for q in range(spp)), tile['cycles']))
+
 if __name__ == '__main__':
     if len(sys.argv) >= 3 and sys.argv[1] == 'schedule':
         for d in sys.argv[2:]:
             schedule(d)
     elif len(sys.argv) in (4, 5) and sys.argv[1] == 'ratio':
         ratio(sys.argv[2], sys.argv[3], int(sys.argv[4]) if len(sys.argv) == 5 else 0)
+    elif len(sys.argv) == 5 and sys.argv[1] == 'tiles':
+        tiles(sys.argv[2], int(sys.argv[3]), sys.argv[4])
     else:
         sys.exit(__doc__)
