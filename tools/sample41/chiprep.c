@@ -2,6 +2,8 @@
  * the estimator of the chosen design replayed on measured cycles, over seeds.
  * Build (not part of make):  gcc -O2 -I. -o build/chiprep tools/sample41/chiprep.c build/libsfsim.a -lgsl -lgslcblas -lm
  * usage: chiprep UNITS.tsv TILES.txt K SPP TARGET N0 PILOT(0|1) SEEDS [TAIL [BC]]
+ *   RHO: the draws' tile errors correlated in frame order, AR(1) with lag-1 correlation RHO
+ *   (usage ... SEEDS TAIL BC RHO; default 0: independent).
  *   BC 1: the tile-effect makespan bias-corrected by its draws (2 M - mean of the draws).
  *   TAIL: up to 2 more units timed in each of the last TAIL tiles in frame order (a tail stratum for
  *   the tile-effect estimate only).
@@ -63,6 +65,7 @@ int main(int argc, char **argv)
     double target = atof(argv[5]); uint32_t n0 = atoi(argv[6]); int pilot = atoi(argv[7]); int seeds = atoi(argv[8]);
     uint32_t tail = argc > 9 ? (uint32_t)atoi(argv[9]) : 0, tail_units = 0; double tail_sum = 0;
     int bias_correct = argc > 10 ? atoi(argv[10]) : 0;
+    double rho = argc > 11 ? atof(argv[11]) : 0.0;
     FILE *f = fopen(argv[2], "r");
     double pt[4096], ct[4096]; T = 0;
     while (fscanf(f, "%lf %lf", &pt[T], &ct[T]) == 2) T++;
@@ -158,12 +161,14 @@ int main(int argc, char **argv)
                 Pt[t] = Pt[t] * sqrt(sa2 * (1 - sh)); }
               Mc = ls(base); }
             /* bootstrap of the tile effects */
-            uint64_t st = 12345 + s; double bs = 0, bs2 = 0; int B = 400;
+            uint64_t st = 12345 + s; double bs = 0, bs2 = 0, ar = 0; int B = 400;
             for (int b = 0; b < B; b++) {
                 for (uint32_t t = 0; t < T; t++) {
                     st = st * 6364136223846793005ull + 1442695040888963407ull; double u1 = ((st >> 11) + 0.5) / 9007199254740992.0;
                     st = st * 6364136223846793005ull + 1442695040888963407ull; double u2 = ((st >> 11) + 0.5) / 9007199254740992.0;
-                    tc[t] = base[t] + Pt[t] * sqrt(-2 * log(u1)) * cos(6.283185307179586 * u2); }
+                    double z = sqrt(-2 * log(u1)) * cos(6.283185307179586 * u2);
+                    ar = t == 0 ? z : rho * ar + sqrt(1 - rho * rho) * z; /* AR(1) in frame order */
+                    tc[t] = base[t] + Pt[t] * ar; }
                 double mb = ls(tc); bs += mb / B; bs2 += mb * mb / B; }
             double vb = bs2 - bs * bs; if (vb < 0) vb = 0;
             double h2 = (n < N ? sample_t975(n - e.k - 1) : 0) * sqrt(v + vb);

@@ -1,7 +1,7 @@
 #!/bin/sh
 # tools/sample41/runs.sh OUT -- the detailed runs of issue 41's design study (docs/sampling.md,
 # "Sampling a chip (issue 41): the design, measured"). The conference room, 32 x 32 tiles
-# (stream.rays = 1024), one host thread each. About 15 minutes of one host core in all (2026-12-07).
+# (stream.rays = 1024), one host thread each. About 20 minutes of the 2 host cores in all (2026-12-07).
 set -e
 out=${1:?usage: runs.sh OUT}
 mkdir -p "$out"
@@ -28,7 +28,9 @@ run stress16 256 256 4 -c $c16 --set l2.size_kb=256                   # an L2 th
 run stress1 256 256 4 -c $c16 --set l2.size_kb=256 --set chip.cores=1
 run g64 512 512 1 -c $c64
 run g64k1 512 512 1 -c $c64 --set chip.cores=1
+run warm1k 1024 1024 1 -c $c16                                       # 64 tiles a core: the paper frame's tiling
 # the paper machine's per-unit cycles and the golden model's per-unit counts (units-conference.tsv)
 make build/bench/speed_vs_error
 build/bench/speed_vs_error --size 256x256x16 "$out/bench16"
 build/bench/speed_vs_error --size 512x512x4 "$out/bench512x4"
+build/bench/speed_vs_error --size 1024x1024x1 "$out/bench1k"
