@@ -351,7 +351,7 @@ $(BUILD)/fuzz/fuzz_rays: tests/fuzz/fuzz_rays.c sim/raybatch.c host/outfile.c ho
 # The timing model of one core: what fuzz_config builds from the config it fuzzes.
 TM_SRC := sim/timing.c sim/event.c $(wildcard sim/machine/*.c sim/timing/*.c) sim/mem/cache.c sim/mem/bus.c
 # ... and the chip's shared memory, whose keys the config's check asks about (sim/chip/chip.h)
-TM_SRC += sim/chip/chip.c sim/mem/dram.c sim/mem/dram_sched.c sim/mem/dram_level.c sim/mem/l2.c sim/mem/noc.c
+TM_SRC += sim/chip/chip.c sim/mem/dram.c sim/mem/dram_sched.c sim/mem/dram_level.c sim/mem/l2.c sim/mem/noc.c sim/mem/monitor.c
 
 $(BUILD)/fuzz/fuzz_config: tests/fuzz/fuzz_config.c sim/config.c sim/ini.c host/infile.c $(TM_SRC) isa/isa.c
 	@mkdir -p $(dir $@)
