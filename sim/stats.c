@@ -64,6 +64,7 @@ int stats_dim_size(StatsDim d)
     case STATS_D_COUNTER: return FUNC_KD_COUNTERS;
     case STATS_D_BOUND: return 2;
     case STATS_D_CORE: return 0;
+    case STATS_D_PASS: return 0;
     case STATS_D_PART: return EN_P_COUNT;
     case STATS_D_LEVEL: return EN_L_COUNT;
     case STATS_D_DRAMPART: return EN_D_COUNT;
@@ -89,7 +90,7 @@ const char *stats_dim_key(StatsDim d, int i)
     case STATS_D_LEVEL: return energy_level_keys[i];
     case STATS_D_DRAMPART: return energy_dram_keys[i];
     case STATS_D_AREA: return energy_area_keys[i];
-    case STATS_D_GEN: case STATS_D_TILE: case STATS_D_CORE: case STATS_D_COUNT: break;
+    case STATS_D_GEN: case STATS_D_TILE: case STATS_D_PASS: case STATS_D_CORE: case STATS_D_COUNT: break;
     }
     return "";
 }
@@ -105,6 +106,8 @@ int stats_dim_len(const StatsCtx *c, StatsDim d)
         return c->f ? (int)c->f->ntiles : 0;
     if (d == STATS_D_CORE)
         return c->f ? (int)c->f->chip_cores : 0;
+    if (d == STATS_D_PASS)
+        return c->f && c->f->pass_cycles ? (int)c->f->pass_spp : 0;
     return stats_dim_size(d);
 }
 
@@ -379,6 +382,11 @@ static double chip_sum(const StatsCtx *c, int which)
     return s;
 }
 FIG(chip_cores) { UNUSED_FIG_ARGS; return c->f->chip_cores; }
+FIG(tile_pass_cycles)
+{
+    UNUSED_FIG_ARGS; /* (PASS has no elements without the array: stats_dim_len) */
+    return (double)c->f->pass_cycles[(uint64_t)idx[0] * c->f->pass_spp + (uint64_t)idx[1]];
+}
 FIG(chip_busy) { UNUSED_FIG_ARGS; return chip_sum(c, 0); }
 FIG(chip_stall) { UNUSED_FIG_ARGS; return chip_sum(c, 1); }
 FIG(chip_idle) { UNUSED_FIG_ARGS; return chip_sum(c, 2); }
@@ -821,8 +829,8 @@ int stats_row_check(const StatsRow *r, char *err, size_t errlen)
         what = "FN rows, and only they, have a function";
     else if (r->src == STATS_SRC_TILE && (r->ndims == 0 || r->dims[0] != STATS_D_TILE))
         what = "a TILE field's first dimension is the tile";
-    else if (r->src != STATS_SRC_TILE && r->ndims && r->dims[0] == STATS_D_TILE)
-        what = "the tile dimension indexes FuncTile fields";
+    else if (r->src != STATS_SRC_TILE && r->src != STATS_SRC_FN && r->ndims && r->dims[0] == STATS_D_TILE)
+        what = "the tile dimension indexes FuncTile fields (or a figure's function)";
     else if ((r->src == STATS_SRC_CHIPCORE) != (r->ndims && r->dims[0] == STATS_D_CORE) && r->src != STATS_SRC_FN)
         what = "a CHIPCORE field's first dimension is the core, and the core dimension indexes FuncCore fields";
     else if ((r->src == STATS_SRC_CHIPCORE || r->src == STATS_SRC_CHIPMEM) && !(r->modes & STATS_M_CHIP))

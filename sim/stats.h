@@ -84,6 +84,7 @@ typedef enum StatsSrc {
     X(CATEGORY, "category", "operation category (001 Table 5, plus integer and control)") \
     X(GEN,      "gen",      "breadth-first ray generation (array, as many as the run reached)") \
     X(TILE,     "tile",     "tile, raster order (array)") \
+    X(PASS,     "pass",     "a pass of a tile, one sample per pixel (array, render.spp)") \
     X(OPCODE,   "opcode",   "instruction, by mnemonic") \
     X(UNIT,     "unit",     "functional-unit class (isa.h ISA_UNITS)") \
     X(KIND,     "kind",     "ray kind: camera, indirect, shadow") \

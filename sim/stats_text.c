@@ -222,7 +222,7 @@ static int dim_sums(StatsDim d)
 {
     switch (d) {
     case STATS_D_STAGE: case STATS_D_FILTER: case STATS_D_CAUSE: case STATS_D_CATEGORY: case STATS_D_GEN:
-    case STATS_D_TILE: case STATS_D_OPCODE: case STATS_D_UNIT: case STATS_D_KIND: return 1;
+    case STATS_D_TILE: case STATS_D_PASS: case STATS_D_OPCODE: case STATS_D_UNIT: case STATS_D_KIND: return 1;
     case STATS_D_CORE: case STATS_D_PART: case STATS_D_LEVEL: case STATS_D_DRAMPART: return 1;
     case STATS_D_COUNTER: case STATS_D_BOUND: case STATS_D_AREA: case STATS_D_COUNT: break;
     }

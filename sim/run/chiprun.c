@@ -143,6 +143,8 @@ static int pass_finish(ChipRun *r, int k, CoreExit ex)
     FuncTile *ft = cr->ft;
     ft->sampled = 1;
     ft->cycles += s->cycles - cr->before.cycles;
+    if (r->job->pass_cycles)
+        r->job->pass_cycles[(uint64_t)cr->tile * r->passes + cr->pass] = s->cycles - cr->before.cycles;
     ft->busy += s->busy - cr->before.busy;
     for (int i = 0; i < TM_CAUSE_COUNT; i++)
         ft->stalls[i] += s->stalls[i] - cr->before.stalls[i];
@@ -523,7 +525,9 @@ uint32_t chip_run_frame(Job *j)
     r.cr = calloc((size_t)r.k, sizeof *r.cr);
     r.runnable = calloc((size_t)r.k, sizeof *r.runnable);
     j->cores = calloc((size_t)r.k, sizeof *j->cores);
-    if (!r.cr || !r.runnable || !j->cores) {
+    if (!j->fp->batch && j->ntiles && j->spp)
+        j->pass_cycles = calloc((size_t)j->ntiles * j->spp, sizeof *j->pass_cycles);
+    if (!r.cr || !r.runnable || !j->cores || (!j->fp->batch && j->ntiles && j->spp && !j->pass_cycles)) {
         eng_fail(j, "out of memory for the chip's cores", 0);
         free(r.cr);
         free(r.runnable);
@@ -567,8 +571,11 @@ uint32_t chip_run_frame(Job *j)
             figures(&r);
         if (!atomic_load(&j->failed) && j->fp->mem_trace)
             trace_gather(&r);
-        if (r.k == 1 && !r.chip) /* the paper's machine, run here for its trace: reported as ever */
+        if (r.k == 1 && !r.chip) { /* the paper's machine, run here for its trace: reported as ever */
             j->ncores = 0;
+            free(j->pass_cycles);
+            j->pass_cycles = NULL;
+        }
     }
     /* Every core's replays of the blocks they share counted now, while core 0 (whose memo they
      * share) is alive: the workers' statistics are read again as each is closed, in core order. */

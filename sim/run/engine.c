@@ -576,6 +576,7 @@ static void session_free(FuncSession *s)
     free(s->job.workers);
     free(s->job.cores);
     free(s->job.chip_mem);
+    free(s->job.pass_cycles);
     free(s->job.trace);
     pthread_mutex_destroy(&s->job.lock);
     if (s->built)
@@ -690,6 +691,9 @@ static int session_finish(FuncSession *s, FuncStats *st, char *err, size_t errle
     st->cores = job->cores;
     st->makespan = job->makespan;
     st->chip_mem = job->chip_mem;
+    st->pass_cycles = job->pass_cycles;
+    st->pass_spp = job->pass_cycles ? job->spp : 0;
+    job->pass_cycles = NULL;
     st->trace = job->trace;
     st->ntrace = job->ntrace;
     job->trace = NULL;
@@ -783,6 +787,9 @@ void func_stats_free(FuncStats *st)
     st->cores = NULL;
     free(st->chip_mem);
     st->chip_mem = NULL;
+    free(st->pass_cycles);
+    st->pass_cycles = NULL;
+    st->pass_spp = 0;
     free(st->trace);
     st->trace = NULL;
     st->ntrace = 0;

@@ -126,6 +126,10 @@ typedef struct FuncStats {
     uint32_t chip_cores;                            /* 0: not a chip run */
     FuncCore *cores;
     uint64_t makespan;
+    /* a chip's frame (not a ray batch): each (tile, pass) unit's cycles on its core, from its
+     * start to its end, tile * pass_spp + pass; NULL otherwise */
+    uint64_t *pass_cycles;
+    uint32_t pass_spp;
     struct ChipMemStats *chip_mem;
     FuncMemRec *trace;                              /* FuncParams.mem_trace */
     size_t ntrace;

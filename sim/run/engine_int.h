@@ -37,6 +37,7 @@ typedef struct Job {
     FuncCore *cores;
     uint32_t ncores;
     uint64_t makespan;
+    uint64_t *pass_cycles;     /* a chip's frame: tile t's pass p took pass_cycles[t * spp + p] */
     struct ChipMemStats *chip_mem;
     FuncMemRec *trace;
     size_t ntrace;

@@ -81,6 +81,16 @@ static void check_chip_accounting(const FuncStats *st, uint32_t k)
     }
     cr_expect_eq(latest, st->makespan);
     cr_expect_eq(busy + stall + idle, (uint64_t)k * st->makespan);
+    /* a frame's (tile, pass) units: each took cycles, and a tile's passes make its cycles */
+    for (uint32_t t = 0; st->pass_cycles && t < st->ntiles; t++) {
+        uint64_t sum = 0;
+        for (uint32_t p = 0; p < st->pass_spp; p++) {
+            cr_expect_gt(st->pass_cycles[(uint64_t)t * st->pass_spp + p], 0, "tile %u pass %u took no cycles", t, p);
+            sum += st->pass_cycles[(uint64_t)t * st->pass_spp + p];
+        }
+        cr_expect_eq(sum, st->tiles[t].cycles, "tile %u: its passes %llu cycles, the tile %llu", t,
+                     (unsigned long long)sum, (unsigned long long)st->tiles[t].cycles);
+    }
     cr_expect_eq(busy, st->timing.busy);
     cr_expect_eq(busy + stall, st->timing.cycles);
     cr_expect_eq(tiles, st->ntiles);
@@ -125,6 +135,7 @@ Test(chip, own_bus_cold_units_time_each_tile_as_one_core)
         cr_expect_eq(a.tiles[t].cycles, b.tiles[t].cycles, "tile %u: %llu cycles alone, %llu on the chip", t,
                      (unsigned long long)a.tiles[t].cycles, (unsigned long long)b.tiles[t].cycles);
     cr_expect_eq(a.timing.cycles, b.timing.cycles);
+    cr_assert(b.pass_cycles && b.pass_spp == 2, "a chip's frame reports each pass's cycles");
     check_chip_accounting(&b, 4);
     check_distribution(&b, 4);
     free(ra);
