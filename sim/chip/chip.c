@@ -193,6 +193,21 @@ oom:
     return NULL;
 }
 
+void chip_reset(Chip *c)
+{
+    if (c->noc)
+        noc_reset(c->noc);
+    if (c->l2)
+        l2_reset(c->l2);
+    dram_reset(c->dram);
+    dram_level_reset(c->dl);
+    c->n = 0;
+    for (int k = 0; k < c->cores; k++) {
+        c->port[k].seq = 0;
+        c->port[k].nout = 0;
+    }
+}
+
 /* ---- requests on their way in ----------------------------------------------------------------- */
 
 /* *a holds at least need elements of size bytes (its capacity *cap doubled as needed); -1 on out

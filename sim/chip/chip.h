@@ -39,6 +39,9 @@ extern const char *const chip_level_keys[CHIP_LEVELS];
  * on a bad config or out of memory. */
 Chip *chip_new(const CfgMachine *cfg, int cores, const MemWatch *watch, char *err, size_t errlen);
 void chip_free(Chip *c);
+/* Every level cold and idle, nothing in flight, as chip_new left it (the counters go on): before
+ * a sampled chip's unit (sim/run/chipunit.h), whose cores' models are reset too. */
+void chip_reset(Chip *c);
 /* Core k's timing model sends its L1's misses and write-backs here from now on. 0, or -1 on out
  * of memory. */
 int chip_attach(Chip *c, int k, Timing *t);

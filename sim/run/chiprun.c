@@ -82,6 +82,8 @@ typedef struct ChipRun {
 
 int chip_run_wanted(const FuncParams *fp)
 {
+    if (fp->chip_unit)
+        return 0;
     return fp->timed && (fp->cfg->chip_cores > 1 || chip_shared(fp->cfg) || fp->mem_trace || fp->timeline);
 }
 

@@ -71,6 +71,8 @@ static void timing_begin(Worker *w, Core *c, TimingStats *before)
         return;
     timing_attach(w->tc.tm, c);
     timing_reset(w->tc.tm);
+    if (w->cu.chip)
+        chipunit_reset(&w->cu);
     *before = *timing_stats(w->tc.tm);
 }
 
@@ -282,7 +284,24 @@ static int run_pass(Worker *w, Core *c, const FuncTile *ft, uint32_t pass, FuncU
     eng_pass_set(j, c, pass);
     TimingStats tbefore;
     timing_begin(w, c, &tbefore);
-    CoreExit ex = core_run(c, (uint64_t)j->fp->cfg->sim_max_instructions);
+    const uint64_t limit = (uint64_t)j->fp->cfg->sim_max_instructions;
+    CoreExit ex;
+    if (w->cu.chip) {
+        char err[300];
+        if (chipunit_run(&w->cu, c, limit, &ex, err, sizeof err)) {
+            eng_fail(j, err, 0);
+            return -1;
+        }
+        if (ex == CORE_EXIT_LIMIT && !core_trap_message(c)[0]) {
+            char msg[300];
+            snprintf(msg, sizeof msg, "kernel, tile at (%u, %u), pass %u: instruction limit of %llu reached (sim.max_instructions)",
+                     ft->x0, ft->y0, pass, (unsigned long long)limit);
+            eng_fail(j, msg, 1);
+            return -1;
+        }
+    } else {
+        ex = core_run(c, limit);
+    }
     if (timing_close(w, &tbefore, fu))
         return -1;
     return eng_pass_end(j, c, ft, pass, ex);
@@ -448,6 +467,11 @@ int eng_worker_begin(void *ctx, int index)
         eng_fail(j, msg, 0);
         return -1;
     }
+    if (j->fp->chip_unit && w->tc.tm && chipunit_open(&w->cu, j->fp->cfg, w->tc.tm, err, sizeof err)) {
+        snprintf(msg, sizeof msg, "chip: %s", err);
+        eng_fail(j, msg, 0);
+        return -1;
+    }
     /* The packed scene into scene memory: mapped copy-on-write from the image the caller passed
      * (FuncParams.image, the open scene's), or copied. */
     if (j->fp->image) {
@@ -483,6 +507,7 @@ static void workers_close(Job *j)
         }
         if (w->tc.tm)
             w->st.timing = *timing_stats(w->tc.tm);
+        chipunit_close(&w->cu);
         timedcore_close(&w->tc);
     }
 }

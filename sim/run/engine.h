@@ -54,6 +54,10 @@ typedef struct FuncParams {
     /* Detailed mode: record the run's timeline here (sim/timeline.h; the frame then runs on the
      * chip's run too), or NULL. */
     struct Timeline *timeline;
+    /* Timed, on a chip with shared memory (chip.memory = shared): each tile or unit runs alone on
+     * one core of the chip's network, L2 and DRAM, every level cold at its start (sim/run/
+     * chipunit.h: a sampled chip's units), instead of the chip's frame. */
+    int chip_unit;
 } FuncParams;
 
 typedef struct FuncTile {

@@ -11,6 +11,7 @@
 #include <stdatomic.h>
 
 #include "engine.h"
+#include "chipunit.h"
 #include "timedcore.h"
 
 typedef struct Job {
@@ -46,6 +47,7 @@ typedef struct Job {
 typedef struct Worker {
     Job *job;
     TimedCore tc;              /* the core; its timing model in the timed modes */
+    ChipUnit cu;               /* FuncParams.chip_unit: the chip's shared memory, tc as its core 0 */
     FuncStats st;
 } Worker;
 

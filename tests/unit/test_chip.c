@@ -298,3 +298,71 @@ Test(chip, without_an_l2_every_miss_is_drams)
     func_stats_free(&st);
     unload();
 }
+
+/* A sampled chip's units (sim/run/chipunit.h): units [0, n) of the loaded frame, each alone on one
+ * core of cfg's shared memory (chip_unit) or of its bus (not), on `threads`, in the order given. */
+static void units_on(const CfgMachine *cfg, int chip_unit, int threads, const uint32_t *order, uint32_t n, FuncUnit *out)
+{
+    static char err[65536];
+    FuncParams fp = {.cfg = cfg, .kernel_path = "kernels/pathtrace.s", .needs = scene.needs, .seed = 1,
+                     .threads = threads, .timed = 1, .chip_unit = chip_unit};
+    FuncSession *s;
+    cr_assert_eq(func_open(&packed, &fp, &s, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(func_units_total(s), n);
+    cr_assert_eq(func_units(s, order, n, out, err, sizeof err), 0, "%s", err);
+    FuncStats st;
+    cr_assert_eq(func_close(s, &st, err, sizeof err), 0, "%s", err);
+    func_stats_free(&st);
+}
+
+/* A frame of one tile and one pass on a chip: its one unit is the chip's frame, so the unit timed
+ * alone on one core of the chip's memory takes exactly the frame's cycles and stalls. */
+Test(chip, a_unit_on_the_chips_memory_is_the_one_unit_frame)
+{
+    load("scenes/cornell/scene.ini", 32, 32, 1);
+    CfgMachine chip;
+    small_frame(&chip);
+    shared_memory(&chip, 4);
+    FuncStats st;
+    float *rgb = render(&chip, &st);
+    cr_assert_eq(st.ntiles, 1);
+    const uint32_t unit = 0;
+    FuncUnit u;
+    units_on(&chip, 1, 1, &unit, 1, &u);
+    cr_expect_eq(u.cycles, st.makespan, "alone %llu cycles, the chip's frame %llu", (unsigned long long)u.cycles,
+                 (unsigned long long)st.makespan);
+    cr_expect_eq(u.busy, st.tiles[0].busy);
+    for (int c = 0; c < TM_CAUSE_COUNT; c++)
+        cr_expect_eq(u.stalls[c], st.tiles[0].stalls[c], "stall cause %d", c);
+    cr_expect_eq(u.instructions, st.tiles[0].instructions);
+    free(rgb);
+    func_stats_free(&st);
+    unload();
+}
+
+/* Every unit starts from a cold chip: its figures do not depend on the units run before it on the
+ * same host thread, nor on the threads; and they are the chip's memory's, not the bus's. */
+Test(chip, chip_units_start_cold_on_any_thread_in_any_order)
+{
+    load("scenes/cornell/scene.ini", 64, 64, 2); /* 4 tiles, 2 passes: 8 units */
+    CfgMachine chip;
+    small_frame(&chip);
+    shared_memory(&chip, 16);
+    enum { N = 8 };
+    const uint32_t fwd[N] = {0, 1, 2, 3, 4, 5, 6, 7}, back[N] = {7, 6, 5, 4, 3, 2, 1, 0};
+    FuncUnit a[N], b[N], bus[N];
+    units_on(&chip, 1, 1, fwd, N, a);
+    units_on(&chip, 1, 2, back, N, b);
+    units_on(&chip, 0, 2, fwd, N, bus);
+    int differ = 0;
+    for (uint32_t i = 0; i < N; i++) {
+        const FuncUnit *x = &a[i], *y = &b[N - 1 - i];
+        cr_assert_eq(x->unit, y->unit);
+        cr_expect_eq(x->cycles, y->cycles, "unit %u: %llu cycles after the units before it on one thread, %llu "
+                     "in the other order on two", x->unit, (unsigned long long)x->cycles, (unsigned long long)y->cycles);
+        cr_expect_eq(x->instructions, bus[i].instructions);
+        differ += x->cycles != bus[i].cycles;
+    }
+    cr_expect(differ > 0, "no unit's cycles changed with the chip's memory in place of the bus");
+    unload();
+}
