@@ -78,13 +78,15 @@ typedef struct ChipRun {
     uint64_t fb_tile;            /* bytes of a tile's framebuffer, in whole lines */
     int cold;
     uint32_t passes;             /* a tile's passes (spp); a ray batch of `sfsim trace`: 1 */
+    atomic_uint opening_left;    /* FuncParams.opening: the first wave's units still running */
 } ChipRun;
 
 int chip_run_wanted(const FuncParams *fp)
 {
     if (fp->chip_unit)
         return 0;
-    return fp->timed && (fp->cfg->chip_cores > 1 || chip_shared(fp->cfg) || fp->mem_trace || fp->timeline);
+    return fp->timed && (fp->cfg->chip_cores > 1 || chip_shared(fp->cfg) || fp->mem_trace || fp->timeline ||
+                         fp->opening);
 }
 
 static Timing *tm_of(const ChipRun *r, int k) { return r->job->workers[k].tc.tm; }
@@ -217,11 +219,13 @@ static int core_go(ChipRun *r, int k)
         }
         if (pass_finish(r, k, ex))
             return -1;
+        if (r->job->fp->opening && cr->pass == 0 && cr->tile < (uint32_t)r->k)
+            atomic_fetch_sub(&r->opening_left, 1u);
         if (++cr->pass < r->passes) {
             pass_begin(r, k);
             continue;
         }
-        if (!r->job->fp->batch)
+        if (!r->job->fp->batch && r->job->rgb) /* (an opening may make no picture) */
             eng_tile_pixels(r->job, c, cr->ft, 0);
         atomic_fetch_add(&r->tiles_done, 1u);
         cr->state = CS_TILE;
@@ -466,9 +470,12 @@ static void figures(ChipRun *r)
 {
     Job *j = r->job;
     uint64_t makespan = 0;
-    for (int k = 0; k < r->k; k++)
-        if (r->cr[k].done_at > makespan)
-            makespan = r->cr[k].done_at;
+    for (int k = 0; k < r->k; k++) {
+        /* (an opening stops cores within a tile: each is as far as its model got) */
+        const uint64_t at = j->fp->opening && r->cr[k].state != CS_DONE ? timing_now(tm_of(r, k)) : r->cr[k].done_at;
+        if (at > makespan)
+            makespan = at;
+    }
     for (int k = 0; k < r->k; k++) {
         FuncCore *fc = &j->cores[k];
         const TimingStats *s = timing_stats(tm_of(r, k));
@@ -536,6 +543,7 @@ uint32_t chip_run_frame(Job *j)
         return 0;
     }
     atomic_init(&r.tiles_done, 0u);
+    atomic_init(&r.opening_left, j->fp->opening ? (j->ntiles < (uint32_t)r.k ? j->ntiles : (uint32_t)r.k) : 0u);
     j->ncores = (uint32_t)r.k;
     const MemWatch mw = j->fp->timeline ? timeline_mem_watch(j->fp->timeline) : (MemWatch){0};
     if (chip_shared(cfg) && !(r.chip = chip_new(cfg, r.k, j->fp->timeline ? &mw : NULL, err, sizeof err))) {
@@ -556,7 +564,7 @@ uint32_t chip_run_frame(Job *j)
             }
         }
         int go = 1;
-        while (go > 0 && !atomic_load(&j->failed)) {
+        while (go > 0 && !atomic_load(&j->failed) && !(j->fp->opening && atomic_load(&r.opening_left) == 0)) {
             /* the cores woken or given a tile, in core order (the order does not change a result:
                  * it only keeps the host's work the same from run to run) */
             qsort(r.runnable, (size_t)r.nrunnable, sizeof *r.runnable, int_order);

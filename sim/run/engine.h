@@ -58,6 +58,11 @@ typedef struct FuncParams {
      * one core of the chip's network, L2 and DRAM, every level cold at its start (sim/run/
      * chipunit.h: a sampled chip's units), instead of the chip's frame. */
     int chip_unit;
+    /* Detailed, on a chip: the frame only until pass 0 of each of its first K tiles (the chip's
+     * first wave, a sampled chip's opening: docs/sampling.md) has ended. Every (tile, pass) unit
+     * that ended by then has its exact cycles in FuncStats.pass_cycles (the others 0); the chip's
+     * figures are those of that moment, and the picture holds the tiles that ended. */
+    int opening;
 } FuncParams;
 
 typedef struct FuncTile {

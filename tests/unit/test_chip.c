@@ -366,3 +366,41 @@ Test(chip, chip_units_start_cold_on_any_thread_in_any_order)
     cr_expect(differ > 0, "no unit's cycles changed with the chip's memory in place of the bus");
     unload();
 }
+
+/* A sampled chip's opening (FuncParams.opening): the chip's frame until pass 0 of its first K
+ * tiles has ended. Every unit that ended by then took exactly its cycles in the whole frame; the
+ * first wave's all did. On one host thread and on two. */
+Test(chip, the_opening_is_the_frames_first_wave_exactly)
+{
+    load("scenes/cornell/scene.ini", 128, 128, 2); /* 16 tiles, 2 passes */
+    CfgMachine chip;
+    small_frame(&chip);
+    shared_memory(&chip, 4);
+    FuncStats full;
+    float *rgb = render(&chip, &full);
+    cr_assert(full.pass_cycles && full.pass_spp == 2);
+    for (int threads = 1; threads <= 2; threads++) {
+        static char err[65536];
+        FuncParams fp = {.cfg = &chip, .kernel_path = "kernels/pathtrace.s", .needs = scene.needs, .seed = 1,
+                         .threads = threads, .timed = 1, .opening = 1};
+        FuncStats op;
+        cr_assert_eq(func_render(&packed, &fp, NULL, &op, err, sizeof err), 0, "%s", err);
+        cr_assert(op.pass_cycles && op.pass_spp == 2);
+        uint32_t ended = 0;
+        for (uint32_t u = 0; u < 16 * 2; u++) {
+            if (u % 2 == 0 && u / 2 < 4)
+                cr_expect_gt(op.pass_cycles[u], 0, "the first wave's unit %u did not end", u);
+            if (op.pass_cycles[u]) {
+                ended++;
+                cr_expect_eq(op.pass_cycles[u], full.pass_cycles[u], "unit %u: %llu cycles in the opening, %llu in the frame",
+                             u, (unsigned long long)op.pass_cycles[u], (unsigned long long)full.pass_cycles[u]);
+            }
+        }
+        cr_expect_lt(ended, 16 * 2, "the opening ran the whole frame");
+        cr_expect_lt(op.makespan, full.makespan);
+        func_stats_free(&op);
+    }
+    free(rgb);
+    func_stats_free(&full);
+    unload();
+}
