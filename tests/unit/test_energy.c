@@ -247,7 +247,7 @@ Test(energy_run, sampled_mode_has_an_interval, .timeout = 300)
 /* ==== energy_dram: `sfsim mem` on hand-made traces ================================================== */
 
 /* `sfsim mem` on the trace text (DRAMsim3's format) with extra arguments; report.json's "energy". */
-static cJSON *mem_energy(const char *trace, const char *set, cJSON **root)
+static cJSON *mem_energy2(const char *trace, const char *set, const char *set2, cJSON **root)
 {
     char dir[] = "/tmp/sfsim-energy-mem-XXXXXX", path[320], out[64];
     cr_assert_not_null(mkdtemp(dir));
@@ -257,8 +257,8 @@ static cJSON *mem_energy(const char *trace, const char *set, cJSON **root)
     fputs(trace, f);
     fclose(f);
     snprintf(out, sizeof out, "%s/out", dir);
-    char *argv[] = {"mem", "--trace", path, "-o", out, "--set", (char *)set, NULL};
-    int argc = set ? 7 : 5;
+    char *argv[] = {"mem", "--trace", path, "-o", out, "--set", (char *)set, "--set", (char *)set2, NULL};
+    int argc = set ? (set2 ? 9 : 7) : 5;
     FILE *saved = stdout;
     stdout = fopen("/dev/null", "w");
     int rc = cmd_mem(argc, argv);
@@ -274,6 +274,10 @@ static cJSON *mem_energy(const char *trace, const char *set, cJSON **root)
     cr_assert_eq(system(cmd), 0);
     cr_assert_not_null(*root);
     return cJSON_GetObjectItemCaseSensitive(*root, "energy");
+}
+static cJSON *mem_energy(const char *trace, const char *set, cJSON **root)
+{
+    return mem_energy2(trace, set, NULL, root);
 }
 
 /* DDR4-2400 (Micron MT40A1G8 -083E: VDD 1.2 V, IDD0 48, IDD2N 34, IDD3N 43, IDD4R 135, IDD4W 123,
@@ -332,14 +336,64 @@ Test(energy_dram, a_refresh)
     cJSON_Delete(root);
 }
 
-/* A preset without currents (LPDDR5) reports no energy rather than zero joules. */
-Test(energy_dram, no_currents_no_energy)
+/* LPDDR5-6400 (Micron MT62F LPDDR5 data sheet, Table 7, VDD2H column at 6400 Mb/s: VDD 1.05 V,
+ * IDD0 45, IDD2N 30, IDD3N 39, IDD4R 372, IDD5B 170 mA; one x16 device a channel), tCK 1.25 ns, so
+ * VDD x tCK = 1.3125 V ns:
+ *   ACT+PRE = 1.3125 (45 x 49 - (39 x 34 + 30 x 15)) = 1.3125 x 429      = 563.0625 pJ
+ *   RD      = 1.3125 (372 - 39) x 2 (BL16 over 2 CK, WCK 4:1 DDR)        = 874.125 pJ
+ * One read to a closed bank, closed page: ACT 0, RD at tRCD 15, data done 15 + CL 20 + 2 = 37, a span
+ * of 38 cycles on each of 4 channels = 152 rank-cycles; the auto-precharge closes the bank at tRAS 34,
+ * so 34 are active (1.3125 x 39 each) and 118 precharged (1.3125 x 30 each):
+ *   563.0625 + 874.125 + 34 x 51.1875 + 118 x 39.375 = 7823.8125 pJ over one 32-byte burst. */
+Test(energy_dram, lpddr5_a_read_to_a_closed_bank)
 {
     cJSON *root;
-    const cJSON *e = mem_energy("0x0 READ 0\n", "dram.preset=lpddr5_6400", &root);
-    cr_expect(cJSON_IsFalse(cJSON_GetObjectItemCaseSensitive(e, "known")));
-    cr_expect_null(cJSON_GetObjectItemCaseSensitive(e, "total_j"));
+    const cJSON *e = mem_energy2("0x0 READ 0\n", "dram.preset=lpddr5_6400", "dram.page_policy=closed", &root);
+    cr_expect(cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(e, "known")));
+    cr_expect_eq(num(root, "total.cycles"), 38);
+    cr_expect_eq(num(root, "total.active_cycles"), 34);
+    cr_expect_eq(num(root, "total.bytes"), 32);
+    EXPECT_SAME(num(e, "act_pre_pj"), 563.0625, "ACT+PRE");
+    EXPECT_SAME(num(e, "read_burst_pj"), 874.125, "RD");
+    EXPECT_SAME(num(e, "rank_cycles"), 152.0, "rank-cycles");
+    EXPECT_SAME(num(e, "total_j"), 7823.8125e-12, "ACT + RD + PRE + standby");
+    EXPECT_SAME(num(e, "pj_per_bit"), 7823.8125 / 256, "pJ/bit");
     cJSON_Delete(root);
+}
+
+/* GDDR6-14000 (DRAMsim3 configs/GDDR6_8Gb_x16.ini: VDD 1.35 V, IDD0 71, IDD2N 60, IDD3N 61, IDD4R
+ * 248 mA a x16 channel), tCK 1/1.75 ns, so VDD x tCK = 1.35 / 1.75 V ns:
+ *   ACT+PRE = (71 x 79 - (61 x 53 + 60 x 26)) = 816 mA CK, RD = (248 - 61) x 2 = 374 mA CK.
+ * A read to a closed bank: RD at tRCD 26, done 26 + CL 24 + 2 = 52, 53 cycles on each of 2 channels;
+ * tRAS 53 keeps channel 0's bank open all 53, channel 1 precharged all 53:
+ *   (816 + 374 + 53 x 61 + 53 x 60) x 1.35 / 1.75 = 7603 x 1.35 / 1.75 pJ. */
+Test(energy_dram, gddr6_a_read_to_a_closed_bank)
+{
+    cJSON *root;
+    const cJSON *e = mem_energy2("0x0 READ 0\n", "dram.preset=gddr6_14000", "dram.page_policy=closed", &root);
+    const double v_tck = 1.35 / 1.75;
+    cr_expect_eq(num(root, "total.cycles"), 53);
+    cr_expect_eq(num(root, "total.active_cycles"), 53);
+    EXPECT_SAME(num(e, "act_pre_pj"), 816 * v_tck, "ACT+PRE");
+    EXPECT_SAME(num(e, "read_burst_pj"), 374 * v_tck, "RD");
+    EXPECT_SAME(num(e, "total_j"), 7603 * v_tck * 1e-12, "ACT + RD + PRE + standby");
+    cJSON_Delete(root);
+}
+
+/* Currents of 0 (a preset or user without figures) give no energy rather than zero joules. */
+Test(energy_dram, no_currents_no_energy)
+{
+    CfgMachine c;
+    cfg_defaults(&c);
+    DramParams p;
+    char err[256];
+    cr_assert_eq(dram_params(&c, &p, err, sizeof err), 0, "%s", err);
+    p.power = (DramPower){0};
+    DramChanStats s = {.activates = 1, .reads = 1, .bytes = 64};
+    DramEnergy e;
+    dram_energy(&p, &s, 100, 0, &e);
+    cr_expect(!e.known);
+    cr_expect_eq(e.core, 0);
 }
 
 /* ==== energy_magnitude: against published figures ==================================================== */

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # tests/cli/cases/mem.sh -- `sfsim mem`: the four trace shapes of docs/validation.md (DRAM section)
 # at an idle and a saturating rate on DDR4-2400 and DDR5-4800 give the documented figures (each
-# beside its closed form there), both trace formats and the clock conversion, -o and --json, and
+# beside its closed form there), both trace formats and the clock conversion, every preset's DRAM
+# energy (LPDDR5's and GDDR6's per command as tests/unit/test_energy.c derives them), -o and --json, and
 # every bad input gets a message naming file and line and exit code 1, without a hang; 10^6
 # requests replay within a minute even on a loaded machine (a guard against a hang, not a benchmark).
 set -u
@@ -99,6 +100,22 @@ bad "too many fields"     '0x0 READ 1 2\n'              'bad\.trc:1: expected'
 bad "a bad sfsim header"  'sfsim-memtrace 2 clock_mhz=500\n1 R 0x0\n' 'bad\.trc:1: expected the header'
 bad "a bad sfsim line"    'sfsim-memtrace 1 clock_mhz=500\n1 R 0x0\n2 X 0x0\n' 'bad\.trc:3: bad operation .X.'
 bad "a DRAMsim3 line read as sfsim" '0x0 READ 1\n' 'bad\.trc:1: expected the header' '--format sfsim'
+
+# Every preset has IDD currents (sim/mem/dram_presets.def, sources in docs/energy.md), so each prints
+# its energy; LPDDR5's and GDDR6's per-command figures are the closed forms of tests/unit/test_energy.c
+# (LPDDR5: 1.3125 V ns x 429 and x 666 mA CK; GDDR6: 1.35 / 1.75 V ns x 816 and x 374 mA CK).
+begin "mem: every preset reports the DRAM's energy; LPDDR5's and GDDR6's per command as derived"
+for preset in ddr4_2400 ddr5_4800 lpddr5_6400 gddr6_14000 hbm2_2000; do
+    run "$SFSIM" mem --trace tests/mem/example.trc --set dram.preset=$preset
+    want_rc 0
+    grep -q 'not computed' "$T/out" && no "$preset: energy not computed"
+    grep -qE '^  total +[0-9.]+ nJ, [0-9.]+ pJ/bit' "$T/out" || no "$preset: no energy total"
+    case $preset in
+    lpddr5_6400) want_out 'VDD 1\.05 V; IDD0 45,'; want_out 'ACT\+PRE 563\.06 pJ, RD burst 874\.13 pJ' ;;
+    gddr6_14000) want_out 'VDD 1\.35 V; IDD0 71,'; want_out 'ACT\+PRE 629\.49 pJ, RD burst 288\.51 pJ' ;;
+    esac
+done
+end
 
 begin "mem: bad input: a line of 1 MB (no hang, no crash)"
 head -c 1000000 /dev/zero | tr '\0' 'a' >"$T/huge.trc"
