@@ -279,11 +279,11 @@ static void scene_defines(const PackedScene *p, uint32_t needs, AsmDefine *defs,
 
 /* kernel.unroll_box as it runs: the key's 1 or 2, or for 0 (auto) 2 in stream mode where a run's
  * stream starts with at least KERNEL_UNROLL_MIN_VECTORS ID vectors (rays: a tile's, or for
- * `sfsim trace` at most its batch's), else 1. The pair loop saves a box test's
- * latency but costs its pair test on every box filter, so it pays where traversal streams are many
- * vectors long: measured (docs/validation.md, "The scheduled kernel") on the Cornell box,
- * conference and sponza, 4096-ray tiles gain 1.4-6.5 % at N = 4-16 (at most +0.12 % at N = 16 in
- * the per-ray order) and lose up to 1.4 % at N = 32 and 64 on the big scenes; 1024-ray tiles gain
+ * `sfsim trace` its batch's if fewer), else 1. The pair loop hides a box test's latency behind
+ * another's but costs a pair test on every box filter, so it pays where traversal streams are
+ * many vectors long. Measured on the Cornell box, conference and sponza (docs/validation.md, "When
+ * the pair loop pays"): 4096-ray tiles gain up to 6.5 % at N = 4-16 (at worst +0.12 % at N = 16 in
+ * the per-ray order) and lose up to 1.4 % on the big scenes at N = 32 and 64; 1024-ray tiles gain
  * at N = 4 and lose up to 1.1 % at N = 16; packet mode loses 2.4-3.4 %. A kd-tree kernel has no
  * BVH box-test loop: 1. */
 static int box_unroll(const CfgMachine *cfg, uint32_t rays)

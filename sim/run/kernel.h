@@ -6,7 +6,8 @@
  * the config (docs/kernel.md: RAYS, SPAD_BYTES, WORKLOAD, BOUNCES, HAS_*, ACCEL_KD, KD_VARIANT,
  * KD_STACK_DEPTH, ORDER_FIRST, TRACE_ONLY, BOX_UNROLL), with kernel.unroll_box = 0 (auto)
  * resolved; assembling; the ABI symbols (kernels/lib/abi.inc is their only definition); checking
- * that the machine's memories hold what the kernel keeps in them. Must not: run the kernel (sim/run/engine.c) or time it.
+ * that the machine's memories hold what the kernel keeps in them. Must not: run the kernel
+ * (sim/run/engine.c) or time it.
  */
 #ifndef SFSIM_RUN_KERNEL_H
 #define SFSIM_RUN_KERNEL_H
