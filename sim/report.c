@@ -91,6 +91,7 @@ static void add_kernel_json(cJSON *root, const FuncStats *f, const CfgMachine *c
     cJSON_AddNumberToObject(k, "tile_width", f->tile_w);
     cJSON_AddNumberToObject(k, "tile_height", f->tile_h);
     cJSON_AddStringToObject(k, "defines", f->defines);
+    cJSON_AddNumberToObject(k, "unroll_box", f->unroll_box); /* resolved: config's kernel.unroll_box may be 0, auto */
     cJSON_AddNumberToObject(k, "instructions", f->kernel_instructions);
 }
 
@@ -301,10 +302,12 @@ void report_txt(const Report *r, char *txt, size_t cap)
     if (functional) {
         const FuncStats *f = &rsp->f;
         len += snprintf(txt + len, cap - (size_t)len,
-                        "machine      N = %d lanes, %s of %u x %u rays, workload %s; kernel %u instructions (%s)\n",
+                        "machine      N = %d lanes, %s of %u x %u rays, workload %s; kernel %u instructions (%s), "
+                        "kernel.unroll_box %d%s\n",
                         cfg->core_simd_width, cfg->stream_mode == CFG_STREAM_MODE_PACKET ? "packets" : "streams",
                         f->tile_w, f->tile_h, cfg_enum_name("workload", "kind", cfg->workload_kind),
-                        f->kernel_instructions, f->defines);
+                        f->kernel_instructions, f->defines, f->unroll_box,
+                        cfg->kernel_unroll_box == 0 ? " (0, auto)" : "");
         if (f->kd)
             len += kd_text(txt + len, cap - (size_t)len, r);
     }

@@ -620,7 +620,8 @@ int func_open(const PackedScene *p, const FuncParams *fp, FuncSession **out, cha
     Job *job = &s->job;
     pthread_mutex_init(&job->lock, NULL);
     atomic_init(&job->failed, 0);
-    if (kernel_build(p, fp->cfg, fp->kernel_path, fp->needs, fp->batch != NULL, &s->k, err, errlen) != 0) {
+    if (kernel_build(p, fp->cfg, fp->kernel_path, fp->needs, fp->batch != NULL, fp->batch ? fp->batch->count : 0, &s->k,
+                     err, errlen) != 0) {
         session_free(s);
         return -1;
     }
@@ -629,6 +630,7 @@ int func_open(const PackedScene *p, const FuncParams *fp, FuncSession **out, cha
     h->tile_w = s->k.tile_w;
     h->tile_h = s->k.tile_h;
     snprintf(h->defines, sizeof h->defines, "%s", s->k.defines);
+    h->unroll_box = s->k.unroll_box;
     h->kd = s->k.kd;
     h->kd_stack_depth = s->k.kd_stack_depth;
     h->kernel_instructions = s->k.obj.ntext;

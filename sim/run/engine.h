@@ -121,6 +121,7 @@ typedef struct FuncStats {
     uint32_t kernel_instructions;                   /* program size */
     uint32_t tile_w, tile_h;                        /* pixels (= rays) of a stream's tile */
     char defines[512];                              /* the -D symbols the kernel was built with */
+    int unroll_box;                                 /* the box-test loop as built: 1 or 2 (auto resolved) */
     int timed;                                      /* detailed mode: timing holds the sums */
     TimingStats timing;                             /* (sampled mode: of the sampled units) */
     uint32_t tiles_timed;                           /* detailed mode: every tile; sampled: tiles with a unit */

@@ -273,9 +273,31 @@ static void scene_defines(const PackedScene *p, uint32_t needs, AsmDefine *defs,
         add_define(defs, nd, list, len, "HAS_AMBIENT", 1);
 }
 
+/* kernel.unroll_box = 0 (auto) unrolls the box-test loop for tiles of at least this many ID
+ * vectors (rays / N). */
+#define KERNEL_UNROLL_MIN_VECTORS 256u
+
+/* kernel.unroll_box as it runs: the key's 1 or 2, or for 0 (auto) 2 in stream mode where a run's
+ * stream starts with at least KERNEL_UNROLL_MIN_VECTORS ID vectors (rays: a tile's, or for
+ * `sfsim trace` its batch's if fewer), else 1. The pair loop hides a box test's latency behind
+ * another's but costs a pair test on every box filter, so it pays where traversal streams are
+ * many vectors long. Measured on the Cornell box, conference and sponza (docs/validation.md, "When
+ * the pair loop pays"): 4096-ray tiles gain up to 6.5 % at N = 4-16 (at worst +0.12 % at N = 16 in
+ * the per-ray order) and lose up to 1.4 % on the big scenes at N = 32 and 64; 1024-ray tiles gain
+ * at N = 4 and lose up to 1.1 % at N = 16; packet mode loses 2.4-3.4 %. A kd-tree kernel has no
+ * BVH box-test loop: 1. */
+static int box_unroll(const CfgMachine *cfg, uint32_t rays)
+{
+    if (cfg->kernel_unroll_box != 0)
+        return cfg->kernel_unroll_box;
+    if (cfg->accel_structure == CFG_ACCEL_KD || cfg->stream_mode == CFG_STREAM_MODE_PACKET)
+        return 1;
+    return rays >= KERNEL_UNROLL_MIN_VECTORS * (uint32_t)cfg->core_simd_width ? 2 : 1;
+}
+
 /* Every -D symbol, in the order report.json's kernel.defines lists them. */
 static int choose_defines(const PackedScene *p, const CfgMachine *cfg, uint32_t needs, int trace_only,
-                          AsmDefine *defs, int *nd, Kernel *k, char *err, size_t errlen)
+                          uint32_t trace_rays, AsmDefine *defs, int *nd, Kernel *k, char *err, size_t errlen)
 {
     char *list = k->defines;
     size_t len = sizeof k->defines;
@@ -296,7 +318,8 @@ static int choose_defines(const PackedScene *p, const CfgMachine *cfg, uint32_t 
         add_define(defs, nd, list, len, "BOUNCES", cfg->workload_bounces);
     }
     add_define(defs, nd, list, len, "SPAD_BYTES", (uint32_t)cfg->spad_size_kb * 1024u);
-    if (cfg->kernel_unroll_box == 2)
+    k->unroll_box = box_unroll(cfg, trace_only && trace_rays < k->rays ? trace_rays : k->rays);
+    if (k->unroll_box == 2)
         add_define(defs, nd, list, len, "BOX_UNROLL", 1);
     scene_defines(p, needs, defs, nd, k);
     if (cfg->accel_structure == CFG_ACCEL_KD) {
@@ -382,12 +405,12 @@ static int memories_ok(const PackedScene *p, const CfgMachine *cfg, const Kernel
 }
 
 int kernel_build(const PackedScene *p, const CfgMachine *cfg, const char *path, uint32_t needs, int trace_only,
-                 Kernel *k, char *err, size_t errlen)
+                 uint32_t trace_rays, Kernel *k, char *err, size_t errlen)
 {
     memset(k, 0, sizeof *k);
     AsmDefine defs[24];
     int nd = 0;
-    if (choose_defines(p, cfg, needs, trace_only, defs, &nd, k, err, errlen) != 0)
+    if (choose_defines(p, cfg, needs, trace_only, trace_rays, defs, &nd, k, err, errlen) != 0)
         return -1;
     if (assemble(path, defs, nd, cfg, &k->obj, err, errlen) != 0)
         return -1;

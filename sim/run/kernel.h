@@ -4,9 +4,10 @@
  *
  * Owns: the tile (or packet) shape; the -D symbols chosen from the packed scene's features and
  * the config (docs/kernel.md: RAYS, SPAD_BYTES, WORKLOAD, BOUNCES, HAS_*, ACCEL_KD, KD_VARIANT,
- * KD_STACK_DEPTH, ORDER_FIRST, TRACE_ONLY); assembling; the ABI symbols (kernels/lib/abi.inc is
- * their only definition); checking that the machine's memories hold what the kernel keeps in
- * them. Must not: run the kernel (sim/run/engine.c) or time it.
+ * KD_STACK_DEPTH, ORDER_FIRST, TRACE_ONLY, BOX_UNROLL), with kernel.unroll_box = 0 (auto)
+ * resolved; assembling; the ABI symbols (kernels/lib/abi.inc is their only definition); checking
+ * that the machine's memories hold what the kernel keeps in them. Must not: run the kernel
+ * (sim/run/engine.c) or time it.
  */
 #ifndef SFSIM_RUN_KERNEL_H
 #define SFSIM_RUN_KERNEL_H
@@ -53,14 +54,16 @@ typedef struct Kernel {
     char defines[512];         /* the -D symbols, "RAYS=1024 SPAD_BYTES=65536 ..." */
     int kd;                    /* accel.structure = kd */
     uint32_t kd_stack_depth;   /* KD_STACK_DEPTH */
+    int unroll_box;            /* kernel.unroll_box resolved: 1 or 2 (BOX_UNROLL) */
 } Kernel;
 
 /* Assemble the kernel at path for packed scene p on the machine of cfg (needs: SCENE_NEED_* of
- * the scene; trace_only: `sfsim trace`'s build, traversal and intersection of a ray batch). 0, or
- * -1 with a message (assembly errors, a missing ABI symbol, memories too small, a kd config
- * without a packed kd-tree). Free k with kernel_free either way. */
+ * the scene; trace_only: `sfsim trace`'s build, traversal and intersection of a ray batch of
+ * trace_rays rays, which a run's stream holds at most of: kernel.unroll_box = 0 resolves for
+ * them). 0, or -1 with a message (assembly errors, a missing ABI symbol, memories too small, a kd
+ * config without a packed kd-tree). Free k with kernel_free either way. */
 int kernel_build(const PackedScene *p, const CfgMachine *cfg, const char *path, uint32_t needs, int trace_only,
-                 Kernel *k, char *err, size_t errlen);
+                 uint32_t trace_rays, Kernel *k, char *err, size_t errlen);
 void kernel_free(Kernel *k);
 
 /* The shipped kernel: $SFSIM_KERNEL, or kernels/pathtrace.s in the data folder (sim/datadir.h). */

@@ -76,9 +76,46 @@ begin "every row of the same-outputs table computes the same with kernel.schedul
 bash tests/outputs/check.sh --schedule "$other" > "$T/same" 2>&1 || no "$(grep -A2 FAIL "$T/same" | head -12)"
 end
 
-begin "kernel.unroll_box = 2 renders the same images with fewer stalls on the Cornell box"
-bash tests/outputs/check.sh --images-with kernel.unroll_box=2 cornell-detailed-n16 cornell-packet cornell-trace-detailed \
-    conference-detailed-n16 > "$T/unroll" 2>&1 || no "$(grep -A2 FAIL "$T/unroll" | head -12)"
+# kernel.unroll_box = 0 (auto, the default) runs 2 on cornell-detailed-m4096 and 1 on the other rows:
+# each explicit value renders the same images as the table's.
+for u in 1 2; do
+    begin "kernel.unroll_box = $u renders the same images as the default (auto)"
+    bash tests/outputs/check.sh --images-with kernel.unroll_box=$u cornell-detailed-n16 cornell-detailed-m4096 \
+        cornell-packet cornell-trace-detailed conference-detailed-n16 > "$T/unroll$u" 2>&1 ||
+        no "$(grep -A2 FAIL "$T/unroll$u" | head -12)"
+    end
+done
+
+# What auto resolves to, as the report says (sim/run/kernel.c, box_unroll): 2 in stream mode when a
+# tile holds at least 256 ID vectors (rays / N), else 1; packet mode, kd-trees and a trace batch of
+# fewer rays 1.
+unroll_of() { python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["kernel"]["unroll_box"])' "$1" 2>/dev/null; }
+begin "kernel.unroll_box = 0 (auto) resolves by the stream's length, and report.json and report.txt say so"
+i=0
+while read -r want sets; do
+    i=$((i + 1))
+    args=()
+    for kv in $sets; do args+=(--set "$kv"); done
+    run "$SFSIM" run --mode functional -s scenes/cornell/scene.ini --set render.width=16 --set render.height=16 \
+        --set render.spp=1 "${args[@]}" -j 1 -o "$T/auto$i"
+    want_rc 0
+    got=$(unroll_of "$T/auto$i/report.json")
+    [ "$got" = "$want" ] || no "$sets: kernel.unroll_box resolved to '$got', not $want"
+done <<'W'
+2 stream.rays=4096
+2 stream.rays=4096 core.simd_width=8
+1 stream.rays=4096 core.simd_width=32
+1 stream.rays=1024
+2 stream.rays=1024 core.simd_width=4
+1 stream.rays=4096 stream.mode=packet
+1 stream.rays=4096 accel.structure=kd
+1 stream.rays=4096 kernel.unroll_box=1
+2 stream.rays=1024 kernel.unroll_box=2
+W
+grep -q "kernel.unroll_box 2 (0, auto)" "$T/auto1/report.txt" || no "report.txt does not say auto chose 2"
+grep -q "BOX_UNROLL" "$T/auto4/report.txt" && no "1024-ray tiles were built with BOX_UNROLL"
+run "$SFSIM" config --dump --set kernel.unroll_box=3
+want_rc 1; want_err "kernel.unroll_box=3: value 3 out of range 0..2"
 end
 
 cli_summary "cli sched"
