@@ -208,6 +208,14 @@ void chip_reset(Chip *c)
     }
 }
 
+void chip_warm(Chip *c, const uint64_t *addr, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        if (!c->l2 || l2_warm(c->l2, addr[i]))
+            dram_warm(c->dram, addr[i]);
+    }
+}
+
 /* ---- requests on their way in ----------------------------------------------------------------- */
 
 /* *a holds at least need elements of size bytes (its capacity *cap doubled as needed); -1 on out

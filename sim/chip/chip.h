@@ -42,6 +42,11 @@ void chip_free(Chip *c);
 /* Every level cold and idle, nothing in flight, as chip_new left it (the counters go on): before
  * a sampled chip's unit (sim/run/chipunit.h), whose cores' models are reset too. */
 void chip_reset(Chip *c);
+/* Functional warming of a reset chip (a sampled chip's unit): the n line addresses, oldest first,
+ * read as if each had been read and nothing else had happened: into the L2 (when there is one),
+ * and the DRAM row of each that the L2 did not hold (every one without an L2) opened. No time
+ * passes and nothing is counted. */
+void chip_warm(Chip *c, const uint64_t *addr, size_t n);
 /* Core k's timing model sends its L1's misses and write-backs here from now on. 0, or -1 on out
  * of memory. */
 int chip_attach(Chip *c, int k, Timing *t);

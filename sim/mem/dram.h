@@ -127,6 +127,10 @@ Dram *dram_new(const DramParams *p, char *err, size_t errlen);
 void dram_free(Dram *d);
 /* Cold: banks precharged, queues empty, time 0; counters kept. */
 void dram_reset(Dram *d);
+/* Functional warming (a sampled chip's unit: docs/sampling.md): the row addr maps to left open in
+ * its bank, as an access would leave it with an open page (nothing with a closed page); no time
+ * passes and nothing is counted. Only on an idle DRAM (after dram_reset, before the first push). */
+void dram_warm(Dram *d, uint64_t addr);
 /* Requests arrive in non-decreasing cycle order, at or after the until of the last dram_run (an
  * earlier cycle is taken as that one). Always accepted: one that finds its queue full waits in an
  * arrival FIFO (counted as back-pressure) and enters when a slot frees. id is the caller's. */

@@ -696,6 +696,14 @@ void dram_free(Dram *d)
     free(d);
 }
 
+void dram_warm(Dram *d, uint64_t addr)
+{
+    if (d->p.page_policy != DRAM_PAGE_OPEN)
+        return;
+    const DramAddr a = dram_decode(&d->p, addr);
+    d->ch[a.ch].bank[(a.ra * d->p.bankgroups + a.bg) * d->p.banks + a.ba].open_row = a.ro;
+}
+
 void dram_push(Dram *d, uint64_t addr, int write, uint64_t cycle, uint64_t id)
 {
     DramAddr a = dram_decode(&d->p, addr);

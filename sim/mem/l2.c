@@ -167,6 +167,26 @@ void l2_reset(L2 *l)
 
 const L2Stats *l2_stats(const L2 *l) { return &l->st; }
 
+static int victim(const L2 *l, const L2Bank *b, size_t base);
+
+int l2_warm(L2 *l, uint64_t addr)
+{
+    const uint64_t line = addr >> l->shift;
+    L2Bank *b = &l->bank[line % (uint64_t)l->p.banks];
+    const size_t base = (size_t)((line / (uint64_t)l->p.banks) % (uint64_t)l->sets) * (size_t)l->p.ways;
+    int w = 0;
+    while (w < l->p.ways && b->tag[base + (size_t)w] != line + 1)
+        w++;
+    const int miss = w == l->p.ways;
+    if (miss) { /* (an idle L2 has no way being filled: victim finds one) */
+        w = victim(l, b, base);
+        b->tag[base + (size_t)w] = line + 1;
+        b->dirty[base + (size_t)w] = 0;
+    }
+    b->lru[base + (size_t)w] = ++l->stamp;
+    return miss;
+}
+
 void l2_push(L2 *l, uint64_t addr, int write, uint64_t cycle, uint64_t id)
 {
     l->next_ok = 0;

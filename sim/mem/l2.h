@@ -62,6 +62,11 @@ L2 *l2_new(const L2Params *p, MemLevel below, char *err, size_t errlen);
 void l2_free(L2 *l);
 /* Cold: empty, nothing queued or in flight (the level below is reset by its owner); counters kept. */
 void l2_reset(L2 *l);
+/* Functional warming (a sampled chip's unit: docs/sampling.md): the line of addr brought into its
+ * set as a read would bring it, most recently used and clean, the set's least recently used line
+ * leaving; no time passes, nothing is counted or sent below. Only on an idle L2 (after l2_reset,
+ * before the first push). 1 when the line was not there (a read would have gone below), else 0. */
+int l2_warm(L2 *l, uint64_t addr);
 const L2Stats *l2_stats(const L2 *l);
 /* The level interface (level.h). */
 void l2_push(L2 *l, uint64_t addr, int write, uint64_t cycle, uint64_t id);

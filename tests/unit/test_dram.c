@@ -472,6 +472,41 @@ Test(dram_policy, reset_is_cold_and_keeps_counters)
     dram_free(d);
 }
 
+/* Functional warming (dram_warm, a sampled chip's unit): the row is open as if read, with no
+ * time spent and nothing counted. */
+Test(dram_policy, warming_opens_the_row_and_nothing_else)
+{
+    /* Row 7 of bank (0, 0) warmed open: a read of it at 0 is a row hit, RD at 0, done CL + 4 = 20;
+     * a read of row 8 of the same bank at 0 a conflict: PRE 0 (nothing to wait for), ACT at tRP =
+     * 16, RD at 16 + tRCD = 32, done 32 + 20 = 52. */
+    DramParams p = ddr4();
+    Dram *d = make(&p);
+    dram_warm(d, A(0, 0, 7, 0));
+    cr_expect_eq(dram_outstanding(d), 0);
+    cr_expect_eq(st(d)->activates, 0, "warming counts no command");
+    Rq r[] = {{A(0, 0, 7, 5), 0, 0}};
+    Got g;
+    replay(d, r, 1, &g);
+    cr_expect_eq(g.done[0], 20);
+    cr_expect_eq(st(d)->row_hits, 1);
+    cr_expect_eq(st(d)->activates, 0);
+    dram_reset(d);
+    dram_warm(d, A(0, 0, 7, 0));
+    Rq r2[] = {{A(0, 0, 8, 0), 0, 0}};
+    replay(d, r2, 1, &g);
+    cr_expect_eq(g.done[0], 52);
+    cr_expect_eq(st(d)->row_conflicts, 1);
+    dram_free(d);
+    /* Closed page: nothing stays open, so warming opens nothing: a closed bank, done 36. */
+    p.page_policy = DRAM_PAGE_CLOSED;
+    d = make(&p);
+    dram_warm(d, A(0, 0, 7, 0));
+    replay(d, r, 1, &g);
+    cr_expect_eq(g.done[0], 36);
+    cr_expect_eq(st(d)->row_misses, 1);
+    dram_free(d);
+}
+
 /* ==== dram_stream ================================================================================ */
 
 /* A sequential read stream of n bursts, all waiting at 0: data-bus busy / elapsed cycles. */

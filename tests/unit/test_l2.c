@@ -206,3 +206,32 @@ Test(l2, impossible_geometry_is_refused)
     p.line_bytes = 48;
     cr_expect_eq(l2_check(&p, err, sizeof err), -1);
 }
+
+/* Functional warming (l2_warm, a sampled chip's unit): a warmed line hits with nothing sent below
+ * and nothing counted; warming is least-recently-used like reads. */
+Test(l2, warming_brings_lines_in_as_reads_would)
+{
+    Fix f;
+    open_fix(&f, params());
+    /* lines 0, 8, 16 map to bank 0, set 0 (line / 2 banks = 0, 4, 8: set 0 of 4); 2 ways, so
+     * warming all three leaves 8 and 16. A read of 16 at 10 hits: 10 + 3 = 13. Of 0 at 20: a miss,
+     * below at 23, back at 43. */
+    cr_expect_eq(l2_warm(f.l2, L(0)), 1);
+    cr_expect_eq(l2_warm(f.l2, L(8)), 1);
+    cr_expect_eq(l2_warm(f.l2, L(0)), 0, "line 0 is there: now the most recent");
+    cr_expect_eq(l2_warm(f.l2, L(16)), 1, "line 8, the least recent, leaves");
+    cr_expect_eq(l2_warm(f.l2, L(16)), 0);
+    cr_expect_eq(l2_stats(f.l2)->reads, 0, "warming counts nothing");
+    l2_push(f.l2, L(16), 0, 10, 1);
+    l2_push(f.l2, L(0), 0, 11, 2);
+    l2_push(f.l2, L(8), 0, 20, 3);
+    run_all(&f);
+    cr_expect_eq(f.ans[1], 13);
+    cr_expect_eq(f.ans[2], 14);
+    cr_expect_eq(f.ans[3], 43);
+    cr_expect_eq(f.below.n, 1, "only line 8 was read below");
+    const L2Stats *s = l2_stats(f.l2);
+    cr_expect_eq(s->hits, 2);
+    cr_expect_eq(s->misses, 1);
+    l2_free(f.l2);
+}
