@@ -356,13 +356,20 @@ void ref_count_free(RefSetCount *c)
 void ref_count_close(RefSetCount *c, uint32_t simd, uint64_t *node_steps, uint64_t *leaf_steps)
 {
     uint32_t nodes = sm_u32(c->p, sm_hdr(c->p, SM_HDR_NODES));
+    const uint64_t prim0 = c->line ? sm_u32(c->p, sm_hdr(c->p, SM_HDR_PRIMS)) : 0;
     for (uint32_t i = 0; i < c->ntouched; i++) {
         uint32_t n = c->touched[i];
         *node_steps += (c->node_rays[n] + (uint64_t)simd - 1) / simd;
+        if (c->line)
+            c->line(c->line_ctx, sm_rec(nodes, SM_NODE_WORDS, n, 0), 4u * SM_NODE_WORDS);
         if (c->leaf_rays[n]) {
             /* a leaf entered: its primitives, one after another, on each group of N rays */
             uint32_t prims = sm_u32(c->p, sm_rec(nodes, SM_NODE_WORDS, n, SM_NODE_INFO));
             *leaf_steps += (c->leaf_rays[n] + (uint64_t)simd - 1) / simd * prims;
+            if (c->line && prims) {
+                const uint32_t first = sm_u32(c->p, sm_rec(nodes, SM_NODE_WORDS, n, SM_NODE_FIRST));
+                c->line(c->line_ctx, prim0 + 4ull * SM_PRIM_WORDS * first, 4ull * SM_PRIM_WORDS * prims);
+            }
         }
         c->node_rays[n] = c->leaf_rays[n] = 0;
     }

@@ -30,8 +30,16 @@ typedef struct RefHit {
  * ceil(rays / N) steps on a node's box test, and as many on each primitive of a leaf the rays
  * enter. One per thread; a query counts into it only when RefTraceStats.count points to it, and
  * closing a set costs O(nodes touched), never O(nodes). */
+/* A piece of scene memory a walk read: addr (a byte offset in the packed image, scene memory's
+ * address) and its size in bytes. */
+typedef void (*RefLineSink)(void *ctx, uint64_t addr, uint64_t bytes);
+
 typedef struct RefSetCount {
     const PackedScene *p;
+    RefLineSink line;          /* when not NULL, told at each close of the scene memory the set
+                                  read: each node box-tested, each entered leaf's primitives, in
+                                  the order the set first touched the nodes */
+    void *line_ctx;
     uint32_t *node_rays;       /* nnodes entries: rays of the set that box-tested node n */
     uint32_t *leaf_rays;       /* nnodes entries: rays of the set that entered leaf n (box hit) */
     uint32_t *touched;         /* the nodes with a non-zero node_rays, ntouched of them */
@@ -42,8 +50,8 @@ typedef struct RefSetCount {
 int ref_count_init(RefSetCount *c, const PackedScene *p);
 void ref_count_free(RefSetCount *c);
 /* Close the set: add sum over touched nodes of ceil(node_rays / simd) to *node_steps and sum over
- * entered leaves of ceil(leaf_rays / simd) x (primitives in the leaf) to *leaf_steps, and zero
- * the counts for the next set. simd >= 1. */
+ * entered leaves of ceil(leaf_rays / simd) x (primitives in the leaf) to *leaf_steps (and tell
+ * c->line what the set read), and zero the counts for the next set. simd >= 1. */
 void ref_count_close(RefSetCount *c, uint32_t simd, uint64_t *node_steps, uint64_t *leaf_steps);
 
 typedef struct RefTraceStats {

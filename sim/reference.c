@@ -153,7 +153,15 @@ typedef struct Worker {
     RefStats st;
     RefSetCount set;
     RefSetCount *count;       /* &set when units are asked for, else NULL: nothing is counted */
+    uint32_t unit;            /* the unit being rendered (for RefParams.unit_line) */
 } Worker;
+
+/* RefSetCount's line sink: the worker's unit to RefParams.unit_line. */
+static void unit_line(void *ctx, uint64_t addr, uint64_t bytes)
+{
+    Worker *w = ctx;
+    w->c->rp->unit_line(w->c->rp->unit_line_ctx, w->unit, addr, bytes);
+}
 
 static int finite3(const float *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
 
@@ -798,6 +806,7 @@ static void render_tile(Worker *w, uint32_t tile)
     uint32_t x0 = (tile % tiles_x) * T, y0 = (tile / tiles_x) * T;
     uint32_t pass1 = c->rp->pass1 ? c->rp->pass1 : c->spp;
     for (uint32_t sample = c->rp->pass0; sample < pass1 && sample < c->spp; sample++) {
+        w->unit = tile * c->spp + sample;
         RefStats before = w->st;
         RefUnitStats steps;
         memset(&steps, 0, sizeof steps);
@@ -837,7 +846,8 @@ typedef struct Launch {
 static int launch_tile(void *ctx, int index, uint32_t tile)
 {
     Launch *l = ctx;
-    render_tile(&l->ws[index], tile);
+    const RefParams *rp = l->ws[index].c->rp;
+    render_tile(&l->ws[index], rp->tiles_only ? rp->tiles_only[tile] : tile);
     return 0;
 }
 
@@ -852,12 +862,16 @@ static int worker_init(Worker *w, Ctx *c, uint32_t T, char *err, size_t errlen)
         snprintf(err, errlen, "reference: out of memory for ray buffers");
         return -1;
     }
-    if (c->rp->units) {
+    if (c->rp->units || c->rp->unit_line) {
         if (ref_count_init(&w->set, c->p) != 0) {
             snprintf(err, errlen, "reference: out of memory for the unit counts' node counters");
             return -1;
         }
         w->count = &w->set;
+        if (c->rp->unit_line) {
+            w->set.line = unit_line;
+            w->set.line_ctx = w;
+        }
     }
     return 0;
 }
@@ -932,6 +946,13 @@ int ref_render(const PackedScene *p, const RefParams *rp, float *rgb, RefStats *
     }
     uint32_t T = (uint32_t)rp->tile;
     uint32_t ntiles = ((c.width + T - 1) / T) * ((c.height + T - 1) / T);
+    for (uint32_t i = 0; rp->tiles_only && i < rp->ntiles_only; i++)
+        if (rp->tiles_only[i] >= ntiles) {
+            snprintf(err, errlen, "reference: tile %u of a frame of %u tiles", rp->tiles_only[i], ntiles);
+            return -1;
+        }
+    if (rp->tiles_only)
+        ntiles = rp->ntiles_only;
     int nthreads = tiles_threads(rp->threads, ntiles);
     Worker *ws = calloc((size_t)nthreads, sizeof(Worker));
     int rc = 0;

@@ -38,6 +38,16 @@ typedef struct RefParams {
      * entries zeroed by the caller (sampled mode's auxiliary variables, docs/sampling.md). */
     struct RefUnitStats *units;
     int simd_width;    /* N of the units' SIMD-step counts (core.simd_width); 0: 16. Only with units */
+    /* When not NULL: told, unit by unit (tile * spp + pass), of each piece of scene memory the BVH
+     * walks of a generation read, after the generation (RefSetCount's line sink: the nodes
+     * box-tested, the primitives of the leaves entered; a sampled chip's functional warming,
+     * docs/sampling.md). Calls come from several threads at once, each unit's from one. */
+    void (*unit_line)(void *ctx, uint32_t unit, uint64_t addr, uint64_t bytes);
+    void *unit_line_ctx;
+    /* When not NULL: only these tiles (ntiles_only of them, each below the frame's count) are
+     * rendered, the others left black and uncounted. */
+    const uint32_t *tiles_only;
+    uint32_t ntiles_only;
 } RefParams;
 
 /* One (tile, pass) unit's work in the golden model. The SIMD-step counts model a stream filter of

@@ -16,6 +16,7 @@
 #include "../../sim/chip/chip.h"
 #include "../../sim/config.h"
 #include "../../sim/run/engine.h"
+#include "../../sim/reference.h"
 #include "../../sim/timing.h"
 
 #include "../support/packed.h"
@@ -402,5 +403,107 @@ Test(chip, the_opening_is_the_frames_first_wave_exactly)
     }
     free(rgb);
     func_stats_free(&full);
+    unload();
+}
+
+/* The golden model's record of what a unit reads (RefParams.unit_line): the nodes and primitives
+ * of the kernel's packed scene at their scene-memory addresses, so they can warm a sampled chip's
+ * L2. A frame of one unit on one core of a chip whose L1 starts cold: the lines its L1 fetched
+ * are the lines the kernel read. The golden model walks each ray on its own and the kernel a
+ * stream, so the two sets differ a little; most of the golden model's lines must be the kernel's
+ * (a wrong address would give none). */
+typedef struct LineSet {
+    uint64_t *line;
+    size_t n, cap;
+    uint32_t units_seen;
+} LineSet;
+
+static void note_line(void *ctx, uint32_t unit, uint64_t addr, uint64_t bytes)
+{
+    LineSet *s = ctx;
+    s->units_seen |= 1u << (unit & 31);
+    for (uint64_t l = addr / 64; l <= (addr + bytes - 1) / 64; l++) {
+        if (s->n == s->cap) {
+            s->cap = s->cap ? 2 * s->cap : 1024;
+            s->line = realloc(s->line, s->cap * sizeof *s->line);
+            cr_assert_not_null(s->line);
+        }
+        s->line[s->n++] = l;
+    }
+}
+
+static int u64_order(const void *a, const void *b)
+{
+    const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+Test(chip, the_golden_models_lines_are_the_kernels)
+{
+    load("scenes/cornell/scene.ini", 32, 32, 1);
+    CfgMachine chip;
+    small_frame(&chip);
+    shared_memory(&chip, 1);
+    static char err[65536];
+    FuncParams fp = {.cfg = &chip, .kernel_path = "kernels/pathtrace.s", .needs = scene.needs, .seed = 1,
+                     .threads = 1, .timed = 1, .mem_trace = 1};
+    FuncStats st;
+    cr_assert_eq(func_render(&packed, &fp, NULL, &st, err, sizeof err), 0, "%s", err);
+    uint64_t *kernel = malloc((st.ntrace ? st.ntrace : 1) * sizeof *kernel);
+    size_t nk = 0;
+    for (size_t i = 0; i < st.ntrace; i++)
+        if (!st.trace[i].write)
+            kernel[nk++] = st.trace[i].addr / 64;
+    qsort(kernel, nk, sizeof *kernel, u64_order);
+
+    LineSet g = {0};
+    float *rgb = calloc(3 * 32 * 32, sizeof *rgb);
+    RefParams rp = {.tile = 32, .seed = 1, .threads = 1, .unit_line = note_line, .unit_line_ctx = &g};
+    cr_assert_eq(ref_render(&packed, &rp, rgb, NULL, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(g.units_seen, 1u, "one unit, unit 0");
+    cr_assert_gt(g.n, 0);
+    qsort(g.line, g.n, sizeof *g.line, u64_order);
+    size_t distinct = 0, found = 0;
+    for (size_t i = 0; i < g.n; i++) {
+        if (i && g.line[i] == g.line[i - 1])
+            continue;
+        distinct++;
+        found += bsearch(&g.line[i], kernel, nk, sizeof *kernel, u64_order) != NULL;
+    }
+    cr_expect_geq(found * 10, distinct * 9, "%zu of the golden model's %zu lines were the kernel's (of its %zu)", found,
+                  distinct, nk);
+    free(rgb);
+    free(g.line);
+    free(kernel);
+    func_stats_free(&st);
+    unload();
+}
+
+/* RefParams.tiles_only: the golden model renders just the tiles asked for (a warming needs a few
+ * units' lines, not the frame's), and refuses a tile the frame does not have. */
+Test(chip, the_golden_model_renders_only_the_tiles_asked_for)
+{
+    load("scenes/cornell/scene.ini", 64, 64, 1); /* 4 tiles */
+    static char err[4096];
+    LineSet g = {0};
+    float *rgb = calloc(3 * 64 * 64, sizeof *rgb);
+    const uint32_t two = 2, nine = 9;
+    RefParams rp = {.tile = 32, .seed = 1, .threads = 2, .unit_line = note_line, .unit_line_ctx = &g,
+                    .tiles_only = &two, .ntiles_only = 1};
+    RefStats rs;
+    cr_assert_eq(ref_render(&packed, &rp, rgb, &rs, err, sizeof err), 0, "%s", err);
+    cr_expect_eq(g.units_seen, 1u << 2, "only tile 2's unit");
+    cr_expect_eq(rs.tiles, 1);
+    double outside = 0;
+    for (int y = 0; y < 64; y++)
+        for (int x = 0; x < 64; x++)
+            if (!(x < 32 && y >= 32)) /* tile 2: the lower left */
+                outside += rgb[3 * (64 * y + x)] + rgb[3 * (64 * y + x) + 1] + rgb[3 * (64 * y + x) + 2];
+    cr_expect_eq(outside, 0.0, "pixels outside tile 2 were rendered");
+    rp.tiles_only = &nine;
+    cr_expect_eq(ref_render(&packed, &rp, rgb, NULL, err, sizeof err), -1);
+    cr_expect(strstr(err, "tile 9 of a frame of 4 tiles"), "%s", err);
+    free(rgb);
+    free(g.line);
     unload();
 }
