@@ -29,6 +29,8 @@ void chipunit_close(ChipUnit *u)
 
 void chipunit_reset(ChipUnit *u) { chip_reset(u->chip); }
 
+void chipunit_warm(ChipUnit *u, const uint64_t *lines, size_t n) { chip_warm(u->chip, lines, n); }
+
 /* The shared memory steps until the record the core yielded at has its answers. 0, or -1 with
  * err. */
 static int wait_answers(ChipUnit *u, const CoreRecord *rec, char *err, size_t errlen)

@@ -34,6 +34,8 @@ int chipunit_open(ChipUnit *u, const CfgMachine *cfg, Timing *t, char *err, size
 void chipunit_close(ChipUnit *u);
 /* The shared levels cold and idle, before a unit (after timing_reset of the core's model). */
 void chipunit_reset(ChipUnit *u);
+/* Then the n lines (oldest first) read into them as if by the units before (chip_warm). */
+void chipunit_warm(ChipUnit *u, const uint64_t *lines, size_t n);
 /* Core c (whose model is u's) runs the launched pass until it halts, traps or reaches `limit`
  * instructions (sim.max_instructions; 0: none), the shared memory stepped whenever the core waits
  * for it. *ex: how it ended; CORE_EXIT_LIMIT may come without a trap message (the limit fell on a

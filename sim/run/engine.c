@@ -276,14 +276,22 @@ int eng_pass_end(Job *j, Core *c, const FuncTile *ft, uint32_t pass, CoreExit ex
     return 0;
 }
 
-/* One kernel run: pass `pass` of the launched tile, on a cold machine when timed (fu gets its
- * timed figures). 0, or -1 after eng_fail(). */
-static int run_pass(Worker *w, Core *c, const FuncTile *ft, uint32_t pass, FuncUnit *fu)
+/* One kernel run: unit `unit` (tile * spp + pass) of the launched tile, on a cold machine when
+ * timed (fu gets its timed figures; on a chip's unit, its levels warmed first when asked). 0, or
+ * -1 after eng_fail(). */
+static int run_pass(Worker *w, Core *c, const FuncTile *ft, uint32_t unit, FuncUnit *fu)
 {
     Job *j = w->job;
+    const uint32_t pass = unit % j->spp;
     eng_pass_set(j, c, pass);
     TimingStats tbefore;
     timing_begin(w, c, &tbefore);
+    if (w->cu.chip && j->fp->unit_warm) {
+        size_t n = 0;
+        const uint64_t *lines = j->fp->unit_warm(j->fp->unit_warm_ctx, unit, &n);
+        if (lines)
+            chipunit_warm(&w->cu, lines, n);
+    }
     const uint64_t limit = (uint64_t)j->fp->cfg->sim_max_instructions;
     CoreExit ex;
     if (w->cu.chip) {
@@ -343,7 +351,7 @@ static int tile_pass(Worker *w, Core *c, FuncTile *ft, uint32_t pass, FuncStats 
         lanes_before[k] = core_stats(c)->active_lanes[k];
     eng_pass_launch(j, c, ft, pass == 0);
     FuncUnit fu = {0};
-    int rc = run_pass(w, c, ft, pass, &fu);
+    int rc = run_pass(w, c, ft, (uint32_t)(ft - j->tiles) * j->spp + pass, &fu);
     if (w->tc.tm)
         tile_add_timed(ft, &fu);
     if (rc)
@@ -441,7 +449,7 @@ static int run_unit(Worker *w, Core *c, uint32_t i, FuncStats *st)
     uint64_t before = core_instructions(c), lanes_before[ISA_STAGE_COUNT];
     for (int k = 0; k < ISA_STAGE_COUNT; k++)
         lanes_before[k] = core_stats(c)->active_lanes[k];
-    if (run_pass(w, c, &place, fu->unit % j->spp, fu))
+    if (run_pass(w, c, &place, fu->unit, fu))
         return -1;
     fu->instructions = core_instructions(c) - before;
     for (int k = 0; k < ISA_STAGE_COUNT; k++)

@@ -58,6 +58,10 @@ typedef struct FuncParams {
      * one core of the chip's network, L2 and DRAM, every level cold at its start (sim/run/
      * chipunit.h: a sampled chip's units), instead of the chip's frame. */
     int chip_unit;
+    /* With chip_unit: the lines to warm the chip's levels with before unit u (chip_warm: oldest
+     * first), or NULL for none; called from the host thread that runs u, several at once. */
+    const uint64_t *(*unit_warm)(void *ctx, uint32_t unit, size_t *n);
+    void *unit_warm_ctx;
     /* Detailed, on a chip: the frame only until pass 0 of each of its first K tiles (the chip's
      * first wave, a sampled chip's opening: docs/sampling.md) has ended. Every (tile, pass) unit
      * that ended by then has its exact cycles in FuncStats.pass_cycles (the others 0); the chip's
