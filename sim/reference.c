@@ -224,8 +224,9 @@ static void interp2(const Ctx *c, uint32_t a, float w0, float u, float v, float 
     *tv = w0 * sm_f32(p, a + 4) + u * sm_f32(p, a + 12) + v * sm_f32(p, a + 20);
 }
 
-/* The texel word of texture tex at (tu, tv): nearest texel, repeat wrapping (docs/golden-model.md). */
-static uint32_t texel(const Ctx *c, uint32_t tex, float tu, float tv)
+/* The scene-memory address of texture tex's texel at (tu, tv): nearest texel, repeat wrapping
+ * (docs/golden-model.md). */
+static uint32_t texel_addr(const Ctx *c, uint32_t tex, float tu, float tv)
 {
     const PackedScene *p = c->p;
     uint32_t ta = sm_rec(c->texs, SM_TEX_WORDS, tex, 0);
@@ -234,8 +235,11 @@ static uint32_t texel(const Ctx *c, uint32_t tex, float tu, float tv)
     int32_t ix = (int32_t)(fu * (float)w), iy = (int32_t)(fv * (float)h);
     ix = ix < 0 ? 0 : (ix >= (int32_t)w ? (int32_t)w - 1 : ix);
     iy = iy < 0 ? 0 : (iy >= (int32_t)h ? (int32_t)h - 1 : iy);
-    return sm_u32(p, sm_u32(p, ta + 4 * SM_TEX_TEXELS) + 4u * ((uint32_t)iy * w + (uint32_t)ix));
+    return sm_u32(p, ta + 4 * SM_TEX_TEXELS) + 4u * ((uint32_t)iy * w + (uint32_t)ix);
 }
+
+/* The texel word of texture tex at (tu, tv). */
+static uint32_t texel(const Ctx *c, uint32_t tex, float tu, float tv) { return sm_u32(c->p, texel_addr(c, tex, tu, tv)); }
 
 /* Channel k (0 red .. 2 blue) of a texel word, sRGB-decoded through the header's table. */
 static float texel_channel(const Ctx *c, uint32_t t, int k)
@@ -601,11 +605,36 @@ static int roulette(const Ray *r, uint32_t depth, float *thr)
     return 1;
 }
 
+/* RefParams.unit_line: the scene memory a hit's shading reads (its material, the vertex normals,
+ * colours and texture coordinates of its primitive, the texel of its base colour), as the kernel
+ * reads them; the primitive itself was told with its leaf. */
+static void note_surface(const Worker *w, const Ray *r, const Surface *s)
+{
+    const Ctx *c = w->c;
+    const RefSetCount *k = &w->set;
+    k->line(k->line_ctx, sm_rec(c->mats, SM_MAT_WORDS, s->mat, 0), 4u * SM_MAT_WORDS);
+    if (s->is_sphere)
+        return;
+    if (c->normals)
+        k->line(k->line_ctx, c->normals + 36u * s->src, 36);
+    if (c->colors)
+        k->line(k->line_ctx, c->colors + 36u * s->src, 36);
+    const int32_t tex = (int32_t)mat_u32(c, s->mat, SM_MAT_TEX);
+    if (tex >= 0 && c->uvs) {
+        float tu, tv;
+        k->line(k->line_ctx, c->uvs + 24u * s->src, 24);
+        interp2(c, c->uvs + 24u * s->src, 1.0f - r->hit.u - r->hit.v, r->hit.u, r->hit.v, &tu, &tv);
+        k->line(k->line_ctx, texel_addr(c, (uint32_t)tex, tu, tv), 4);
+    }
+}
+
 static void shade_hit(Worker *w, const Ray *r, uint32_t *n)
 {
     const Ctx *c = w->c;
     Surface s;
     surface(c, r, &s);
+    if (w->set.line)
+        note_surface(w, r, &s);
     float em[3];
     for (int k = 0; k < 3; k++)
         em[k] = mat_f32(c, s.mat, SM_MAT_EMISSION + k);
