@@ -183,10 +183,14 @@ Test(energy_run, every_figure_recomputes_from_the_counters, .timeout = 300)
                 num(j, "units.interconnect.data_path_transfers") * n * 32 * wire * 0.5 * sqrt(a_rb) * 1e-12, "icn");
     EXPECT_SAME(part(j, "noc", "events_j"), num(j, "noc.bytes") * 8 * wire * 0.5 * sqrt(a_chip) * 1e-12, "noc");
     /* Leakage, W, of 2 cores and the L2, over the frame. */
-    const double leak_w = 2 * (2 * 32 * 19.0 + 37.4 + 74.2 + 71.5 + 19.0 / 8) * 1e-3 + 8 * 176.1 * 1e-3;
+    /* and the SIMD datapath's logic, 17.80 mW per mm^2 of its area (Nangate 45 nm FA_X1: 75.762 nW
+     * over 4.256 um^2; docs/energy.md). */
+    const double leak_w = 2 * (2 * 32 * 19.0 + 37.4 + 74.2 + 71.5 + 19.0 / 8) * 1e-3 + 8 * 176.1 * 1e-3 +
+                          2 * 17.80 * a_simd * 1e-3;
     EXPECT_SAME(num(j, "power.leakage_w"), leak_w, "leakage W");
     EXPECT_SAME(num(j, "energy.leakage_j"), leak_w * seconds, "leakage J");
     EXPECT_SAME(part(j, "ray_buffers", "leakage_j"), 2 * 2 * 32 * 19.0e-3 * seconds, "ray-buffer leakage");
+    EXPECT_SAME(part(j, "logic", "leakage_j"), 2 * 17.80 * a_simd * 1e-3 * seconds, "logic leakage");
     /* DRAM (DDR4-2400: VDD 1.2 V, tCK 1/1.2 ns, 8 devices; docs/energy.md): pJ a command. */
     /* VDD x tCK = 1.2 V x 1/1.2 ns = 1: a rank's pJ are 8 x mA x CK cycles. */
     const double act = 8.0 * (48 * 55 - (43 * 39 + 34 * 16)), rd = 8.0 * (135 - 43) * 4,
