@@ -226,20 +226,22 @@ static cJSON *json_block(const DramChanStats *s, const Figures *f)
 
 /* The DRAM's energy over the replay, cycles 0 to the last (sim/energy/dramenergy.h, docs/energy.md):
  * report.txt's lines and report.json's "energy". */
-static cJSON *energy_block(FILE *o, const DramParams *p, const DramChanStats *s, double io_pj_bit)
+static cJSON *energy_block(FILE *o, const DramParams *p, const DramChanStats *s)
 {
     DramEnergy e;
     const double rank_cycles = (double)p->channels * p->ranks * (double)s->cycles;
-    dram_energy(p, s, rank_cycles, io_pj_bit, &e);
+    dram_energy(p, s, rank_cycles, &e);
     const DramPower *w = &p->power;
     cJSON *j = cJSON_CreateObject();
     cJSON_AddBoolToObject(j, "known", e.known);
     cJSON_AddStringToObject(j, "source", w->source ? w->source : "");
     cJSON_AddNumberToObject(j, "io_pj_per_bit", e.io_pj_per_bit);
+    cJSON_AddStringToObject(j, "io_source", w->io_source ? w->io_source : "");
     cJSON_AddNumberToObject(j, "io_j", e.io);
     if (!e.known) {
         fprintf(o, "energy\n  not computed: the preset gives no IDD currents (%s)\n", w->source ? w->source : "-");
         fprintf(o, "  I/O                 %.4g nJ (%g pJ/bit)\n", e.io * 1e9, e.io_pj_per_bit);
+        fprintf(o, "  I/O figure          %g pJ/bit: %s\n", w->io_pj_bit, w->io_source ? w->io_source : "-");
         return j;
     }
     const double dev = (double)p->bus_bits / p->device_width;
@@ -255,6 +257,7 @@ static cJSON *energy_block(FILE *o, const DramParams *p, const DramChanStats *s,
             rank_cycles);
     fprintf(o, "  total               %.4g nJ, %.3f pJ/bit; I/O apart: %.4g nJ (%g pJ/bit)\n", e.core * 1e9, e.pj_per_bit,
             e.io * 1e9, e.io_pj_per_bit);
+    fprintf(o, "  I/O figure          %g pJ/bit: %s\n", w->io_pj_bit, w->io_source ? w->io_source : "-");
     const struct { const char *k; double v; } f[] = {
         {"vdd", w->vdd}, {"idd0", w->idd0}, {"idd2n", w->idd2n}, {"idd3n", w->idd3n}, {"idd4r", w->idd4r},
         {"idd4w", w->idd4w}, {"idd5b", w->idd5b}, {"devices_per_rank", dev}, {"act_pre_pj", e.act_pj},
@@ -268,8 +271,7 @@ static cJSON *energy_block(FILE *o, const DramParams *p, const DramChanStats *s,
 }
 
 /* report.txt and report.json as text (malloc'ed), or -1. */
-static int build_reports(const Dram *d, const Replay *r, const char *trace, MtrFormat fmt, double io_pj_bit, char **txt,
-                         char **json)
+static int build_reports(const Dram *d, const Replay *r, const char *trace, MtrFormat fmt, char **txt, char **json)
 {
     const DramParams *p = dram_get_params(d);
     const DramStats *s = dram_stats(d);
@@ -312,7 +314,7 @@ static int build_reports(const Dram *d, const Replay *r, const char *trace, MtrF
     text_block(o, "total", &s->total, &f);
     cJSON_AddItemToObject(root, "channels", chans);
     cJSON_AddItemToObject(root, "total", json_block(&s->total, &f));
-    cJSON_AddItemToObject(root, "energy", energy_block(o, p, &s->total, io_pj_bit));
+    cJSON_AddItemToObject(root, "energy", energy_block(o, p, &s->total));
     int bad = fclose(o) != 0;
     char *j = cJSON_Print(root);
     cJSON_Delete(root);
@@ -405,13 +407,12 @@ static int parse(int argc, char **argv, MemOpts *m)
     return EXIT_OK;
 }
 
-static Dram *open_dram(const MemOpts *m, DramParams *dp, double *io_pj_bit)
+static Dram *open_dram(const MemOpts *m, DramParams *dp)
 {
     CfgMachine cfg;
     char err[512];
     if (cli_config_build(&m->cfg, &cfg))
         return NULL;
-    *io_pj_bit = cfg.energy_dram_io_pj_bit;
     if (dram_params(&cfg, dp, err, sizeof err)) {
         fprintf(stderr, "sfsim mem: %s\n", err);
         return NULL;
@@ -450,8 +451,7 @@ int cmd_mem(int argc, char **argv)
         return EXIT_IO;
     }
     DramParams dp;
-    double io_pj_bit = 0;
-    Dram *d = open_dram(&m, &dp, &io_pj_bit);
+    Dram *d = open_dram(&m, &dp);
     MtrReader *t = d ? mtr_open(m.trace, m.fmt, err, sizeof err) : NULL;
     Replay r = {.p = d ? dram_get_params(d) : NULL};
     char *txt = NULL, *json = NULL;
@@ -464,7 +464,7 @@ int cmd_mem(int argc, char **argv)
         fprintf(stderr, "sfsim mem: %s\n", r.lat ? err : "out of memory");
         goto out;
     }
-    if (build_reports(d, &r, m.trace, mtr_format(t), io_pj_bit, &txt, &json)) {
+    if (build_reports(d, &r, m.trace, mtr_format(t), &txt, &json)) {
         fprintf(stderr, "sfsim mem: out of memory writing the report\n");
         goto out;
     }

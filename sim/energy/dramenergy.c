@@ -5,9 +5,10 @@
  */
 #include "dramenergy.h"
 
-void dram_energy(const DramParams *p, const DramChanStats *s, double rank_cycles, double io_pj_bit, DramEnergy *e)
+void dram_energy(const DramParams *p, const DramChanStats *s, double rank_cycles, DramEnergy *e)
 {
     const DramPower *w = &p->power;
+    const double io_pj_bit = w->io_pj_bit;
     const double tck = 1000.0 / p->clock_mhz, dev = (double)p->bus_bits / p->device_width;
     *e = (DramEnergy){0};
     e->bits = 8.0 * (double)s->bytes;

@@ -12,7 +12,8 @@
  *   WR burst           VDD (IDD4W - IDD3N) burst_cycles tCK                     per write burst
  *   REF                VDD (IDD5B - IDD3N) tRFC tCK                             per all-bank REF
  *   background         VDD (IDD3N (active + refresh) + IDD2N (rest)) tCK       over rank-cycles
- * I/O (the interface and its termination, on the controller's side too) is apart: io_pj_bit per bit.
+ * I/O (the interface and its termination, on the controller's side too) is apart: p->power.io_pj_bit
+ * per bit transferred (the preset's, or the key energy.dram_io_pj_bit's: sim/mem/dram.c).
  */
 #ifndef SFSIM_ENERGY_DRAMENERGY_H
 #define SFSIM_ENERGY_DRAMENERGY_H
@@ -33,7 +34,7 @@ typedef struct DramEnergy {
 } DramEnergy;
 
 /* The energy of counts s over rank_cycles = channels x ranks x the DRAM cycles of the span
- * (s->active_cycles and s->refresh_cycles of them in active standby), io_pj_bit the I/O figure. */
-void dram_energy(const DramParams *p, const DramChanStats *s, double rank_cycles, double io_pj_bit, DramEnergy *e);
+ * (s->active_cycles and s->refresh_cycles of them in active standby). */
+void dram_energy(const DramParams *p, const DramChanStats *s, double rank_cycles, DramEnergy *e);
 
 #endif

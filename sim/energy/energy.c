@@ -222,7 +222,7 @@ static void chip_events(const CfgMachine *c, const FuncStats *f, const Figs *g, 
         return;
     DramEnergy e;
     const double rank_cycles = (double)p.channels * p.ranks * seconds * p.clock_mhz * 1e6;
-    dram_energy(&p, &m->dram, rank_cycles, c->energy_dram_io_pj_bit, &e);
+    dram_energy(&p, &m->dram, rank_cycles, &e);
     r->has_dram = 1;
     r->dram_known = e.known;
     r->dram[EN_D_ACTIVATE] = e.activate;

@@ -17,11 +17,11 @@ typedef struct PresetRow {
 static const PresetRow presets[DRAM_NPRESETS] = {
 #define DRAM_PRESET(nm, mhz, bt, ch, ra, bg, ba, ro, co, wd, bus, bl, cl, cwl, trcd, trp, tras, trc, ccds, ccdl, \
                     rrds, rrdl, faw, twr, wtrs, wtrl, rtp, trefi, trfc, rtrs, rtw, map, src, vdd, idd0, idd2n,  \
-                    idd3n, idd4r, idd4w, idd5b, psrc)                                                          \
+                    idd3n, idd4r, idd4w, idd5b, psrc, io, iosrc)                                               \
     {#nm, src,                                                                                                   \
      {#nm, mhz, bt, ch, ra, bg, ba, ro, co, wd, bus, bl, cl, cwl, trcd, trp, tras, trc, ccds, ccdl, rrds, rrdl,   \
       faw, twr, wtrs, wtrl, rtp, trefi, trfc, rtrs, rtw, map, 0, 0, 0, 0, 0, 0, 0, {0}, {0}, 0, 0,               \
-      {vdd, idd0, idd2n, idd3n, idd4r, idd4w, idd5b, psrc}}},
+      {vdd, idd0, idd2n, idd3n, idd4r, idd4w, idd5b, psrc, io, iosrc}}},
 #include "dram_presets.def"
 #undef DRAM_PRESET
 };
@@ -212,6 +212,10 @@ int dram_params(const CfgMachine *c, DramParams *p, char *err, size_t errlen)
         p->power.field = c->dram_##field;
     OVRF(vdd) OVRF(idd0) OVRF(idd2n) OVRF(idd3n) OVRF(idd4r) OVRF(idd4w) OVRF(idd5b)
 #undef OVRF
+    if (c->energy_dram_io_pj_bit > 0) {
+        p->power.io_pj_bit = c->energy_dram_io_pj_bit;
+        p->power.io_source = "the key energy.dram_io_pj_bit";
+    }
     if (c->dram_mapping > 0) {
         const char *m = cfg_enum_name("dram", "mapping", c->dram_mapping);
         if (!m) {

@@ -32,10 +32,13 @@ typedef enum DramField { DRAM_F_CH, DRAM_F_RA, DRAM_F_BG, DRAM_F_BA, DRAM_F_RO, 
 enum { DRAM_PAGE_OPEN = 0, DRAM_PAGE_CLOSED = 1 };
 
 /* The devices' supply and currents (dram_presets.def's power columns, docs/energy.md): V, and mA of
- * one device; 0: not given. Read only by the energy model (sim/energy/dramenergy.h). */
+ * one device; 0: not given. The I/O figure: pJ per bit moved on the data bus, at the preset's data
+ * rate; 0: not modelled. Read only by the energy model (sim/energy/dramenergy.h). */
 typedef struct DramPower {
     double vdd, idd0, idd2n, idd3n, idd4r, idd4w, idd5b;
     const char *source;             /* the data sheet, or why there is none */
+    double io_pj_bit;               /* the preset's, or the key energy.dram_io_pj_bit's when not 0 */
+    const char *io_source;          /* its derivation, or why there is none */
 } DramPower;
 
 typedef struct DramParams {

@@ -183,10 +183,14 @@ Test(energy_run, every_figure_recomputes_from_the_counters, .timeout = 300)
                 num(j, "units.interconnect.data_path_transfers") * n * 32 * wire * 0.5 * sqrt(a_rb) * 1e-12, "icn");
     EXPECT_SAME(part(j, "noc", "events_j"), num(j, "noc.bytes") * 8 * wire * 0.5 * sqrt(a_chip) * 1e-12, "noc");
     /* Leakage, W, of 2 cores and the L2, over the frame. */
-    const double leak_w = 2 * (2 * 32 * 19.0 + 37.4 + 74.2 + 71.5 + 19.0 / 8) * 1e-3 + 8 * 176.1 * 1e-3;
+    /* and the SIMD datapath's logic, 17.80 mW per mm^2 of its area (Nangate 45 nm FA_X1: 75.762 nW
+     * over 4.256 um^2; docs/energy.md). */
+    const double leak_w = 2 * (2 * 32 * 19.0 + 37.4 + 74.2 + 71.5 + 19.0 / 8) * 1e-3 + 8 * 176.1 * 1e-3 +
+                          2 * 17.80 * a_simd * 1e-3;
     EXPECT_SAME(num(j, "power.leakage_w"), leak_w, "leakage W");
     EXPECT_SAME(num(j, "energy.leakage_j"), leak_w * seconds, "leakage J");
     EXPECT_SAME(part(j, "ray_buffers", "leakage_j"), 2 * 2 * 32 * 19.0e-3 * seconds, "ray-buffer leakage");
+    EXPECT_SAME(part(j, "logic", "leakage_j"), 2 * 17.80 * a_simd * 1e-3 * seconds, "logic leakage");
     /* DRAM (DDR4-2400: VDD 1.2 V, tCK 1/1.2 ns, 8 devices; docs/energy.md): pJ a command. */
     /* VDD x tCK = 1.2 V x 1/1.2 ns = 1: a rank's pJ are 8 x mA x CK cycles. */
     const double act = 8.0 * (48 * 55 - (43 * 39 + 34 * 16)), rd = 8.0 * (135 - 43) * 4,
@@ -198,6 +202,8 @@ Test(energy_run, every_figure_recomputes_from_the_counters, .timeout = 300)
     EXPECT_SAME(num(j, "energy.dram.refresh_j"), num(j, "dram.refreshes") * ref * 1e-12, "dram ref");
     EXPECT_SAME(num(j, "energy.dram.background_active_j"), 43 * active * 8 * 1e-12, "dram active standby");
     EXPECT_SAME(num(j, "energy.dram.background_precharged_j"), 34 * (rank_cycles - active) * 8 * 1e-12, "dram pre");
+    /* I/O, apart: DDR4-2400's 2.287 pJ per bit moved (docs/energy.md, "DRAM I/O"). */
+    EXPECT_SAME(part(j, "dram_io", "events_j"), num(j, "dram.bytes") * 8 * 2.287e-12, "dram I/O");
     cr_expect_gt(num(j, "dram.reads"), 0, "the frame reaches DRAM");
     /* The sums and the figures of merit. */
     double ev = 0, lk = 0;
@@ -302,7 +308,43 @@ Test(energy_dram, a_read_to_a_closed_bank)
     EXPECT_SAME(num(e, "read_burst_pj"), 2944.0, "RD");
     EXPECT_SAME(num(e, "total_j"), 19024e-12, "ACT + RD + PRE + standby");
     EXPECT_SAME(num(e, "pj_per_bit"), 19024.0 / 512, "pJ/bit");
+    /* I/O apart, not in the total: the 512 bits of the burst x DDR4-2400's 2.287 pJ/bit. */
+    EXPECT_SAME(num(e, "io_pj_per_bit"), 2.287, "I/O pJ/bit");
+    EXPECT_SAME(num(e, "io_j"), 512 * 2.287e-12, "I/O");
     cJSON_Delete(root);
+}
+
+/* DDR4-2400's I/O figure is its termination (docs/energy.md, "DRAM I/O"): POD12, so a DQ pin draws
+ * current only while low, through R_TT + R_s + R_ON = 120 + 10 + 34 = 164 ohm from VDDQ 1.2 V, on a
+ * read (the controller's R_TT, the device's R_ON) as on a write (the device's R_TT(WR), the
+ * controller's R_ON). Per low bit: 1.44 / 164 W x 1 / 2.4 ns = 3.6585 pJ; half the DQ bits are low,
+ * and of each x8 device's strobe pair one pin is low all burst (1/8 of a low pin per DQ bit):
+ *   3.6585 x (1/2 + 1/8) = 2.2866 pJ/bit, the preset's 2.287 to its 4 digits. */
+Test(energy_dram, ddr4_io_is_its_termination)
+{
+    CfgMachine c;
+    cfg_defaults(&c);
+    DramParams p;
+    char err[256];
+    cr_assert_eq(dram_params(&c, &p, err, sizeof err), 0, "%s", err);
+    const double per_low_bit_pj = 1.2 * 1.2 / (120 + 10 + 34) / 2.4 * 1e3;
+    const double io = per_low_bit_pj * (0.5 + 1.0 / 8);
+    cr_expect(fabs(p.power.io_pj_bit - io) < 5e-4, "preset %g, derived %g", p.power.io_pj_bit, io);
+    cr_expect(p.power.io_source && strstr(p.power.io_source, "energydram"), "%s", p.power.io_source);
+    /* The key stands for the preset's figure when given; a preset without a figure has 0 and says why. */
+    c.energy_dram_io_pj_bit = 5;
+    cr_assert_eq(dram_params(&c, &p, err, sizeof err), 0, "%s", err);
+    cr_expect_eq(p.power.io_pj_bit, 5);
+    cr_expect(strstr(p.power.io_source, "energy.dram_io_pj_bit"), "%s", p.power.io_source);
+    c.energy_dram_io_pj_bit = 0;
+    c.dram_preset = 4;   /* hbm2_2000 */
+    cr_assert_eq(dram_params(&c, &p, err, sizeof err), 0, "%s", err);
+    cr_expect_eq(p.power.io_pj_bit, 0);
+    cr_expect(strstr(p.power.io_source, "none"), "%s", p.power.io_source);
+    DramChanStats s = {.activates = 1, .reads = 1, .bytes = 128};
+    DramEnergy e;
+    dram_energy(&p, &s, 0, &e);
+    cr_expect_eq(e.io, 0);
 }
 
 /* A row hit: A (row 0, column 0) misses, B (row 0, column 1: address bit 8) hits: ACT 0, RD 16,
@@ -391,7 +433,7 @@ Test(energy_dram, no_currents_no_energy)
     p.power = (DramPower){0};
     DramChanStats s = {.activates = 1, .reads = 1, .bytes = 64};
     DramEnergy e;
-    dram_energy(&p, &s, 100, 0, &e);
+    dram_energy(&p, &s, 100, &e);
     cr_expect(!e.known);
     cr_expect_eq(e.core, 0);
 }
@@ -438,9 +480,9 @@ Test(energy_magnitude, ddr4_read_per_bit)
     cr_assert_eq(dram_params(&c, &h, err, sizeof err), 0, "%s", err);
     DramChanStats s = {.activates = 1, .reads = 1, .bytes = 64};
     DramEnergy e, eh;
-    dram_energy(&p, &s, 0, 0, &e);
+    dram_energy(&p, &s, 0, &e);
     s.bytes = (uint64_t)h.burst_bytes;
-    dram_energy(&h, &s, 0, 0, &eh);
+    dram_energy(&h, &s, 0, &eh);
     cr_expect(e.pj_per_bit > 5 && e.pj_per_bit < 40, "DDR4 %g pJ/bit", e.pj_per_bit);
     cr_expect(e.pj_per_bit > eh.pj_per_bit, "DDR4 %g, HBM2 %g pJ/bit", e.pj_per_bit, eh.pj_per_bit);
 }
