@@ -1,0 +1,223 @@
+/* tools/sample41/warmbias.c -- issue 41's step 5 measured (docs/sampling.md, "What remains to
+ * build"): how far a unit timed alone on one core of the chip's memory (sim/run/chipunit.h) is
+ * from the same unit inside the chip's whole frame, cold and with the levels warmed from the
+ * golden model's record of the units before it.
+ *
+ * Build (not part of make; after `make all`):
+ *   gcc -O2 -I. -o build/warmbias tools/sample41/warmbias.c build/libsfsim.a -linih -ltinygltf \
+ *       -ltinyobjloader -lcjson -lOpenEXRCore-3_1 -lpng16 -lfreetype -lgsl -lgslcblas -lstdc++ -lpthread -ldl -lm
+ * usage: warmbias SCENE.ini CONFIG.ini W H SPP [THREADS]
+ *
+ * 1. The chip's frame in detailed mode (stream.rays = 1024: 32 x 32 tiles): every unit's cycles
+ *    (tiles[].passes[]) and its core; each unit's start is the sum of the units before it on its
+ *    core (a core's units run back to back: busy + stall = finish, tests/unit/test_chip.c).
+ * 2. The golden model's lines of every unit (RefParams.unit_line), each unit's distinct lines.
+ * 3. Every unit timed alone on one core of the chip's memory (FuncParams.chip_unit): cold, and
+ *    warmed with the lines of the units that started before it (those still running at its start
+ *    whole: a little of what they read later), in the order they started, the last L2-capacity
+ *    worth kept (chip_warm replays them oldest first). The frame's schedule is used, where a
+ *    sampler would have only the predicted one.
+ * Prints per unit and the mean and spread of (alone / in the frame - 1), cold and warm, over the
+ * units after the first wave (the first K units start on a cold chip in the frame too). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "scenes/bvh.h"
+#include "scenes/pack.h"
+#include "scenes/scene.h"
+#include "sim/config.h"
+#include "sim/reference.h"
+#include "sim/run/engine.h"
+
+typedef struct Lines {
+    uint64_t *a;
+    size_t n, cap;
+} Lines;
+
+static Lines *unit_lines;
+static uint32_t nunits;
+
+static void push(Lines *l, uint64_t v)
+{
+    if (l->n == l->cap) {
+        l->cap = l->cap ? 2 * l->cap : 256;
+        l->a = realloc(l->a, l->cap * sizeof *l->a);
+        if (!l->a)
+            abort();
+    }
+    l->a[l->n++] = v;
+}
+
+/* RefParams.unit_line: each unit's lines (64-byte), repeats dropped later. Each unit's calls come
+ * from one thread. */
+static void on_line(void *ctx, uint32_t unit, uint64_t addr, uint64_t bytes)
+{
+    (void)ctx;
+    if (unit >= nunits)
+        abort();
+    for (uint64_t l = addr / 64; l <= (addr + bytes - 1) / 64; l++)
+        push(&unit_lines[unit], l * 64);
+}
+
+/* unit's warming lines, made before the units run */
+static Lines *warm;
+static const uint64_t *warm_of(void *ctx, uint32_t unit, size_t *n)
+{
+    (void)ctx;
+    *n = warm[unit].n;
+    return warm[unit].a;
+}
+
+static int u64_order(const void *a, const void *b)
+{
+    const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+static uint64_t *start;
+static int start_order(const void *a, const void *b)
+{
+    const uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    if (start[x] != start[y])
+        return start[x] < start[y] ? -1 : 1;
+    return (x > y) - (x < y);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 6) {
+        fprintf(stderr, "usage: warmbias SCENE.ini CONFIG.ini W H SPP [THREADS]\n");
+        return 2;
+    }
+    const int W = atoi(argv[3]), H = atoi(argv[4]), S = atoi(argv[5]), threads = argc > 6 ? atoi(argv[6]) : 2;
+    static char err[65536];
+    Scene scene;
+    PackedScene packed;
+    if (scene_load(argv[1], &scene, err, sizeof err)) {
+        fprintf(stderr, "%s: %s\n", argv[1], err);
+        return 1;
+    }
+    scene.render.width = W;
+    scene.render.height = H;
+    scene.render.spp = S;
+    BvhParams bp;
+    bvh_default_params(&bp);
+    if (pack_scene(&scene, &bp, 0, &packed, err, sizeof err)) {
+        fprintf(stderr, "pack: %s\n", err);
+        return 1;
+    }
+    CfgMachine cfg;
+    cfg_defaults(&cfg);
+    CfgErrors errs = {0};
+    if (cfg_load(&cfg, argv[2], &errs)) {
+        fprintf(stderr, "%s: %s\n", argv[2], errs.text ? errs.text : "?");
+        return 1;
+    }
+    cfg_errors_free(&errs);
+    cfg.stream_rays = 1024;
+
+    /* 1. the chip's frame */
+    FuncParams fp = {.cfg = &cfg, .kernel_path = "kernels/pathtrace.s", .needs = scene.needs, .seed = 1,
+                     .threads = threads, .timed = 1};
+    FuncStats full;
+    if (func_render(&packed, &fp, NULL, &full, err, sizeof err)) {
+        fprintf(stderr, "frame: %s\n", err);
+        return 1;
+    }
+    nunits = full.ntiles * (uint32_t)S;
+    start = calloc(nunits, sizeof *start);
+    uint64_t *core_at = calloc(full.chip_cores, sizeof *core_at);
+    for (uint32_t t = 0; t < full.ntiles; t++) /* a core's tiles in frame order, passes in order */
+        for (uint32_t p = 0; p < (uint32_t)S; p++) {
+            const uint32_t u = t * (uint32_t)S + p, k = full.tiles[t].core;
+            start[u] = core_at[k];
+            core_at[k] += full.pass_cycles[u];
+        }
+    fprintf(stderr, "frame: %u units on %u cores, makespan %llu\n", nunits, full.chip_cores,
+            (unsigned long long)full.makespan);
+
+    /* 2. the golden model's lines */
+    unit_lines = calloc(nunits, sizeof *unit_lines);
+    float *rgb = calloc(3 * (size_t)W * H, sizeof *rgb);
+    RefParams rp = {.tile = 32, .seed = 1, .threads = threads, .unit_line = on_line};
+    if (ref_render(&packed, &rp, rgb, NULL, err, sizeof err)) {
+        fprintf(stderr, "golden: %s\n", err);
+        return 1;
+    }
+    for (uint32_t u = 0; u < nunits; u++) { /* each unit's distinct lines (in address order) */
+        Lines *l = &unit_lines[u];
+        qsort(l->a, l->n, sizeof *l->a, u64_order);
+        size_t d = 0;
+        for (size_t q = 0; q < l->n; q++)
+            if (!d || l->a[q] != l->a[d - 1])
+                l->a[d++] = l->a[q];
+        l->n = d;
+    }
+    /* 3. warming lists: the units started before u (those still running when u starts too, whole),
+     * in start order; the last `cap` lines kept */
+    const size_t cap = (size_t)cfg.l2_size_kb * 1024 / 64;
+    uint32_t *order = malloc(nunits * sizeof *order);
+    for (uint32_t u = 0; u < nunits; u++)
+        order[u] = u;
+    qsort(order, nunits, sizeof *order, start_order);
+    warm = calloc(nunits, sizeof *warm);
+    for (uint32_t i = 0; i < nunits; i++) {
+        const uint32_t u = order[i];
+        size_t total = 0;
+        uint32_t j = i;
+        while (j > 0 && total < cap) /* back from the latest start before u's */
+            total += unit_lines[order[--j]].n;
+        for (; j < i; j++)
+            for (size_t q = 0; q < unit_lines[order[j]].n; q++)
+                push(&warm[u], unit_lines[order[j]].a[q]);
+        if (warm[u].n > cap) { /* the oldest beyond the capacity out */
+            memmove(warm[u].a, warm[u].a + (warm[u].n - cap), cap * sizeof *warm[u].a);
+            warm[u].n = cap;
+        }
+    }
+
+    /* 4. every unit alone, cold and warm */
+    uint32_t *all = malloc(nunits * sizeof *all);
+    for (uint32_t u = 0; u < nunits; u++)
+        all[u] = u;
+    FuncUnit *cold = calloc(nunits, sizeof *cold), *hot = calloc(nunits, sizeof *hot);
+    for (int pass = 0; pass < 2; pass++) {
+        FuncParams up = fp;
+        up.chip_unit = 1;
+        up.unit_warm = pass ? warm_of : NULL;
+        FuncSession *s;
+        FuncStats st;
+        if (func_open(&packed, &up, &s, err, sizeof err) || func_units(s, all, nunits, pass ? hot : cold, err, sizeof err) ||
+            func_close(s, &st, err, sizeof err)) {
+            fprintf(stderr, "units: %s\n", err);
+            return 1;
+        }
+        func_stats_free(&st);
+    }
+    double sc = 0, sc2 = 0, sw = 0, sw2 = 0;
+    uint32_t n = 0;
+    printf("unit\tcore\tstart\tframe\tcold\twarm\twarm_lines\n");
+    for (uint32_t u = 0; u < nunits; u++) {
+        printf("%u\t%u\t%llu\t%llu\t%llu\t%llu\t%zu\n", u, full.tiles[u / S].core, (unsigned long long)start[u],
+               (unsigned long long)full.pass_cycles[u], (unsigned long long)cold[u].cycles,
+               (unsigned long long)hot[u].cycles, warm[u].n);
+        if (start[u] == 0) /* the first wave: a cold chip in the frame too */
+            continue;
+        const double c = (double)cold[u].cycles / (double)full.pass_cycles[u] - 1,
+                     w = (double)hot[u].cycles / (double)full.pass_cycles[u] - 1;
+        sc += c;
+        sc2 += c * c;
+        sw += w;
+        sw2 += w * w;
+        n++;
+    }
+    if (n) {
+        const double mc = sc / n, mw = sw / n;
+        printf("# %u units after the first wave: alone / in the frame - 1: cold mean %+.3f %% (sd %.3f %%), "
+               "warm mean %+.3f %% (sd %.3f %%)\n",
+               n, 100 * mc, 100 * sqrt(fmax(0, sc2 / n - mc * mc)), 100 * mw, 100 * sqrt(fmax(0, sw2 / n - mw * mw)));
+    }
+    return 0;
+}
