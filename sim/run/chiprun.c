@@ -30,7 +30,7 @@ enum { CS_RUN, CS_MEM, CS_TILE, CS_DONE };
 typedef struct CoreRun {
     int state;
     int resume;                  /* it yielded: its record is timed again first */
-    uint32_t tile, pass;
+    uint32_t tile, pass, pass_end;  /* the passes [pass, pass_end) of its tile */
     FuncTile *ft;
     uint64_t wake;               /* CS_RUN: the cycle it goes on from */
     uint64_t done_at;            /* CS_TILE: the cycle its tile ended */
@@ -86,7 +86,7 @@ int chip_run_wanted(const FuncParams *fp)
     if (fp->chip_unit)
         return 0;
     return fp->timed && (fp->cfg->chip_cores > 1 || chip_shared(fp->cfg) || fp->mem_trace || fp->timeline ||
-                         fp->opening);
+                         fp->opening || fp->wave);
 }
 
 static Timing *tm_of(const ChipRun *r, int k) { return r->job->workers[k].tc.tm; }
@@ -101,7 +101,7 @@ static void pass_begin(ChipRun *r, int k)
     if (r->job->fp->batch) {
         eng_batch_launch(r->job, c, cr->tile);
     } else {
-        eng_pass_launch(r->job, c, cr->ft, cr->pass == 0);
+        eng_pass_launch(r->job, c, cr->ft, cr->pass == 0 || r->job->fp->wave); /* (a wave's: as a unit) */
         eng_pass_set(r->job, c, cr->pass);
     }
     timing_continue(t, r->cold);
@@ -113,11 +113,12 @@ static void pass_begin(ChipRun *r, int k)
         cr->lanes0[s] = core_stats(c)->active_lanes[s];
 }
 
-static void tile_begin(ChipRun *r, int k, uint32_t tile)
+static void tile_begin(ChipRun *r, int k, uint32_t tile, uint32_t pass, uint32_t pass_end)
 {
     CoreRun *cr = &r->cr[k];
     cr->tile = tile;
-    cr->pass = 0;
+    cr->pass = pass;
+    cr->pass_end = pass_end;
     cr->ft = r->job->fp->batch ? &r->job->tiles[tile] : eng_tile_start(r->job, tile);
     cr->ft->core = (uint32_t)k;
     r->job->cores[k].tiles++;
@@ -221,7 +222,7 @@ static int core_go(ChipRun *r, int k)
             return -1;
         if (r->job->fp->opening && cr->pass == 0 && cr->tile < (uint32_t)r->k)
             atomic_fetch_sub(&r->opening_left, 1u);
-        if (++cr->pass < r->passes) {
+        if (++cr->pass < cr->pass_end) {
             pass_begin(r, k);
             continue;
         }
@@ -282,7 +283,8 @@ static int trace_gather(ChipRun *r)
     }
     size_t o = 0;
     for (int k = 0; k < r->k; k++) {
-        memcpy(all + o, r->cr[k].tr, r->cr[k].ntr * sizeof *all);
+        if (r->cr[k].ntr) /* (a core that sent nothing has no list) */
+            memcpy(all + o, r->cr[k].tr, r->cr[k].ntr * sizeof *all);
         o += r->cr[k].ntr;
     }
     qsort(all, n, sizeof *all, trace_order);
@@ -436,7 +438,7 @@ static int shared_step(ChipRun *r)
             r->ntile--;
             if (r->next_tile < r->job->ntiles) {
                 const uint64_t at = r->cr[w].done_at;
-                tile_begin(r, w, r->next_tile++);
+                tile_begin(r, w, r->next_tile++, 0, r->passes);
                 r->cr[w].wake = at;
                 r->runnable[r->nrunnable++] = w;
                 if (at < r->xmin)
@@ -542,6 +544,15 @@ uint32_t chip_run_frame(Job *j)
         free(r.runnable);
         return 0;
     }
+    for (uint32_t i = 0; j->fp->wave && i < j->fp->nwave; i++)
+        if (j->fp->nwave > (uint32_t)r.k || j->fp->wave[i] >= (uint64_t)j->ntiles * j->spp) {
+            snprintf(err, sizeof err, "chip: a wave of %u units on %d cores, unit %u of %llu", j->fp->nwave, r.k,
+                     j->fp->wave[i], (unsigned long long)j->ntiles * j->spp);
+            eng_fail(j, err, 0);
+            free(r.cr);
+            free(r.runnable);
+            return 0;
+        }
     atomic_init(&r.tiles_done, 0u);
     atomic_init(&r.opening_left, j->fp->opening ? (j->ntiles < (uint32_t)r.k ? j->ntiles : (uint32_t)r.k) : 0u);
     j->ncores = (uint32_t)r.k;
@@ -555,9 +566,18 @@ uint32_t chip_run_frame(Job *j)
     const int threads = j->fp->threads < 1 ? 1 : j->fp->threads > r.k ? r.k : j->fp->threads;
     pool_open(&r.pool, &r, threads - 1);
     if (cores_open(&r) == 0) {
+        if (j->fp->wave) { /* one wave: unit i on core i, on levels warmed first; no more tiles */
+            if (r.chip)
+                chip_warm(r.chip, j->fp->wave_warm, j->fp->nwave_warm);
+            r.next_tile = j->ntiles;
+        }
         for (int k = 0; k < r.k; k++) {
-            if (r.next_tile < j->ntiles) {
-                tile_begin(&r, k, r.next_tile++);
+            if (j->fp->wave && (uint32_t)k < j->fp->nwave) {
+                const uint32_t u = j->fp->wave[k];
+                tile_begin(&r, k, u / j->spp, u % j->spp, u % j->spp + 1);
+                r.runnable[r.nrunnable++] = k;
+            } else if (!j->fp->wave && r.next_tile < j->ntiles) {
+                tile_begin(&r, k, r.next_tile++, 0, r.passes);
                 r.runnable[r.nrunnable++] = k;
             } else {
                 r.cr[k].state = CS_DONE;

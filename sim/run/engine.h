@@ -67,6 +67,15 @@ typedef struct FuncParams {
      * that ended by then has its exact cycles in FuncStats.pass_cycles (the others 0); the chip's
      * figures are those of that moment, and the picture holds the tiles that ended. */
     int opening;
+    /* Detailed, on a chip with shared memory: instead of the frame, one wave (a sampled chip's,
+     * docs/sampling.md): unit wave[i] (tile * spp + pass; nwave <= chip.cores) starts on core i
+     * at cycle 0, from a cleared launch block as a sampled unit does, after the shared levels are
+     * warmed with wave_warm[0..nwave_warm) (oldest first; chip_warm); each core then stops.
+     * FuncStats.pass_cycles has the wave's units' cycles (the others 0). */
+    const uint32_t *wave;
+    uint32_t nwave;
+    const uint64_t *wave_warm;
+    size_t nwave_warm;
 } FuncParams;
 
 typedef struct FuncTile {

@@ -570,3 +570,56 @@ Test(chip, a_chip_unit_warmed_with_its_own_lines_is_faster)
     free(w.lines);
     unload();
 }
+
+/* A sampled chip's wave (FuncParams.wave): K units starting together on a cold chip. A frame of K
+ * tiles and one pass is one wave, so the wave of its units takes exactly the frame's cycles per
+ * unit; warmed with lines, the same wave takes other cycles; more units than cores is refused. */
+Test(chip, a_wave_of_the_frames_units_is_the_frame)
+{
+    load("scenes/cornell/scene.ini", 64, 64, 1); /* 4 tiles */
+    CfgMachine chip;
+    small_frame(&chip);
+    shared_memory(&chip, 4);
+    chip.scene_cache_kb = 4;
+    FuncStats full;
+    float *rgb = render(&chip, &full);
+    static char err[65536];
+    const uint32_t wave[5] = {0, 1, 2, 3, 0};
+    FuncParams fp = {.cfg = &chip, .kernel_path = "kernels/pathtrace.s", .needs = scene.needs, .seed = 1,
+                     .threads = 2, .timed = 1, .wave = wave, .nwave = 4};
+    FuncStats w;
+    cr_assert_eq(func_render(&packed, &fp, NULL, &w, err, sizeof err), 0, "%s", err);
+    for (uint32_t u = 0; u < 4; u++)
+        cr_expect_eq(w.pass_cycles[u], full.pass_cycles[u], "unit %u: %llu in the wave, %llu in the frame", u,
+                     (unsigned long long)w.pass_cycles[u], (unsigned long long)full.pass_cycles[u]);
+    func_stats_free(&w);
+    /* warmed with every line the frame's L1s fetched: fewer cycles in all */
+    fp.mem_trace = 1;
+    FuncStats tr;
+    cr_assert_eq(func_render(&packed, &fp, NULL, &tr, err, sizeof err), 0, "%s", err);
+    uint64_t *lines = malloc((tr.ntrace ? tr.ntrace : 1) * sizeof *lines);
+    size_t n = 0;
+    for (size_t i = 0; i < tr.ntrace; i++)
+        if (!tr.trace[i].write)
+            lines[n++] = tr.trace[i].addr;
+    func_stats_free(&tr);
+    fp.mem_trace = 0;
+    fp.wave_warm = lines;
+    fp.nwave_warm = n;
+    cr_assert_eq(func_render(&packed, &fp, NULL, &w, err, sizeof err), 0, "%s", err);
+    uint64_t cold = 0, warm = 0;
+    for (uint32_t u = 0; u < 4; u++) {
+        cold += full.pass_cycles[u];
+        warm += w.pass_cycles[u];
+    }
+    cr_expect_lt(warm, cold, "warmed %llu cycles, cold %llu", (unsigned long long)warm, (unsigned long long)cold);
+    func_stats_free(&w);
+    fp.nwave = 5;
+    cr_expect_eq(func_render(&packed, &fp, NULL, &w, err, sizeof err), -1);
+    cr_expect(strstr(err, "a wave of 5 units on 4 cores"), "%s", err);
+    func_stats_free(&w);
+    free(lines);
+    free(rgb);
+    func_stats_free(&full);
+    unload();
+}
