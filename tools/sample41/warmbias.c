@@ -6,7 +6,7 @@
  * Build (not part of make; after `make all`):
  *   gcc -O2 -I. -o build/warmbias tools/sample41/warmbias.c build/libsfsim.a -linih -ltinygltf \
  *       -ltinyobjloader -lcjson -lOpenEXRCore-3_1 -lpng16 -lfreetype -lgsl -lgslcblas -lstdc++ -lpthread -ldl -lm
- * usage: warmbias SCENE.ini CONFIG.ini W H SPP [THREADS]
+ * usage: warmbias SCENE.ini CONFIG.ini W H SPP [THREADS [WAVES]]
  *
  * 1. The chip's frame in detailed mode (stream.rays = 1024: 32 x 32 tiles): every unit's cycles
  *    (tiles[].passes[]) and its core; each unit's start is the sum of the units before it on its
@@ -18,7 +18,12 @@
  *    worth kept (chip_warm replays them oldest first). The frame's schedule is used, where a
  *    sampler would have only the predicted one.
  * Prints per unit and the mean and spread of (alone / in the frame - 1), cold and warm, over the
- * units after the first wave (the first K units start on a cold chip in the frame too). */
+ * units after the first wave (the first K units start on a cold chip in the frame too).
+ * 4. With WAVES: at WAVES instants evenly spaced over the frame after its first wave, the K units
+ *    running then (one a core) timed together as a wave (FuncParams.wave), warmed with the lines
+ *    of the units that started before the earliest of them; per wave, the wave's cycles over the
+ *    same units' in the frame (the waves' alignment: they start together, the frame's do not) and
+ *    over the same units alone and warmed (design C's factor r, against the frame's). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -212,6 +217,48 @@ int main(int argc, char **argv)
         sw += w;
         sw2 += w * w;
         n++;
+    }
+    const int nw = argc > 7 ? atoi(argv[7]) : 0;
+    uint64_t first_end = 0;
+    for (uint32_t u = 0; u < nunits; u++)
+        if (start[u] == 0 && full.pass_cycles[u] > first_end)
+            first_end = full.pass_cycles[u];
+    for (int wv = 0; wv < nw; wv++) {
+        const uint64_t at = first_end + (full.makespan - first_end) * (uint64_t)(2 * wv + 1) / (uint64_t)(2 * nw);
+        uint32_t wave[1024], nwave = 0;
+        uint64_t earliest = UINT64_MAX;
+        for (uint32_t u = 0; u < nunits && nwave < full.chip_cores; u++)
+            if (start[u] <= at && at < start[u] + full.pass_cycles[u]) {
+                wave[nwave++] = u;
+                if (start[u] < earliest)
+                    earliest = start[u];
+            }
+        Lines wl = {0};
+        for (uint32_t i = 0; i < nunits; i++) /* the units started before the earliest, in order */
+            if (start[order[i]] < earliest)
+                for (size_t q = 0; q < unit_lines[order[i]].n; q++)
+                    push(&wl, unit_lines[order[i]].a[q]);
+        const size_t keep = wl.n > cap ? cap : wl.n;
+        FuncParams wp = fp;
+        wp.wave = wave;
+        wp.nwave = nwave;
+        wp.wave_warm = wl.a ? wl.a + (wl.n - keep) : NULL;
+        wp.nwave_warm = keep;
+        FuncStats ws;
+        if (func_render(&packed, &wp, NULL, &ws, err, sizeof err)) {
+            fprintf(stderr, "wave: %s\n", err);
+            return 1;
+        }
+        double wsum = 0, fsum = 0, asum = 0;
+        for (uint32_t i = 0; i < nwave; i++) {
+            wsum += (double)ws.pass_cycles[wave[i]];
+            fsum += (double)full.pass_cycles[wave[i]];
+            asum += (double)hot[wave[i]].cycles;
+        }
+        printf("# wave %d at cycle %llu: %u units; wave / frame - 1 %+.3f %%; r: wave / alone %.4f, frame / alone %.4f\n",
+               wv, (unsigned long long)at, nwave, 100 * (wsum / fsum - 1), wsum / asum, fsum / asum);
+        func_stats_free(&ws);
+        free(wl.a);
     }
     if (n) {
         const double mc = sc / n, mw = sw / n;
