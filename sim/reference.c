@@ -29,31 +29,7 @@
 #define PHONG_EXP_MIN 1.0f    /* lowest shininess: no cos^0 step at the highlight's edge */
 #define PHONG_TRI_U (4.0f / 9.0f) /* sample_light's u of a triangle's centroid (sqrt(u) = 2/3) */
 
-/* ---- random numbers ------------------------------------------------------------------------ */
-
-/* A 32-bit integer hash with good avalanche (the "lowbias32" constants published by
- * C. Wellons, 2018): xor-shift, multiply, xor-shift, multiply, xor-shift -- seven vector integer
- * instructions in the kernel. */
-uint32_t ref_hash32(uint32_t x)
-{
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return x;
-}
-
-uint32_t ref_path_key(uint32_t seed, uint32_t pixel, uint32_t sample)
-{
-    return ref_hash32(ref_hash32(pixel ^ ref_hash32(seed)) + sample);
-}
-
-float ref_rand(uint32_t path_key, uint32_t vertex, uint32_t dim)
-{
-    uint32_t h = ref_hash32(path_key + vertex * 16u + dim);
-    return (float)(h >> 8) * (1.0f / 16777216.0f);
-}
+/* ---- random numbers: the generator is sim/ref_random.c; the dimensions a hit vertex uses ---- */
 
 /* Random dimensions used at a hit vertex (vertex 0 is the camera: jitter 0-1, lens 2-3). */
 enum { DIM_DIRECT = 0, DIM_LIGHT = 1, DIM_LIGHT_U = 2, DIM_LIGHT_V = 3, DIM_LOBE = 4,
