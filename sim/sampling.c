@@ -26,7 +26,7 @@ uint32_t sample_count(uint32_t ntiles, double fraction)
     return n > ntiles ? ntiles : n;
 }
 
-static uint64_t splitmix64(uint64_t *s)
+uint64_t sample_splitmix64(uint64_t *s)
 {
     uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
@@ -48,7 +48,7 @@ void sample_order(uint32_t N, uint32_t seed, uint32_t *order)
     for (uint32_t i = 0; i < N; i++)
         order[i] = i;
     for (uint32_t i = 0; i + 1 < N; i++) {
-        uint32_t j = i + (uint32_t)(splitmix64(&s) % (uint64_t)(N - i));
+        uint32_t j = i + (uint32_t)(sample_splitmix64(&s) % (uint64_t)(N - i));
         uint32_t t = order[i];
         order[i] = order[j];
         order[j] = t;

@@ -62,6 +62,10 @@ uint32_t sample_count(uint32_t ntiles, double fraction);
  * prefix order[0, n) is a simple random sample without replacement of size n. */
 void sample_order(uint32_t N, uint32_t seed, uint32_t *order);
 
+/* splitmix64 (Steele, Lea & Flood 2014): advances *state and returns 64 random bits. The one
+ * generator of sampled mode (sample_order's shuffle, sim/chipsampling.c's tile-effect draws). */
+uint64_t sample_splitmix64(uint64_t *state);
+
 #define SAMPLE_MAX_AUX 8 /* auxiliary variables the regression estimator takes at most */
 
 typedef struct SampleEstimate {
