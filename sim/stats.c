@@ -255,6 +255,9 @@ StatsFrame stats_frame_of(const StatsCtx *c)
         s.busy = (double)c->t->busy / k;
         s.fps = s.fps_lo = s.fps_hi = s.cycles > 0 ? hz / s.cycles : 0.0;
         s.fps_no_stall = s.busy > 0 ? hz / s.busy : 0.0;
+    } else if (c->est && c->cfg && c->cfg->chip_cores > 1) { /* a sampled chip: its busy over the K cores */
+        s.busy /= (double)c->cfg->chip_cores;
+        s.fps_no_stall = s.busy > 0 ? mhz * 1e6 / s.busy : 0.0;
     }
     return s;
 }
@@ -280,6 +283,21 @@ FIG(sample_t) { UNUSED_FIG_ARGS; return c->est->t; }
 FIG(sample_std_error) { UNUSED_FIG_ARGS; return c->est->std_error; }
 FIG(sample_r2) { UNUSED_FIG_ARGS; return c->est->r2; }
 FIG(sample_instr) { UNUSED_FIG_ARGS; return c->est_instructions ? c->est_instructions->total : 0.0; }
+static const StatsChipSample *cs(const StatsCtx *c) { return c->chip_sample; }
+FIG(cs_opening_units) { UNUSED_FIG_ARGS; return cs(c)->opening_units; }
+FIG(cs_waves) { UNUSED_FIG_ARGS; return cs(c)->waves; }
+FIG(cs_wave_units) { UNUSED_FIG_ARGS; return cs(c)->wave_units; }
+FIG(cs_alone_units) { UNUSED_FIG_ARGS; return cs(c)->alone_units; }
+FIG(cs_r) { UNUSED_FIG_ARGS; return cs(c)->r; }
+FIG(cs_r_ci95) { UNUSED_FIG_ARGS; return idx[0] ? cs(c)->r_hi : cs(c)->r_lo; }
+FIG(cs_plain) { UNUSED_FIG_ARGS; return cs(c)->plain; }
+FIG(cs_var_jack) { UNUSED_FIG_ARGS; return cs(c)->var_jack; }
+FIG(cs_var_draws) { UNUSED_FIG_ARGS; return cs(c)->var_draws; }
+FIG(cs_var_r) { UNUSED_FIG_ARGS; return cs(c)->var_r; }
+FIG(cs_sigma_a) { UNUSED_FIG_ARGS; return cs(c)->sigma_a; }
+FIG(cs_sigma_e) { UNUSED_FIG_ARGS; return cs(c)->sigma_e; }
+FIG(cs_warm_units) { UNUSED_FIG_ARGS; return cs(c)->warm_units; }
+FIG(cs_warm_seconds) { UNUSED_FIG_ARGS; return cs(c)->warm_seconds; }
 FIG(rays_total) { UNUSED_FIG_ARGS; return (double)(c->run->primary + c->run->shadow + c->run->indirect); }
 FIG(instructions) { UNUSED_FIG_ARGS; return (double)c->f->instructions; }
 FIG(ops) { UNUSED_FIG_ARGS; return (double)stats_ops(&c->f->core, idx[0]); }
@@ -478,28 +496,32 @@ FIG(dram_queue_avg)
 
 /* ---- energy, power and area (sim/energy/energy.h computes them once after the run) ---------- */
 
-/* A view with no energy computed (a report built without report_energy) reads zeros. */
-static const EnergyReport *en(const StatsCtx *c)
+/* A view with no energy computed (a report built without report_energy, or a run whose energy is
+ * not estimated: a sampled chip with shared memory, docs/energy.md) reads zeros marked as having no
+ * meaning (null in report.json, "-" in report.txt). */
+static const EnergyReport *en(const StatsCtx *c, int *na)
 {
     static const EnergyReport none;
+    if (!c->energy)
+        *na = 1;
     return c->energy ? c->energy : &none;
 }
-FIG(energy_total) { UNUSED_FIG_ARGS; return en(c)->total_j; }
-FIG(energy_events) { UNUSED_FIG_ARGS; return en(c)->events_j; }
-FIG(energy_leakage) { UNUSED_FIG_ARGS; return en(c)->leakage_j; }
-FIG(energy_ci95) { UNUSED_FIG_ARGS; return idx[0] ? en(c)->total_hi : en(c)->total_lo; }
-FIG(energy_part_events) { UNUSED_FIG_ARGS; return en(c)->events[idx[0]]; }
-FIG(energy_part_leakage) { UNUSED_FIG_ARGS; return en(c)->leakage[idx[0]]; }
-FIG(energy_level) { UNUSED_FIG_ARGS; return en(c)->level[idx[0]]; }
-FIG(energy_dram) { return defined_if(en(c)->dram[idx[0]], en(c)->dram_known || idx[0] == EN_D_IO, na); }
-FIG(energy_dram_pj_bit) { (void)idx; return defined_if(en(c)->dram_pj_per_bit, en(c)->dram_known, na); }
-FIG(power_average) { UNUSED_FIG_ARGS; return en(c)->average_w; }
-FIG(power_leakage) { UNUSED_FIG_ARGS; return en(c)->leakage_w; }
-FIG(mrays_per_j) { (void)idx; return defined_if(en(c)->mrays_per_j, en(c)->total_j > 0, na); }
-FIG(fps_per_w) { (void)idx; return defined_if(en(c)->fps_per_w, en(c)->total_j > 0, na); }
-FIG(area) { UNUSED_FIG_ARGS; return en(c)->area[idx[0]]; }
-FIG(fps_per_mm2) { (void)idx; return defined_if(en(c)->fps_per_mm2, en(c)->fps_per_mm2 > 0, na); }
-FIG(energy_node) { UNUSED_FIG_ARGS; return en(c)->node_nm; }
+FIG(energy_total) { UNUSED_FIG_ARGS; return en(c, na)->total_j; }
+FIG(energy_events) { UNUSED_FIG_ARGS; return en(c, na)->events_j; }
+FIG(energy_leakage) { UNUSED_FIG_ARGS; return en(c, na)->leakage_j; }
+FIG(energy_ci95) { UNUSED_FIG_ARGS; return idx[0] ? en(c, na)->total_hi : en(c, na)->total_lo; }
+FIG(energy_part_events) { UNUSED_FIG_ARGS; return en(c, na)->events[idx[0]]; }
+FIG(energy_part_leakage) { UNUSED_FIG_ARGS; return en(c, na)->leakage[idx[0]]; }
+FIG(energy_level) { UNUSED_FIG_ARGS; return en(c, na)->level[idx[0]]; }
+FIG(energy_dram) { return defined_if(en(c, na)->dram[idx[0]], c->energy && (en(c, na)->dram_known || idx[0] == EN_D_IO), na); }
+FIG(energy_dram_pj_bit) { (void)idx; return defined_if(en(c, na)->dram_pj_per_bit, c->energy && en(c, na)->dram_known, na); }
+FIG(power_average) { UNUSED_FIG_ARGS; return en(c, na)->average_w; }
+FIG(power_leakage) { UNUSED_FIG_ARGS; return en(c, na)->leakage_w; }
+FIG(mrays_per_j) { (void)idx; return defined_if(en(c, na)->mrays_per_j, en(c, na)->total_j > 0, na); }
+FIG(fps_per_w) { (void)idx; return defined_if(en(c, na)->fps_per_w, en(c, na)->total_j > 0, na); }
+FIG(area) { UNUSED_FIG_ARGS; return en(c, na)->area[idx[0]]; }
+FIG(fps_per_mm2) { (void)idx; return defined_if(en(c, na)->fps_per_mm2, en(c, na)->fps_per_mm2 > 0, na); }
+FIG(energy_node) { UNUSED_FIG_ARGS; return en(c, na)->node_nm; }
 
 /* ---- the table ------------------------------------------------------------------------------ */
 

@@ -195,6 +195,20 @@ int stats_dim_size(StatsDim d);
 const char *stats_dim_key(StatsDim d, int i);
 
 /* What the walk reads. */
+/* A sampled chip's own figures (sim/run/chipsampled.c, docs/sampling.md "Sampling a chip"). */
+typedef struct StatsChipSample {
+    int on;                    /* the frame was a chip's, sampled */
+    uint32_t cores;            /* chip.cores */
+    uint32_t opening_units;    /* units timed exactly in the chip's opening (its first wave) */
+    uint32_t waves, wave_units, alone_units; /* waves timed on the whole chip, their units, and those timed alone too */
+    double r, r_lo, r_hi;      /* the other cores' factor (the waves' cycles over the same units' alone), 95 % */
+    double plain;              /* the makespan estimate without the tile-effect correction */
+    double var_jack, var_draws, var_r; /* the makespan's variance by part */
+    double sigma_a, sigma_e;   /* tile effect and within-tile spread of the fit's relative residuals */
+    uint32_t warm_units;       /* units whose lines the golden model recorded for the warming */
+    double warm_seconds;       /* ... and its host time */
+} StatsChipSample;
+
 struct StatsCtx {
     unsigned mode;               /* one of STATS_M_REF/FUNC/DET/SAMP/EXEC, | STATS_M_KD */
     const CfgMachine *cfg;       /* lanes, clock, scene cache (may be NULL in exec) */
@@ -204,6 +218,7 @@ struct StatsCtx {
     const SampleEstimate *est;   /* sampled mode: the cycles */
     const SampleEstimate *est_instructions; /* ... the instructions */
     uint32_t rounds;             /* ... rounds of the sequential rule */
+    const StatsChipSample *chip_sample; /* ... on a chip */
     const struct EnergyReport *energy; /* timed modes: the run's energy and area (sim/energy/energy.h) */
 };
 

@@ -183,12 +183,6 @@ static int run_machine(const RenderOptions *o, const CfgMachine *cfg)
         fprintf(stderr, "sfsim run: --mode reference: workload.kind = %s has no golden model (path and phong do)\n", kind);
         return EXIT_INPUT;
     }
-    if (o->mode == RUN_SAMPLED && (cfg->chip_cores > 1 || cfg->chip_memory == CFG_CHIP_MEMORY_SHARED)) {
-        fprintf(stderr, "sfsim run: --mode sampled: a chip (chip.cores = %d, chip.memory = %s) is simulated in "
-                        "detailed mode only for now (docs/chip.md); use --mode detailed\n", cfg->chip_cores,
-                cfg_enum_name("chip", "memory", cfg->chip_memory));
-        return EXIT_INPUT;
-    }
     if (o->mode == RUN_SAMPLED && !run_workload_golden(cfg)) {
         fprintf(stderr, "sfsim run: --mode sampled: workload.kind = %s has no golden model to draw the units' "
                         "auxiliary counts from (path and phong do); use --mode detailed\n", kind);

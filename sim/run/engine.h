@@ -65,7 +65,9 @@ typedef struct FuncParams {
     /* Detailed, on a chip: the frame only until pass 0 of each of its first K tiles (the chip's
      * first wave, a sampled chip's opening: docs/sampling.md) has ended. Every (tile, pass) unit
      * that ended by then has its exact cycles in FuncStats.pass_cycles (the others 0); the chip's
-     * figures are those of that moment, and the picture holds the tiles that ended. */
+     * figures are those of that moment (the timing sums hold the busy and stall cycles of the units
+     * cut off, not their cycles, so they are not checked), and the picture holds the tiles that
+     * ended. */
     int opening;
     /* Detailed, on a chip with shared memory: instead of the frame, one wave (a sampled chip's,
      * docs/sampling.md): unit wave[i] (tile * spp + pass; nwave <= chip.cores) starts on core i

@@ -17,6 +17,7 @@
 #include "../reference.h"
 #include "../ref_trace.h"
 #include "../util.h"
+#include "chipsampled.h"
 #include "sampled.h"
 
 /* The caller's size over the scene's [render], and the ranges a frame needs. */
@@ -121,6 +122,8 @@ static int kernel_frame(const RunScene *sc, const RunSpec *spec, const CfgMachin
                      .timed = run_mode_timed(spec->mode),
                      .mem_trace = spec->mode == RUN_DETAILED && spec->mem_trace,
                      .timeline = spec->mode == RUN_DETAILED ? spec->timeline : NULL};
+    if (spec->mode == RUN_SAMPLED && chipsampled_wanted(cfg))
+        return chipsampled_frame(sc, spec, cfg, &fp, fr, err, errlen);
     if (spec->mode == RUN_SAMPLED)
         return sampled_frame(sc, spec, cfg, &fp, fr, err, errlen);
     int rc = func_render(&sc->p, &fp, fr->rgb, &fr->f, err, errlen);

@@ -72,6 +72,7 @@ typedef struct RunFrame {
     uint32_t rounds;           /* RUN_SAMPLED: rounds of the sequential rule */
     double golden_seconds;     /* RUN_SAMPLED: host time of the golden model (image and counts) */
     double *tile_cycles;       /* RUN_SAMPLED: each tile's estimated cycles (f.ntiles entries) */
+    StatsChipSample chip;      /* RUN_SAMPLED on a chip */
     int tile;                  /* the stream's tile side for the golden model: sqrt(stream.rays) */
     int threads;               /* host threads used */
     double seconds;            /* host time rendering */

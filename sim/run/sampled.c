@@ -59,17 +59,24 @@ static int measure(void *ctx, const uint32_t *units, uint32_t count, double *ys)
     return 0;
 }
 
+RefParams sampled_ref_params(const RunSpec *spec, const CfgMachine *cfg, const RunFrame *fr)
+{
+    assert(run_workload_golden(cfg)); /* the options' check refused the others (sim/cli/runopts.c) */
+    return (RefParams){.tile = fr->tile, .seed = spec->seed, .threads = fr->threads, .progress = spec->progress,
+                       .progress_ctx = spec->progress_ctx, .bounces = cfg->workload_bounces,
+                       .workload = cfg->workload_kind == CFG_WORKLOAD_PHONG ? REF_WORKLOAD_PHONG : REF_WORKLOAD_PATH,
+                       .simd_width = cfg->core_simd_width};
+}
+
 /* The golden model over the frame (or, with no image, over its pilot passes): the image, the
  * rays, and each unit's counts. */
 static int golden_units(const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg, RunFrame *fr,
                         RefUnitStats *units, RefStats *rs, char *err, size_t errlen)
 {
-    assert(run_workload_golden(cfg)); /* the options' check refused the others (sim/cli/runopts.c) */
-    RefParams rp = {.tile = fr->tile, .seed = spec->seed, .threads = fr->threads, .progress = spec->progress,
-                    .progress_ctx = spec->progress_ctx, .bounces = cfg->workload_bounces,
-                    .workload = cfg->workload_kind == CFG_WORKLOAD_PHONG ? REF_WORKLOAD_PHONG : REF_WORKLOAD_PATH,
-                    .units = units, .simd_width = cfg->core_simd_width,
-                    .pass0 = 0, .pass1 = spec->no_image ? SAMPLED_PILOT_PASSES : 0};
+    RefParams rp = sampled_ref_params(spec, cfg, fr);
+    rp.units = units;
+    rp.pass0 = 0;
+    rp.pass1 = spec->no_image ? SAMPLED_PILOT_PASSES : 0;
     if (rp.pass1 >= (uint32_t)sc->s.render.spp)
         rp.pass1 = 0;
     return ref_render(&sc->p, &rp, fr->rgb, rs, err, errlen);
@@ -163,9 +170,7 @@ static double *tile_estimates(const SampleEstimate *e, const double *x, const Me
     return tc;
 }
 
-/* Sampled mode numbers a frame's (tile, pass) units in 32 bits: 0, or -1 with fs closed and a
- * message when the frame has more. */
-static int units_countable(FuncSession *fs, char *err, size_t errlen)
+int sampled_countable(FuncSession *fs, char *err, size_t errlen)
 {
     if (func_units_total(fs) <= UINT32_MAX)
         return 0;
@@ -179,41 +184,56 @@ static int units_countable(FuncSession *fs, char *err, size_t errlen)
     return -1;
 }
 
+int sampled_golden(const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg, RunFrame *fr, uint32_t N,
+                   double *x, char *err, size_t errlen)
+{
+    const uint32_t spp = (uint32_t)sc->s.render.spp, ntiles = N / spp;
+    const uint32_t pilot = spec->no_image && spp > SAMPLED_PILOT_PASSES ? SAMPLED_PILOT_PASSES : 0;
+    RefUnitStats *units = calloc(N ? N : 1, sizeof *units);
+    if (!units) {
+        snprintf(err, errlen, "out of memory for %u units", N);
+        return -1;
+    }
+    const double t0 = util_now();
+    RefStats rs;
+    int rc = golden_units(sc, spec, cfg, fr, units, &rs, err, errlen);
+    fr->golden_seconds = util_now() - t0;
+    if (rc == 0 && rs.tiles != ntiles) {
+        snprintf(err, errlen, "sampled mode: the golden model has %llu tiles, the kernel %u",
+                 (unsigned long long)rs.tiles, ntiles);
+        rc = -1;
+    }
+    if (rc == 0) {
+        if (spec->no_image) /* the pilot's passes are not the frame's image */
+            memset(fr->rgb, 0, 3 * sizeof(float) * (size_t)sc->s.render.width * (size_t)sc->s.render.height);
+        golden_run_figures(&rs, spp, pilot, &fr->run);
+        sampled_aux_matrix(units, ntiles, spp, pilot, x);
+    }
+    free(units);
+    return rc;
+}
+
 int sampled_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg, const FuncParams *fp,
                   RunFrame *fr, char *err, size_t errlen)
 {
     err[0] = '\0';
     uint32_t spp = (uint32_t)sc->s.render.spp;
-    uint32_t pilot = spec->no_image && (uint32_t)spp > SAMPLED_PILOT_PASSES ? SAMPLED_PILOT_PASSES : 0;
     FuncSession *fs = NULL;
     if (func_open(&sc->p, fp, &fs, err, errlen) != 0)
         return -1;
-    if (units_countable(fs, err, errlen) != 0)
+    if (sampled_countable(fs, err, errlen) != 0)
         return -1;
     uint32_t N = (uint32_t)func_units_total(fs), ntiles = N / spp;
-    RefUnitStats *units = calloc(N, sizeof *units);
     double *x = malloc((size_t)N * AUX_K * sizeof *x), *ys = malloc((size_t)N * sizeof *ys);
     Measured m = {.fs = fs, .units = calloc(N, sizeof(FuncUnit)), .instructions = malloc((size_t)N * sizeof(double)),
                   .spec = spec};
     int rc = -1;
-    if (!units || !x || !ys || !m.units || !m.instructions) {
+    if (!x || !ys || !m.units || !m.instructions) {
         snprintf(err, errlen, "out of memory for %u units", N);
         goto out;
     }
-    double t0 = util_now();
-    RefStats rs;
-    if (golden_units(sc, spec, cfg, fr, units, &rs, err, errlen) != 0)
+    if (sampled_golden(sc, spec, cfg, fr, N, x, err, errlen) != 0)
         goto out;
-    fr->golden_seconds = util_now() - t0;
-    if (rs.tiles != ntiles) {
-        snprintf(err, errlen, "sampled mode: the golden model has %llu tiles, the kernel %u",
-                 (unsigned long long)rs.tiles, ntiles);
-        goto out;
-    }
-    if (spec->no_image) /* the pilot's passes are not the frame's image */
-        memset(fr->rgb, 0, 3 * sizeof(float) * (size_t)sc->s.render.width * (size_t)sc->s.render.height);
-    golden_run_figures(&rs, spp, pilot, &fr->run);
-    sampled_aux_matrix(units, ntiles, spp, pilot, x);
     m.N = N;
     rc = draw_sample(spec, x, N, &m, ys, fr, err, errlen);
     if (rc == 0 && !(fr->tile_cycles = tile_estimates(&fr->est, x, &m, ntiles, spp))) {
@@ -229,7 +249,6 @@ out:;
         rc = crc;
     }
     fr->units_sampled = m.n;
-    free(units);
     free(x);
     free(ys);
     free(m.units);
@@ -270,7 +289,7 @@ int sampled_population(const RunScene *sc, const RunSpec *spec, SampledPopulatio
     FuncSession *fs;
     if (func_open(&sc->p, &fp, &fs, err, errlen) != 0)
         return -1;
-    if (units_countable(fs, err, errlen) != 0)
+    if (sampled_countable(fs, err, errlen) != 0)
         return -1;
     pop->N = (uint32_t)func_units_total(fs);
     pop->spp = (uint32_t)sc->s.render.spp;

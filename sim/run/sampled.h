@@ -11,6 +11,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "../reference.h"
 #include "run.h"
 
 /* --no-image: the golden model runs only the first passes of every tile (the pilot), and the
@@ -36,6 +37,17 @@ void sampled_aux_matrix(const struct RefUnitStats *units, uint32_t ntiles, uint3
  * image (unless spec->no_image), run figures, estimates and counters. 0, -1 or -2 as run_frame. */
 int sampled_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg, const FuncParams *fp,
                   RunFrame *fr, char *err, size_t errlen);
+
+/* Sampled mode's and a sampled chip's golden model (sim/run/chipsampled.c): the frame's
+ * RefParams for spec on cfg with fr's tile and threads (no units, passes or tiles chosen). */
+RefParams sampled_ref_params(const RunSpec *spec, const CfgMachine *cfg, const RunFrame *fr);
+/* The golden model over the frame (or the pilot of --no-image) into fr (image, run figures,
+ * golden_seconds) and the N units' auxiliaries into x (N x SAMPLED_AUX_K). 0, or -1 with err. */
+int sampled_golden(const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg, RunFrame *fr, uint32_t N,
+                   double *x, char *err, size_t errlen);
+/* Sampled mode numbers a frame's (tile, pass) units in 32 bits: 0, or -1 with fs closed and a
+ * message when the frame has more. */
+int sampled_countable(struct FuncSession *fs, char *err, size_t errlen);
 
 /* The whole population of a frame's units, for the tests and bench/speed_vs_error: every unit
  * timed on the kernel (its cycles are those of the full detailed run, tests/unit/test_units.c) and

@@ -2,8 +2,8 @@
 # tests/cli/cases/chip.sh -- `sfsim run` on a chip (docs/chip.md): the chip's report (per-core
 # busy + stall + idle = cores x cycles, the memory sections, stalls by level) and `--mem-trace`
 # (one line per request the scene caches sent below, the count the report gives, replayable by
-# `sfsim mem`), and the misuses: --mem-trace outside detailed mode, a chip in sampled mode or in
-# `sfsim trace`, an L2 that does not divide into sets.
+# `sfsim mem`), sampled mode on a chip against its detailed run, and the misuses: --mem-trace
+# outside detailed mode, a chip in `sfsim trace`, an L2 that does not divide into sets.
 set -u
 cd "$(dirname "$0")/../../.." || exit 2
 SFSIM=${SFSIM:-bin/sfsim}
@@ -55,10 +55,22 @@ want_err "--mem-trace"
 [ ! -e "$T/x.trc" ] || no "a trace was written"
 end
 
-begin "chip: sampled mode on a chip says it is not built yet"
-run "$SFSIM" run --mode sampled --sample 0.5 --set chip.cores=2 "${small[@]}" -o "$T/s"
-want_rc 1
-want_err "detailed mode only"
+begin "chip: sampled mode on 4 cores with an L2 and DDR4 estimates the makespan with an interval"
+sm=(--set render.width=128 --set render.height=128 --set render.spp=4 --set stream.rays=1024)
+run "$SFSIM" run --mode sampled --sample 0.5 -c configs/chip16-ddr4.ini --set chip.cores=4 "${sm[@]}" -o "$T/s"
+want_rc 0
+want_out "wrote .*report.json"
+grep -q '^chip sample ' "$T/s/report.txt" || no "report.txt lacks the chip sample line"
+[ "$(json "$T/s/report.json" "j['cycles_ci95'][0] <= j['cycles'] <= j['cycles_ci95'][1]")" = True ] ||
+    no "the estimate is not inside its interval"
+[ "$(json "$T/s/report.json" "j['sample']['chip']['opening_units'] >= 4 and j['sample']['chip']['waves'] == 4")" = True ] ||
+    no "no opening of 4 units or not 4 waves"
+[ "$(json "$T/s/report.json" "j['energy']['total_j']")" = 0 ] || no "energy is given though not estimated"
+grep -q '^energy .*total j -' "$T/s/report.txt" || no "report.txt gives an energy it did not estimate"
+run "$SFSIM" run --mode detailed -c configs/chip16-ddr4.ini --set chip.cores=4 "${sm[@]}" -o "$T/d"
+want_rc 0
+[ "$(python3 -c "import json; s=json.load(open('$T/s/report.json')); d=json.load(open('$T/d/report.json')); print(abs(s['cycles'] / d['cycles'] - 1) < 0.03)")" = True ] ||
+    no "the sampled makespan is more than 3 % from the detailed one"
 end
 
 begin "chip: sfsim trace on 4 cores with an L2 and DDR4 gives functional mode's hits"

@@ -1,0 +1,519 @@
+/* sim/run/chipsampled.c -- sampled mode on a chip (chipsampled.h; docs/sampling.md, "Sampling a
+ * chip"). */
+#include "chipsampled.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../chipsampling.h"
+#include "../sampling.h"
+#include "../util.h"
+#include "chipwarm.h"
+#include "sampled.h"
+
+enum { AUX_K = SAMPLED_AUX_K };
+
+typedef struct ChipSampler {
+    const RunScene *sc;
+    const RunSpec *spec;
+    RunFrame *fr;
+    CfgMachine ucfg;           /* the units' machine: cfg, or one core on its bus for a chip of buses */
+    FuncParams fp;             /* the chip's frame (the opening, the waves) */
+    FuncParams up;             /* the units alone (a session keeps a pointer to it) */
+    uint32_t N, ntiles, spp, K;
+    int shared;                /* chip.memory = shared: units on the chip's levels, warmed; waves */
+    double *x, *exact, *pred, *start; /* N each: auxiliaries (N x AUX_K), exact chip cycles (< 0:
+                                         unknown), predicted cycles and start */
+    uint32_t *order, *pos;     /* N each: units in predicted start order, each unit's position */
+    double *tile, *tstart;     /* ntiles each */
+    ChipWarm *warm;
+    uint64_t **wl;             /* N: the warming list of each unit being timed (else NULL) */
+    size_t *wlen;
+    FuncSession *fs;
+    FuncUnit *units;           /* N: phase 1's units in sample order, n of them */
+    double *instructions;      /* N: their instructions */
+    uint32_t n;
+    double started;
+    char *err;
+    size_t errlen;
+} ChipSampler;
+
+uint32_t chipsampled_waves(uint32_t cores) { return cores > 64 ? 2u : 4u; }
+
+int chipsampled_wanted(const CfgMachine *cfg)
+{
+    return cfg->chip_cores > 1 || cfg->chip_memory == CFG_CHIP_MEMORY_SHARED;
+}
+
+/* FuncParams.unit_warm: the list made for the unit before its batch ran. */
+static const uint64_t *warm_of(void *ctx, uint32_t unit, size_t *n)
+{
+    const ChipSampler *s = ctx;
+    *n = s->wlen[unit];
+    return s->wl[unit];
+}
+
+static void note(const ChipSampler *s, const char *fmt, unsigned a, unsigned b, unsigned c)
+{
+    if (!s->spec->note)
+        return;
+    char line[240];
+    snprintf(line, sizeof line, fmt, a, b, c);
+    size_t len = strlen(line);
+    snprintf(line + len, sizeof line - len, " (%.1fs so far)", util_now() - s->started);
+    s->spec->note(s->spec->progress_ctx, line);
+}
+
+/* ---- the predicted schedule -------------------------------------------------------------------- */
+
+typedef struct StartKey {
+    double start;
+    uint32_t unit;
+} StartKey;
+
+static int start_order(const void *a, const void *b)
+{
+    const StartKey *x = a, *y = b;
+    if (x->start != y->start)
+        return x->start < y->start ? -1 : 1;
+    return (x->unit > y->unit) - (x->unit < y->unit);
+}
+
+/* Every unit's predicted cycles (exact where known, else coef's fit of the golden counts, at least
+ * 1), the list schedule of the tiles, each unit's start, and the units in start order. */
+static int schedule(ChipSampler *s, const double *coef)
+{
+    StartKey *keys = malloc((size_t)s->N * sizeof *keys);
+    if (!keys) {
+        snprintf(s->err, s->errlen, "out of memory for %u units' schedule", s->N);
+        return -1;
+    }
+    for (uint32_t t = 0; t < s->ntiles; t++)
+        s->tile[t] = 0.0;
+    for (uint32_t u = 0; u < s->N; u++) {
+        double p = coef[0];
+        for (int j = 0; j < AUX_K; j++)
+            p += coef[j + 1] * s->x[(size_t)u * AUX_K + j];
+        s->pred[u] = s->exact[u] >= 0.0 ? s->exact[u] : p > 1.0 ? p : 1.0;
+        s->tile[u / s->spp] += s->pred[u];
+    }
+    if (chip_list_schedule(s->tile, s->ntiles, s->K, s->tstart, NULL) < 0.0) {
+        snprintf(s->err, s->errlen, "out of memory for %u cores' schedule", s->K);
+        free(keys);
+        return -1;
+    }
+    for (uint32_t t = 0; t < s->ntiles; t++) {
+        double at = s->tstart[t];
+        for (uint32_t p = 0; p < s->spp; p++) {
+            const uint32_t u = t * s->spp + p;
+            s->start[u] = at;
+            at += s->pred[u];
+            keys[u] = (StartKey){s->start[u], u};
+        }
+    }
+    qsort(keys, s->N, sizeof *keys, start_order);
+    for (uint32_t i = 0; i < s->N; i++) {
+        s->order[i] = keys[i].unit;
+        s->pos[keys[i].unit] = i;
+    }
+    free(keys);
+    return 0;
+}
+
+/* The first schedule's fit: the opening's exact units on their golden counts when there are enough
+ * of them for the regression, else the counts' sum (only the order of the starts matters here). */
+static void first_coef(const ChipSampler *s, double coef[AUX_K + 1])
+{
+    coef[0] = 0.0;
+    for (int j = 0; j < AUX_K; j++)
+        coef[j + 1] = 1.0;
+    uint32_t *sample = malloc((size_t)s->N * sizeof *sample);
+    double *ys = malloc((size_t)s->N * sizeof *ys);
+    uint32_t n = 0;
+    for (uint32_t u = 0; sample && ys && u < s->N; u++)
+        if (s->exact[u] >= 0.0) {
+            sample[n] = u;
+            ys[n++] = s->exact[u];
+        }
+    SampleEstimate e;
+    if (sample && ys && n >= AUX_K + 3 && n < s->N &&
+        sample_regression_estimate(ys, s->x, AUX_K, sample, n, s->N, &e) == 0 && e.r2 > 0.5)
+        memcpy(coef, e.coef, (AUX_K + 1) * sizeof *coef);
+    free(sample);
+    free(ys);
+}
+
+/* ---- timing units ------------------------------------------------------------------------------ */
+
+/* The units alone (units[i] into out[i]), each warmed from the current schedule's units before it. */
+static int time_alone(ChipSampler *s, const uint32_t *units, uint32_t n, FuncUnit *out)
+{
+    int rc = 0;
+    if (s->shared) {
+        uint32_t *pos = calloc(n ? n : 1, sizeof *pos);
+        uint64_t **lists = calloc(n ? n : 1, sizeof *lists);
+        size_t *lens = calloc(n ? n : 1, sizeof *lens);
+        if (!pos || !lists || !lens) {
+            snprintf(s->err, s->errlen, "out of memory for %u units' warming", n);
+            rc = -1;
+        }
+        for (uint32_t i = 0; rc == 0 && i < n; i++)
+            pos[i] = s->pos[units[i]];
+        if (rc == 0)
+            rc = chipwarm_lists(s->warm, s->order, pos, n, run_spec_threads(s->spec), lists, lens, s->err, s->errlen);
+        for (uint32_t i = 0; rc == 0 && i < n; i++) { /* (a unit twice in a batch: one list kept) */
+            free(s->wl[units[i]]);
+            s->wl[units[i]] = lists[i];
+            s->wlen[units[i]] = lens[i];
+            lists[i] = NULL;
+        }
+        free(pos);
+        free(lists);
+        free(lens);
+    }
+    if (rc == 0)
+        rc = func_units(s->fs, units, n, out, s->err, s->errlen);
+    for (uint32_t i = 0; s->shared && i < n; i++) {
+        free(s->wl[units[i]]);
+        s->wl[units[i]] = NULL;
+        s->wlen[units[i]] = 0;
+    }
+    return rc;
+}
+
+/* sim/sampling.h's SampleMeasure: phase 1's next units. */
+static int measure(void *ctx, const uint32_t *units, uint32_t count, double *ys)
+{
+    ChipSampler *s = ctx;
+    note(s, "timing units %u..%u of %u alone", s->n + 1, s->n + count, s->N);
+    FuncUnit *out = &s->units[s->n];
+    if (time_alone(s, units, count, out) != 0)
+        return -1;
+    for (uint32_t i = 0; i < count; i++) {
+        ys[i] = (double)out[i].cycles;
+        s->instructions[s->n + i] = (double)out[i].instructions;
+    }
+    s->n += count;
+    return 0;
+}
+
+/* The opening: the chip's frame until pass 0 of its first K tiles has ended; every unit that ended
+ * by then is exact. */
+static int opening(ChipSampler *s)
+{
+    FuncParams op = s->fp;
+    op.opening = 1;
+    op.progress = NULL;
+    FuncStats st;
+    note(s, "the chip's opening: its first %u units in full", s->ntiles < s->K ? s->ntiles : s->K, 0, 0);
+    int rc = func_render(&s->sc->p, &op, NULL, &st, s->err, s->errlen);
+    if (rc == 0 && (!st.pass_cycles || st.pass_spp != s->spp)) {
+        snprintf(s->err, s->errlen, "sampled chip: the opening reported no units' cycles");
+        rc = -1;
+    }
+    for (uint32_t u = 0; rc == 0 && u < s->N; u++)
+        if (st.pass_cycles[u] > 0) {
+            s->exact[u] = (double)st.pass_cycles[u];
+            s->fr->chip.opening_units++;
+        }
+    func_stats_free(&st);
+    return rc;
+}
+
+/* ---- phase 2: the waves ------------------------------------------------------------------------ */
+
+/* One wave at cycle `at` of the predicted schedule: its units' cycles together (*wsum) and alone
+ * (*asum), over the units timed both ways. 0 (nothing running then: *wsum = *asum = 0), or -1. */
+static int wave_at(ChipSampler *s, double at, double *wsum, double *asum)
+{
+    *wsum = *asum = 0.0;
+    uint32_t *wave = malloc((size_t)s->K * sizeof *wave), nwave = 0, first = s->N;
+    FuncUnit *alone = calloc(CHIPSAMPLED_WAVE_ALONE, sizeof *alone);
+    if (!wave || !alone) {
+        snprintf(s->err, s->errlen, "out of memory for a wave of %u units", s->K);
+        free(wave);
+        free(alone);
+        return -1;
+    }
+    for (uint32_t i = 0; i < s->N && nwave < s->K; i++) { /* in start order: the earliest first */
+        const uint32_t u = s->order[i];
+        if (s->start[u] <= at && at < s->start[u] + s->pred[u]) {
+            wave[nwave++] = u;
+            if (first == s->N)
+                first = i;
+        }
+    }
+    int rc = 0;
+    if (nwave) {
+        uint64_t *lines = NULL;
+        size_t nlines = 0;
+        rc = chipwarm_lists(s->warm, s->order, &first, 1, run_spec_threads(s->spec), &lines, &nlines, s->err,
+                            s->errlen);
+        FuncParams wp = s->fp;
+        wp.wave = wave;
+        wp.nwave = nwave;
+        wp.wave_warm = lines;
+        wp.nwave_warm = nlines;
+        wp.progress = NULL;
+        FuncStats st = {0};
+        if (rc == 0)
+            rc = func_render(&s->sc->p, &wp, NULL, &st, s->err, s->errlen);
+        free(lines);
+        const uint32_t m = nwave < CHIPSAMPLED_WAVE_ALONE ? nwave : CHIPSAMPLED_WAVE_ALONE;
+        uint32_t pick[CHIPSAMPLED_WAVE_ALONE];
+        for (uint32_t i = 0; i < m; i++) /* evenly over the wave's cores */
+            pick[i] = wave[(uint32_t)((uint64_t)i * nwave / m)];
+        if (rc == 0)
+            rc = time_alone(s, pick, m, alone);
+        for (uint32_t i = 0; rc == 0 && i < m; i++) {
+            *wsum += (double)st.pass_cycles[pick[i]];
+            *asum += (double)alone[i].cycles;
+        }
+        if (rc == 0) {
+            s->fr->chip.wave_units += nwave;
+            s->fr->chip.alone_units += m;
+        }
+        func_stats_free(&st);
+    }
+    free(wave);
+    free(alone);
+    return rc;
+}
+
+/* The other cores' factor r over waves evenly spaced after the opening (a seeded offset), and its
+ * relative variance (the delete-one jackknife over waves). No waves to time (the opening is the
+ * frame): r = 1, exact. */
+static int waves(ChipSampler *s, double *r, double *rel_var)
+{
+    *r = 1.0;
+    *rel_var = 0.0;
+    double first_end = 0.0, end = 0.0;
+    for (uint32_t u = 0; u < s->N; u++) {
+        if (s->exact[u] >= 0.0 && s->start[u] + s->pred[u] > first_end)
+            first_end = s->start[u] + s->pred[u];
+        if (s->start[u] + s->pred[u] > end)
+            end = s->start[u] + s->pred[u];
+    }
+    const uint32_t w = chipsampled_waves(s->K);
+    if (!s->shared || s->K < 2 || end <= first_end)
+        return 0;
+    double ws[8] = {0}, as[8] = {0}, W = 0.0, A = 0.0;
+    uint64_t z = (uint64_t)s->spec->sample_seed * 0x9e3779b97f4a7c15ull + 0x632be59bd9b4e019ull;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    const double offset = (double)((z ^ (z >> 31)) >> 11) / 9007199254740992.0;
+    uint32_t got = 0;
+    for (uint32_t i = 0; i < w; i++) {
+        note(s, "wave %u of %u: the units running then, on the whole chip and alone", i + 1, w, 0);
+        const double at = first_end + (end - first_end) * ((double)i + offset) / (double)w;
+        if (wave_at(s, at, &ws[got], &as[got]) != 0)
+            return -1;
+        if (as[got] > 0.0) {
+            W += ws[got];
+            A += as[got];
+            got++;
+        }
+    }
+    s->fr->chip.waves = got;
+    if (!got || A <= 0.0)
+        return 0;
+    *r = W / A;
+    if (got < 2) { /* one wave: no spread to tell; the interval says nothing of r */
+        *rel_var = 0.0;
+        return 0;
+    }
+    double jm[8], mean = 0.0, v = 0.0;
+    for (uint32_t i = 0; i < got; i++) {
+        jm[i] = (W - ws[i]) / (A - as[i]);
+        mean += jm[i] / got;
+    }
+    for (uint32_t i = 0; i < got; i++)
+        v += (jm[i] - mean) * (jm[i] - mean);
+    v *= (double)(got - 1) / got;
+    *rel_var = v / (*r * *r);
+    const double h = sample_t975(got - 1) * sqrt(v);
+    s->fr->chip.r_lo = *r - h;
+    s->fr->chip.r_hi = *r + h;
+    return 0;
+}
+
+/* ---- the frame --------------------------------------------------------------------------------- */
+
+static int sampler_open(ChipSampler *s, const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg,
+                        const FuncParams *fp, RunFrame *fr, char *err, size_t errlen)
+{
+    memset(s, 0, sizeof *s);
+    *s = (ChipSampler){.sc = sc, .spec = spec, .fr = fr, .ucfg = *cfg, .fp = *fp, .err = err, .errlen = errlen,
+                       .K = (uint32_t)cfg->chip_cores, .shared = cfg->chip_memory == CFG_CHIP_MEMORY_SHARED,
+                       .started = util_now()};
+    s->fp.timed = 1;
+    s->up = s->fp;
+    s->up.progress = NULL;
+    if (s->shared) {
+        s->up.chip_unit = 1;
+        s->up.unit_warm = warm_of;
+        s->up.unit_warm_ctx = s;
+    } else { /* cores on buses of their own: a unit is the paper machine's */
+        s->ucfg.chip_cores = 1;
+        s->up.cfg = &s->ucfg;
+    }
+    if (func_open(&sc->p, &s->up, &s->fs, err, errlen) != 0)
+        return -1;
+    if (sampled_countable(s->fs, err, errlen) != 0) {
+        s->fs = NULL;
+        return -1;
+    }
+    s->spp = (uint32_t)sc->s.render.spp;
+    s->N = (uint32_t)func_units_total(s->fs);
+    s->ntiles = s->N / s->spp;
+    const size_t N = s->N ? s->N : 1, T = s->ntiles ? s->ntiles : 1;
+    s->x = malloc(N * AUX_K * sizeof *s->x);
+    s->exact = malloc(N * sizeof *s->exact);
+    s->pred = malloc(N * sizeof *s->pred);
+    s->start = malloc(N * sizeof *s->start);
+    s->order = malloc(N * sizeof *s->order);
+    s->pos = malloc(N * sizeof *s->pos);
+    s->tile = malloc(T * sizeof *s->tile);
+    s->tstart = malloc(T * sizeof *s->tstart);
+    s->wl = calloc(N, sizeof *s->wl);
+    s->wlen = calloc(N, sizeof *s->wlen);
+    s->units = calloc(N, sizeof *s->units);
+    s->instructions = malloc(N * sizeof *s->instructions);
+    if (!s->x || !s->exact || !s->pred || !s->start || !s->order || !s->pos || !s->tile || !s->tstart || !s->wl ||
+        !s->wlen || !s->units || !s->instructions) {
+        snprintf(err, errlen, "out of memory for %u units", s->N);
+        return -1;
+    }
+    for (uint32_t u = 0; u < s->N; u++)
+        s->exact[u] = -1.0;
+    if (s->shared) {
+        const RefParams rp = sampled_ref_params(spec, cfg, fr);
+        const size_t line = (size_t)cfg->scene_line_bytes;
+        const size_t cap = cfg->l2_size_kb > 0 ? (size_t)cfg->l2_size_kb * 1024 / line : 4096;
+        if (!(s->warm = chipwarm_new(&sc->p, &rp, s->ntiles, s->spp, (uint32_t)line, cap))) {
+            snprintf(err, errlen, "out of memory for the warming's record");
+            return -1;
+        }
+    }
+    return 0;
+}
+
+/* Closes the units' session into fr->f (its failure is the cause when there is one). */
+static int sampler_close(ChipSampler *s, int rc)
+{
+    if (s->fs) {
+        char cerr[1024];
+        const int crc = func_close(s->fs, &s->fr->f, cerr, sizeof cerr);
+        if (crc != 0) {
+            snprintf(s->err, s->errlen, "%s", cerr);
+            rc = crc;
+        }
+    }
+    if (s->warm) {
+        s->fr->chip.warm_units = chipwarm_recorded(s->warm);
+        s->fr->chip.warm_seconds = chipwarm_seconds(s->warm);
+    }
+    chipwarm_free(s->warm);
+    for (uint32_t u = 0; s->wl && u < s->N; u++)
+        free(s->wl[u]);
+    free(s->x);
+    free(s->exact);
+    free(s->pred);
+    free(s->start);
+    free(s->order);
+    free(s->pos);
+    free(s->tile);
+    free(s->tstart);
+    free(s->wl);
+    free(s->wlen);
+    free(s->units);
+    free(s->instructions);
+    return rc;
+}
+
+/* Phase 1 (the sample and the regression), phase 2 (r) and the makespan into fr. */
+static int estimate(ChipSampler *s)
+{
+    RunFrame *fr = s->fr;
+    uint32_t *order = malloc((size_t)s->N * sizeof *order);
+    double *ys = malloc((size_t)s->N * sizeof *ys);
+    int rc = -1;
+    if (!order || !ys) {
+        snprintf(s->err, s->errlen, "out of memory for %u units", s->N);
+        goto out;
+    }
+    sample_order(s->N, s->spec->sample_seed, order);
+    const uint32_t n0 = s->spec->target_error > 0.0 ? (s->N < SAMPLED_FIRST_UNITS ? s->N : SAMPLED_FIRST_UNITS)
+                                                    : sample_count(s->N, s->spec->sample);
+    SampleEstimate e;
+    if (sample_sequential(s->x, AUX_K, order, s->N, n0, s->spec->target_error, measure, s, ys, &e, &fr->rounds) != 0 ||
+        sample_regression_estimate(s->instructions, s->x, AUX_K, order, s->n, s->N, &fr->est_instructions) != 0) {
+        if (!s->err[0])
+            snprintf(s->err, s->errlen, "sampled mode: cannot estimate from %u of %u units (the frame needs at "
+                                        "least 2; use --mode detailed)", s->n, s->N);
+        goto out;
+    }
+    double r, r_rel_var;
+    if (schedule(s, e.coef) != 0 || waves(s, &r, &r_rel_var) != 0)
+        goto out;
+    /* r's own t (its jackknife has waves - 1 degrees of freedom) carried into the makespan's interval,
+     * which takes the regression's */
+    const uint32_t wv = fr->chip.waves;
+    const double tr = wv >= 2 ? sample_t975(wv - 1) : 0.0, tf = e.n < e.N ? sample_t975(e.df) : 1.959963985;
+    ChipSampleIn in = {.ntiles = s->ntiles, .spp = s->spp, .cores = s->K, .x = s->x, .k = AUX_K,
+                       .sample = order, .ys = ys, .n = s->n, .fit = &e, .exact = s->exact, .r = r,
+                       .r_rel_var = r_rel_var * (tr / tf) * (tr / tf), .seed = s->spec->sample_seed};
+    ChipSampleOut out;
+    if (!(fr->tile_cycles = malloc((s->ntiles ? s->ntiles : 1) * sizeof *fr->tile_cycles)) ||
+        chip_sample_estimate(&in, fr->tile_cycles, &out) != 0) {
+        snprintf(s->err, s->errlen, "sampled chip: out of memory estimating the makespan of %u tiles", s->ntiles);
+        goto out;
+    }
+    fr->est = e;
+    fr->est.total = out.makespan;
+    fr->est.lo = out.lo;
+    fr->est.hi = out.hi;
+    fr->est.std_error = out.std_error;
+    fr->est.t = out.t;
+    StatsChipSample *c = &fr->chip;
+    c->r = r;
+    if (wv < 2)
+        c->r_lo = c->r_hi = r;
+    c->plain = out.plain;
+    c->var_jack = out.var_jack;
+    c->var_draws = out.var_draws;
+    c->var_r = out.var_r;
+    c->sigma_a = out.sigma_a;
+    c->sigma_e = out.sigma_e;
+    fr->has_est = 1;
+    rc = 0;
+out:
+    free(order);
+    free(ys);
+    return rc;
+}
+
+int chipsampled_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg, const FuncParams *fp,
+                      RunFrame *fr, char *err, size_t errlen)
+{
+    err[0] = '\0';
+    ChipSampler s;
+    int rc = sampler_open(&s, sc, spec, cfg, fp, fr, err, errlen);
+    fr->chip.on = 1;
+    fr->chip.cores = (uint32_t)cfg->chip_cores;
+    if (rc == 0)
+        rc = sampled_golden(sc, spec, cfg, fr, s.N, s.x, err, errlen);
+    if (rc == 0)
+        rc = opening(&s);
+    double coef[AUX_K + 1];
+    if (rc == 0) {
+        first_coef(&s, coef);
+        rc = schedule(&s, coef);
+    }
+    if (rc == 0)
+        rc = estimate(&s);
+    fr->units_sampled = s.n;
+    return sampler_close(&s, rc);
+}

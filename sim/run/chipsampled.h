@@ -1,0 +1,46 @@
+/* sim/run/chipsampled.h -- sampled mode on a chip (chip.cores > 1 or chip.memory = shared;
+ * docs/sampling.md, "Sampling a chip", design C; issue 41).
+ *
+ * 1. The golden model renders the frame (or the --no-image pilot) and counts every (tile, pass)
+ *    unit's work, as sampled mode does on one core (sim/run/sampled.c).
+ * 2. The opening, exact: the chip's frame in full detail until pass 0 of its first K tiles has
+ *    ended (FuncParams.opening); those units' cycles are known exactly.
+ * 3. A predicted schedule: every unit's cycles predicted from its golden counts (a fit on the
+ *    opening's units first, the sample's fit later) and the distributor's list schedule of the
+ *    tiles (chip_list_schedule); a unit starts after its tile's earlier passes.
+ * 4. Phase 1: today's sample and sequential rule (sim/sampling.h) over the units, each timed alone
+ *    on one core of the chip's memory (FuncParams.chip_unit), its L2 and DRAM rows warmed with the
+ *    golden model's lines of the units that start before it in the predicted schedule
+ *    (sim/run/chipwarm.h); the regression of their cycles on the golden counts.
+ * 5. Phase 2, the other cores: waves at evenly spaced instants of the predicted schedule (a seeded
+ *    offset): the K units running then timed together on the whole chip (FuncParams.wave), and up
+ *    to CHIPSAMPLED_WAVE_ALONE of them alone; their ratio r, with a jackknife over waves.
+ * 6. The makespan: every tile's estimate (exact, sampled or predicted units, times r, with the
+ *    tile-effect correction) list-scheduled, with its 95 % interval (sim/chipsampling.h).
+ * A chip whose cores have buses of their own (chip.memory = bus) has no shared level to warm or
+ * contend for: its units are timed as sampled mode's (a cold core on its bus) and r = 1.
+ *
+ * Owns: the order of those steps, the predicted schedule, the waves' instants and r. Must not:
+ * estimate the makespan itself (sim/chipsampling.c), time anything itself, or write files.
+ */
+#ifndef SFSIM_RUN_CHIPSAMPLED_H
+#define SFSIM_RUN_CHIPSAMPLED_H
+
+#include <stddef.h>
+
+#include "run.h"
+
+/* The units of a wave also timed alone (evenly spread over its cores) for the ratio r. */
+#define CHIPSAMPLED_WAVE_ALONE 16u
+
+/* Waves timed on a chip of K cores: 4, or 2 above 64 cores (a wave costs K units). */
+uint32_t chipsampled_waves(uint32_t cores);
+
+/* Whether a run on cfg is a chip's (sampled mode goes here rather than to sampled_frame). */
+int chipsampled_wanted(const CfgMachine *cfg);
+
+/* As sampled_frame (sim/run/sampled.h), on a chip. */
+int chipsampled_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg, const FuncParams *fp,
+                      RunFrame *fr, char *err, size_t errlen);
+
+#endif
