@@ -337,7 +337,7 @@ Test(energy_dram, ddr4_io_is_its_termination)
     cr_expect_eq(p.power.io_pj_bit, 5);
     cr_expect(strstr(p.power.io_source, "energy.dram_io_pj_bit"), "%s", p.power.io_source);
     c.energy_dram_io_pj_bit = 0;
-    c.dram_preset = 4;   /* hbm2_2000 */
+    c.dram_preset = DRAM_PRESET_gddr6_14000;
     cr_assert_eq(dram_params(&c, &p, err, sizeof err), 0, "%s", err);
     cr_expect_eq(p.power.io_pj_bit, 0);
     cr_expect(strstr(p.power.io_source, "none"), "%s", p.power.io_source);
@@ -345,6 +345,38 @@ Test(energy_dram, ddr4_io_is_its_termination)
     DramEnergy e;
     dram_energy(&p, &s, 0, &e);
     cr_expect_eq(e.io, 0);
+}
+
+/* HBM2-2000's I/O figure is its DQ lines' switching (docs/energy.md, "DRAM I/O"): an unterminated
+ * bus, so a line draws C V^2 from VDDQ on each rising edge and nothing while it holds. With random
+ * data a bit is a rising edge one time in four (0 then 1), so per bit 1/4 x C_IO x VDDQ^2 =
+ * 0.25 x 2.4 pF x 1.2^2 V^2 = 0.864 pJ, whatever the data rate; C_IO 2.4 pF is the HBM I/O
+ * capacitance "up to 2.4 pF" quoted in the abstract of IEEE Xplore 9980680 (2022). The other presets
+ * without a figure (DDR5, LPDDR5, GDDR6) keep 0 and say why. */
+Test(energy_dram, hbm2_io_is_its_switched_capacitance)
+{
+    CfgMachine c;
+    cfg_defaults(&c);
+    c.dram_preset = DRAM_PRESET_hbm2_2000;
+    DramParams p;
+    char err[256];
+    cr_assert_eq(dram_params(&c, &p, err, sizeof err), 0, "%s", err);
+    const double c_io_pf = 2.4, vddq = 1.2, rising = 0.25;
+    const double io = rising * c_io_pf * vddq * vddq;
+    cr_expect(fabs(p.power.io_pj_bit - io) < 5e-4, "preset %g, derived %g", p.power.io_pj_bit, io);
+    cr_expect(strstr(p.power.io_source, "9980680"), "%s", p.power.io_source);
+    /* A burst's I/O is its bits times the figure, apart from the core's energy. */
+    DramChanStats s = {.activates = 1, .reads = 1, .bytes = (uint64_t)p.burst_bytes};
+    DramEnergy e;
+    dram_energy(&p, &s, 0, &e);
+    EXPECT_SAME(e.io, p.burst_bytes * 8 * io * 1e-12, "HBM2 burst I/O");
+    const int none[] = {DRAM_PRESET_ddr5_4800, DRAM_PRESET_lpddr5_6400, DRAM_PRESET_gddr6_14000};
+    for (int i = 0; i < 3; i++) {
+        c.dram_preset = none[i];
+        cr_assert_eq(dram_params(&c, &p, err, sizeof err), 0, "%s", err);
+        cr_expect_eq(p.power.io_pj_bit, 0, "preset %d", none[i]);
+        cr_expect(strstr(p.power.io_source, "none"), "%s", p.power.io_source);
+    }
 }
 
 /* A row hit: A (row 0, column 0) misses, B (row 0, column 1: address bit 8) hits: ACT 0, RD 16,

@@ -115,9 +115,11 @@ for preset in ddr4_2400 ddr5_4800 lpddr5_6400 gddr6_14000 hbm2_2000; do
     gddr6_14000) want_out 'VDD 1\.35 V; IDD0 71,'; want_out 'ACT\+PRE 629\.49 pJ, RD burst 288\.51 pJ' ;;
     esac
     # I/O apart: DDR4's termination figure (docs/energy.md, "DRAM I/O") over the trace's 4 x 64 bytes,
-    # 2048 x 2.287 pJ; the other presets have none and say so.
+    # 2048 x 2.287 pJ; HBM2's switched-capacitance figure, 2048 x 0.864 pJ; the other presets have
+    # none and say so.
     case $preset in
     ddr4_2400) want_out 'I/O apart: 4\.684 nJ \(2\.287 pJ/bit\)'; want_out 'I/O figure +2\.287 pJ/bit: derived' ;;
+    hbm2_2000) want_out 'I/O apart: 1\.769 nJ \(0\.864 pJ/bit\)'; want_out 'I/O figure +0\.864 pJ/bit: derived' ;;
     *) want_out 'I/O apart: 0 nJ \(0 pJ/bit\)'; want_out 'I/O figure +0 pJ/bit: none' ;;
     esac
 done
