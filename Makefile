@@ -107,7 +107,7 @@ SHIM_ASAN_OBJ = $(patsubst %.cpp,$(BUILD)/asan/%.o,$(SHIM_SRC))
 LIBDIR  := $(patsubst ./%,%,$(dir $(BIN))lib)
 IMGLIB  := $(LIBDIR)/sfsim/libsfsim-img.so
 
-.PHONY: all deps install uninstall run test test-standalone test-asan test-unit test-hard test-slurm test-portable fuzz fuzz-run bench validation paper docs check-docs clean run-built test-built check-outputs help
+.PHONY: all deps install uninstall run test test-standalone test-asan test-unit test-hard test-slurm test-portable fuzz fuzz-run bench validation paper paper-chip docs check-docs clean run-built test-built check-outputs help
 
 all: $(BIN)/sfasm $(BIN)/sfsim $(IMGLIB)
 
@@ -123,6 +123,7 @@ help:
 	@echo "                sampled mode's speed against error at 512 x 512 x 16, per-ray time against Embree)"
 	@echo "make validation the papers' experiments at reduced size into docs/validation-data.md (needs ../shared)"
 	@echo "make paper      seed 001 Table 6 at the paper's scale in sampled mode, checked by one full detailed run"
+	@echo "make paper-chip the paper's frame on chips of 1-256 cores with DDR4 and GDDR6, sampled (PAPER_CHIP_ARGS=--check: one detailed run)"
 	@echo "                (about 90 min; PAPER_ARGS= skips the detailed run) into docs/validation-data.md"
 	@echo "make docs       regenerate docs/config.md, docs/isa.md, docs/exit-codes.md, docs/report.md's statistics, the layout include and docs, the kernel constants, the shipped Cornell box"
 	@echo "make check-outputs  the same-outputs table alone (tests/outputs/check.sh; part of make test)"
@@ -285,7 +286,7 @@ TEST_ENV = SFSIM_BUILD=$(BUILD) SFSIM_GEN_ISADOC=$(BUILD)/gen_isadoc SFSIM_TEST_
 
 # The tools the test suite does not run are still built (-Werror), so they cannot rot.
 test-built: all $(BUILD)/tests/unit $(BUILD)/tests/io $(BUILD)/gen_cornell $(BUILD)/outputs_digest \
-		$(BUILD)/validation $(BUILD)/paper $(BUILD)/bench/speed_vs_error $(BUILD)/bench/per_ray \
+		$(BUILD)/validation $(BUILD)/paper $(BUILD)/paper_chip $(BUILD)/bench/speed_vs_error $(BUILD)/bench/per_ray \
 		$(BUILD)/bench/chip_speed
 	@bash tests/outputs/check.sh
 	@bash tests/cli/run.sh
@@ -410,6 +411,10 @@ $(BUILD)/paper: tools/paper.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
 
+$(BUILD)/paper_chip: tools/paper_chip.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
+
 # The utilization experiments of docs/validation.md (several minutes on 2 cores). The section
 # `make paper` wrote is kept.
 validation: deps
@@ -427,6 +432,22 @@ paper: deps
 	$(BUILD)/paper $(PAPER_ARGS) > $(BUILD)/paper-section.md
 	sed '/<!-- make paper: begin -->/,/<!-- make paper: end -->/d' docs/validation-data.md > $(BUILD)/validation-data.md
 	cat $(BUILD)/validation-data.md $(BUILD)/paper-section.md > docs/validation-data.md
+
+# The paper's frame on chips of K = 1, 4, 16, 64, 256 cores with two memories, each point sampled
+# at 1 % (tools/paper_chip.c: under 30 minutes on 2 cores); --check adds one full detailed run of
+# K = 16 with DDR4 (about 95 minutes more). Its section of docs/validation-data.md is replaced and
+# docs/img/paper-chip-fps.png redrawn with gnuplot.
+PAPER_CHIP_ARGS ?=
+paper-chip: deps
+	@$(MAKE) --no-print-directory all $(BUILD)/paper_chip
+	$(BUILD)/paper_chip $(PAPER_CHIP_ARGS) $(BUILD)/paper-chip.dat > $(BUILD)/paper-chip-section.md
+	sed '/<!-- make paper-chip: begin -->/,/<!-- make paper-chip: end -->/d' docs/validation-data.md > $(BUILD)/validation-data.md
+	cat $(BUILD)/validation-data.md $(BUILD)/paper-chip-section.md > docs/validation-data.md
+	gnuplot -e "set terminal pngcairo size 800,500; set output 'docs/img/paper-chip-fps.png'; \
+		set logscale xy 2; set xlabel 'cores K'; set ylabel 'fps (1024 x 1024, 64 spp), 95 % interval'; \
+		set key top left; set grid; \
+		plot '$(BUILD)/paper-chip.dat' using 1:2:3:4 with yerrorlines title 'DDR4-2400 x 2, 4 MB L2', \
+		'' using 1:5:6:7 with yerrorlines title 'GDDR6 x 16, 8 MB L2'"
 
 bench: deps
 	@$(MAKE) --no-print-directory $(BUILD)/bench/core_speed $(BUILD)/bench/embree_xcheck $(BUILD)/bench/functional_speed \
