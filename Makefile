@@ -120,7 +120,8 @@ help:
 	@echo "make fuzz       build the libFuzzer targets, assembler and scene loader (clang);"
 	@echo "                make fuzz-run FUZZ_SECONDS=600 runs each for that long"
 	@echo "make bench      build and run the benchmarks in bench/ (core, functional and detailed speed, Embree,"
-	@echo "                sampled mode's speed against error at 512 x 512 x 16, per-ray time against Embree)"
+	@echo "                sampled mode's speed against error at 512 x 512 x 16, per-ray time against Embree,"
+	@echo "                the chip's speed, sampled mode's error on chips of 16 and 64 cores: hours)"
 	@echo "make validation the papers' experiments at reduced size into docs/validation-data.md (needs ../shared)"
 	@echo "make paper      seed 001 Table 6 at the paper's scale in sampled mode, checked by one full detailed run"
 	@echo "make paper-chip the paper's frame on chips of 1-256 cores with DDR4 and GDDR6, sampled (PAPER_CHIP_ARGS=--check: one detailed run)"
@@ -287,7 +288,7 @@ TEST_ENV = SFSIM_BUILD=$(BUILD) SFSIM_GEN_ISADOC=$(BUILD)/gen_isadoc SFSIM_TEST_
 # The tools the test suite does not run are still built (-Werror), so they cannot rot.
 test-built: all $(BUILD)/tests/unit $(BUILD)/tests/io $(BUILD)/gen_cornell $(BUILD)/outputs_digest \
 		$(BUILD)/validation $(BUILD)/paper $(BUILD)/paper_chip $(BUILD)/bench/speed_vs_error $(BUILD)/bench/per_ray \
-		$(BUILD)/bench/chip_speed
+		$(BUILD)/bench/chip_speed $(BUILD)/bench/chip_error
 	@bash tests/outputs/check.sh
 	@bash tests/cli/run.sh
 	@bash tests/cli/sweep.sh
@@ -398,6 +399,10 @@ $(BUILD)/bench/chip_speed: bench/chip_speed.c tests/support/shared.c $(BUILD)/li
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(LTO_LINK) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
 
+$(BUILD)/bench/chip_error: bench/chip_error.c tests/support/shared.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(LTO_LINK) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
+
 $(BUILD)/bench/speed_vs_error: bench/speed_vs_error.c tests/support/shared.c $(BUILD)/libsfsim.a $(SHIM_OBJ)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(LTO_LINK) $^ -o $@ $(INIH) $(LDLIBS) $(OIIO)
@@ -452,7 +457,7 @@ paper-chip: deps
 bench: deps
 	@$(MAKE) --no-print-directory $(BUILD)/bench/core_speed $(BUILD)/bench/embree_xcheck $(BUILD)/bench/functional_speed \
 		$(BUILD)/bench/detailed_speed $(BUILD)/bench/speed_vs_error $(BUILD)/bench/per_ray $(BUILD)/bench/sched_speed \
-		$(BUILD)/bench/chip_speed
+		$(BUILD)/bench/chip_speed $(BUILD)/bench/chip_error
 	$(BUILD)/bench/core_speed
 	$(BUILD)/bench/embree_xcheck
 	$(BUILD)/bench/functional_speed
@@ -461,6 +466,7 @@ bench: deps
 	$(BUILD)/bench/per_ray
 	$(BUILD)/bench/sched_speed
 	$(BUILD)/bench/chip_speed
+	$(BUILD)/bench/chip_error out/bench
 
 # ---- the example `make run` executes --------------------------------------------------------
 # The default scene on the default machine in detailed mode, sized to take one to two minutes

@@ -18,6 +18,8 @@
  * usage: speed_vs_error [--size WxHxS] [--all] [OUTDIR]   (default out/bench): OUTDIR/speed_vs_error.md,
  * and OUTDIR/units-<scene>.tsv with every unit's figures
  * Not a test: numbers depend on the host. docs/validation.md quotes a run.
+ * The chip's rows (K = 16 and 64, DDR4 and GDDR6; every seed a whole sampled run, since a chip's
+ * units depend on each other) are bench/chip_error.c's.
  */
 #include <math.h>
 #include <stdio.h>
