@@ -135,6 +135,7 @@ void timing_reset(Timing *t)
         return;
     }
     units_cold(t, 0);
+    tm_pend_reset(t); /* (fills a unit left out are dropped with its chip's in-flight requests) */
     if (++t->run == 0) { /* wrapped: no entry may look current */
         memo_fold_all(t);
         for (uint32_t i = 0; i < t->desc_cap; i++)

@@ -213,6 +213,20 @@ void tm_pend_free(Timing *t)
     t->pend = NULL;
 }
 
+void tm_pend_reset(Timing *t)
+{
+    Pend *p = t->pend;
+    if (!p)
+        return;
+    for (uint32_t f = 0; f < p->nfill; f++)
+        p->line[f] = UINT64_MAX;
+    for (uint32_t g = 0; g < p->ngrp; g++)
+        p->grp_live[g] = 0;
+    p->nfill = p->nfree_fill = p->live_fills = 0;
+    p->ngrp = p->nfree_grp = p->nlive_grp = 0;
+    memset(p->cand, 0, sizeof p->cand);
+}
+
 void tm_pend_note(Timing *t, const TmDesc *d)
 {
     for (int i = 0; i < d->ndst; i++)

@@ -241,6 +241,9 @@ int tm_yield_if_pending(Timing *t, const TmDesc *d);
  * one); an answer looks at such registers only. */
 void tm_pend_note(Timing *t, const TmDesc *d);
 void tm_pend_free(Timing *t);
+/* Every fill and group forgotten, ids from 0 again, as a new model's (timing_reset: a unit alone on
+ * a chip's levels, whose chip_reset drops what was still in flight, so no answer comes for them). */
+void tm_pend_reset(Timing *t);
 
 /* ---- what the memo asks of the model (sim/timing/issue.c) --------------------------------- */
 
