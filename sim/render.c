@@ -324,6 +324,22 @@ static int write_mem_trace(const char *path, const CfgMachine *cfg, const FuncSt
     return mtr_finish(w, err, errlen);
 }
 
+/* A sampled chip's --target-error stops on the units' total (docs/sampling.md, "Built: sampled
+ * mode on a chip"); when the makespan's own interval came out wider, the user is told, not left
+ * to find it in the report. */
+static void warn_makespan_interval(const RunSpec *spec, const RunFrame *fr)
+{
+    if (!fr->chip.on || !fr->has_est || spec->target_error <= 0.0 || fr->est.total <= 0.0)
+        return;
+    const double half = (fr->est.hi - fr->est.lo) / 2.0 / fr->est.total;
+    if (half > spec->target_error)
+        fprintf(stderr,
+                "sfsim run: warning: the makespan's 95 %% interval is +-%.2f %%, wider than --target-error %g %%: on a "
+                "chip the sample stops on the units' total, and with few tiles a core the makespan rests on single "
+                "tiles (docs/sampling.md); --sample F times a larger share\n",
+                100.0 * half, 100.0 * spec->target_error);
+}
+
 int render_run(const RenderOptions *o, char *err, size_t errlen)
 {
     CfgMachine defcfg;
@@ -358,6 +374,8 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     if (rc == 0) {
         pr.start = util_now();
         rc = run_frame(&sc, &spec, &fr, err, errlen);
+        if (rc == 0)
+            warn_makespan_interval(&spec, &fr);
         if (rc == -2 && spec.mode != RUN_SAMPLED) /* sampled mode's image is the golden model's, never partial */
             keep_partial(o, &sc, &fr, err, errlen);
     }

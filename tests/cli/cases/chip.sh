@@ -73,6 +73,15 @@ want_rc 0
     no "the sampled makespan is more than 3 % from the detailed one"
 end
 
+begin "chip: sampled mode says when the makespan's interval is wider than --target-error"
+run "$SFSIM" run --mode sampled --target-error 0.01 -c configs/chip16-ddr4.ini --set chip.cores=64 \
+    --set render.width=256 --set render.height=256 --set render.spp=8 --set stream.rays=1024 -o "$T/w"
+want_rc 0
+want_err "warning: the makespan's 95 % interval is \+-[0-9.]+ %, wider than --target-error 1 %"
+[ "$(json "$T/w/report.json" "(j['cycles_ci95'][1] - j['cycles_ci95'][0]) / 2 / j['cycles'] > 0.01")" = True ] ||
+    no "the warning came with an interval within 1 %"
+end
+
 begin "chip: sfsim trace on 4 cores with an L2 and DDR4 gives functional mode's hits"
 awk 'BEGIN { print "# ox oy oz dx dy dz"; for (i = 0; i < 9000; i++) printf "278 273 -800 %.4f %.4f 1\n", (i % 97) / 200.0 - 0.24, int(i / 97) / 200.0 - 0.24 }' \
     >"$T/rays.txt"
