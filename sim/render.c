@@ -335,9 +335,10 @@ static void warn_makespan_interval(const RunSpec *spec, const RunFrame *fr)
     if (half > spec->target_error)
         fprintf(stderr,
                 "sfsim run: warning: the makespan's 95 %% interval is +-%.2f %%, wider than --target-error %g %%: on a "
-                "chip the sample stops on the units' total, and with few tiles a core the makespan rests on single "
-                "tiles (docs/sampling.md); --sample F times a larger share\n",
-                100.0 * half, 100.0 * spec->target_error);
+                "chip the makespan rests on the tiles the latest cores end with, and the %u units timed for them "
+                "beyond the sample (at most twice its units) left it so (docs/sampling.md); --sample F times a "
+                "larger share\n",
+                100.0 * half, 100.0 * spec->target_error, fr->chip.tail_units);
 }
 
 int render_run(const RenderOptions *o, char *err, size_t errlen)

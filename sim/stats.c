@@ -296,6 +296,7 @@ FIG(cs_var_draws) { UNUSED_FIG_ARGS; return cs(c)->var_draws; }
 FIG(cs_var_r) { UNUSED_FIG_ARGS; return cs(c)->var_r; }
 FIG(cs_sigma_a) { UNUSED_FIG_ARGS; return cs(c)->sigma_a; }
 FIG(cs_sigma_e) { UNUSED_FIG_ARGS; return cs(c)->sigma_e; }
+FIG(cs_tail_units) { UNUSED_FIG_ARGS; return cs(c)->tail_units; }
 FIG(cs_warm_units) { UNUSED_FIG_ARGS; return cs(c)->warm_units; }
 FIG(cs_warm_seconds) { UNUSED_FIG_ARGS; return cs(c)->warm_seconds; }
 FIG(rays_total) { UNUSED_FIG_ARGS; return (double)(c->run->primary + c->run->shadow + c->run->indirect); }

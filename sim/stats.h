@@ -205,6 +205,7 @@ typedef struct StatsChipSample {
     double plain;              /* the makespan estimate without the tile-effect correction */
     double var_jack, var_draws, var_r; /* the makespan's variance by part */
     double sigma_a, sigma_e;   /* tile effect and within-tile spread of the fit's relative residuals */
+    uint32_t tail_units;       /* units timed for the makespan's tail, beyond phase 1's sample */
     uint32_t warm_units;       /* units whose lines the golden model recorded for the warming */
     double warm_seconds;       /* ... and its host time */
 } StatsChipSample;

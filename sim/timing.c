@@ -113,6 +113,19 @@ uint64_t timing_now(const Timing *t) { return t->now; }
 
 void timing_set_fb_base(Timing *t, uint64_t base) { t->mem.fb_base = base; }
 
+int timing_warm_l1(Timing *t, const uint64_t *lines, size_t n, uint64_t fb_bytes)
+{
+    const uint64_t line = (uint64_t)t->l1.p.line_bytes, fb = ((uint64_t)1 << MEM_SPACE_SHIFT) + t->mem.fb_base;
+    int rc = 0;
+    for (uint64_t b = 0; rc == 0 && b < fb_bytes; b += line)
+        rc = cache_warm(&t->l1, fb + b, 1);
+    for (size_t i = 0; rc == 0 && i < n; i++)
+        rc = cache_warm(&t->l1, lines[i], 0);
+    if (rc)
+        internal_error(t, "out of memory for the scene cache's tags");
+    return rc;
+}
+
 static uint64_t tap_request(void *below, const MemReq *r)
 {
     Timing *t = below;

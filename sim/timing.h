@@ -103,6 +103,11 @@ void timing_continue(Timing *t, int cold);
 /* Where the core's framebuffer starts in the framebuffer's physical space (a chip: its tile's
  * place in the frame's framebuffer, so that two tiles' lines never meet below the L1s). */
 void timing_set_fb_base(Timing *t, uint64_t base);
+/* A sampled chip's functional warming of the core's L1 (docs/sampling.md, "Sampling a chip"),
+ * after the reset and before the run: the first fb_bytes of the core's framebuffer (at its
+ * fb_base; dirty, as the unit's earlier passes left them), then the n scene lines (oldest first),
+ * each as cache_warm brings it in. 0, or -1 out of memory (the model's error set). */
+int timing_warm_l1(Timing *t, const uint64_t *lines, size_t n, uint64_t fb_bytes);
 /* The cycle the next instruction may issue in. */
 uint64_t timing_now(const Timing *t);
 

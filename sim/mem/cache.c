@@ -176,3 +176,32 @@ void cache_hits(Cache *c, size_t way, uint64_t n)
     c->lru[way] = c->stamp;
     c->last_way = way;
 }
+
+int cache_warm(Cache *c, uint64_t addr, int dirty)
+{
+    if (c->sets == 0)
+        return 0;
+    if (!c->instantiated && instantiate(c))
+        return -1;
+    const uint64_t line = cache_line(c, addr);
+    const size_t set = set_of(c, line), w = (size_t)c->p.ways;
+    size_t k = set * w, i = 0;
+    while (i < w && c->tag[set * w + i] != line + 1)
+        i++;
+    if (i < w) {
+        k = set * w + i;
+    } else {
+        for (i = 1; i < w; i++) /* the least recently used way, as a miss takes */
+            if (c->lru[set * w + i] < c->lru[k])
+                k = set * w + i;
+        c->tag[k] = line + 1;
+        c->dirty[k] = 0;
+    }
+    c->lru[k] = ++c->stamp;
+    c->ready[k] = 0;
+    c->from[k] = 0;
+    if (dirty)
+        c->dirty[k] = 1;
+    c->last_way = k;
+    return 0;
+}

@@ -87,5 +87,10 @@ int cache_peek(const Cache *c, uint64_t addr, size_t *way);
 /* n loads that hit the line in `way`, one after another, with nothing between them: their counts
  * and the line's use (cache_access's hit path n times, but for the cycles it returns). */
 void cache_hits(Cache *c, size_t way, uint64_t n);
+/* Functional warming (docs/sampling.md, "Sampling a chip"): the line holding addr brought in as an
+ * access at no time would bring it, most recently used, ready at once, dirty if `dirty`; a victim
+ * is dropped (no write-back) and nothing is counted. 0, or -1 if the tag array cannot be
+ * allocated (nothing with no cache). */
+int cache_warm(Cache *c, uint64_t addr, int dirty);
 
 #endif

@@ -575,6 +575,8 @@ uint32_t chip_run_frame(Job *j)
             if (j->fp->wave && (uint32_t)k < j->fp->nwave) {
                 const uint32_t u = j->fp->wave[k];
                 tile_begin(&r, k, u / j->spp, u % j->spp, u % j->spp + 1);
+                if (eng_warm_l1(j, tm_of(&r, k), u) != 0)
+                    break;
                 r.runnable[r.nrunnable++] = k;
             } else if (!j->fp->wave && r.next_tile < j->ntiles) {
                 tile_begin(&r, k, r.next_tile++, 0, r.passes);

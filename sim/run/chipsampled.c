@@ -27,14 +27,16 @@ typedef struct ChipSampler {
     double *x, *exact, *pred, *start; /* N each: auxiliaries (N x AUX_K), exact chip cycles (< 0:
                                          unknown), predicted cycles and start */
     uint32_t *order, *pos;     /* N each: units in predicted start order, each unit's position */
+    uint32_t *pos0;            /* N: each unit's position in the first schedule (the warming's) */
     double *tile, *tstart;     /* ntiles each */
+    uint32_t *tcore, *tprev;   /* ntiles each: its core, the tile before it there (UINT32_MAX: none) */
     ChipWarm *warm;
-    uint64_t **wl;             /* N: the warming list of each unit being timed (else NULL) */
-    size_t *wlen;
+    uint64_t **wl, **wl1;      /* N: the L2's and the L1's warming lists of each unit being timed */
+    size_t *wlen, *wlen1;
     FuncSession *fs;
     FuncUnit *units;           /* N: phase 1's units in sample order, n of them */
     double *instructions;      /* N: their instructions */
-    uint32_t n;
+    uint32_t n, ntail;         /* phase 1's units (a simple random sample), the tail's after them */
     double started;
     char *err;
     size_t errlen;
@@ -47,12 +49,19 @@ int chipsampled_wanted(const CfgMachine *cfg)
     return cfg->chip_cores > 1 || cfg->chip_memory == CFG_CHIP_MEMORY_SHARED;
 }
 
-/* FuncParams.unit_warm: the list made for the unit before its batch ran. */
+/* FuncParams.unit_warm and unit_warm_l1: the lists made for the unit before its batch ran. */
 static const uint64_t *warm_of(void *ctx, uint32_t unit, size_t *n)
 {
     const ChipSampler *s = ctx;
     *n = s->wlen[unit];
     return s->wl[unit];
+}
+
+static const uint64_t *warm1_of(void *ctx, uint32_t unit, size_t *n)
+{
+    const ChipSampler *s = ctx;
+    *n = s->wlen1[unit];
+    return s->wl1[unit];
 }
 
 static void note(const ChipSampler *s, const char *fmt, unsigned a, unsigned b, unsigned c)
@@ -99,11 +108,20 @@ static int schedule(ChipSampler *s, const double *coef)
         s->pred[u] = s->exact[u] >= 0.0 ? s->exact[u] : p > 1.0 ? p : 1.0;
         s->tile[u / s->spp] += s->pred[u];
     }
-    if (chip_list_schedule(s->tile, s->ntiles, s->K, s->tstart, NULL) < 0.0) {
+    uint32_t *last = malloc((size_t)s->K * sizeof *last);
+    if (!last || chip_list_schedule(s->tile, s->ntiles, s->K, s->tstart, s->tcore) < 0.0) {
         snprintf(s->err, s->errlen, "out of memory for %u cores' schedule", s->K);
         free(keys);
+        free(last);
         return -1;
     }
+    for (uint32_t k = 0; k < s->K; k++)
+        last[k] = UINT32_MAX;
+    for (uint32_t t = 0; t < s->ntiles; t++) { /* (a core's tiles come in the frame's order) */
+        s->tprev[t] = last[s->tcore[t]];
+        last[s->tcore[t]] = t;
+    }
+    free(last);
     for (uint32_t t = 0; t < s->ntiles; t++) {
         double at = s->tstart[t];
         for (uint32_t p = 0; p < s->spp; p++) {
@@ -147,39 +165,67 @@ static void first_coef(const ChipSampler *s, double coef[AUX_K + 1])
 
 /* ---- timing units ------------------------------------------------------------------------------ */
 
-/* The units alone (units[i] into out[i]), each warmed from the current schedule's units before it. */
+/* The unit before u on its core in the current schedule (UINT32_MAX: none). */
+static uint32_t core_prev(const ChipSampler *s, uint32_t u)
+{
+    if (u % s->spp)
+        return u - 1;
+    const uint32_t t = s->tprev[u / s->spp];
+    return t == UINT32_MAX ? t : t * s->spp + s->spp - 1;
+}
+
+/* The L1 lists of units[0..n) into wl1 (and the L2's, when l2, into wl). 0, or -1. */
+static int warm_lists(ChipSampler *s, const uint32_t *units, uint32_t n, int l2)
+{
+    uint32_t *prev = calloc(n ? n : 1, sizeof *prev);
+    uint64_t **lists = calloc(n ? n : 1, sizeof *lists);
+    size_t *lens = calloc(n ? n : 1, sizeof *lens);
+    int rc = 0;
+    if (!prev || !lists || !lens) {
+        snprintf(s->err, s->errlen, "out of memory for %u units' warming", n);
+        rc = -1;
+    }
+    for (uint32_t i = 0; rc == 0 && i < n; i++)
+        prev[i] = core_prev(s, units[i]);
+    if (rc == 0)
+        rc = chipwarm_l1(s->warm, prev, n, run_spec_threads(s->spec), lists, lens, s->err, s->errlen);
+    for (uint32_t i = 0; rc == 0 && i < n; i++) { /* (a unit twice in a batch: one list kept) */
+        free(s->wl1[units[i]]);
+        s->wl1[units[i]] = lists[i];
+        s->wlen1[units[i]] = lens[i];
+        lists[i] = NULL;
+        if (l2 && !s->wl[units[i]])
+            rc = chipwarm_l2(s->warm, s->pos0[units[i]], &s->wl[units[i]], &s->wlen[units[i]], s->err, s->errlen);
+    }
+    for (uint32_t i = 0; lists && i < n; i++)
+        free(lists[i]);
+    free(prev);
+    free(lists);
+    free(lens);
+    return rc;
+}
+
+/* The lists of units[0..n) freed. */
+static void warm_drop(ChipSampler *s, const uint32_t *units, uint32_t n)
+{
+    for (uint32_t i = 0; i < n; i++) {
+        const uint32_t u = units[i];
+        free(s->wl[u]);
+        free(s->wl1[u]);
+        s->wl[u] = s->wl1[u] = NULL;
+        s->wlen[u] = s->wlen1[u] = 0;
+    }
+}
+
+/* The units alone (units[i] into out[i]), each warmed as the first schedule's start says (the L2)
+ * and from the unit before it on its core (the L1). */
 static int time_alone(ChipSampler *s, const uint32_t *units, uint32_t n, FuncUnit *out)
 {
-    int rc = 0;
-    if (s->shared) {
-        uint32_t *pos = calloc(n ? n : 1, sizeof *pos);
-        uint64_t **lists = calloc(n ? n : 1, sizeof *lists);
-        size_t *lens = calloc(n ? n : 1, sizeof *lens);
-        if (!pos || !lists || !lens) {
-            snprintf(s->err, s->errlen, "out of memory for %u units' warming", n);
-            rc = -1;
-        }
-        for (uint32_t i = 0; rc == 0 && i < n; i++)
-            pos[i] = s->pos[units[i]];
-        if (rc == 0)
-            rc = chipwarm_lists(s->warm, s->order, pos, n, run_spec_threads(s->spec), lists, lens, s->err, s->errlen);
-        for (uint32_t i = 0; rc == 0 && i < n; i++) { /* (a unit twice in a batch: one list kept) */
-            free(s->wl[units[i]]);
-            s->wl[units[i]] = lists[i];
-            s->wlen[units[i]] = lens[i];
-            lists[i] = NULL;
-        }
-        free(pos);
-        free(lists);
-        free(lens);
-    }
+    int rc = s->shared ? warm_lists(s, units, n, 1) : 0;
     if (rc == 0)
         rc = func_units(s->fs, units, n, out, s->err, s->errlen);
-    for (uint32_t i = 0; s->shared && i < n; i++) {
-        free(s->wl[units[i]]);
-        s->wl[units[i]] = NULL;
-        s->wlen[units[i]] = 0;
-    }
+    if (s->shared)
+        warm_drop(s, units, n);
     return rc;
 }
 
@@ -249,18 +295,22 @@ static int wave_at(ChipSampler *s, double at, double *wsum, double *asum)
     if (nwave) {
         uint64_t *lines = NULL;
         size_t nlines = 0;
-        rc = chipwarm_lists(s->warm, s->order, &first, 1, run_spec_threads(s->spec), &lines, &nlines, s->err,
-                            s->errlen);
+        rc = chipwarm_l2(s->warm, s->pos0[s->order[first]], &lines, &nlines, s->err, s->errlen);
+        if (rc == 0)
+            rc = warm_lists(s, wave, nwave, 0);
         FuncParams wp = s->fp;
         wp.wave = wave;
         wp.nwave = nwave;
         wp.wave_warm = lines;
         wp.nwave_warm = nlines;
+        wp.unit_warm_l1 = warm1_of;
+        wp.unit_warm_ctx = s;
         wp.progress = NULL;
         FuncStats st = {0};
         if (rc == 0)
             rc = func_render(&s->sc->p, &wp, NULL, &st, s->err, s->errlen);
         free(lines);
+        warm_drop(s, wave, nwave);
         const uint32_t m = nwave < CHIPSAMPLED_WAVE_ALONE ? nwave : CHIPSAMPLED_WAVE_ALONE;
         uint32_t pick[CHIPSAMPLED_WAVE_ALONE];
         for (uint32_t i = 0; i < m; i++) /* evenly over the wave's cores */
@@ -354,6 +404,7 @@ static int sampler_open(ChipSampler *s, const RunScene *sc, const RunSpec *spec,
     if (s->shared) {
         s->up.chip_unit = 1;
         s->up.unit_warm = warm_of;
+        s->up.unit_warm_l1 = warm1_of;
         s->up.unit_warm_ctx = s;
     } else { /* cores on buses of their own: a unit is the paper machine's */
         s->ucfg.chip_cores = 1;
@@ -375,14 +426,19 @@ static int sampler_open(ChipSampler *s, const RunScene *sc, const RunSpec *spec,
     s->start = malloc(N * sizeof *s->start);
     s->order = malloc(N * sizeof *s->order);
     s->pos = malloc(N * sizeof *s->pos);
+    s->pos0 = malloc(N * sizeof *s->pos0);
     s->tile = malloc(T * sizeof *s->tile);
     s->tstart = malloc(T * sizeof *s->tstart);
+    s->tcore = malloc(T * sizeof *s->tcore);
+    s->tprev = malloc(T * sizeof *s->tprev);
     s->wl = calloc(N, sizeof *s->wl);
     s->wlen = calloc(N, sizeof *s->wlen);
+    s->wl1 = calloc(N, sizeof *s->wl1);
+    s->wlen1 = calloc(N, sizeof *s->wlen1);
     s->units = calloc(N, sizeof *s->units);
     s->instructions = malloc(N * sizeof *s->instructions);
-    if (!s->x || !s->exact || !s->pred || !s->start || !s->order || !s->pos || !s->tile || !s->tstart || !s->wl ||
-        !s->wlen || !s->units || !s->instructions) {
+    if (!s->x || !s->exact || !s->pred || !s->start || !s->order || !s->pos || !s->pos0 || !s->tile || !s->tstart ||
+        !s->tcore || !s->tprev || !s->wl || !s->wlen || !s->wl1 || !s->wlen1 || !s->units || !s->instructions) {
         snprintf(err, errlen, "out of memory for %u units", s->N);
         return -1;
     }
@@ -391,8 +447,8 @@ static int sampler_open(ChipSampler *s, const RunScene *sc, const RunSpec *spec,
     if (s->shared) {
         const RefParams rp = sampled_ref_params(spec, cfg, fr);
         const size_t line = (size_t)cfg->scene_line_bytes;
-        const size_t cap = cfg->l2_size_kb > 0 ? (size_t)cfg->l2_size_kb * 1024 / line : 4096;
-        if (!(s->warm = chipwarm_new(&sc->p, &rp, s->ntiles, s->spp, (uint32_t)line, cap))) {
+        const size_t l2 = (size_t)cfg->l2_size_kb * 1024 / line, l1 = (size_t)cfg->scene_cache_kb * 1024 / line;
+        if (!(s->warm = chipwarm_new(&sc->p, &rp, s->ntiles, s->spp, (uint32_t)line, l2, l1))) {
             snprintf(err, errlen, "out of memory for the warming's record");
             return -1;
         }
@@ -416,31 +472,168 @@ static int sampler_close(ChipSampler *s, int rc)
         s->fr->chip.warm_seconds = chipwarm_seconds(s->warm);
     }
     chipwarm_free(s->warm);
-    for (uint32_t u = 0; s->wl && u < s->N; u++)
+    for (uint32_t u = 0; s->wl && s->wl1 && u < s->N; u++) {
         free(s->wl[u]);
+        free(s->wl1[u]);
+    }
     free(s->x);
     free(s->exact);
     free(s->pred);
     free(s->start);
     free(s->order);
     free(s->pos);
+    free(s->pos0);
     free(s->tile);
     free(s->tstart);
+    free(s->tcore);
+    free(s->tprev);
     free(s->wl);
     free(s->wlen);
+    free(s->wl1);
+    free(s->wlen1);
     free(s->units);
     free(s->instructions);
     return rc;
 }
 
-/* Phase 1 (the sample and the regression), phase 2 (r) and the makespan into fr. */
+/* ---- the makespan, and its tail ------------------------------------------------------------------ */
+
+/* What the makespan's estimate takes besides the sample: r and its relative variance, carried. */
+typedef struct Carry {
+    double r, r_rel_var;
+} Carry;
+
+/* The makespan from the n units samp[0..n) timed alone (ys), fit by regression: e, out, and the
+ * tiles' estimates in fr->tile_cycles. 0, or -1 (err says). */
+static int makespan(ChipSampler *s, const uint32_t *samp, const double *ys, uint32_t n, const Carry *c,
+                    SampleEstimate *e, ChipSampleOut *out)
+{
+    if (sample_regression_estimate(ys, s->x, AUX_K, samp, n, s->N, e) != 0) {
+        snprintf(s->err, s->errlen, "sampled mode: cannot estimate from %u of %u units (the frame needs at least 2; "
+                                    "use --mode detailed)", n, s->N);
+        return -1;
+    }
+    /* r's own t (its jackknife has waves - 1 degrees of freedom) carried into the makespan's
+     * interval, which takes the regression's */
+    const uint32_t wv = s->fr->chip.waves;
+    const double tr = wv >= 2 ? sample_t975(wv - 1) : 0.0, tf = e->n < e->N ? sample_t975(e->df) : 1.959963985;
+    ChipSampleIn in = {.ntiles = s->ntiles, .spp = s->spp, .cores = s->K, .x = s->x, .k = AUX_K,
+                       .sample = samp, .ys = ys, .n = n, .fit = e, .exact = s->exact, .r = c->r,
+                       .r_rel_var = c->r_rel_var * (tr / tf) * (tr / tf), .seed = s->spec->sample_seed};
+    if (chip_sample_estimate(&in, s->fr->tile_cycles, out) != 0) {
+        snprintf(s->err, s->errlen, "sampled chip: out of memory estimating the makespan of %u tiles", s->ntiles);
+        return -1;
+    }
+    return 0;
+}
+
+/* The tail's next units into pick (at most CHIPSAMPLED_TAIL_CORES x CHIPSAMPLED_TAIL_UNITS): on
+ * each of the cores that end last in the estimate's schedule (those that may end within 3 standard
+ * errors of its makespan), the tile with the most cycles still predicted, up to
+ * CHIPSAMPLED_TAIL_UNITS of its units neither timed nor exact (from a seeded pass on). Returns
+ * how many (0: none left that could matter). */
+static uint32_t tail_pick(ChipSampler *s, const uint8_t *timed, const ChipSampleOut *out, uint32_t *pick)
+{
+    double *start = malloc((size_t)s->ntiles * sizeof *start), *end = calloc(s->K, sizeof *end);
+    uint32_t *core = malloc((size_t)s->ntiles * sizeof *core), n = 0;
+    uint8_t *used = calloc(s->K, 1);
+    if (start && end && core && used &&
+        chip_list_schedule(s->fr->tile_cycles, s->ntiles, s->K, start, core) >= 0.0) {
+        for (uint32_t t = 0; t < s->ntiles; t++)
+            if (start[t] + s->fr->tile_cycles[t] > end[core[t]])
+                end[core[t]] = start[t] + s->fr->tile_cycles[t];
+        const double floor = out->makespan - 3.0 * out->std_error;
+        for (uint32_t round = 0; round < CHIPSAMPLED_TAIL_CORES; round++) {
+            uint32_t k = s->K; /* the latest core not yet looked at */
+            for (uint32_t q = 0; q < s->K; q++)
+                if (!used[q] && end[q] >= floor && (k == s->K || end[q] > end[k]))
+                    k = q;
+            if (k == s->K)
+                break;
+            used[k] = 1;
+            uint32_t best = s->ntiles;
+            double most = 0.0;
+            for (uint32_t t = 0; t < s->ntiles; t++) {
+                if (core[t] != k)
+                    continue;
+                double left = 0.0;
+                for (uint32_t u = t * s->spp; u < (t + 1) * s->spp; u++)
+                    if (!timed[u] && s->exact[u] < 0.0)
+                        left += s->pred[u];
+                if (left > most) {
+                    most = left;
+                    best = t;
+                }
+            }
+            if (best == s->ntiles) { /* this core's tiles are all known: look at the next */
+                round--;
+                continue;
+            }
+            uint64_t z = (uint64_t)s->spec->sample_seed * 0x9e3779b97f4a7c15ull + best;
+            const uint32_t from = (uint32_t)(sample_splitmix64(&z) % s->spp);
+            uint32_t got = 0;
+            for (uint32_t i = 0; i < s->spp && got < CHIPSAMPLED_TAIL_UNITS; i++) {
+                const uint32_t u = best * s->spp + (from + i) % s->spp;
+                if (!timed[u] && s->exact[u] < 0.0) {
+                    pick[n++] = u;
+                    got++;
+                }
+            }
+        }
+    }
+    free(start);
+    free(end);
+    free(core);
+    free(used);
+    return n;
+}
+
+/* The makespan's tail, with --target-error: while its interval is wider than the target, the units
+ * of the tiles the latest cores end with are timed alone too (they join the sample the estimate
+ * fits: chosen on the schedule of the estimate, never on their own cycles), up to twice phase 1's
+ * units. samp and ys (N each) hold phase 1's n units; e and out end as the last estimate's. */
+static int tail(ChipSampler *s, uint32_t *samp, double *ys, const Carry *c, SampleEstimate *e, ChipSampleOut *out)
+{
+    uint8_t *timed = calloc(s->N, 1);
+    uint32_t pick[CHIPSAMPLED_TAIL_CORES * CHIPSAMPLED_TAIL_UNITS];
+    int rc = timed ? makespan(s, samp, ys, s->n, c, e, out) : -1;
+    if (!timed)
+        snprintf(s->err, s->errlen, "out of memory for %u units", s->N);
+    for (uint32_t i = 0; timed && i < s->n; i++)
+        timed[samp[i]] = 1;
+    const uint32_t budget = s->spec->target_error > 0.0 ? 2 * s->n : 0;
+    while (rc == 0 && s->ntail < budget && out->makespan > 0.0 &&
+           (out->hi - out->lo) / 2.0 > s->spec->target_error * out->makespan) {
+        uint32_t m = tail_pick(s, timed, out, pick);
+        if (m > budget - s->ntail)
+            m = budget - s->ntail;
+        if (!m)
+            break;
+        note(s, "timing the tail: units %u..%u (the makespan's interval +-%u per mille, wider than the target)",
+             s->ntail + 1, s->ntail + m, (unsigned)(500.0 * (out->hi - out->lo) / out->makespan + 0.5));
+        FuncUnit *got = &s->units[s->n + s->ntail];
+        if ((rc = time_alone(s, pick, m, got)) != 0)
+            break;
+        for (uint32_t i = 0; i < m; i++) {
+            samp[s->n + s->ntail + i] = pick[i];
+            ys[s->n + s->ntail + i] = (double)got[i].cycles;
+            timed[pick[i]] = 1;
+        }
+        s->ntail += m;
+        rc = makespan(s, samp, ys, s->n + s->ntail, c, e, out);
+    }
+    free(timed);
+    return rc;
+}
+
+/* Phase 1 (the sample and the regression), phase 2 (r), the tail and the makespan into fr. */
 static int estimate(ChipSampler *s)
 {
     RunFrame *fr = s->fr;
     uint32_t *order = malloc((size_t)s->N * sizeof *order);
     double *ys = malloc((size_t)s->N * sizeof *ys);
     int rc = -1;
-    if (!order || !ys) {
+    if (!order || !ys || !(fr->tile_cycles = malloc((s->ntiles ? s->ntiles : 1) * sizeof *fr->tile_cycles))) {
         snprintf(s->err, s->errlen, "out of memory for %u units", s->N);
         goto out;
     }
@@ -455,38 +648,29 @@ static int estimate(ChipSampler *s)
                                         "least 2; use --mode detailed)", s->n, s->N);
         goto out;
     }
-    double r, r_rel_var;
-    if (schedule(s, e.coef) != 0 || waves(s, &r, &r_rel_var) != 0)
+    Carry c;
+    if (schedule(s, e.coef) != 0 || waves(s, &c.r, &c.r_rel_var) != 0)
         goto out;
-    /* r's own t (its jackknife has waves - 1 degrees of freedom) carried into the makespan's interval,
-     * which takes the regression's */
-    const uint32_t wv = fr->chip.waves;
-    const double tr = wv >= 2 ? sample_t975(wv - 1) : 0.0, tf = e.n < e.N ? sample_t975(e.df) : 1.959963985;
-    ChipSampleIn in = {.ntiles = s->ntiles, .spp = s->spp, .cores = s->K, .x = s->x, .k = AUX_K,
-                       .sample = order, .ys = ys, .n = s->n, .fit = &e, .exact = s->exact, .r = r,
-                       .r_rel_var = r_rel_var * (tr / tf) * (tr / tf), .seed = s->spec->sample_seed};
     ChipSampleOut out;
-    if (!(fr->tile_cycles = malloc((s->ntiles ? s->ntiles : 1) * sizeof *fr->tile_cycles)) ||
-        chip_sample_estimate(&in, fr->tile_cycles, &out) != 0) {
-        snprintf(s->err, s->errlen, "sampled chip: out of memory estimating the makespan of %u tiles", s->ntiles);
+    if (tail(s, order, ys, &c, &e, &out) != 0)
         goto out;
-    }
     fr->est = e;
     fr->est.total = out.makespan;
     fr->est.lo = out.lo;
     fr->est.hi = out.hi;
     fr->est.std_error = out.std_error;
     fr->est.t = out.t;
-    StatsChipSample *c = &fr->chip;
-    c->r = r;
-    if (wv < 2)
-        c->r_lo = c->r_hi = r;
-    c->plain = out.plain;
-    c->var_jack = out.var_jack;
-    c->var_draws = out.var_draws;
-    c->var_r = out.var_r;
-    c->sigma_a = out.sigma_a;
-    c->sigma_e = out.sigma_e;
+    StatsChipSample *cs = &fr->chip;
+    cs->r = c.r;
+    if (cs->waves < 2)
+        cs->r_lo = cs->r_hi = c.r;
+    cs->tail_units = s->ntail;
+    cs->plain = out.plain;
+    cs->var_jack = out.var_jack;
+    cs->var_draws = out.var_draws;
+    cs->var_r = out.var_r;
+    cs->sigma_a = out.sigma_a;
+    cs->sigma_e = out.sigma_e;
     fr->has_est = 1;
     rc = 0;
 out:
@@ -512,8 +696,13 @@ int chipsampled_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine 
         first_coef(&s, coef);
         rc = schedule(&s, coef);
     }
+    if (rc == 0 && s.warm) { /* the L2's warming: each line's first reader in this schedule */
+        memcpy(s.pos0, s.pos, (size_t)s.N * sizeof *s.pos0);
+        note(&s, "the warming's record: each line's first reader (the golden model, %u units)", s.N, 0, 0);
+        rc = chipwarm_first_readers(s.warm, s.pos0, run_spec_threads(spec), err, errlen);
+    }
     if (rc == 0)
         rc = estimate(&s);
-    fr->units_sampled = s.n;
+    fr->units_sampled = s.n + s.ntail;
     return sampler_close(&s, rc);
 }

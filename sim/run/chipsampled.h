@@ -17,6 +17,8 @@
  *    to CHIPSAMPLED_WAVE_ALONE of them alone; their ratio r, with a jackknife over waves.
  * 6. The makespan: every tile's estimate (exact, sampled or predicted units, times r, with the
  *    tile-effect correction) list-scheduled, with its 95 % interval (sim/chipsampling.h).
+ * 7. The tail (with --target-error): while that interval is wider than the target, units of the
+ *    tiles the latest cores end with are timed alone too and join the fit (CHIPSAMPLED_TAIL_*).
  * A chip whose cores have buses of their own (chip.memory = bus) has no shared level to warm or
  * contend for: its units are timed as sampled mode's (a cold core on its bus) and r = 1.
  *
@@ -32,6 +34,12 @@
 
 /* The units of a wave also timed alone (evenly spread over its cores) for the ratio r. */
 #define CHIPSAMPLED_WAVE_ALONE 16u
+
+/* The tail (with --target-error, while the makespan's interval is wider): a round times, on each
+ * of this many of the cores that end last in the estimate, up to this many units of the tile with
+ * the most cycles still predicted; all rounds at most twice phase 1's units. */
+#define CHIPSAMPLED_TAIL_CORES 4u
+#define CHIPSAMPLED_TAIL_UNITS 4u
 
 /* Waves timed on a chip of K cores: 4, or 2 above 64 cores (a wave costs K units). */
 uint32_t chipsampled_waves(uint32_t cores);

@@ -276,6 +276,21 @@ int eng_pass_end(Job *j, Core *c, const FuncTile *ft, uint32_t pass, CoreExit ex
     return 0;
 }
 
+int eng_warm_l1(Job *j, Timing *t, uint32_t unit)
+{
+    if (!j->fp->unit_warm_l1)
+        return 0;
+    size_t n = 0;
+    const uint64_t *lines = j->fp->unit_warm_l1(j->fp->unit_warm_ctx, unit, &n);
+    const uint64_t line = (uint64_t)j->fp->cfg->scene_line_bytes;
+    const uint64_t fb = unit % j->spp ? ((uint64_t)j->k->tile_w * j->k->tile_h * 12 + line - 1) / line * line : 0;
+    if (timing_warm_l1(t, lines, lines ? n : 0, fb) != 0) {
+        eng_fail(j, timing_error(t), 0);
+        return -1;
+    }
+    return 0;
+}
+
 /* One kernel run: unit `unit` (tile * spp + pass) of the launched tile, on a cold machine when
  * timed (fu gets its timed figures; on a chip's unit, its levels warmed first when asked). 0, or
  * -1 after eng_fail(). */
@@ -292,6 +307,8 @@ static int run_pass(Worker *w, Core *c, const FuncTile *ft, uint32_t unit, FuncU
         if (lines)
             chipunit_warm(&w->cu, lines, n);
     }
+    if (w->cu.chip && eng_warm_l1(j, w->tc.tm, unit) != 0)
+        return -1;
     const uint64_t limit = (uint64_t)j->fp->cfg->sim_max_instructions;
     CoreExit ex;
     if (w->cu.chip) {

@@ -62,6 +62,10 @@ typedef struct FuncParams {
      * first), or NULL for none; called from the host thread that runs u, several at once. */
     const uint64_t *(*unit_warm)(void *ctx, uint32_t unit, size_t *n);
     void *unit_warm_ctx;
+    /* With chip_unit or wave: the scene lines to warm unit u's L1 with before it runs (oldest
+     * first), or NULL for none; past the tile's first pass its framebuffer's lines are warmed too
+     * (before them, dirty: the tile's earlier passes wrote them). Same ctx, same threads. */
+    const uint64_t *(*unit_warm_l1)(void *ctx, uint32_t unit, size_t *n);
     /* Detailed, on a chip: the frame only until pass 0 of each of its first K tiles (the chip's
      * first wave, a sampled chip's opening: docs/sampling.md) has ended. Every (tile, pass) unit
      * that ended by then has its exact cycles in FuncStats.pass_cycles (the others 0); the chip's

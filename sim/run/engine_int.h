@@ -70,6 +70,9 @@ void eng_batch_launch(Job *j, Core *c, uint32_t t);
 int eng_batch_end(Job *j, Core *c, uint32_t t, CoreExit ex, FuncStats *st);
 /* The tile's pixels between the core's framebuffer and the frame (to_fb: into the framebuffer). */
 void eng_tile_pixels(Job *j, Core *c, const FuncTile *ft, int to_fb);
+/* A sampled chip's unit (FuncParams.unit_warm_l1): timing model t's L1 warmed for unit `unit`
+ * (tile * spp + pass) after its reset. 0, or -1 after eng_fail. */
+int eng_warm_l1(Job *j, Timing *t, uint32_t unit);
 /* Worker `index`'s core opened and the scene loaded (sim/run/tiles.h's begin). */
 int eng_worker_begin(void *ctx, int index);
 /* The workers' counters into st, in worker order. */

@@ -92,6 +92,38 @@ Test(cache, scene_cache_lru_and_bus)
     l1_close(&f);
 }
 
+Test(cache, warming_brings_lines_in_as_reads_would_at_no_time)
+{
+    /* 2 sets x 2 ways of 64-byte lines; latency 10, 16 bytes per cycle (4 cycles a line). Lines 0,
+     * 128 and 256 share set 0: warming 0, 128, 256 in that order leaves 128 and 256 (0 was least
+     * recently used); 256 warmed dirty. Nothing is counted and the bus stays idle, so the first
+     * read that misses starts at once: line 0 at cycle 0 evicts 128 (the least recent, clean: no
+     * write-back), bus 0..3, ready 14; 256 hits (ready 21 at 20); 128 at 30 evicts 0 (now the
+     * least recent, clean), bus 30..33, ready 44; 0 at 50 evicts the dirty 256: its write-back on
+     * the bus 50..53, the fill 54..57, ready 68. */
+    L1 f;
+    l1_open(&f, (BusParams){10, 16, 64}, (CacheParams){256, 2, 64, 1});
+    cr_assert_eq(cache_warm(&f.c, 0, 0), 0);
+    cr_assert_eq(cache_warm(&f.c, 128, 0), 0);
+    cr_assert_eq(cache_warm(&f.c, 256, 1), 0);
+    cr_expect_eq(f.c.st.accesses + f.c.st.hits + f.c.st.misses + f.c.st.writebacks, 0, "warming counts nothing");
+    cr_expect_eq(f.b.st.requests, 0, "warming sends nothing below");
+    cr_expect_eq(l1_access(&f, 0, 0, 0, 0), 14);
+    cr_expect_eq(l1_access(&f, 0, 256, 20, 0), 21);
+    cr_expect_eq(l1_access(&f, 0, 128, 30, 0), 44);
+    cr_expect_eq(f.c.st.writebacks, 0, "the warmed clean lines leave without a write-back");
+    cr_expect_eq(l1_access(&f, 0, 0, 50, 0), 68);
+    cr_expect_eq(f.c.st.writebacks, 1, "the line warmed dirty is written back");
+    cr_expect_eq(f.c.st.hits, 1);
+    cr_expect_eq(f.c.st.misses, 3);
+    l1_close(&f);
+    /* no cache: nothing to warm */
+    l1_open(&f, (BusParams){10, 16, 64}, (CacheParams){0, 2, 64, 1});
+    cr_expect_eq(cache_warm(&f.c, 0, 1), 0);
+    cr_expect_eq(f.c.instantiated, 0);
+    l1_close(&f);
+}
+
 /* A plain set-associative LRU cache with the same bus and latencies as docs/model.md gives them
  * ("Scene memory"): the reference for the cache's shortcuts (the way of the last hit tried first). */
 typedef struct RefCache {

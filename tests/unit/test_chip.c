@@ -571,6 +571,75 @@ Test(chip, a_chip_unit_warmed_with_its_own_lines_is_faster)
     unload();
 }
 
+/* FuncParams.unit_warm_l1: a chip's unit starts with its L1 warmed by the lines given and, past
+ * its tile's first pass, by its tile's framebuffer (which the earlier passes wrote). Unit 1 (tile
+ * 0, pass 1) of a 32 x 32 x 2 Cornell frame, whose scene lines all fit in the 64 KB L1: with an
+ * empty list its framebuffer's 32 x 32 x 12 bytes = 192 lines are warm, so it misses fewer lines
+ * than cold, at most 192 fewer (the pixels a pass adds to: not all of them), and its stores do
+ * not wait for their lines, so the cycles stay; with every scene line the frame read as well it
+ * misses none (so the framebuffer's warming covered every line it added to) and takes fewer
+ * cycles. Unit 0 (pass 0) has no framebuffer to warm. Each the same twice. */
+static const uint64_t *no_lines(void *ctx, uint32_t unit, size_t *n)
+{
+    (void)ctx;
+    (void)unit;
+    *n = 0;
+    return NULL;
+}
+
+static FuncUnit unit_l1(const CfgMachine *cfg, uint32_t unit, const uint64_t *(*l1)(void *, uint32_t, size_t *),
+                        Warm *w, uint64_t *misses)
+{
+    static char err[65536];
+    FuncParams up = {.cfg = cfg, .kernel_path = "kernels/pathtrace.s", .needs = scene.needs, .seed = 1, .threads = 1,
+                     .timed = 1, .chip_unit = 1, .unit_warm_l1 = l1, .unit_warm_ctx = w};
+    FuncSession *s;
+    FuncUnit u;
+    cr_assert_eq(func_open(&packed, &up, &s, err, sizeof err), 0, "%s", err);
+    cr_assert_eq(func_units(s, &unit, 1, &u, err, sizeof err), 0, "%s", err);
+    FuncStats ss;
+    cr_assert_eq(func_close(s, &ss, err, sizeof err), 0, "%s", err);
+    *misses = ss.timing.l1.misses;
+    func_stats_free(&ss);
+    return u;
+}
+
+Test(chip, a_chip_unit_with_its_l1_warmed_is_faster)
+{
+    load("scenes/cornell/scene.ini", 32, 32, 2);
+    CfgMachine chip;
+    small_frame(&chip);
+    shared_memory(&chip, 4);
+    static char err[65536];
+    FuncParams fp = {.cfg = &chip, .kernel_path = "kernels/pathtrace.s", .needs = scene.needs, .seed = 1,
+                     .threads = 1, .timed = 1, .mem_trace = 1};
+    FuncStats st;
+    cr_assert_eq(func_render(&packed, &fp, NULL, &st, err, sizeof err), 0, "%s", err);
+    Warm w = {malloc((st.ntrace ? st.ntrace : 1) * sizeof(uint64_t)), 0, 0};
+    for (size_t i = 0; i < st.ntrace; i++)
+        if (!st.trace[i].write && !(st.trace[i].addr >> MEM_SPACE_SHIFT)) /* scene lines only */
+            w.lines[w.n++] = st.trace[i].addr;
+    cr_assert_gt(w.n, 0);
+    cr_assert_lt(w.n, (size_t)chip.scene_cache_kb * 1024 / (size_t)chip.scene_line_bytes, "the L1 holds them");
+    func_stats_free(&st);
+    uint64_t m[7];
+    const FuncUnit cold0 = unit_l1(&chip, 0, NULL, &w, &m[0]), cold1 = unit_l1(&chip, 1, NULL, &w, &m[1]);
+    const FuncUnit fb = unit_l1(&chip, 1, no_lines, &w, &m[2]), fb2 = unit_l1(&chip, 1, no_lines, &w, &m[3]);
+    const FuncUnit all = unit_l1(&chip, 1, warm_lines, &w, &m[4]), all2 = unit_l1(&chip, 1, warm_lines, &w, &m[5]);
+    const FuncUnit first = unit_l1(&chip, 0, no_lines, &w, &m[6]);
+    cr_expect(m[2] < m[1] && m[1] - m[2] <= 192, "cold %llu misses, framebuffer warmed %llu",
+              (unsigned long long)m[1], (unsigned long long)m[2]);
+    cr_expect_eq(fb.cycles, cold1.cycles);
+    cr_expect_eq(m[4], 0, "%llu misses with every line warmed", (unsigned long long)m[4]);
+    cr_expect_lt(all.cycles, cold1.cycles, "warmed %llu, cold %llu", (unsigned long long)all.cycles,
+                 (unsigned long long)cold1.cycles);
+    cr_expect(fb.cycles == fb2.cycles && m[2] == m[3] && all.cycles == all2.cycles && m[4] == m[5]);
+    cr_expect_eq(all.instructions, cold1.instructions);
+    cr_expect(first.cycles == cold0.cycles && m[6] == m[0], "a tile's first pass has no framebuffer to warm");
+    free(w.lines);
+    unload();
+}
+
 /* A sampled chip's wave (FuncParams.wave): K units starting together on a cold chip. A frame of K
  * tiles and one pass is one wave, so the wave of its units takes exactly the frame's cycles per
  * unit; warmed with lines, the same wave takes other cycles; more units than cores is refused. */

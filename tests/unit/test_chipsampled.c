@@ -86,10 +86,13 @@ Test(chipsampled, covers_the_detailed_makespan, .init = shared16, .fini = teardo
         cr_expect(fr.chip.r > 0.9 && fr.chip.r < 1.1 && fr.chip.r_lo <= fr.chip.r && fr.chip.r <= fr.chip.r_hi,
                   "seed %u: r %g (%g .. %g)", seed, fr.chip.r, fr.chip.r_lo, fr.chip.r_hi);
         cr_expect(fr.est.lo <= fr.est.total && fr.est.total <= fr.est.hi);
+        cr_expect_leq(fr.chip.tail_units, 2 * (fr.units_sampled - fr.chip.tail_units),
+                      "seed %u: the tail timed %u units, more than twice the sample's", seed, fr.chip.tail_units);
         covered += fr.est.lo <= M && M <= fr.est.hi;
         abs_err += fabs(fr.est.total / M - 1.0) / SEEDS;
-        fprintf(stderr, "chipsampled seed %u: %.0f (%.0f .. %.0f) against %.0f: %+.3f %%, %u units, r %.4f\n", seed,
-                fr.est.total, fr.est.lo, fr.est.hi, M, 100.0 * (fr.est.total / M - 1.0), fr.units_sampled, fr.chip.r);
+        fprintf(stderr, "chipsampled seed %u: %.0f (%.0f .. %.0f) against %.0f: %+.3f %%, %u units (%u the tail's), r %.4f\n",
+                seed, fr.est.total, fr.est.lo, fr.est.hi, M, 100.0 * (fr.est.total / M - 1.0), fr.units_sampled,
+                fr.chip.tail_units, fr.chip.r);
         run_frame_free(&fr);
     }
     if (SEEDS == 20) {

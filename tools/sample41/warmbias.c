@@ -6,7 +6,12 @@
  * Build (not part of make; after `make all`):
  *   gcc -O2 -I. -o build/warmbias tools/sample41/warmbias.c build/libsfsim.a -linih -ltinygltf \
  *       -ltinyobjloader -lcjson -lOpenEXRCore-3_1 -lpng16 -lfreetype -lgsl -lgslcblas -lstdc++ -lpthread -ldl -lm
- * usage: warmbias SCENE.ini CONFIG.ini W H SPP [THREADS [WAVES]]
+ * usage: [WB_MODE=old|distinct|fb] warmbias SCENE.ini CONFIG.ini W H SPP [THREADS [WAVES]]
+ * WB_MODE picks the L2's warming list: old (the last L2-capacity of lines counted with repeats:
+ * the first sampler's), distinct (the latest distinct lines back to an L2's worth or the frame's
+ * start), fb (distinct, and past a tile's first pass its framebuffer's lines), chipwarm (the
+ * sampler's: sim/run/chipwarm.c's first readers for the L2, the unit before on its core for the
+ * L1, with the framebuffer).
  *
  * 1. The chip's frame in detailed mode (stream.rays = 1024: 32 x 32 tiles): every unit's cycles
  *    (tiles[].passes[]) and its core; each unit's start is the sum of the units before it on its
@@ -34,6 +39,7 @@
 #include "scenes/scene.h"
 #include "sim/config.h"
 #include "sim/reference.h"
+#include "sim/run/chipwarm.h"
 #include "sim/run/engine.h"
 
 typedef struct Lines {
@@ -73,6 +79,15 @@ static const uint64_t *warm_of(void *ctx, uint32_t unit, size_t *n)
     (void)ctx;
     *n = warm[unit].n;
     return warm[unit].a;
+}
+
+/* WB_MODE=chipwarm: the L1's lists too */
+static Lines *warm1;
+static const uint64_t *warm1_of(void *ctx, uint32_t unit, size_t *n)
+{
+    (void)ctx;
+    *n = warm1[unit].n;
+    return warm1[unit].a;
 }
 
 static int u64_order(const void *a, const void *b)
@@ -163,25 +178,97 @@ int main(int argc, char **argv)
     /* 3. warming lists: the units started before u (those still running when u starts too, whole),
      * in start order; the last `cap` lines kept */
     const size_t cap = (size_t)cfg.l2_size_kb * 1024 / 64;
+    const char *mode = getenv("WB_MODE") ? getenv("WB_MODE") : "old"; /* old | distinct | fb */
     uint32_t *order = malloc(nunits * sizeof *order);
     for (uint32_t u = 0; u < nunits; u++)
         order[u] = u;
     qsort(order, nunits, sizeof *order, start_order);
     warm = calloc(nunits, sizeof *warm);
+    const size_t hsize = (size_t)1 << 22; /* > 2 cap */
+    uint64_t *hash = calloc(hsize, sizeof *hash);
     for (uint32_t i = 0; i < nunits; i++) {
         const uint32_t u = order[i];
-        size_t total = 0;
-        uint32_t j = i;
-        while (j > 0 && total < cap) /* back from the latest start before u's */
-            total += unit_lines[order[--j]].n;
-        for (; j < i; j++)
-            for (size_t q = 0; q < unit_lines[order[j]].n; q++)
-                push(&warm[u], unit_lines[order[j]].a[q]);
-        if (warm[u].n > cap) { /* the oldest beyond the capacity out */
-            memmove(warm[u].a, warm[u].a + (warm[u].n - cap), cap * sizeof *warm[u].a);
-            warm[u].n = cap;
+        if (!strcmp(mode, "old")) {
+            size_t total = 0;
+            uint32_t j = i;
+            while (j > 0 && total < cap) /* back from the latest start before u's */
+                total += unit_lines[order[--j]].n;
+            for (; j < i; j++)
+                for (size_t q = 0; q < unit_lines[order[j]].n; q++)
+                    push(&warm[u], unit_lines[order[j]].a[q]);
+            if (warm[u].n > cap) { /* the oldest beyond the capacity out */
+                memmove(warm[u].a, warm[u].a + (warm[u].n - cap), cap * sizeof *warm[u].a);
+                warm[u].n = cap;
+            }
+        } else { /* distinct lines from the latest unit back until cap, most recent use kept */
+            memset(hash, 0, hsize * sizeof *hash);
+            Lines rev = {0};
+            for (uint32_t j = i; j > 0 && rev.n < cap; j--) {
+                const Lines *l = &unit_lines[order[j - 1]];
+                for (size_t q = 0; q < l->n && rev.n < cap; q++) {
+                    uint64_t h = (l->a[q] * 0x9E3779B97F4A7C15ull) >> 42;
+                    while (hash[h] && hash[h] != l->a[q] + 1)
+                        h = (h + 1) & (hsize - 1);
+                    if (hash[h])
+                        continue;
+                    hash[h] = l->a[q] + 1;
+                    push(&rev, l->a[q]);
+                }
+            }
+            for (size_t q = rev.n; q > 0; q--) /* oldest first */
+                push(&warm[u], rev.a[q - 1]);
+            free(rev.a);
+            if (!strcmp(mode, "fb") && u % (uint32_t)S) /* the tile's framebuffer, written by its passes before */
+                for (uint64_t b = 0; b < 1024 * 12; b += 64)
+                    push(&warm[u], ((uint64_t)1 << 32) + b);
         }
     }
+    free(hash);
+    if (!strcmp(mode, "chipwarm")) { /* sim/run/chipwarm.c's lists, on the frame's own schedule */
+        uint32_t *pos = malloc(nunits * sizeof *pos), *prev = malloc(nunits * sizeof *prev),
+                 *last = malloc(full.chip_cores * sizeof *last);
+        for (uint32_t i = 0; i < nunits; i++)
+            pos[order[i]] = i;
+        for (uint32_t k = 0; k < full.chip_cores; k++)
+            last[k] = UINT32_MAX;
+        for (uint32_t t = 0; t < full.ntiles; t++) { /* each unit's predecessor on its core */
+            const uint32_t k = full.tiles[t].core;
+            for (uint32_t p = 0; p < (uint32_t)S; p++) {
+                prev[t * S + p] = p ? t * S + p - 1 : last[k];
+            }
+            last[k] = t * S + S - 1;
+        }
+        ChipWarm *cw = chipwarm_new(&packed, &(RefParams){.tile = 32, .seed = 1}, full.ntiles, (uint32_t)S, 64, cap,
+                                    (size_t)cfg.scene_cache_kb * 1024 / 64);
+        uint64_t **l1 = calloc(nunits, sizeof *l1);
+        size_t *n1 = calloc(nunits, sizeof *n1);
+        warm1 = calloc(nunits, sizeof *warm1);
+        if (!cw || chipwarm_first_readers(cw, pos, threads, err, sizeof err) ||
+            chipwarm_l1(cw, prev, nunits, threads, l1, n1, err, sizeof err)) {
+            fprintf(stderr, "chipwarm: %s\n", err);
+            return 1;
+        }
+        for (uint32_t u = 0; u < nunits; u++) {
+            free(warm[u].a);
+            warm[u] = (Lines){0};
+            uint64_t *l2;
+            size_t n2;
+            if (chipwarm_l2(cw, pos[u], &l2, &n2, err, sizeof err)) {
+                fprintf(stderr, "chipwarm: %s\n", err);
+                return 1;
+            }
+            warm[u] = (Lines){l2, n2, n2};
+            warm1[u] = (Lines){l1[u], n1[u], n1[u]};
+        }
+        fprintf(stderr, "chipwarm: %u units recorded, %.1f s\n", chipwarm_recorded(cw), chipwarm_seconds(cw));
+        chipwarm_free(cw);
+        free(l1);
+        free(n1);
+        free(pos);
+        free(prev);
+        free(last);
+    }
+    fprintf(stderr, "warming mode %s\n", mode);
 
     /* 4. every unit alone, cold and warm */
     uint32_t *all = malloc(nunits * sizeof *all);
@@ -192,6 +279,7 @@ int main(int argc, char **argv)
         FuncParams up = fp;
         up.chip_unit = 1;
         up.unit_warm = pass ? warm_of : NULL;
+        up.unit_warm_l1 = pass && warm1 ? warm1_of : NULL;
         FuncSession *s;
         FuncStats st;
         if (func_open(&packed, &up, &s, err, sizeof err) || func_units(s, all, nunits, pass ? hot : cold, err, sizeof err) ||
