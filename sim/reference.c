@@ -438,6 +438,13 @@ static Ray *push(Worker *w, uint32_t *n)
     return &w->next[(*n)++];
 }
 
+/* RefParams.unit_line: the light record a shadow ray was sampled from. */
+static void note_light(const Worker *w, uint32_t l)
+{
+    if (w->set.line)
+        w->set.line(w->set.line_ctx, sm_rec(w->c->lights, SM_LIGHT_WORDS, l, 0), 4u * SM_LIGHT_WORDS);
+}
+
 /* Direct lighting: one shadow ray toward a uniformly chosen light. */
 static void shade_direct(Worker *w, const Ray *r, const Surface *s, float p_direct, uint32_t *n)
 {
@@ -448,6 +455,7 @@ static void shade_direct(Worker *w, const Ray *r, const Surface *s, float p_dire
         l = c->nlights - 1;
     float o[3], dir[3], wi[3], le[3], f[3];
     offset_point(s->p, s->nf, o);
+    note_light(w, l);
     if (!sample_light(c, l, o, ref_rand(r->key, v, DIM_LIGHT_U), ref_rand(r->key, v, DIM_LIGHT_V), dir, wi, le))
         return;
     if (dot3(wi, s->nf) <= 0.0f || dot3(wi, s->ns) <= 0.0f)
@@ -544,6 +552,7 @@ static void shade_phong(Worker *w, const Ray *r, const Surface *s, uint32_t *n)
         float u = kind == SM_LIGHT_TRIANGLE ? PHONG_TRI_U : 0.5f;
         Ray q = {0};
         float wi[3], le[3];
+        note_light(w, l);
         if (!sample_light(c, l, o, u, 0.5f, q.dir, wi, le))
             continue;
         if (dot3(wi, s->nf) <= 0.0f || dot3(wi, s->ns) <= 0.0f)
@@ -812,6 +821,8 @@ static void render_tile(Worker *w, uint32_t tile)
     uint32_t pass1 = c->rp->pass1 ? c->rp->pass1 : c->spp;
     for (uint32_t sample = c->rp->pass0; sample < pass1 && sample < c->spp; sample++) {
         w->unit = tile * c->spp + sample;
+        if (w->set.line) /* RefParams.unit_line: the kernel reads the header's fields in each pass */
+            w->set.line(w->set.line_ctx, sm_hdr(c->p, 0), 4u * SM_HDR_WORDS);
         RefStats before = w->st;
         RefUnitStats steps;
         memset(&steps, 0, sizeof steps);

@@ -577,6 +577,7 @@ uint32_t chip_run_frame(Job *j)
                 tile_begin(&r, k, u / j->spp, u % j->spp, u % j->spp + 1);
                 if (eng_warm_l1(j, tm_of(&r, k), u) != 0)
                     break;
+                eng_warm_fb_shared(j, r.chip, (uint64_t)(u / j->spp) * r.fb_tile, u);
                 r.runnable[r.nrunnable++] = k;
             } else if (!j->fp->wave && r.next_tile < j->ntiles) {
                 tile_begin(&r, k, r.next_tile++, 0, r.passes);

@@ -27,7 +27,8 @@ typedef struct ChipSampler {
     double *x, *exact, *pred, *start; /* N each: auxiliaries (N x AUX_K), exact chip cycles (< 0:
                                          unknown), predicted cycles and start */
     uint32_t *order, *pos;     /* N each: units in predicted start order, each unit's position */
-    uint32_t *pos0;            /* N: each unit's position in the first schedule (the warming's) */
+    uint32_t *wkey, *wthr;     /* N each, the warming's (warm_keys): each unit's rank as a reader, and
+                                  the readers before its start */
     double *tile, *tstart;     /* ntiles each */
     uint32_t *tcore, *tprev;   /* ntiles each: its core, the tile before it there (UINT32_MAX: none) */
     ChipWarm *warm;
@@ -163,6 +164,38 @@ static void first_coef(const ChipSampler *s, double coef[AUX_K + 1])
     free(ys);
 }
 
+/* The warming's keys, from the first schedule: a line counts as read by a unit's start when its
+ * first reader started before it (a unit still running then, whole: halfway through it instead,
+ * the units alone missed 45-140 % more DRAM lines than the full run, against 12-26 % fewer this
+ * way: docs/sampling.md). wkey[u]: the rank of u's start among all units'; wthr[u]: how many
+ * starts come before u's (chipwarm_l2's position). */
+static int warm_keys(ChipSampler *s)
+{
+    StartKey *m = malloc((size_t)s->N * sizeof *m);
+    if (!m) {
+        snprintf(s->err, s->errlen, "out of memory for %u units' warming", s->N);
+        return -1;
+    }
+    for (uint32_t u = 0; u < s->N; u++)
+        m[u] = (StartKey){s->start[u], u};
+    qsort(m, s->N, sizeof *m, start_order);
+    for (uint32_t i = 0; i < s->N; i++)
+        s->wkey[m[i].unit] = i;
+    for (uint32_t u = 0; u < s->N; u++) {
+        uint32_t lo = 0, hi = s->N; /* the first start not before u's */
+        while (lo < hi) {
+            const uint32_t mid = lo + (hi - lo) / 2;
+            if (m[mid].start < s->start[u])
+                lo = mid + 1;
+            else
+                hi = mid;
+        }
+        s->wthr[u] = lo;
+    }
+    free(m);
+    return 0;
+}
+
 /* ---- timing units ------------------------------------------------------------------------------ */
 
 /* The unit before u on its core in the current schedule (UINT32_MAX: none). */
@@ -195,7 +228,7 @@ static int warm_lists(ChipSampler *s, const uint32_t *units, uint32_t n, int l2)
         s->wlen1[units[i]] = lens[i];
         lists[i] = NULL;
         if (l2 && !s->wl[units[i]])
-            rc = chipwarm_l2(s->warm, s->pos0[units[i]], &s->wl[units[i]], &s->wlen[units[i]], s->err, s->errlen);
+            rc = chipwarm_l2(s->warm, s->wthr[units[i]], &s->wl[units[i]], &s->wlen[units[i]], s->err, s->errlen);
     }
     for (uint32_t i = 0; lists && i < n; i++)
         free(lists[i]);
@@ -295,7 +328,7 @@ static int wave_at(ChipSampler *s, double at, double *wsum, double *asum)
     if (nwave) {
         uint64_t *lines = NULL;
         size_t nlines = 0;
-        rc = chipwarm_l2(s->warm, s->pos0[s->order[first]], &lines, &nlines, s->err, s->errlen);
+        rc = chipwarm_l2(s->warm, s->wthr[s->order[first]], &lines, &nlines, s->err, s->errlen);
         if (rc == 0)
             rc = warm_lists(s, wave, nwave, 0);
         FuncParams wp = s->fp;
@@ -426,7 +459,8 @@ static int sampler_open(ChipSampler *s, const RunScene *sc, const RunSpec *spec,
     s->start = malloc(N * sizeof *s->start);
     s->order = malloc(N * sizeof *s->order);
     s->pos = malloc(N * sizeof *s->pos);
-    s->pos0 = malloc(N * sizeof *s->pos0);
+    s->wkey = malloc(N * sizeof *s->wkey);
+    s->wthr = malloc(N * sizeof *s->wthr);
     s->tile = malloc(T * sizeof *s->tile);
     s->tstart = malloc(T * sizeof *s->tstart);
     s->tcore = malloc(T * sizeof *s->tcore);
@@ -437,7 +471,7 @@ static int sampler_open(ChipSampler *s, const RunScene *sc, const RunSpec *spec,
     s->wlen1 = calloc(N, sizeof *s->wlen1);
     s->units = calloc(N, sizeof *s->units);
     s->instructions = malloc(N * sizeof *s->instructions);
-    if (!s->x || !s->exact || !s->pred || !s->start || !s->order || !s->pos || !s->pos0 || !s->tile || !s->tstart ||
+    if (!s->x || !s->exact || !s->pred || !s->start || !s->order || !s->pos || !s->wkey || !s->wthr || !s->tile || !s->tstart ||
         !s->tcore || !s->tprev || !s->wl || !s->wlen || !s->wl1 || !s->wlen1 || !s->units || !s->instructions) {
         snprintf(err, errlen, "out of memory for %u units", s->N);
         return -1;
@@ -482,7 +516,8 @@ static int sampler_close(ChipSampler *s, int rc)
     free(s->start);
     free(s->order);
     free(s->pos);
-    free(s->pos0);
+    free(s->wkey);
+    free(s->wthr);
     free(s->tile);
     free(s->tstart);
     free(s->tcore);
@@ -588,10 +623,11 @@ static uint32_t tail_pick(ChipSampler *s, const uint8_t *timed, const ChipSample
     return n;
 }
 
-/* The makespan's tail, with --target-error: while its interval is wider than the target, the units
- * of the tiles the latest cores end with are timed alone too (they join the sample the estimate
- * fits: chosen on the schedule of the estimate, never on their own cycles), up to twice phase 1's
- * units. samp and ys (N each) hold phase 1's n units; e and out end as the last estimate's. */
+/* The makespan's tail, with --target-error: while its interval is wider than the target and the
+ * last round moved the estimate by more than CHIPSAMPLED_TAIL_MOVE standard errors, the units of the tiles the latest cores end with are timed alone too (they join the sample the
+ * estimate fits: chosen on the schedule of the estimate, never on their own cycles), up to twice
+ * phase 1's units. samp and ys (N each) hold phase 1's n units; e and out end as the last
+ * estimate's. */
 static int tail(ChipSampler *s, uint32_t *samp, double *ys, const Carry *c, SampleEstimate *e, ChipSampleOut *out)
 {
     uint8_t *timed = calloc(s->N, 1);
@@ -602,8 +638,10 @@ static int tail(ChipSampler *s, uint32_t *samp, double *ys, const Carry *c, Samp
     for (uint32_t i = 0; timed && i < s->n; i++)
         timed[samp[i]] = 1;
     const uint32_t budget = s->spec->target_error > 0.0 ? 2 * s->n : 0;
+    int moved = 1;
     while (rc == 0 && s->ntail < budget && out->makespan > 0.0 &&
-           (out->hi - out->lo) / 2.0 > s->spec->target_error * out->makespan) {
+           (out->hi - out->lo) / 2.0 > s->spec->target_error * out->makespan &&
+           moved) {
         uint32_t m = tail_pick(s, timed, out, pick);
         if (m > budget - s->ntail)
             m = budget - s->ntail;
@@ -620,7 +658,9 @@ static int tail(ChipSampler *s, uint32_t *samp, double *ys, const Carry *c, Samp
             timed[pick[i]] = 1;
         }
         s->ntail += m;
+        const double before = out->makespan;
         rc = makespan(s, samp, ys, s->n + s->ntail, c, e, out);
+        moved = fabs(out->makespan - before) > CHIPSAMPLED_TAIL_MOVE * out->std_error;
     }
     free(timed);
     return rc;
@@ -697,9 +737,10 @@ int chipsampled_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine 
         rc = schedule(&s, coef);
     }
     if (rc == 0 && s.warm) { /* the L2's warming: each line's first reader in this schedule */
-        memcpy(s.pos0, s.pos, (size_t)s.N * sizeof *s.pos0);
+        rc = warm_keys(&s);
         note(&s, "the warming's record: each line's first reader (the golden model, %u units)", s.N, 0, 0);
-        rc = chipwarm_first_readers(s.warm, s.pos0, run_spec_threads(spec), err, errlen);
+        if (rc == 0)
+            rc = chipwarm_first_readers(s.warm, s.wkey, run_spec_threads(spec), err, errlen);
     }
     if (rc == 0)
         rc = estimate(&s);

@@ -40,6 +40,9 @@
  * the most cycles still predicted; all rounds at most twice phase 1's units. */
 #define CHIPSAMPLED_TAIL_CORES 4u
 #define CHIPSAMPLED_TAIL_UNITS 4u
+/* ... and the rounds stop once one moved the makespan's estimate by at most this many of its
+ * standard errors (the late tiles are then known as well as the tail can tell). */
+#define CHIPSAMPLED_TAIL_MOVE 0.2
 
 /* Waves timed on a chip of K cores: 4, or 2 above 64 cores (a wave costs K units). */
 uint32_t chipsampled_waves(uint32_t cores);

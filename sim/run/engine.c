@@ -291,6 +291,18 @@ int eng_warm_l1(Job *j, Timing *t, uint32_t unit)
     return 0;
 }
 
+void eng_warm_fb_shared(Job *j, Chip *chip, uint64_t base, uint32_t unit)
+{
+    if (!j->fp->unit_warm_l1 || unit % j->spp == 0 || !chip)
+        return;
+    const uint64_t line = (uint64_t)j->fp->cfg->scene_line_bytes;
+    const uint64_t bytes = ((uint64_t)j->k->tile_w * j->k->tile_h * 12 + line - 1) / line * line;
+    for (uint64_t b = 0; b < bytes; b += line) {
+        const uint64_t a = ((uint64_t)1 << MEM_SPACE_SHIFT) + base + b;
+        chip_warm(chip, &a, 1);
+    }
+}
+
 /* One kernel run: unit `unit` (tile * spp + pass) of the launched tile, on a cold machine when
  * timed (fu gets its timed figures; on a chip's unit, its levels warmed first when asked). 0, or
  * -1 after eng_fail(). */
@@ -307,6 +319,8 @@ static int run_pass(Worker *w, Core *c, const FuncTile *ft, uint32_t unit, FuncU
         if (lines)
             chipunit_warm(&w->cu, lines, n);
     }
+    if (w->cu.chip)
+        eng_warm_fb_shared(j, w->cu.chip, 0, unit); /* (a unit alone: its framebuffer at 0) */
     if (w->cu.chip && eng_warm_l1(j, w->tc.tm, unit) != 0)
         return -1;
     const uint64_t limit = (uint64_t)j->fp->cfg->sim_max_instructions;

@@ -73,6 +73,10 @@ void eng_tile_pixels(Job *j, Core *c, const FuncTile *ft, int to_fb);
 /* A sampled chip's unit (FuncParams.unit_warm_l1): timing model t's L1 warmed for unit `unit`
  * (tile * spp + pass) after its reset. 0, or -1 after eng_fail. */
 int eng_warm_l1(Job *j, Timing *t, uint32_t unit);
+/* ... and past its tile's first pass, the tile's framebuffer lines (at base in the framebuffer's
+ * space) into the chip's shared levels, after what they were warmed with (chip_warm): its earlier
+ * passes left them there. */
+void eng_warm_fb_shared(Job *j, Chip *chip, uint64_t base, uint32_t unit);
 /* Worker `index`'s core opened and the scene loaded (sim/run/tiles.h's begin). */
 int eng_worker_begin(void *ctx, int index);
 /* The workers' counters into st, in worker order. */

@@ -432,6 +432,15 @@ static void note_line(void *ctx, uint32_t unit, uint64_t addr, uint64_t bytes)
     }
 }
 
+/* The frame of chip with --mem-trace's record of its L1s' requests below (st: func_stats_free). */
+static void traced_frame(const CfgMachine *chip, FuncStats *st)
+{
+    static char err[65536];
+    FuncParams fp = {.cfg = chip, .kernel_path = "kernels/pathtrace.s", .needs = scene.needs, .seed = 1,
+                     .threads = 1, .timed = 1, .mem_trace = 1};
+    cr_assert_eq(func_render(&packed, &fp, NULL, st, err, sizeof err), 0, "%s", err);
+}
+
 static int u64_order(const void *a, const void *b)
 {
     const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
@@ -445,10 +454,8 @@ Test(chip, the_golden_models_lines_are_the_kernels)
     small_frame(&chip);
     shared_memory(&chip, 1);
     static char err[65536];
-    FuncParams fp = {.cfg = &chip, .kernel_path = "kernels/pathtrace.s", .needs = scene.needs, .seed = 1,
-                     .threads = 1, .timed = 1, .mem_trace = 1};
     FuncStats st;
-    cr_assert_eq(func_render(&packed, &fp, NULL, &st, err, sizeof err), 0, "%s", err);
+    traced_frame(&chip, &st);
     uint64_t *kernel = malloc((st.ntrace ? st.ntrace : 1) * sizeof *kernel);
     size_t nk = 0;
     for (size_t i = 0; i < st.ntrace; i++)
@@ -538,10 +545,8 @@ Test(chip, a_chip_unit_warmed_with_its_own_lines_is_faster)
     shared_memory(&chip, 4);
     chip.scene_cache_kb = 4; /* an L1 the unit's lines overflow: they come again from below */
     static char err[65536];
-    FuncParams fp = {.cfg = &chip, .kernel_path = "kernels/pathtrace.s", .needs = scene.needs, .seed = 1,
-                     .threads = 1, .timed = 1, .mem_trace = 1};
     FuncStats st;
-    cr_assert_eq(func_render(&packed, &fp, NULL, &st, err, sizeof err), 0, "%s", err);
+    traced_frame(&chip, &st);
     Warm w = {malloc((st.ntrace ? st.ntrace : 1) * sizeof(uint64_t)), 0, 0};
     for (size_t i = 0; i < st.ntrace; i++)
         if (!st.trace[i].write)
@@ -610,11 +615,8 @@ Test(chip, a_chip_unit_with_its_l1_warmed_is_faster)
     CfgMachine chip;
     small_frame(&chip);
     shared_memory(&chip, 4);
-    static char err[65536];
-    FuncParams fp = {.cfg = &chip, .kernel_path = "kernels/pathtrace.s", .needs = scene.needs, .seed = 1,
-                     .threads = 1, .timed = 1, .mem_trace = 1};
     FuncStats st;
-    cr_assert_eq(func_render(&packed, &fp, NULL, &st, err, sizeof err), 0, "%s", err);
+    traced_frame(&chip, &st);
     Warm w = {malloc((st.ntrace ? st.ntrace : 1) * sizeof(uint64_t)), 0, 0};
     for (size_t i = 0; i < st.ntrace; i++)
         if (!st.trace[i].write && !(st.trace[i].addr >> MEM_SPACE_SHIFT)) /* scene lines only */
