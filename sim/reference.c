@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "ref_trace.h"
+#include "ref_vec.h"
 #include "run/tiles.h"
 
 #define PI_F 3.14159265f
@@ -35,66 +36,9 @@
 enum { DIM_DIRECT = 0, DIM_LIGHT = 1, DIM_LIGHT_U = 2, DIM_LIGHT_V = 3, DIM_LOBE = 4,
        DIM_DIR_U = 5, DIM_DIR_V = 6, DIM_RR = 7 };
 
-/* ---- small vector helpers, each one fixed sequence of binary32 operations ------------------- */
-
-static float dot3(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-static void normalize3(float *v)
-{
-    float il = 1.0f / sqrtf(dot3(v, v));
-    v[0] = v[0] * il;
-    v[1] = v[1] * il;
-    v[2] = v[2] * il;
-}
-
-static void cross3(const float *a, const float *b, float *out)
-{
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static float bits_to_float(uint32_t u)
-{
-    float f;
-    memcpy(&f, &u, 4);
-    return f;
-}
-
-static uint32_t float_to_bits(float f)
-{
-    uint32_t u;
-    memcpy(&u, &f, 4);
-    return u;
-}
-
-/* Move a hit point off its surface along n, scale-independently: a fixed number of ulps for
- * coordinates away from zero, a fixed distance near zero (Waechter and Binder, "A Fast and
- * Robust Method for Avoiding Self-Intersection", Ray Tracing Gems, 2019). */
-static void offset_point(const float *p, const float *n, float *out)
-{
-    for (int k = 0; k < 3; k++) {
-        int32_t of = (int32_t)(256.0f * n[k]);
-        uint32_t bits = float_to_bits(p[k]);
-        uint32_t moved = p[k] < 0.0f ? bits - (uint32_t)of : bits + (uint32_t)of;
-        out[k] = fabsf(p[k]) < (1.0f / 32.0f) ? p[k] + (1.0f / 65536.0f) * n[k] : bits_to_float(moved);
-    }
-}
+/* ---- small vector helpers: sim/ref_vec.h ---------------------------------------------------- */
 
 void ref_offset_point(const float *p, const float *n, float *out) { offset_point(p, n, out); }
-
-/* Orthonormal basis around n (Duff et al., "Building an Orthonormal Basis, Revisited", JCGT
- * 2017); returns x * t + y * b + z * n. */
-static void to_world(const float *n, float x, float y, float z, float *out)
-{
-    float sign = copysignf(1.0f, n[2]);
-    float a = -1.0f / (sign + n[2]);
-    float b = n[0] * n[1] * a;
-    float t[3] = {1.0f + sign * n[0] * n[0] * a, sign * b, -sign * n[0]};
-    float bv[3] = {b, sign + n[1] * n[1] * a, -n[1]};
-    for (int k = 0; k < 3; k++)
-        out[k] = x * t[k] + y * bv[k] + z * n[k];
-}
 
 /* ---- rays ------------------------------------------------------------------------------------ */
 

@@ -27,8 +27,8 @@ typedef struct ChipSampler {
     double *x, *exact, *pred, *start; /* N each: auxiliaries (N x AUX_K), exact chip cycles (< 0:
                                          unknown), predicted cycles and start */
     uint32_t *order, *pos;     /* N each: units in predicted start order, each unit's position */
-    uint32_t *wkey, *wthr;     /* N each, the warming's (warm_keys): each unit's rank as a reader, and
-                                  the readers before its start */
+    uint32_t *wthr;            /* N: the units that start before each one in the first schedule (the
+                                  L2 warming's position: warm_thresholds) */
     double *tile, *tstart;     /* ntiles each */
     uint32_t *tcore, *tprev;   /* ntiles each: its core, the tile before it there (UINT32_MAX: none) */
     ChipWarm *warm;
@@ -164,36 +164,17 @@ static void first_coef(const ChipSampler *s, double coef[AUX_K + 1])
     free(ys);
 }
 
-/* The warming's keys, from the first schedule: a line counts as read by a unit's start when its
- * first reader started before it (a unit still running then, whole: halfway through it instead,
- * the units alone missed 45-140 % more DRAM lines than the full run, against 12-26 % fewer this
- * way: docs/sampling.md). wkey[u]: the rank of u's start among all units'; wthr[u]: how many
- * starts come before u's (chipwarm_l2's position). */
-static int warm_keys(ChipSampler *s)
+/* The L2 warming's positions, from the first schedule, whose start order (s->pos) ranks the first
+ * readers: a line counts as read by a unit's start when its first reader started before it (a unit
+ * still running then, whole: halfway through it instead, the units alone missed 45-140 % more DRAM
+ * lines than the full run, against 12-26 % fewer this way: docs/sampling.md). wthr[u]: how many
+ * units start strictly before u (units starting together see none of each other's lines). */
+static void warm_thresholds(ChipSampler *s)
 {
-    StartKey *m = malloc((size_t)s->N * sizeof *m);
-    if (!m) {
-        snprintf(s->err, s->errlen, "out of memory for %u units' warming", s->N);
-        return -1;
+    for (uint32_t i = 0; i < s->N; i++) { /* s->order: the units by start (ties: by unit) */
+        const uint32_t u = s->order[i];
+        s->wthr[u] = i > 0 && s->start[s->order[i - 1]] == s->start[u] ? s->wthr[s->order[i - 1]] : i;
     }
-    for (uint32_t u = 0; u < s->N; u++)
-        m[u] = (StartKey){s->start[u], u};
-    qsort(m, s->N, sizeof *m, start_order);
-    for (uint32_t i = 0; i < s->N; i++)
-        s->wkey[m[i].unit] = i;
-    for (uint32_t u = 0; u < s->N; u++) {
-        uint32_t lo = 0, hi = s->N; /* the first start not before u's */
-        while (lo < hi) {
-            const uint32_t mid = lo + (hi - lo) / 2;
-            if (m[mid].start < s->start[u])
-                lo = mid + 1;
-            else
-                hi = mid;
-        }
-        s->wthr[u] = lo;
-    }
-    free(m);
-    return 0;
 }
 
 /* ---- timing units ------------------------------------------------------------------------------ */
@@ -459,7 +440,6 @@ static int sampler_open(ChipSampler *s, const RunScene *sc, const RunSpec *spec,
     s->start = malloc(N * sizeof *s->start);
     s->order = malloc(N * sizeof *s->order);
     s->pos = malloc(N * sizeof *s->pos);
-    s->wkey = malloc(N * sizeof *s->wkey);
     s->wthr = malloc(N * sizeof *s->wthr);
     s->tile = malloc(T * sizeof *s->tile);
     s->tstart = malloc(T * sizeof *s->tstart);
@@ -471,7 +451,7 @@ static int sampler_open(ChipSampler *s, const RunScene *sc, const RunSpec *spec,
     s->wlen1 = calloc(N, sizeof *s->wlen1);
     s->units = calloc(N, sizeof *s->units);
     s->instructions = malloc(N * sizeof *s->instructions);
-    if (!s->x || !s->exact || !s->pred || !s->start || !s->order || !s->pos || !s->wkey || !s->wthr || !s->tile || !s->tstart ||
+    if (!s->x || !s->exact || !s->pred || !s->start || !s->order || !s->pos || !s->wthr || !s->tile || !s->tstart ||
         !s->tcore || !s->tprev || !s->wl || !s->wlen || !s->wl1 || !s->wlen1 || !s->units || !s->instructions) {
         snprintf(err, errlen, "out of memory for %u units", s->N);
         return -1;
@@ -516,7 +496,6 @@ static int sampler_close(ChipSampler *s, int rc)
     free(s->start);
     free(s->order);
     free(s->pos);
-    free(s->wkey);
     free(s->wthr);
     free(s->tile);
     free(s->tstart);
@@ -737,10 +716,9 @@ int chipsampled_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine 
         rc = schedule(&s, coef);
     }
     if (rc == 0 && s.warm) { /* the L2's warming: each line's first reader in this schedule */
-        rc = warm_keys(&s);
+        warm_thresholds(&s);
         note(&s, "the warming's record: each line's first reader (the golden model, %u units)", s.N, 0, 0);
-        if (rc == 0)
-            rc = chipwarm_first_readers(s.warm, s.wkey, run_spec_threads(spec), err, errlen);
+        rc = chipwarm_first_readers(s.warm, s.pos, run_spec_threads(spec), err, errlen);
     }
     if (rc == 0)
         rc = estimate(&s);
