@@ -34,6 +34,7 @@
 #include <string.h>
 
 #include "../host/outfile.h"
+#include "../sim/chip/chip.h"
 #include "../sim/config.h"
 #include "../sim/run/run.h"
 #include "../sim/util.h"
@@ -41,6 +42,10 @@
 
 #define TARGET 0.01            /* the --target-error of every sampled run */
 #define ME "chip_error"
+
+/* The memory figures the sampled chip estimates (docs/sampling.md, step 8). */
+enum { MEM_LATENCY, MEM_L2_HIT, MEM_DRAM_GBS, MEM_COUNT };
+static const char *const mem_name[MEM_COUNT] = {"memory latency", "L2 hit rate", "DRAM GB/s"};
 
 /* One row: a chip and a frame. */
 typedef struct Row {
@@ -103,7 +108,33 @@ typedef struct Result {
     double det_makespan, det_seconds;
     int seeds, covered;
     double mean_abs, mean_signed, max_abs, mean_units, mean_seconds;
+    /* the memory figures (MEM_*): the detailed run's, and over the seeds that estimated them */
+    double det_mem[MEM_COUNT];
+    int mem_seeds[MEM_COUNT], mem_covered[MEM_COUNT];
+    double mem_abs[MEM_COUNT], mem_signed[MEM_COUNT];
 } Result;
+
+/* A frame's memory figure m (MEM_*) from a detailed run's counters (the report's formulas). */
+static double det_mem(const RunFrame *fr, const CfgMachine *cfg, int m)
+{
+    const ChipMemStats *c = fr->f.chip_mem;
+    const double secs = (double)fr->f.makespan / (cfg->core_clock_mhz * 1e6);
+    if (!c)
+        return -1.0;
+    switch (m) {
+    case MEM_LATENCY: return c->requests ? (double)c->read_latency / (double)c->requests : -1.0;
+    case MEM_L2_HIT: return c->has_l2 && c->l2.reads + c->l2.writes ? (double)c->l2.hits / (double)(c->l2.reads + c->l2.writes) : -1.0;
+    default: return secs > 0.0 ? (double)c->dram.bytes / secs / 1e9 : -1.0;
+    }
+}
+
+/* A sampled frame's estimate of m with its interval (f[3]); 0 when it has none. */
+static int samp_mem(const RunFrame *fr, int m, const double **f)
+{
+    const StatsChipSample *c = &fr->chip;
+    *f = m == MEM_LATENCY ? c->latency : m == MEM_L2_HIT ? c->l2_hit_rate : c->dram_gbs;
+    return m == MEM_L2_HIT ? c->has_l2 : c->has_mem;
+}
 
 /* cfg for row r: its config file, chip.cores, stream.rays = 1024. 0, or -1 after printing why. */
 static int row_machine(const Row *r, CfgMachine *cfg)
@@ -150,6 +181,8 @@ static int row_runs(const Row *r, const Opts *o, const RunScene *sc, const CfgMa
     }
     res->det_makespan = rc == 0 ? (double)fr.f.makespan : 0.0;
     res->det_seconds = s;
+    for (int m = 0; m < MEM_COUNT; m++)
+        res->det_mem[m] = rc == 0 ? det_mem(&fr, cfg, m) : -1.0;
     run_frame_free(&fr);
     if (rc != 0)
         return -1;
@@ -157,7 +190,10 @@ static int row_runs(const Row *r, const Opts *o, const RunScene *sc, const CfgMa
     buf_printf(tsv, "# row %c: K = %d, %s, %s %d x %d x %d; detailed makespan %.0f cycles, %.3f host s; "
                     "--target-error %.2f%s\n", r->id, r->cores, r->dram, r->frame, r->width, r->height, r->spp,
                res->det_makespan, s, TARGET, o->no_image ? ", --no-image" : "");
-    buf_printf(tsv, "# seed\testimate\tlo\thi\terror_pct\tcovered\tunits\tr\tr_lo\tr_hi\thost_s\n");
+    buf_printf(tsv, "# memory figures of the detailed run: latency %.6g cycles, L2 hit rate %.6g, DRAM %.6g GB/s "
+                    "(-1: none)\n", res->det_mem[MEM_LATENCY], res->det_mem[MEM_L2_HIT], res->det_mem[MEM_DRAM_GBS]);
+    buf_printf(tsv, "# seed\testimate\tlo\thi\terror_pct\tcovered\tunits\tr\tr_lo\tr_hi\thost_s"
+                    "\tlatency\tlatency_lo\tlatency_hi\tl2_hit\tl2_hit_lo\tl2_hit_hi\tdram_gbs\tdram_gbs_lo\tdram_gbs_hi\n");
     const double M = res->det_makespan;
     for (int seed = 1; seed <= o->seeds; seed++) {
         RunSpec ss = {.mode = RUN_SAMPLED, .cfg = cfg, .kernel_path = "kernels/pathtrace.s", .seed = 1, .threads = 1,
@@ -180,8 +216,22 @@ static int row_runs(const Row *r, const Opts *o, const RunScene *sc, const CfgMa
         res->max_abs = fabs(e) > res->max_abs ? fabs(e) : res->max_abs;
         res->mean_units += fr.units_sampled;
         res->mean_seconds += s;
-        buf_printf(tsv, "%d\t%.0f\t%.0f\t%.0f\t%+.4f\t%d\t%u\t%.5f\t%.5f\t%.5f\t%.3f\n", seed, fr.est.total, fr.est.lo,
+        buf_printf(tsv, "%d\t%.0f\t%.0f\t%.0f\t%+.4f\t%d\t%u\t%.5f\t%.5f\t%.5f\t%.3f", seed, fr.est.total, fr.est.lo,
                    fr.est.hi, 100.0 * e, in, fr.units_sampled, fr.chip.r, fr.chip.r_lo, fr.chip.r_hi, s);
+        for (int m = 0; m < MEM_COUNT; m++) {
+            const double *f;
+            if (!samp_mem(&fr, m, &f) || res->det_mem[m] <= 0.0) {
+                buf_printf(tsv, "\t-\t-\t-");
+                continue;
+            }
+            const double em = f[0] / res->det_mem[m] - 1.0;
+            res->mem_seeds[m]++;
+            res->mem_covered[m] += f[1] <= res->det_mem[m] && res->det_mem[m] <= f[2];
+            res->mem_abs[m] += fabs(em);
+            res->mem_signed[m] += em;
+            buf_printf(tsv, "\t%.6g\t%.6g\t%.6g", f[0], f[1], f[2]);
+        }
+        buf_printf(tsv, "\n");
         fprintf(stderr, ME ": row %c: seed %d: %+.3f %%, %s, %u units, %.1f s\n", r->id, seed, 100.0 * e,
                 in ? "covered" : "NOT covered", fr.units_sampled, s);
         run_frame_free(&fr);
@@ -194,8 +244,8 @@ static int row_runs(const Row *r, const Opts *o, const RunScene *sc, const CfgMa
     return 0;
 }
 
-/* One row: its table line in md, its seeds in tsv. 0, 1 (skipped: ../shared absent) or -1. */
-static int row(const Row *r, const Opts *o, Buf *md, Buf *tsv, int *skipped)
+/* One row: its table line in md, its memory figures' lines in mem_md, its seeds in tsv. 0, 1 (skipped: ../shared absent) or -1. */
+static int row(const Row *r, const Opts *o, Buf *md, Buf *mem_md, Buf *tsv, int *skipped)
 {
     int ok = bench_scene_ok(ME, r->scene, skipped);
     if (ok <= 0)
@@ -224,6 +274,18 @@ static int row(const Row *r, const Opts *o, Buf *md, Buf *tsv, int *skipped)
              100.0 * res.max_abs, res.mean_units, res.mean_seconds, res.det_seconds / res.mean_seconds);
     buf_printf(md, "%s", line);
     fputs(line, stdout);
+    fflush(stdout);
+    for (int m = 0; m < MEM_COUNT; m++) {
+        const int n = res.mem_seeds[m];
+        if (n)
+            snprintf(line, sizeof line, "| %c | %s | %.6g | %d | %d (%.0f %%) | %.3f %% | %+.3f %% |\n", r->id,
+                     mem_name[m], res.det_mem[m], n, res.mem_covered[m], 100.0 * res.mem_covered[m] / n,
+                     100.0 * res.mem_abs[m] / n, 100.0 * res.mem_signed[m] / n);
+        else
+            snprintf(line, sizeof line, "| %c | %s | %.6g | 0 | - | - | - |\n", r->id, mem_name[m], res.det_mem[m]);
+        buf_printf(mem_md, "%s", line);
+        fputs(line, stdout);
+    }
     fflush(stdout);
     return 0;
 }
@@ -323,7 +385,11 @@ int main(int argc, char **argv)
     if (parse_args(argc, argv, &o) != 0)
         return 2;
     outfile_process_init();
-    Buf md = {0}, tsv[NROWS] = {{0}};
+    Buf md = {0}, mem_md = {0}, tsv[NROWS] = {{0}};
+    buf_printf(&mem_md, "\nThe memory figures (a chip with shared memory; docs/sampling.md, step 8): each seed's "
+                        "estimate against the detailed run's; covered: its 95 %% interval contains it.\n\n"
+                        "| row | figure | detailed | seeds | covered | mean abs. error | signed mean error |\n"
+                        "|---|---|---|---|---|---|---|\n");
     buf_printf(&md, "Sampled mode on a chip (`--target-error %.2f`%s, one host thread) against the chip's detailed "
                     "run of the same frame (one host thread), over sample seeds 1..%d%s. Error: the estimated "
                     "makespan over the detailed one, minus 1; covered: the 95 %% interval contains the detailed "
@@ -345,10 +411,11 @@ int main(int argc, char **argv)
             r.spp = 4;
         }
         total++;
-        if (row(&r, &o, &md, &tsv[k], &skipped) < 0)
+        if (row(&r, &o, &md, &mem_md, &tsv[k], &skipped) < 0)
             rc = 1;
     }
-    if (rc == 0 && (md.oom || tsv[0].oom || tsv[1].oom || tsv[2].oom || tsv[3].oom)) {
+    buf_printf(&md, "%s", mem_md.p ? mem_md.p : "");
+    if (rc == 0 && (md.oom || mem_md.oom || tsv[0].oom || tsv[1].oom || tsv[2].oom || tsv[3].oom)) {
         fprintf(stderr, ME ": out of memory\n");
         rc = 1;
     }
@@ -356,6 +423,7 @@ int main(int argc, char **argv)
         rc = 1;
     bench_scenes_summary(ME, skipped, total);
     free(md.p);
+    free(mem_md.p);
     for (int k = 0; k < NROWS; k++)
         free(tsv[k].p);
     return rc;

@@ -123,7 +123,7 @@ static StatsCtx stats_ctx(const Report *r)
     int kernel = run_mode_kernel(r->mode);
     StatsCtx c = {.mode = mode_bit[r->mode] | (kernel && r->fr->f.kd ? STATS_M_KD : 0) |
                           (kernel && (r->fr->f.chip_cores || r->fr->chip.on) ? STATS_M_CHIP : 0) |
-                          (kernel && r->fr->f.chip_mem ? STATS_M_SHARED : 0),
+                          (kernel && (r->fr->f.chip_mem || (r->fr->chip.on && r->fr->chip.shared)) ? STATS_M_SHARED : 0),
                   .cfg = r->cfg, .run = &r->fr->run, .f = kernel ? &r->fr->f : NULL,
                   .t = run_mode_timed(r->mode) ? &r->fr->f.timing : NULL,
                   .est = r->fr->has_est ? &r->fr->est : NULL,

@@ -429,11 +429,26 @@ FIG(chip_unused)
         n += c->f->cores[k].tiles == 0;
     return n;
 }
+/* A sampled chip's memory figure (sim/chipmemest.h): which 0 the latency, 1 the L2's hit rate, 2
+ * DRAM's bandwidth; bound -1 the estimate, 0 / 1 its interval's low / high end. */
+static double cs_mem(const StatsCtx *c, int which, int bound, int *na)
+{
+    const StatsChipSample *s = cs(c);
+    if (!s)
+        return defined_if(0.0, 0, na);
+    const double *f = which == 0 ? s->latency : which == 1 ? s->l2_hit_rate : s->dram_gbs;
+    return defined_if(f[1 + bound], which == 1 ? s->has_l2 : s->has_mem, na);
+}
+static int sampled(const StatsCtx *c) { return (c->mode & STATS_M_SAMP) != 0; }
+
 FIG(mem_read_latency)
 {
     (void)idx;
+    if (sampled(c))
+        return cs_mem(c, 0, -1, na);
     return defined_if(stats_ratio(mem_of(c)->read_latency, mem_of(c)->requests), mem_of(c)->requests > 0, na);
 }
+FIG(mem_read_latency_ci95) { return cs_mem(c, 0, idx[0], na); }
 FIG(scene_stall_l1)
 {
     UNUSED_FIG_ARGS;
@@ -444,6 +459,8 @@ FIG(noc_present) { UNUSED_FIG_ARGS; return mem_of(c)->has_noc; }
 FIG(l2_hit_rate)
 {
     (void)idx;
+    if (sampled(c))
+        return cs_mem(c, 1, -1, na);
     const L2Stats *l = &mem_of(c)->l2;
     return defined_if(stats_ratio(l->hits, l->reads + l->writes), mem_of(c)->has_l2 && l->reads + l->writes > 0, na);
 }
@@ -461,12 +478,16 @@ FIG(l2_read_latency)
 }
 /* The frame's seconds: the makespan at the cores' clock. */
 static double frame_seconds(const StatsCtx *c) { return (double)c->f->makespan / (c->cfg->core_clock_mhz * 1e6); }
+FIG(l2_hit_rate_ci95) { return cs_mem(c, 1, idx[0], na); }
 FIG(dram_bandwidth)
 {
     (void)idx;
+    if (sampled(c))
+        return cs_mem(c, 2, -1, na);
     const double s = frame_seconds(c);
     return defined_if(s > 0 ? (double)mem_of(c)->dram.bytes / s / 1e9 : 0.0, s > 0, na);
 }
+FIG(dram_bandwidth_ci95) { return cs_mem(c, 2, idx[0], na); }
 FIG(dram_peak) { UNUSED_FIG_ARGS; return mem_of(c)->dram_peak_gbs; }
 FIG(dram_utilization)
 {

@@ -208,6 +208,12 @@ typedef struct StatsChipSample {
     uint32_t tail_units;       /* units timed for the makespan's tail, beyond phase 1's sample */
     uint32_t warm_units;       /* units whose lines the golden model recorded for the warming */
     double warm_seconds;       /* ... and its host time */
+    /* The memory figures (chip.memory = shared; sim/chipmemest.h), each {estimate, lo, hi} of its
+     * 95 % interval: the average read latency below the L1s (cycles; has_mem), the L2's hit rate
+     * (has_l2), DRAM's bandwidth (GB/s over the estimated makespan; has_mem). */
+    int shared;                /* chip.memory = shared (report.json then has these) */
+    int has_mem, has_l2;
+    double latency[3], l2_hit_rate[3], dram_gbs[3];
 } StatsChipSample;
 
 struct StatsCtx {

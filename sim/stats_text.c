@@ -20,6 +20,8 @@ typedef struct TextW {
     char *buf;
     size_t cap, *len;
     int open, items;       /* a line is open; values on it */
+    const char *label;     /* the open line's row label (a MORE row with a path and another label
+                              starts its own line: a mode that lacks a group's LINE row) */
 } TextW;
 
 static void out(TextW *w, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
@@ -151,11 +153,12 @@ static void text_row(void *wp, const StatsRow *r)
     }
     stats_leaf_name(r, name, sizeof name);
     int idx[STATS_MAX_DIMS] = {0}, na;
-    if (r->text == STATS_T_LINE || !w->open) {
+    if (r->text == STATS_T_LINE || !w->open || (r->path && w->label && strcmp(w->label, r->label) != 0)) {
         char head[160];
         int named = r->ndims && name[0] && !(r->flags & (STATS_F_LIST_NZ | STATS_F_LIST_Z));
         snprintf(head, sizeof head, "%s%s%s", r->label, named ? " " : "", named ? name : "");
         line_start(w, head);
+        w->label = r->label;
     }
     if (r->flags & (STATS_F_LIST_NZ | STATS_F_LIST_Z)) {
         int any = 0;

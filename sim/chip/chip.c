@@ -216,6 +216,12 @@ void chip_warm(Chip *c, const uint64_t *addr, size_t n)
     }
 }
 
+void chip_warm_written(Chip *c, const uint64_t *addr, size_t n)
+{
+    for (size_t i = 0; c->l2 && i < n; i++)
+        l2_warm_written(c->l2, addr[i]);
+}
+
 /* ---- requests on their way in ----------------------------------------------------------------- */
 
 /* *a holds at least need elements of size bytes (its capacity *cap doubled as needed); -1 on out

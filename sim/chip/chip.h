@@ -47,6 +47,10 @@ void chip_reset(Chip *c);
  * and the DRAM row of each that the L2 did not hold (every one without an L2) opened. No time
  * passes and nothing is counted. */
 void chip_warm(Chip *c, const uint64_t *addr, size_t n);
+/* ... and as if each had been written (a framebuffer's lines): into a write-back L2, dirty; no
+ * DRAM row opened (a write-back L2 did not send them below yet; without one, or write-through,
+ * the writes left nothing behind). */
+void chip_warm_written(Chip *c, const uint64_t *addr, size_t n);
 /* Core k's timing model sends its L1's misses and write-backs here from now on. 0, or -1 on out
  * of memory. */
 int chip_attach(Chip *c, int k, Timing *t);

@@ -169,7 +169,7 @@ const L2Stats *l2_stats(const L2 *l) { return &l->st; }
 
 static int victim(const L2 *l, const L2Bank *b, size_t base);
 
-int l2_warm(L2 *l, uint64_t addr)
+static int warm_line(L2 *l, uint64_t addr, int dirty)
 {
     const uint64_t line = addr >> l->shift;
     L2Bank *b = &l->bank[line % (uint64_t)l->p.banks];
@@ -183,9 +183,15 @@ int l2_warm(L2 *l, uint64_t addr)
         b->tag[base + (size_t)w] = line + 1;
         b->dirty[base + (size_t)w] = 0;
     }
+    if (dirty)
+        b->dirty[base + (size_t)w] = 1;
     b->lru[base + (size_t)w] = ++l->stamp;
     return miss;
 }
+
+int l2_warm(L2 *l, uint64_t addr) { return warm_line(l, addr, 0); }
+
+int l2_warm_written(L2 *l, uint64_t addr) { return l->p.write_back ? warm_line(l, addr, 1) : 0; }
 
 void l2_push(L2 *l, uint64_t addr, int write, uint64_t cycle, uint64_t id)
 {

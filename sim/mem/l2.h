@@ -67,6 +67,9 @@ void l2_reset(L2 *l);
  * leaving; no time passes, nothing is counted or sent below. Only on an idle L2 (after l2_reset,
  * before the first push). 1 when the line was not there (a read would have gone below), else 0. */
 int l2_warm(L2 *l, uint64_t addr);
+/* ... and as a write would leave it: dirty when the L2 writes back (a write-through L2 does not
+ * allocate on a write: then nothing changes and 0 is returned). */
+int l2_warm_written(L2 *l, uint64_t addr);
 const L2Stats *l2_stats(const L2 *l);
 /* The level interface (level.h). */
 void l2_push(L2 *l, uint64_t addr, int write, uint64_t cycle, uint64_t id);

@@ -530,8 +530,7 @@ uint32_t chip_run_frame(Job *j)
 {
     const CfgMachine *cfg = j->fp->cfg;
     ChipRun r = {.job = j, .k = cfg->chip_cores, .cold = cfg->chip_cold_units, .passes = j->fp->batch ? 1 : j->spp};
-    const uint64_t line = (uint64_t)cfg->scene_line_bytes;
-    r.fb_tile = ((uint64_t)j->k->tile_w * j->k->tile_h * 12 + line - 1) / line * line;
+    r.fb_tile = eng_fb_tile_bytes(j);
     char err[600];
     r.cr = calloc((size_t)r.k, sizeof *r.cr);
     r.runnable = calloc((size_t)r.k, sizeof *r.runnable);
@@ -567,8 +566,10 @@ uint32_t chip_run_frame(Job *j)
     pool_open(&r.pool, &r, threads - 1);
     if (cores_open(&r) == 0) {
         if (j->fp->wave) { /* one wave: unit i on core i, on levels warmed first; no more tiles */
-            if (r.chip)
+            if (r.chip) {
+                eng_warm_fb_tiles(j, r.chip, j->fp->wave_fb_lo, j->fp->wave_fb_hi, UINT32_MAX);
                 chip_warm(r.chip, j->fp->wave_warm, j->fp->nwave_warm);
+            }
             r.next_tile = j->ntiles;
         }
         for (int k = 0; k < r.k; k++) {

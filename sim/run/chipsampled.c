@@ -7,41 +7,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../chip/chip.h"
+#include "../chipmemest.h"
 #include "../chipsampling.h"
 #include "../sampling.h"
 #include "../util.h"
+#include "chipsampled_int.h"
 #include "chipwarm.h"
-#include "sampled.h"
-
-enum { AUX_K = SAMPLED_AUX_K };
-
-typedef struct ChipSampler {
-    const RunScene *sc;
-    const RunSpec *spec;
-    RunFrame *fr;
-    CfgMachine ucfg;           /* the units' machine: cfg, or one core on its bus for a chip of buses */
-    FuncParams fp;             /* the chip's frame (the opening, the waves) */
-    FuncParams up;             /* the units alone (a session keeps a pointer to it) */
-    uint32_t N, ntiles, spp, K;
-    int shared;                /* chip.memory = shared: units on the chip's levels, warmed; waves */
-    double *x, *exact, *pred, *start; /* N each: auxiliaries (N x AUX_K), exact chip cycles (< 0:
-                                         unknown), predicted cycles and start */
-    uint32_t *order, *pos;     /* N each: units in predicted start order, each unit's position */
-    uint32_t *wthr;            /* N: the units that start before each one in the first schedule (the
-                                  L2 warming's position: warm_thresholds) */
-    double *tile, *tstart;     /* ntiles each */
-    uint32_t *tcore, *tprev;   /* ntiles each: its core, the tile before it there (UINT32_MAX: none) */
-    ChipWarm *warm;
-    uint64_t **wl, **wl1;      /* N: the L2's and the L1's warming lists of each unit being timed */
-    size_t *wlen, *wlen1;
-    FuncSession *fs;
-    FuncUnit *units;           /* N: phase 1's units in sample order, n of them */
-    double *instructions;      /* N: their instructions */
-    uint32_t n, ntail;         /* phase 1's units (a simple random sample), the tail's after them */
-    double started;
-    char *err;
-    size_t errlen;
-} ChipSampler;
 
 uint32_t chipsampled_waves(uint32_t cores) { return cores > 64 ? 2u : 4u; }
 
@@ -58,14 +30,37 @@ static const uint64_t *warm_of(void *ctx, uint32_t unit, size_t *n)
     return s->wl[unit];
 }
 
-static const uint64_t *warm1_of(void *ctx, uint32_t unit, size_t *n)
+const uint64_t *cs_warm1_of(void *ctx, uint32_t unit, size_t *n)
 {
     const ChipSampler *s = ctx;
     *n = s->wlen1[unit];
     return s->wl1[unit];
 }
 
-static void note(const ChipSampler *s, const char *fmt, unsigned a, unsigned b, unsigned c)
+/* The tiles (frame order) that start before cycle `at` of the current schedule: the list schedule
+ * hands tiles out in frame order at nondecreasing starts, so they are a prefix. */
+uint32_t cs_tiles_before(const ChipSampler *s, double at)
+{
+    uint32_t lo = 0, hi = s->ntiles;
+    while (lo < hi) {
+        const uint32_t mid = lo + (hi - lo) / 2;
+        if (s->tstart[mid] < at)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* FuncParams.unit_warm_tiles: the tiles whose framebuffers were written before the unit starts. */
+static void warm_tiles_of(void *ctx, uint32_t unit, uint32_t *lo, uint32_t *hi)
+{
+    const ChipSampler *s = ctx;
+    *lo = 0;
+    *hi = cs_tiles_before(s, s->start[unit]);
+}
+
+void cs_note(const ChipSampler *s, const char *fmt, unsigned a, unsigned b, unsigned c)
 {
     if (!s->spec->note)
         return;
@@ -177,6 +172,24 @@ static void warm_thresholds(ChipSampler *s)
     }
 }
 
+/* Each unit's first-read lines (s->first) from the first-reader table, by its position in the
+ * schedule the table was made with (s->pos, unchanged since). (A tile's first pass also touches
+ * its framebuffer's lines first; as a second part of this auxiliary that made DRAM's intervals
+ * narrower than the warming's own bias, docs/sampling.md step 8, so it is not.) 0, or -1. */
+static int first_lines(ChipSampler *s)
+{
+    double *by_pos = malloc((size_t)(s->N ? s->N : 1) * sizeof *by_pos);
+    if (!by_pos) {
+        snprintf(s->err, s->errlen, "out of memory for %u units' first-read lines", s->N);
+        return -1;
+    }
+    chipwarm_first_counts(s->warm, s->N, by_pos);
+    for (uint32_t u = 0; u < s->N; u++)
+        s->first[u] = by_pos[s->pos[u]];
+    free(by_pos);
+    return 0;
+}
+
 /* ---- timing units ------------------------------------------------------------------------------ */
 
 /* The unit before u on its core in the current schedule (UINT32_MAX: none). */
@@ -189,7 +202,7 @@ static uint32_t core_prev(const ChipSampler *s, uint32_t u)
 }
 
 /* The L1 lists of units[0..n) into wl1 (and the L2's, when l2, into wl). 0, or -1. */
-static int warm_lists(ChipSampler *s, const uint32_t *units, uint32_t n, int l2)
+int cs_warm_lists(ChipSampler *s, const uint32_t *units, uint32_t n, int l2)
 {
     uint32_t *prev = calloc(n ? n : 1, sizeof *prev);
     uint64_t **lists = calloc(n ? n : 1, sizeof *lists);
@@ -220,7 +233,7 @@ static int warm_lists(ChipSampler *s, const uint32_t *units, uint32_t n, int l2)
 }
 
 /* The lists of units[0..n) freed. */
-static void warm_drop(ChipSampler *s, const uint32_t *units, uint32_t n)
+void cs_warm_drop(ChipSampler *s, const uint32_t *units, uint32_t n)
 {
     for (uint32_t i = 0; i < n; i++) {
         const uint32_t u = units[i];
@@ -233,13 +246,13 @@ static void warm_drop(ChipSampler *s, const uint32_t *units, uint32_t n)
 
 /* The units alone (units[i] into out[i]), each warmed as the first schedule's start says (the L2)
  * and from the unit before it on its core (the L1). */
-static int time_alone(ChipSampler *s, const uint32_t *units, uint32_t n, FuncUnit *out)
+int cs_time_alone(ChipSampler *s, const uint32_t *units, uint32_t n, FuncUnit *out)
 {
-    int rc = s->shared ? warm_lists(s, units, n, 1) : 0;
+    int rc = s->shared ? cs_warm_lists(s, units, n, 1) : 0;
     if (rc == 0)
         rc = func_units(s->fs, units, n, out, s->err, s->errlen);
     if (s->shared)
-        warm_drop(s, units, n);
+        cs_warm_drop(s, units, n);
     return rc;
 }
 
@@ -247,9 +260,9 @@ static int time_alone(ChipSampler *s, const uint32_t *units, uint32_t n, FuncUni
 static int measure(void *ctx, const uint32_t *units, uint32_t count, double *ys)
 {
     ChipSampler *s = ctx;
-    note(s, "timing units %u..%u of %u alone", s->n + 1, s->n + count, s->N);
+    cs_note(s, "timing units %u..%u of %u alone", s->n + 1, s->n + count, s->N);
     FuncUnit *out = &s->units[s->n];
-    if (time_alone(s, units, count, out) != 0)
+    if (cs_time_alone(s, units, count, out) != 0)
         return -1;
     for (uint32_t i = 0; i < count; i++) {
         ys[i] = (double)out[i].cycles;
@@ -267,7 +280,7 @@ static int opening(ChipSampler *s)
     op.opening = 1;
     op.progress = NULL;
     FuncStats st;
-    note(s, "the chip's opening: its first %u units in full", s->ntiles < s->K ? s->ntiles : s->K, 0, 0);
+    cs_note(s, "the chip's opening: its first %u units in full", s->ntiles < s->K ? s->ntiles : s->K, 0, 0);
     int rc = func_render(&s->sc->p, &op, NULL, &st, s->err, s->errlen);
     if (rc == 0 && (!st.pass_cycles || st.pass_spp != s->spp)) {
         snprintf(s->err, s->errlen, "sampled chip: the opening reported no units' cycles");
@@ -278,129 +291,16 @@ static int opening(ChipSampler *s)
             s->exact[u] = (double)st.pass_cycles[u];
             s->fr->chip.opening_units++;
         }
+    if (rc == 0 && st.chip_mem) { /* its memory traffic, the memory figures' exact stratum */
+        const ChipMemStats *m = st.chip_mem;
+        s->open_mem[CME_REQUESTS] = (double)m->requests;
+        s->open_mem[CME_LATENCY] = (double)m->read_latency;
+        s->open_mem[CME_L2_ACCESSES] = (double)(m->l2.reads + m->l2.writes);
+        s->open_mem[CME_L2_HITS] = (double)m->l2.hits;
+        s->open_mem[CME_DRAM_BYTES] = (double)m->dram.bytes;
+    }
     func_stats_free(&st);
     return rc;
-}
-
-/* ---- phase 2: the waves ------------------------------------------------------------------------ */
-
-/* One wave at cycle `at` of the predicted schedule: its units' cycles together (*wsum) and alone
- * (*asum), over the units timed both ways. 0 (nothing running then: *wsum = *asum = 0), or -1. */
-static int wave_at(ChipSampler *s, double at, double *wsum, double *asum)
-{
-    *wsum = *asum = 0.0;
-    uint32_t *wave = malloc((size_t)s->K * sizeof *wave), nwave = 0, first = s->N;
-    FuncUnit *alone = calloc(CHIPSAMPLED_WAVE_ALONE, sizeof *alone);
-    if (!wave || !alone) {
-        snprintf(s->err, s->errlen, "out of memory for a wave of %u units", s->K);
-        free(wave);
-        free(alone);
-        return -1;
-    }
-    for (uint32_t i = 0; i < s->N && nwave < s->K; i++) { /* in start order: the earliest first */
-        const uint32_t u = s->order[i];
-        if (s->start[u] <= at && at < s->start[u] + s->pred[u]) {
-            wave[nwave++] = u;
-            if (first == s->N)
-                first = i;
-        }
-    }
-    int rc = 0;
-    if (nwave) {
-        uint64_t *lines = NULL;
-        size_t nlines = 0;
-        rc = chipwarm_l2(s->warm, s->wthr[s->order[first]], &lines, &nlines, s->err, s->errlen);
-        if (rc == 0)
-            rc = warm_lists(s, wave, nwave, 0);
-        FuncParams wp = s->fp;
-        wp.wave = wave;
-        wp.nwave = nwave;
-        wp.wave_warm = lines;
-        wp.nwave_warm = nlines;
-        wp.unit_warm_l1 = warm1_of;
-        wp.unit_warm_ctx = s;
-        wp.progress = NULL;
-        FuncStats st = {0};
-        if (rc == 0)
-            rc = func_render(&s->sc->p, &wp, NULL, &st, s->err, s->errlen);
-        free(lines);
-        warm_drop(s, wave, nwave);
-        const uint32_t m = nwave < CHIPSAMPLED_WAVE_ALONE ? nwave : CHIPSAMPLED_WAVE_ALONE;
-        uint32_t pick[CHIPSAMPLED_WAVE_ALONE];
-        for (uint32_t i = 0; i < m; i++) /* evenly over the wave's cores */
-            pick[i] = wave[(uint32_t)((uint64_t)i * nwave / m)];
-        if (rc == 0)
-            rc = time_alone(s, pick, m, alone);
-        for (uint32_t i = 0; rc == 0 && i < m; i++) {
-            *wsum += (double)st.pass_cycles[pick[i]];
-            *asum += (double)alone[i].cycles;
-        }
-        if (rc == 0) {
-            s->fr->chip.wave_units += nwave;
-            s->fr->chip.alone_units += m;
-        }
-        func_stats_free(&st);
-    }
-    free(wave);
-    free(alone);
-    return rc;
-}
-
-/* The other cores' factor r over waves evenly spaced after the opening (a seeded offset), and its
- * relative variance (the delete-one jackknife over waves). No waves to time (the opening is the
- * frame): r = 1, exact. */
-static int waves(ChipSampler *s, double *r, double *rel_var)
-{
-    *r = 1.0;
-    *rel_var = 0.0;
-    double first_end = 0.0, end = 0.0;
-    for (uint32_t u = 0; u < s->N; u++) {
-        if (s->exact[u] >= 0.0 && s->start[u] + s->pred[u] > first_end)
-            first_end = s->start[u] + s->pred[u];
-        if (s->start[u] + s->pred[u] > end)
-            end = s->start[u] + s->pred[u];
-    }
-    const uint32_t w = chipsampled_waves(s->K);
-    if (!s->shared || s->K < 2 || end <= first_end)
-        return 0;
-    double ws[8] = {0}, as[8] = {0}, W = 0.0, A = 0.0;
-    uint64_t z = (uint64_t)s->spec->sample_seed * 0x9e3779b97f4a7c15ull + 0x632be59bd9b4e019ull;
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    const double offset = (double)((z ^ (z >> 31)) >> 11) / 9007199254740992.0;
-    uint32_t got = 0;
-    for (uint32_t i = 0; i < w; i++) {
-        note(s, "wave %u of %u: the units running then, on the whole chip and alone", i + 1, w, 0);
-        const double at = first_end + (end - first_end) * ((double)i + offset) / (double)w;
-        if (wave_at(s, at, &ws[got], &as[got]) != 0)
-            return -1;
-        if (as[got] > 0.0) {
-            W += ws[got];
-            A += as[got];
-            got++;
-        }
-    }
-    s->fr->chip.waves = got;
-    if (!got || A <= 0.0)
-        return 0;
-    *r = W / A;
-    if (got < 2) { /* one wave: no spread to tell; the interval says nothing of r */
-        *rel_var = 0.0;
-        return 0;
-    }
-    double jm[8], mean = 0.0, v = 0.0;
-    for (uint32_t i = 0; i < got; i++) {
-        jm[i] = (W - ws[i]) / (A - as[i]);
-        mean += jm[i] / got;
-    }
-    for (uint32_t i = 0; i < got; i++)
-        v += (jm[i] - mean) * (jm[i] - mean);
-    v *= (double)(got - 1) / got;
-    *rel_var = v / (*r * *r);
-    const double h = sample_t975(got - 1) * sqrt(v);
-    s->fr->chip.r_lo = *r - h;
-    s->fr->chip.r_hi = *r + h;
-    return 0;
 }
 
 /* ---- the frame --------------------------------------------------------------------------------- */
@@ -418,7 +318,8 @@ static int sampler_open(ChipSampler *s, const RunScene *sc, const RunSpec *spec,
     if (s->shared) {
         s->up.chip_unit = 1;
         s->up.unit_warm = warm_of;
-        s->up.unit_warm_l1 = warm1_of;
+        s->up.unit_warm_tiles = warm_tiles_of;
+        s->up.unit_warm_l1 = cs_warm1_of;
         s->up.unit_warm_ctx = s;
     } else { /* cores on buses of their own: a unit is the paper machine's */
         s->ucfg.chip_cores = 1;
@@ -441,6 +342,7 @@ static int sampler_open(ChipSampler *s, const RunScene *sc, const RunSpec *spec,
     s->order = malloc(N * sizeof *s->order);
     s->pos = malloc(N * sizeof *s->pos);
     s->wthr = malloc(N * sizeof *s->wthr);
+    s->first = calloc(N, sizeof *s->first);
     s->tile = malloc(T * sizeof *s->tile);
     s->tstart = malloc(T * sizeof *s->tstart);
     s->tcore = malloc(T * sizeof *s->tcore);
@@ -451,7 +353,7 @@ static int sampler_open(ChipSampler *s, const RunScene *sc, const RunSpec *spec,
     s->wlen1 = calloc(N, sizeof *s->wlen1);
     s->units = calloc(N, sizeof *s->units);
     s->instructions = malloc(N * sizeof *s->instructions);
-    if (!s->x || !s->exact || !s->pred || !s->start || !s->order || !s->pos || !s->wthr || !s->tile || !s->tstart ||
+    if (!s->x || !s->exact || !s->pred || !s->start || !s->order || !s->pos || !s->wthr || !s->first || !s->tile || !s->tstart ||
         !s->tcore || !s->tprev || !s->wl || !s->wlen || !s->wl1 || !s->wlen1 || !s->units || !s->instructions) {
         snprintf(err, errlen, "out of memory for %u units", s->N);
         return -1;
@@ -497,6 +399,7 @@ static int sampler_close(ChipSampler *s, int rc)
     free(s->order);
     free(s->pos);
     free(s->wthr);
+    free(s->first);
     free(s->tile);
     free(s->tstart);
     free(s->tcore);
@@ -508,6 +411,49 @@ static int sampler_close(ChipSampler *s, int rc)
     free(s->units);
     free(s->instructions);
     return rc;
+}
+
+/* ---- the memory figures ------------------------------------------------------------------------ */
+
+/* The memory figures of a chip with shared memory into fr->chip (chipmemest.h): the opening's
+ * traffic exact, the rest from phase 1's units (a simple random sample: the tail's are chosen on
+ * the estimate and left out). Without them (no request below the L1s, too few units) they stay
+ * unset and the report has none. */
+static void memory_figures(ChipSampler *s, const uint32_t *order, const SampleEstimate *makespan)
+{
+    StatsChipSample *cs = &s->fr->chip;
+    double *ys = malloc((size_t)(s->n ? s->n : 1) * CME_COUNT * sizeof *ys);
+    uint8_t *opened = malloc(s->N ? s->N : 1);
+    if (!s->shared || !ys || !opened) {
+        free(ys);
+        free(opened);
+        return;
+    }
+    for (uint32_t i = 0; i < s->n; i++) {
+        const FuncUnit *u = &s->units[i];
+        double *y = ys + (size_t)i * CME_COUNT;
+        y[CME_REQUESTS] = (double)u->mem_requests;
+        y[CME_LATENCY] = (double)u->mem_read_latency;
+        y[CME_L2_ACCESSES] = (double)u->l2_accesses;
+        y[CME_L2_HITS] = (double)u->l2_hits;
+        y[CME_DRAM_BYTES] = (double)u->dram_bytes;
+    }
+    for (uint32_t u = 0; u < s->N; u++)
+        opened[u] = s->exact[u] >= 0.0;
+    ChipMemIn in = {.N = s->N, .x = s->x, .k = AUX_K, .first = s->first, .opened = opened, .sample = order,
+                    .ys = ys, .n = s->n, .makespan = makespan->total, .makespan_se = makespan->std_error,
+                    .clock_mhz = s->ucfg.core_clock_mhz, .has_l2 = s->ucfg.l2_size_kb > 0};
+    memcpy(in.open, s->open_mem, sizeof in.open);
+    ChipMemOut out;
+    if (chip_mem_estimate(&in, &out) == 0) {
+        cs->has_mem = out.has_mem;
+        cs->has_l2 = out.has_l2;
+        memcpy(cs->latency, out.latency, sizeof cs->latency);
+        memcpy(cs->l2_hit_rate, out.l2_hit_rate, sizeof cs->l2_hit_rate);
+        memcpy(cs->dram_gbs, out.dram_gbs, sizeof cs->dram_gbs);
+    }
+    free(ys);
+    free(opened);
 }
 
 /* ---- the makespan, and its tail ------------------------------------------------------------------ */
@@ -602,10 +548,13 @@ static uint32_t tail_pick(ChipSampler *s, const uint8_t *timed, const ChipSample
     return n;
 }
 
-/* The makespan's tail, with --target-error: while its interval is wider than the target and the
- * last round moved the estimate by more than CHIPSAMPLED_TAIL_MOVE standard errors, the units of the tiles the latest cores end with are timed alone too (they join the sample the
- * estimate fits: chosen on the schedule of the estimate, never on their own cycles), up to twice
- * phase 1's units. samp and ys (N each) hold phase 1's n units; e and out end as the last
+/* The makespan's tail, with --target-error: one round, then more while its interval is wider than
+ * the target and not CHIPSAMPLED_TAIL_STILL rounds in a row moved the estimate by at most
+ * CHIPSAMPLED_TAIL_MOVE standard errors: the units of the tiles the latest cores end with are
+ * timed alone too (they join the sample the estimate fits: chosen on the schedule of the
+ * estimate, never on their own cycles), up to twice phase 1's units. The first round is always
+ * timed: phase 1's interval rests on the tile effects' spread, which its few same-tile pairs
+ * estimate poorly, and the first round's same-tile units are what shows it. samp and ys (N each) hold phase 1's n units; e and out end as the last
  * estimate's. */
 static int tail(ChipSampler *s, uint32_t *samp, double *ys, const Carry *c, SampleEstimate *e, ChipSampleOut *out)
 {
@@ -617,19 +566,20 @@ static int tail(ChipSampler *s, uint32_t *samp, double *ys, const Carry *c, Samp
     for (uint32_t i = 0; timed && i < s->n; i++)
         timed[samp[i]] = 1;
     const uint32_t budget = s->spec->target_error > 0.0 ? 2 * s->n : 0;
-    int moved = 1;
+    uint32_t rounds = 0, still = 0; /* rounds timed; the last ones in a row that moved the estimate little */
     while (rc == 0 && s->ntail < budget && out->makespan > 0.0 &&
-           (out->hi - out->lo) / 2.0 > s->spec->target_error * out->makespan &&
-           moved) {
+           (rounds == 0 || (out->hi - out->lo) / 2.0 > s->spec->target_error * out->makespan) &&
+           still < CHIPSAMPLED_TAIL_STILL) {
         uint32_t m = tail_pick(s, timed, out, pick);
         if (m > budget - s->ntail)
             m = budget - s->ntail;
         if (!m)
             break;
-        note(s, "timing the tail: units %u..%u (the makespan's interval +-%u per mille, wider than the target)",
+        cs_note(s, rounds ? "timing the tail: units %u..%u (the makespan's interval +-%u per mille, wider than the target)"
+                       : "timing the tail: units %u..%u (its first round; the makespan's interval +-%u per mille)",
              s->ntail + 1, s->ntail + m, (unsigned)(500.0 * (out->hi - out->lo) / out->makespan + 0.5));
         FuncUnit *got = &s->units[s->n + s->ntail];
-        if ((rc = time_alone(s, pick, m, got)) != 0)
+        if ((rc = cs_time_alone(s, pick, m, got)) != 0)
             break;
         for (uint32_t i = 0; i < m; i++) {
             samp[s->n + s->ntail + i] = pick[i];
@@ -639,7 +589,8 @@ static int tail(ChipSampler *s, uint32_t *samp, double *ys, const Carry *c, Samp
         s->ntail += m;
         const double before = out->makespan;
         rc = makespan(s, samp, ys, s->n + s->ntail, c, e, out);
-        moved = fabs(out->makespan - before) > CHIPSAMPLED_TAIL_MOVE * out->std_error;
+        rounds++;
+        still = fabs(out->makespan - before) > CHIPSAMPLED_TAIL_MOVE * out->std_error ? 0 : still + 1;
     }
     free(timed);
     return rc;
@@ -668,7 +619,7 @@ static int estimate(ChipSampler *s)
         goto out;
     }
     Carry c;
-    if (schedule(s, e.coef) != 0 || waves(s, &c.r, &c.r_rel_var) != 0)
+    if (schedule(s, e.coef) != 0 || chipwaves_run(s, &c.r, &c.r_rel_var) != 0)
         goto out;
     ChipSampleOut out;
     if (tail(s, order, ys, &c, &e, &out) != 0)
@@ -690,6 +641,7 @@ static int estimate(ChipSampler *s)
     cs->var_r = out.var_r;
     cs->sigma_a = out.sigma_a;
     cs->sigma_e = out.sigma_e;
+    memory_figures(s, order, &fr->est);
     fr->has_est = 1;
     rc = 0;
 out:
@@ -706,6 +658,7 @@ int chipsampled_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine 
     int rc = sampler_open(&s, sc, spec, cfg, fp, fr, err, errlen);
     fr->chip.on = 1;
     fr->chip.cores = (uint32_t)cfg->chip_cores;
+    fr->chip.shared = cfg->chip_memory == CFG_CHIP_MEMORY_SHARED;
     if (rc == 0)
         rc = sampled_golden(sc, spec, cfg, fr, s.N, s.x, err, errlen);
     if (rc == 0)
@@ -717,8 +670,10 @@ int chipsampled_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine 
     }
     if (rc == 0 && s.warm) { /* the L2's warming: each line's first reader in this schedule */
         warm_thresholds(&s);
-        note(&s, "the warming's record: each line's first reader (the golden model, %u units)", s.N, 0, 0);
+        cs_note(&s, "the warming's record: each line's first reader (the golden model, %u units)", s.N, 0, 0);
         rc = chipwarm_first_readers(s.warm, s.pos, run_spec_threads(spec), err, errlen);
+        if (rc == 0)
+            rc = first_lines(&s);
     }
     if (rc == 0)
         rc = estimate(&s);

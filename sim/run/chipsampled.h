@@ -11,14 +11,20 @@
  * 4. Phase 1: today's sample and sequential rule (sim/sampling.h) over the units, each timed alone
  *    on one core of the chip's memory (FuncParams.chip_unit), its L2 and DRAM rows warmed with the
  *    golden model's lines of the units that start before it in the predicted schedule
- *    (sim/run/chipwarm.h); the regression of their cycles on the golden counts.
+ *    (sim/run/chipwarm.h), after the framebuffer lines of the tiles that started before it (as
+ *    written: dirty in the L2); the regression of their cycles on the golden counts.
  * 5. Phase 2, the other cores: waves at evenly spaced instants of the predicted schedule (a seeded
  *    offset): the K units running then timed together on the whole chip (FuncParams.wave), and up
  *    to CHIPSAMPLED_WAVE_ALONE of them alone; their ratio r, with a jackknife over waves.
  * 6. The makespan: every tile's estimate (exact, sampled or predicted units, times r, with the
  *    tile-effect correction) list-scheduled, with its 95 % interval (sim/chipsampling.h).
- * 7. The tail (with --target-error): while that interval is wider than the target, units of the
- *    tiles the latest cores end with are timed alone too and join the fit (CHIPSAMPLED_TAIL_*).
+ * 7. The tail (with --target-error): a first round, then more while that interval is wider than the
+ *    target: units of the tiles the latest cores end with are timed alone too and join the fit
+ *    (CHIPSAMPLED_TAIL_*).
+ * 8. The memory figures (chip.memory = shared): the opening's traffic exactly, the rest from phase
+ *    1's units alone, with each unit's first-read lines (the warming's table) as an auxiliary
+ *    (sim/chipmemest.h): the average read latency, the L2's hit rate and DRAM's bandwidth, each
+ *    with a 95 % interval.
  * A chip whose cores have buses of their own (chip.memory = bus) has no shared level to warm or
  * contend for: its units are timed as sampled mode's (a cold core on its bus) and r = 1.
  *
@@ -40,9 +46,11 @@
  * the most cycles still predicted; all rounds at most twice phase 1's units. */
 #define CHIPSAMPLED_TAIL_CORES 4u
 #define CHIPSAMPLED_TAIL_UNITS 4u
-/* ... and the rounds stop once one moved the makespan's estimate by at most this many of its
- * standard errors (the late tiles are then known as well as the tail can tell). */
+/* ... and the rounds after the first stop once CHIPSAMPLED_TAIL_STILL in a row each moved the
+ * makespan's estimate by at most CHIPSAMPLED_TAIL_MOVE of its standard errors (the late tiles are
+ * then known as well as the tail can tell). */
 #define CHIPSAMPLED_TAIL_MOVE 0.2
+#define CHIPSAMPLED_TAIL_STILL 2u
 
 /* Waves timed on a chip of K cores: 4, or 2 above 64 cores (a wave costs K units). */
 uint32_t chipsampled_waves(uint32_t cores);

@@ -263,6 +263,16 @@ int chipwarm_first_readers(ChipWarm *w, const uint32_t *pos, int threads, char *
     return rc;
 }
 
+void chipwarm_first_counts(const ChipWarm *w, uint32_t npos, double *counts)
+{
+    memset(counts, 0, (size_t)npos * sizeof *counts);
+    for (uint32_t i = 0; i < w->nhot; i++) {
+        const uint32_t f = atomic_load_explicit(&w->first[w->hot[i]], memory_order_relaxed);
+        if (f < npos)
+            counts[f] += 1.0;
+    }
+}
+
 int chipwarm_l2(const ChipWarm *w, uint32_t pos, uint64_t **list, size_t *len, char *err, size_t errlen)
 {
     *list = NULL;

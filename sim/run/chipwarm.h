@@ -37,6 +37,11 @@ void chipwarm_free(ChipWarm *w);
  * One golden-model pass over the whole frame on `threads` host threads. 0, or -1 with err. */
 int chipwarm_first_readers(ChipWarm *w, const uint32_t *pos, int threads, char *err, size_t errlen);
 
+/* Lines first read at each position (after chipwarm_first_readers): counts[pos] for pos < npos,
+ * the lines of the record whose first reader is at pos (the full run's compulsory misses, as far
+ * as the record tells them and the order is the run's). */
+void chipwarm_first_counts(const ChipWarm *w, uint32_t npos, double *counts);
+
 /* The L2 warming list of a unit at position `pos` of that order (after chipwarm_first_readers):
  * malloc'd into *list (NULL when empty), *len lines. 0, or -1 out of memory (err says). */
 int chipwarm_l2(const ChipWarm *w, uint32_t pos, uint64_t **list, size_t *len, char *err, size_t errlen);

@@ -291,16 +291,52 @@ int eng_warm_l1(Job *j, Timing *t, uint32_t unit)
     return 0;
 }
 
+uint64_t eng_fb_tile_bytes(const Job *j)
+{
+    const uint64_t line = (uint64_t)j->fp->cfg->scene_line_bytes;
+    return ((uint64_t)j->k->tile_w * j->k->tile_h * 12 + line - 1) / line * line;
+}
+
+/* The framebuffer lines of the tile at base, as written. */
+static void warm_fb_written(Job *j, Chip *chip, uint64_t base)
+{
+    const uint64_t line = (uint64_t)j->fp->cfg->scene_line_bytes, bytes = eng_fb_tile_bytes(j);
+    for (uint64_t b = 0; b < bytes; b += line) {
+        const uint64_t a = ((uint64_t)1 << MEM_SPACE_SHIFT) + base + b;
+        chip_warm_written(chip, &a, 1);
+    }
+}
+
 void eng_warm_fb_shared(Job *j, Chip *chip, uint64_t base, uint32_t unit)
 {
     if (!j->fp->unit_warm_l1 || unit % j->spp == 0 || !chip)
         return;
-    const uint64_t line = (uint64_t)j->fp->cfg->scene_line_bytes;
-    const uint64_t bytes = ((uint64_t)j->k->tile_w * j->k->tile_h * 12 + line - 1) / line * line;
-    for (uint64_t b = 0; b < bytes; b += line) {
-        const uint64_t a = ((uint64_t)1 << MEM_SPACE_SHIFT) + base + b;
-        chip_warm(chip, &a, 1);
-    }
+    warm_fb_written(j, chip, base);
+}
+
+void eng_warm_fb_tiles(Job *j, Chip *chip, uint32_t lo, uint32_t hi, uint32_t skip)
+{
+    if (!chip || hi <= lo)
+        return;
+    const uint64_t fbt = eng_fb_tile_bytes(j);
+    const uint64_t cap = (uint64_t)j->fp->cfg->l2_size_kb * 1024 / fbt + 1; /* tiles an L2 holds, and one */
+    if (hi - lo > cap)
+        lo = hi - (uint32_t)cap;
+    for (uint32_t t = lo; t < hi; t++)
+        if (t != skip)
+            warm_fb_written(j, chip, (uint64_t)t * fbt);
+}
+
+/* A chip's unit's traffic below its L1 (FuncUnit): the shared levels' counters now less m0's. */
+static void unit_mem(const Chip *chip, const ChipMemStats *m0, FuncUnit *fu)
+{
+    ChipMemStats m1;
+    chip_stats(chip, &m1);
+    fu->mem_requests += m1.requests - m0->requests;
+    fu->mem_read_latency += m1.read_latency - m0->read_latency;
+    fu->l2_accesses += (m1.l2.reads + m1.l2.writes) - (m0->l2.reads + m0->l2.writes);
+    fu->l2_hits += m1.l2.hits - m0->l2.hits;
+    fu->dram_bytes += m1.dram.bytes - m0->dram.bytes;
 }
 
 /* One kernel run: unit `unit` (tile * spp + pass) of the launched tile, on a cold machine when
@@ -313,6 +349,14 @@ static int run_pass(Worker *w, Core *c, const FuncTile *ft, uint32_t unit, FuncU
     eng_pass_set(j, c, pass);
     TimingStats tbefore;
     timing_begin(w, c, &tbefore);
+    const uint32_t tile = unit / j->spp;
+    if (w->cu.chip) { /* the unit's framebuffer where the chip's frame has it, past the earlier tiles' */
+        timing_set_fb_base(w->tc.tm, (uint64_t)tile * eng_fb_tile_bytes(j));
+        uint32_t lo = 0, hi = 0;
+        if (j->fp->unit_warm_tiles)
+            j->fp->unit_warm_tiles(j->fp->unit_warm_ctx, unit, &lo, &hi);
+        eng_warm_fb_tiles(j, w->cu.chip, lo, hi, tile);
+    }
     if (w->cu.chip && j->fp->unit_warm) {
         size_t n = 0;
         const uint64_t *lines = j->fp->unit_warm(j->fp->unit_warm_ctx, unit, &n);
@@ -320,12 +364,14 @@ static int run_pass(Worker *w, Core *c, const FuncTile *ft, uint32_t unit, FuncU
             chipunit_warm(&w->cu, lines, n);
     }
     if (w->cu.chip)
-        eng_warm_fb_shared(j, w->cu.chip, 0, unit); /* (a unit alone: its framebuffer at 0) */
+        eng_warm_fb_shared(j, w->cu.chip, (uint64_t)tile * eng_fb_tile_bytes(j), unit);
     if (w->cu.chip && eng_warm_l1(j, w->tc.tm, unit) != 0)
         return -1;
     const uint64_t limit = (uint64_t)j->fp->cfg->sim_max_instructions;
     CoreExit ex;
+    ChipMemStats m0;
     if (w->cu.chip) {
+        chip_stats(w->cu.chip, &m0);
         char err[300];
         if (chipunit_run(&w->cu, c, limit, &ex, err, sizeof err)) {
             eng_fail(j, err, 0);
@@ -341,6 +387,8 @@ static int run_pass(Worker *w, Core *c, const FuncTile *ft, uint32_t unit, FuncU
     } else {
         ex = core_run(c, limit);
     }
+    if (w->cu.chip && fu)
+        unit_mem(w->cu.chip, &m0, fu);
     if (timing_close(w, &tbefore, fu))
         return -1;
     return eng_pass_end(j, c, ft, pass, ex);

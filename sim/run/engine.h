@@ -62,6 +62,10 @@ typedef struct FuncParams {
      * first), or NULL for none; called from the host thread that runs u, several at once. */
     const uint64_t *(*unit_warm)(void *ctx, uint32_t unit, size_t *n);
     void *unit_warm_ctx;
+    /* ... and before those, the framebuffer lines of tiles [*lo, *hi) (frame order: the tiles
+     * that started before u), as written (chip_warm_written), oldest first, the last L2-capacity
+     * of them; u's own tile is left out. NULL: none. Same ctx, same threads. */
+    void (*unit_warm_tiles)(void *ctx, uint32_t unit, uint32_t *lo, uint32_t *hi);
     /* With chip_unit or wave: the scene lines to warm unit u's L1 with before it runs (oldest
      * first), or NULL for none; past the tile's first pass its framebuffer's lines are warmed too
      * (before them, dirty: the tile's earlier passes wrote them). Same ctx, same threads. */
@@ -82,6 +86,7 @@ typedef struct FuncParams {
     uint32_t nwave;
     const uint64_t *wave_warm;
     size_t nwave_warm;
+    uint32_t wave_fb_lo, wave_fb_hi; /* ... after the framebuffer lines of tiles [lo, hi) as unit_warm_tiles's */
 } FuncParams;
 
 typedef struct FuncTile {
@@ -105,6 +110,10 @@ typedef struct FuncUnit {
     uint64_t cycles, busy;     /* when timed */
     uint64_t stalls[TM_CAUSE_COUNT];
     uint64_t active_lanes[ISA_STAGE_COUNT];
+    /* A chip's unit (FuncParams.chip_unit), from its shared levels' counters (ChipMemStats): the
+     * requests its L1 sent below, the sum of their read latencies, the L2's accesses (reads and
+     * writes) and hits, and DRAM's bytes. */
+    uint64_t mem_requests, mem_read_latency, l2_accesses, l2_hits, dram_bytes;
 } FuncUnit;
 
 /* A chip's core over the frame (docs/chip.md): busy + stall + idle = the makespan. */

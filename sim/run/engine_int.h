@@ -74,9 +74,14 @@ void eng_tile_pixels(Job *j, Core *c, const FuncTile *ft, int to_fb);
  * (tile * spp + pass) after its reset. 0, or -1 after eng_fail. */
 int eng_warm_l1(Job *j, Timing *t, uint32_t unit);
 /* ... and past its tile's first pass, the tile's framebuffer lines (at base in the framebuffer's
- * space) into the chip's shared levels, after what they were warmed with (chip_warm): its earlier
- * passes left them there. */
+ * space) into the chip's shared levels as written, after what they were warmed with
+ * (chip_warm_written): its earlier passes left them there. */
 void eng_warm_fb_shared(Job *j, Chip *chip, uint64_t base, uint32_t unit);
+/* The framebuffer lines of tiles [lo, hi) but tile `skip`, the last L2-capacity of them, into the
+ * chip's shared levels as written, oldest first (FuncParams.unit_warm_tiles). */
+void eng_warm_fb_tiles(Job *j, Chip *chip, uint32_t lo, uint32_t hi, uint32_t skip);
+/* A tile's framebuffer bytes in the chip's framebuffer space, in whole lines (tile t at t times it). */
+uint64_t eng_fb_tile_bytes(const Job *j);
 /* Worker `index`'s core opened and the scene loaded (sim/run/tiles.h's begin). */
 int eng_worker_begin(void *ctx, int index);
 /* The workers' counters into st, in worker order. */

@@ -235,3 +235,32 @@ Test(l2, warming_brings_lines_in_as_reads_would)
     cr_expect_eq(s->misses, 1);
     l2_free(f.l2);
 }
+
+/* l2_warm_written: a line warmed as written is dirty, so the read that evicts it writes it back
+ * first (nothing counted for the warming itself). Bank 0, set 2 (lines 12, 28, 44): 12 warmed
+ * written, 28 warmed read; a read of 44 at 400 evicts 12, the least recent: one write-back of line
+ * 12 and one read of 44 below, answered at 423 as in a_dirty_victim_is_written_back. Warmed as
+ * read instead, line 12 leaves with nothing written. */
+Test(l2, a_line_warmed_as_written_is_written_back)
+{
+    for (int written = 0; written <= 1; written++) {
+        Fix f;
+        open_fix(&f, params());
+        cr_expect_eq(written ? l2_warm_written(f.l2, L(12)) : l2_warm(f.l2, L(12)), 1);
+        cr_expect_eq(l2_warm(f.l2, L(28)), 1);
+        cr_expect_eq(l2_stats(f.l2)->writes, 0, "warming counts nothing");
+        l2_push(f.l2, L(44), 0, 400, 1);
+        run_all(&f);
+        cr_expect_eq(f.ans[1], 423);
+        int writes = 0;
+        for (int i = 0; i < f.below.n; i++)
+            if (f.below.write[i]) {
+                writes++;
+                cr_expect_eq(f.below.addr[i], L(12));
+            }
+        cr_expect_eq(f.below.n, 1 + written, "warmed %s: %d requests below", written ? "written" : "read", f.below.n);
+        cr_expect_eq(writes, written);
+        cr_expect_eq(l2_stats(f.l2)->writebacks, (uint64_t)written);
+        l2_free(f.l2);
+    }
+}
