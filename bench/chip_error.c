@@ -114,18 +114,14 @@ typedef struct Result {
     double mem_abs[MEM_COUNT], mem_signed[MEM_COUNT];
 } Result;
 
-/* A frame's memory figure m (MEM_*) from a detailed run's counters (the report's formulas). */
+/* A frame's memory figure m (MEM_*) from a detailed run's counters (the report's: chip_mem_figures). */
 static double det_mem(const RunFrame *fr, const CfgMachine *cfg, int m)
 {
-    const ChipMemStats *c = fr->f.chip_mem;
-    const double secs = (double)fr->f.makespan / (cfg->core_clock_mhz * 1e6);
-    if (!c)
+    if (!fr->f.chip_mem)
         return -1.0;
-    switch (m) {
-    case MEM_LATENCY: return c->requests ? (double)c->read_latency / (double)c->requests : -1.0;
-    case MEM_L2_HIT: return c->has_l2 && c->l2.reads + c->l2.writes ? (double)c->l2.hits / (double)(c->l2.reads + c->l2.writes) : -1.0;
-    default: return secs > 0.0 ? (double)c->dram.bytes / secs / 1e9 : -1.0;
-    }
+    double f[CHIP_FIG_COUNT];
+    chip_mem_figures(fr->f.chip_mem, (double)fr->f.makespan / (cfg->core_clock_mhz * 1e6), f);
+    return f[m == MEM_LATENCY ? CHIP_FIG_LATENCY : m == MEM_L2_HIT ? CHIP_FIG_L2_HIT_RATE : CHIP_FIG_DRAM_GBS];
 }
 
 /* A sampled frame's estimate of m with its interval (f[3]); 0 when it has none. */

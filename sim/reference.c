@@ -763,7 +763,8 @@ static void render_tile(Worker *w, uint32_t tile)
     uint32_t tiles_x = (c->width + T - 1) / T;
     uint32_t x0 = (tile % tiles_x) * T, y0 = (tile / tiles_x) * T;
     uint32_t pass1 = c->rp->pass1 ? c->rp->pass1 : c->spp;
-    for (uint32_t sample = c->rp->pass0; sample < pass1 && sample < c->spp; sample++) {
+    const uint32_t step = c->rp->pass_step > 1 ? c->rp->pass_step : 1;
+    for (uint32_t sample = c->rp->pass0; sample < pass1 && sample < c->spp; sample += step) {
         w->unit = tile * c->spp + sample;
         if (w->set.line) /* RefParams.unit_line: the kernel reads the header's fields in each pass */
             w->set.line(w->set.line_ctx, sm_hdr(c->p, 0), 4u * SM_HDR_WORDS);

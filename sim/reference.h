@@ -34,6 +34,8 @@ typedef struct RefParams {
     /* The passes (samples per pixel) to render, [pass0, pass1); pass1 = 0: every pass. The image
      * then holds the sum of those passes over the frame's spp (a pilot's image is not the frame). */
     uint32_t pass0, pass1;
+    /* Every pass_step-th of those passes (pass0, pass0 + step, ...); 0 or 1: each of them. */
+    uint32_t pass_step;
     /* When not NULL: the counts of each (tile, pass) unit, units[tile * spp + pass], ntiles * spp
      * entries zeroed by the caller (sampled mode's auxiliary variables, docs/sampling.md). */
     struct RefUnitStats *units;

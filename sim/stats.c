@@ -441,13 +441,18 @@ static double cs_mem(const StatsCtx *c, int which, int bound, int *na)
 }
 static int sampled(const StatsCtx *c) { return (c->mode & STATS_M_SAMP) != 0; }
 
-FIG(mem_read_latency)
+/* The frame's seconds: the makespan at the cores' clock. */
+static double frame_seconds(const StatsCtx *c) { return (double)c->f->makespan / (c->cfg->core_clock_mhz * 1e6); }
+/* A chip's memory figure `which` (CHIP_FIG_*) of its counters, or the sampled chip's estimate. */
+static double mem_fig(const StatsCtx *c, int which, int *na)
 {
-    (void)idx;
     if (sampled(c))
-        return cs_mem(c, 0, -1, na);
-    return defined_if(stats_ratio(mem_of(c)->read_latency, mem_of(c)->requests), mem_of(c)->requests > 0, na);
+        return cs_mem(c, which, -1, na);
+    double f[CHIP_FIG_COUNT];
+    chip_mem_figures(mem_of(c), frame_seconds(c), f);
+    return defined_if(f[which] >= 0.0 ? f[which] : 0.0, f[which] >= 0.0, na);
 }
+FIG(mem_read_latency) { (void)idx; return mem_fig(c, CHIP_FIG_LATENCY, na); }
 FIG(mem_read_latency_ci95) { return cs_mem(c, 0, idx[0], na); }
 FIG(scene_stall_l1)
 {
@@ -456,14 +461,7 @@ FIG(scene_stall_l1)
 }
 FIG(l2_present) { UNUSED_FIG_ARGS; return mem_of(c)->has_l2; }
 FIG(noc_present) { UNUSED_FIG_ARGS; return mem_of(c)->has_noc; }
-FIG(l2_hit_rate)
-{
-    (void)idx;
-    if (sampled(c))
-        return cs_mem(c, 1, -1, na);
-    const L2Stats *l = &mem_of(c)->l2;
-    return defined_if(stats_ratio(l->hits, l->reads + l->writes), mem_of(c)->has_l2 && l->reads + l->writes > 0, na);
-}
+FIG(l2_hit_rate) { (void)idx; return mem_fig(c, CHIP_FIG_L2_HIT_RATE, na); }
 FIG(l2_mpki)
 {
     (void)idx;
@@ -476,17 +474,8 @@ FIG(l2_read_latency)
     const L2Stats *l = &mem_of(c)->l2;
     return defined_if(stats_ratio(l->read_latency, l->reads), l->reads > 0, na);
 }
-/* The frame's seconds: the makespan at the cores' clock. */
-static double frame_seconds(const StatsCtx *c) { return (double)c->f->makespan / (c->cfg->core_clock_mhz * 1e6); }
 FIG(l2_hit_rate_ci95) { return cs_mem(c, 1, idx[0], na); }
-FIG(dram_bandwidth)
-{
-    (void)idx;
-    if (sampled(c))
-        return cs_mem(c, 2, -1, na);
-    const double s = frame_seconds(c);
-    return defined_if(s > 0 ? (double)mem_of(c)->dram.bytes / s / 1e9 : 0.0, s > 0, na);
-}
+FIG(dram_bandwidth) { (void)idx; return mem_fig(c, CHIP_FIG_DRAM_GBS, na); }
 FIG(dram_bandwidth_ci95) { return cs_mem(c, 2, idx[0], na); }
 FIG(dram_peak) { UNUSED_FIG_ARGS; return mem_of(c)->dram_peak_gbs; }
 FIG(dram_utilization)

@@ -38,6 +38,13 @@ static void out(TextW *w, const char *fmt, ...)
     va_end(ap);
 }
 
+/* A frame rate with three significant digits below 1 fps (0.0794, not 0.08), else two decimals. */
+static const char *fps_text(double v, char *buf, size_t len)
+{
+    snprintf(buf, len, v >= 1.0 || v <= 0.0 ? "%.2f" : "%.3g", v);
+    return buf;
+}
+
 /* A value in its unit's format; "-" where it has no meaning. */
 static const char *fmt_value(const StatsRow *r, double v, int na, char *buf, size_t len)
 {
@@ -47,7 +54,7 @@ static const char *fmt_value(const StatsRow *r, double v, int na, char *buf, siz
     case STATS_U_RATIO: snprintf(buf, len, "%.1f%%", 100.0 * v); break;
     case STATS_U_PER_RAY: case STATS_U_CPI: snprintf(buf, len, "%.3f", v); break;
     case STATS_U_RAYS_PER_STREAM: snprintf(buf, len, "%.1f", v); break;
-    case STATS_U_FPS: snprintf(buf, len, "%.2f", v); break;
+    case STATS_U_FPS: fps_text(v, buf, len); break;
     case STATS_U_MHZ: case STATS_U_NUMBER: snprintf(buf, len, "%g", v); break;
     case STATS_U_JOULES: case STATS_U_WATTS: case STATS_U_MM2: snprintf(buf, len, "%.4g", v); break;
     case STATS_U_FLAG: snprintf(buf, len, "%s", v != 0 ? "yes" : "no"); break;
@@ -95,21 +102,24 @@ static void headline(TextW *w, const StatsRow *r)
     }
     StatsFrame s = stats_frame_of(c);
     double mhz = c->cfg->core_clock_mhz;
+    char f0[32], f1[32], f2[32], f3[32];
+    fps_text(s.fps, f0, sizeof f0);
+    fps_text(s.fps_no_stall, f3, sizeof f3);
     if (c->est)
         out(w, "%-12s ~%.0f (95%%: %.0f .. %.0f) = ~%.0f busy + ~%.0f stalled; estimated from %u of %u units\n"
-            "fps          ~%.2f (95%%: %.2f .. %.2f) at %g MHz (%.2f fps with no stalls)\n"
+            "fps          ~%s (95%%: %s .. %s) at %g MHz (%s fps with no stalls)\n"
             "sample       the shares and unit lines below are those of the %u sampled units (docs/sampling.md)\n",
-            r->label, s.cycles, s.cycles_lo, s.cycles_hi, s.busy, s.cycles - s.busy, c->est->n, c->est->N, s.fps,
-            s.fps_lo, s.fps_hi, mhz, s.fps_no_stall, c->est->n);
+            r->label, s.cycles, s.cycles_lo, s.cycles_hi, s.busy, s.cycles - s.busy, c->est->n, c->est->N, f0,
+            fps_text(s.fps_lo, f1, sizeof f1), fps_text(s.fps_hi, f2, sizeof f2), mhz, f3, c->est->n);
     else if (c->f && c->f->chip_cores)
-        out(w, "%-12s %llu, the makespan of %u cores (core-cycles: %llu busy + %llu stalled + %llu idle); %.2f fps "
-            "at %g MHz (%.2f fps with no stalls and even load)\n", r->label, (unsigned long long)c->f->makespan,
+        out(w, "%-12s %llu, the makespan of %u cores (core-cycles: %llu busy + %llu stalled + %llu idle); %s fps "
+            "at %g MHz (%s fps with no stalls and even load)\n", r->label, (unsigned long long)c->f->makespan,
             c->f->chip_cores, (unsigned long long)t->busy, (unsigned long long)(t->cycles - t->busy),
-            (unsigned long long)((uint64_t)c->f->chip_cores * c->f->makespan - t->cycles), s.fps, mhz, s.fps_no_stall);
+            (unsigned long long)((uint64_t)c->f->chip_cores * c->f->makespan - t->cycles), f0, mhz, f3);
     else
-        out(w, "%-12s %llu = %llu busy + %llu stalled; %.2f fps at %g MHz (%.2f fps with no stalls)\n", r->label,
+        out(w, "%-12s %llu = %llu busy + %llu stalled; %s fps at %g MHz (%s fps with no stalls)\n", r->label,
             (unsigned long long)t->cycles, (unsigned long long)t->busy, (unsigned long long)(t->cycles - t->busy),
-            s.fps, mhz, s.fps_no_stall);
+            f0, mhz, f3);
 }
 
 /* A 2-D row as a table (kd counters per ray: a line per ray kind), or one more line of it. */

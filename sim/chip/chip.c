@@ -391,3 +391,11 @@ void chip_stats(const Chip *c, ChipMemStats *s)
     s->dram_clock_mhz = p->clock_mhz;
     s->dram_peak_gbs = (double)p->channels * (p->bus_bits / 8) * p->beats * p->clock_mhz * 1e6 / 1e9;
 }
+
+void chip_mem_figures(const ChipMemStats *s, double seconds, double out[CHIP_FIG_COUNT])
+{
+    const uint64_t acc = s->l2.reads + s->l2.writes;
+    out[CHIP_FIG_LATENCY] = s->requests ? (double)s->read_latency / (double)s->requests : -1.0;
+    out[CHIP_FIG_L2_HIT_RATE] = s->has_l2 && acc ? (double)s->l2.hits / (double)acc : -1.0;
+    out[CHIP_FIG_DRAM_GBS] = seconds > 0.0 ? (double)s->dram.bytes / seconds / 1e9 : -1.0;
+}

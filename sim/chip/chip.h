@@ -83,4 +83,11 @@ typedef struct ChipMemStats {
 } ChipMemStats;
 void chip_stats(const Chip *c, ChipMemStats *s);
 
+/* The memory figures the report gives of a chip's counters over a frame of `seconds`
+ * (docs/report.md): the average read latency below the L1s (cycles), the L2's hit rate and DRAM's
+ * bandwidth (GB/s, 10^9 bytes); each -1 where it has no meaning (no request, no L2 or no access
+ * to it, no time). */
+enum { CHIP_FIG_LATENCY, CHIP_FIG_L2_HIT_RATE, CHIP_FIG_DRAM_GBS, CHIP_FIG_COUNT };
+void chip_mem_figures(const ChipMemStats *s, double seconds, double out[CHIP_FIG_COUNT]);
+
 #endif

@@ -650,6 +650,14 @@ out:
     return rc;
 }
 
+/* The first-reader record's pass step: every pass of the frame would cost as much as the golden
+ * model's whole image again, so CHIPSAMPLED_RECORD_PASSES of each tile's passes, evenly spaced,
+ * are recorded (docs/sampling.md, step 4, "The warming's record"). */
+static uint32_t record_step(uint32_t spp)
+{
+    return spp <= CHIPSAMPLED_RECORD_PASSES ? 1 : (spp + CHIPSAMPLED_RECORD_PASSES - 1) / CHIPSAMPLED_RECORD_PASSES;
+}
+
 int chipsampled_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg, const FuncParams *fp,
                       RunFrame *fr, char *err, size_t errlen)
 {
@@ -671,7 +679,7 @@ int chipsampled_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine 
     if (rc == 0 && s.warm) { /* the L2's warming: each line's first reader in this schedule */
         warm_thresholds(&s);
         cs_note(&s, "the warming's record: each line's first reader (the golden model, %u units)", s.N, 0, 0);
-        rc = chipwarm_first_readers(s.warm, s.pos, run_spec_threads(spec), err, errlen);
+        rc = chipwarm_first_readers(s.warm, s.pos, record_step(s.spp), run_spec_threads(spec), err, errlen);
         if (rc == 0)
             rc = first_lines(&s);
     }

@@ -52,6 +52,10 @@
 #define CHIPSAMPLED_TAIL_MOVE 0.2
 #define CHIPSAMPLED_TAIL_STILL 2u
 
+/* The warming's first-reader record renders this many passes of each tile (every ceil(spp /
+ * this)-th); at this many samples or fewer, all of them. */
+#define CHIPSAMPLED_RECORD_PASSES 8u
+
 /* Waves timed on a chip of K cores: 4, or 2 above 64 cores (a wave costs K units). */
 uint32_t chipsampled_waves(uint32_t cores);
 

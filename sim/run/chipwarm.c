@@ -207,7 +207,8 @@ static int hot_order(const void *a, const void *b)
     return (x->line > y->line) - (x->line < y->line);
 }
 
-int chipwarm_first_readers(ChipWarm *w, const uint32_t *pos, int threads, char *err, size_t errlen)
+int chipwarm_first_readers(ChipWarm *w, const uint32_t *pos, uint32_t pass_step, int threads, char *err,
+                           size_t errlen)
 {
     const double t0 = util_now();
     w->maxseen = (threads < 1 ? 1 : threads) + 1; /* (the calling thread may render too) */
@@ -227,6 +228,7 @@ int chipwarm_first_readers(ChipWarm *w, const uint32_t *pos, int threads, char *
     rp.progress = NULL;
     rp.pass0 = 0;
     rp.pass1 = 0;
+    rp.pass_step = pass_step;
     rp.tiles_only = NULL;
     rp.ntiles_only = 0;
     rp.unit_line = on_first;

@@ -34,8 +34,12 @@ ChipWarm *chipwarm_new(const PackedScene *p, const RefParams *rp, uint32_t ntile
 void chipwarm_free(ChipWarm *w);
 
 /* The first-reader table: pos[u] is unit u's position in the schedule's start order (N units).
- * One golden-model pass over the whole frame on `threads` host threads. 0, or -1 with err. */
-int chipwarm_first_readers(ChipWarm *w, const uint32_t *pos, int threads, char *err, size_t errlen);
+ * One golden-model pass over the frame on `threads` host threads, of every pass_step-th pass of
+ * each tile (0 or 1: all of them; a line that only the passes left out read is then not in the
+ * table, and the first reader of one they read first is a later pass: docs/sampling.md, "The
+ * warming's record"). 0, or -1 with err. */
+int chipwarm_first_readers(ChipWarm *w, const uint32_t *pos, uint32_t pass_step, int threads, char *err,
+                           size_t errlen);
 
 /* Lines first read at each position (after chipwarm_first_readers): counts[pos] for pos < npos,
  * the lines of the record whose first reader is at pos (the full run's compulsory misses, as far

@@ -68,11 +68,9 @@ static double detailed_makespan_mem(double mem[3])
     cr_assert_gt(det.f.makespan, 0);
     const double m = (double)det.f.makespan;
     if (mem) {
-        const ChipMemStats *c = det.f.chip_mem;
-        cr_assert(c && c->requests > 0 && c->has_l2);
-        mem[0] = (double)c->read_latency / (double)c->requests;
-        mem[1] = (double)c->l2.hits / (double)(c->l2.reads + c->l2.writes);
-        mem[2] = (double)c->dram.bytes / (m / (cfg.core_clock_mhz * 1e6)) / 1e9;
+        cr_assert(det.f.chip_mem);
+        chip_mem_figures(det.f.chip_mem, m / (cfg.core_clock_mhz * 1e6), mem);
+        cr_assert(mem[CHIP_FIG_LATENCY] > 0.0 && mem[CHIP_FIG_L2_HIT_RATE] >= 0.0 && mem[CHIP_FIG_DRAM_GBS] >= 0.0);
     }
     run_frame_free(&det);
     return m;

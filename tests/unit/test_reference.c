@@ -263,8 +263,22 @@ Test(reference, rmse_falls_as_one_over_sqrt_spp, .timeout = 60)
     free(ref);
 }
 
+/* v's units (tiles x spp) are u's for the passes in the mask, and zero for the others. */
+static void expect_passes(const RefUnitStats *v, const RefUnitStats *u, int tiles, int spp, unsigned mask,
+                          const char *what)
+{
+    RefUnitStats zero;
+    memset(&zero, 0, sizeof zero);
+    for (int t = 0; t < tiles; t++)
+        for (int q = 0; q < spp; q++) {
+            const RefUnitStats *want = mask >> q & 1u ? &u[t * spp + q] : &zero;
+            cr_expect_eq(memcmp(&v[t * spp + q], want, sizeof zero), 0, "%s: tile %d pass %d", what, t, q);
+        }
+}
+
 /* Sampled mode's auxiliary variables: every (tile, pass) unit's counts add up to the frame's, and
- * a unit rendered alone (a pass range) counts exactly what it counted in the whole frame. */
+ * a unit rendered alone (a pass range, or every second pass) counts exactly what it counted in the
+ * whole frame. */
 Test(reference, unit_counts_add_up_and_a_pass_alone_counts_the_same)
 {
     Scene s;
@@ -303,13 +317,14 @@ Test(reference, unit_counts_add_up_and_a_pass_alone_counts_the_same)
     one.threads = 1;
     one.units = v;
     cr_assert_eq(ref_render(&p, &one, rgb1, NULL, err, sizeof err), 0, "%s", err);
-    for (int t = 0; t < TILES; t++)
-        for (int q = 0; q < SPP; q++) {
-            RefUnitStats zero;
-            memset(&zero, 0, sizeof zero);
-            const RefUnitStats *want = q == 1 ? &u[t * SPP + q] : &zero;
-            cr_expect_eq(memcmp(&v[t * SPP + q], want, sizeof zero), 0, "tile %d pass %d", t, q);
-        }
+    expect_passes(v, u, TILES, SPP, 1u << 1, "pass 1 alone");
+    /* every second pass (0 and 2), on two threads: those count what they counted, the others nothing */
+    RefParams step = rp;
+    step.pass_step = 2;
+    memset(v, 0, UNITS * sizeof *v);
+    step.units = v;
+    cr_assert_eq(ref_render(&p, &step, rgb1, NULL, err, sizeof err), 0, "%s", err);
+    expect_passes(v, u, TILES, SPP, 1u << 0 | 1u << 2, "every second pass");
     /* passes outside the frame */
     static const uint32_t bad[][2] = {{2, 2}, {0, 4}, {3, 1}};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {

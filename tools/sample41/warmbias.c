@@ -243,7 +243,7 @@ int main(int argc, char **argv)
         uint64_t **l1 = calloc(nunits, sizeof *l1);
         size_t *n1 = calloc(nunits, sizeof *n1);
         warm1 = calloc(nunits, sizeof *warm1);
-        if (!cw || chipwarm_first_readers(cw, pos, threads, err, sizeof err) ||
+        if (!cw || chipwarm_first_readers(cw, pos, 1, threads, err, sizeof err) ||
             chipwarm_l1(cw, prev, nunits, threads, l1, n1, err, sizeof err)) {
             fprintf(stderr, "chipwarm: %s\n", err);
             return 1;
