@@ -29,6 +29,7 @@
 #include "provenance.h"
 #include "reference.h"
 #include "report.h"
+#include "run/chipsampled.h"
 #include "run/run.h"
 #include "stats.h"
 #include "util.h"
@@ -341,6 +342,19 @@ static void warn_makespan_interval(const RunSpec *spec, const RunFrame *fr)
                 100.0 * half, 100.0 * spec->target_error, fr->chip.tail_units);
 }
 
+/* A sampled chip's memory figures need the warming's whole record, which --no-image cuts
+ * (docs/sampling.md, step 4): the user is told why they read "-". */
+static void warn_partial_record(const RunFrame *fr)
+{
+    if (fr->chip.on && fr->chip.shared && fr->chip.record_step > 1)
+        fprintf(stderr,
+                "sfsim run: warning: with --no-image above %u samples per pixel the L2's warming record holds one "
+                "pass in %u of each tile: the makespan is estimated as ever, the memory figures (latency, L2 hit "
+                "rate, DRAM bandwidth) are not (with part of the record DRAM's traffic reads tens of per cent "
+                "high; docs/sampling.md); run without --no-image for them\n",
+                CHIPSAMPLED_RECORD_PASSES, fr->chip.record_step);
+}
+
 int render_run(const RenderOptions *o, char *err, size_t errlen)
 {
     CfgMachine defcfg;
@@ -375,8 +389,10 @@ int render_run(const RenderOptions *o, char *err, size_t errlen)
     if (rc == 0) {
         pr.start = util_now();
         rc = run_frame(&sc, &spec, &fr, err, errlen);
-        if (rc == 0)
+        if (rc == 0) {
             warn_makespan_interval(&spec, &fr);
+            warn_partial_record(&fr);
+        }
         if (rc == -2 && spec.mode != RUN_SAMPLED) /* sampled mode's image is the golden model's, never partial */
             keep_partial(o, &sc, &fr, err, errlen);
     }

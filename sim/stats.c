@@ -298,6 +298,7 @@ FIG(cs_sigma_a) { UNUSED_FIG_ARGS; return cs(c)->sigma_a; }
 FIG(cs_sigma_e) { UNUSED_FIG_ARGS; return cs(c)->sigma_e; }
 FIG(cs_tail_units) { UNUSED_FIG_ARGS; return cs(c)->tail_units; }
 FIG(cs_warm_units) { UNUSED_FIG_ARGS; return cs(c)->warm_units; }
+FIG(cs_record_step) { UNUSED_FIG_ARGS; return cs(c)->record_step; }
 FIG(cs_warm_seconds) { UNUSED_FIG_ARGS; return cs(c)->warm_seconds; }
 FIG(rays_total) { UNUSED_FIG_ARGS; return (double)(c->run->primary + c->run->shadow + c->run->indirect); }
 FIG(instructions) { UNUSED_FIG_ARGS; return (double)c->f->instructions; }

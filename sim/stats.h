@@ -207,6 +207,7 @@ typedef struct StatsChipSample {
     double sigma_a, sigma_e;   /* tile effect and within-tile spread of the fit's relative residuals */
     uint32_t tail_units;       /* units timed for the makespan's tail, beyond phase 1's sample */
     uint32_t warm_units;       /* units whose lines the golden model recorded for the warming */
+    uint32_t record_step;      /* the warming's first-reader record held every record_step-th pass (0: none) */
     double warm_seconds;       /* ... and its host time */
     /* The memory figures (chip.memory = shared; sim/chipmemest.h), each {estimate, lo, hi} of its
      * 95 % interval: the average read latency below the L1s (cycles; has_mem), the L2's hit rate

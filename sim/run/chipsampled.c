@@ -422,6 +422,8 @@ static int sampler_close(ChipSampler *s, int rc)
 static void memory_figures(ChipSampler *s, const uint32_t *order, const SampleEstimate *makespan)
 {
     StatsChipSample *cs = &s->fr->chip;
+    if (cs->record_step > 1) /* a partial record leaves lines unwarmed: DRAM's traffic reads high (step 4) */
+        return;
     double *ys = malloc((size_t)(s->n ? s->n : 1) * CME_COUNT * sizeof *ys);
     uint8_t *opened = malloc(s->N ? s->N : 1);
     if (!s->shared || !ys || !opened) {
@@ -650,12 +652,14 @@ out:
     return rc;
 }
 
-/* The first-reader record's pass step: every pass of the frame would cost as much as the golden
- * model's whole image again, so CHIPSAMPLED_RECORD_PASSES of each tile's passes, evenly spaced,
- * are recorded (docs/sampling.md, step 4, "The warming's record"). */
-static uint32_t record_step(uint32_t spp)
+/* The first-reader record's pass step: with --no-image every pass of the frame would cost the
+ * golden model's whole image, which the user declined, so CHIPSAMPLED_RECORD_PASSES of each tile's
+ * passes, evenly spaced, are recorded (docs/sampling.md, step 4, "The warming's record"). */
+static uint32_t record_step(const RunSpec *spec, uint32_t spp)
 {
-    return spp <= CHIPSAMPLED_RECORD_PASSES ? 1 : (spp + CHIPSAMPLED_RECORD_PASSES - 1) / CHIPSAMPLED_RECORD_PASSES;
+    if (!spec->no_image || spp <= CHIPSAMPLED_RECORD_PASSES)
+        return 1;
+    return (spp + CHIPSAMPLED_RECORD_PASSES - 1) / CHIPSAMPLED_RECORD_PASSES;
 }
 
 int chipsampled_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine *cfg, const FuncParams *fp,
@@ -679,7 +683,8 @@ int chipsampled_frame(const RunScene *sc, const RunSpec *spec, const CfgMachine 
     if (rc == 0 && s.warm) { /* the L2's warming: each line's first reader in this schedule */
         warm_thresholds(&s);
         cs_note(&s, "the warming's record: each line's first reader (the golden model, %u units)", s.N, 0, 0);
-        rc = chipwarm_first_readers(s.warm, s.pos, record_step(s.spp), run_spec_threads(spec), err, errlen);
+        s.fr->chip.record_step = record_step(spec, s.spp);
+        rc = chipwarm_first_readers(s.warm, s.pos, s.fr->chip.record_step, run_spec_threads(spec), err, errlen);
         if (rc == 0)
             rc = first_lines(&s);
     }

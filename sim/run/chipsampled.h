@@ -52,8 +52,9 @@
 #define CHIPSAMPLED_TAIL_MOVE 0.2
 #define CHIPSAMPLED_TAIL_STILL 2u
 
-/* The warming's first-reader record renders this many passes of each tile (every ceil(spp /
- * this)-th); at this many samples or fewer, all of them. */
+/* With --no-image, the warming's first-reader record renders this many passes of each tile (every
+ * ceil(spp / this)-th); with the image, or at this many samples or fewer, all of them. A partial
+ * record leaves the memory figures unestimated (docs/sampling.md, step 4). */
 #define CHIPSAMPLED_RECORD_PASSES 8u
 
 /* Waves timed on a chip of K cores: 4, or 2 above 64 cores (a wave costs K units). */

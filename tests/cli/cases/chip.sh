@@ -91,6 +91,23 @@ want_rc 0
 grep -q "warning: the makespan" "$T/err" && no "a warning though the interval is within the target"
 end
 
+begin "chip: sampled mode with --no-image above 8 spp estimates the makespan but not the memory figures, and says so"
+# (the L2's warming record then holds one pass in ceil(spp / 8): DRAM's traffic would read high)
+cs=(-s scenes/cornell/scene.ini -c configs/chip16-ddr4.ini --set render.width=128 --set render.height=128
+    --set render.spp=16 --set stream.rays=1024 --target-error 0.02 --no-progress)
+run "$SFSIM" run --mode sampled --no-image "${cs[@]}" -o "$T/ni"
+want_rc 0
+want_err "warning: with --no-image above 8 samples per pixel the L2's warming record holds one pass in 2 of each tile"
+[ "$(json "$T/ni/report.json" "j['sample']['chip']['record_step'] == 2 and j['cycles'] > 0")" = True ] ||
+    no "report.json: not a record of one pass in 2 with a makespan"
+grep -qE '^dram +bandwidth gbs -$' "$T/ni/report.txt" || no "report.txt gives DRAM's bandwidth from a partial record"
+run "$SFSIM" run --mode sampled "${cs[@]}" -o "$T/wi"
+want_rc 0
+grep -q "warming record" "$T/err" && no "a warning about the record though the image was made"
+[ "$(json "$T/wi/report.json" "j['sample']['chip']['record_step'] == 1 and j['dram']['bandwidth_gbs'] > 0")" = True ] ||
+    no "with the image: not the whole record, or no DRAM bandwidth"
+end
+
 begin "chip: sfsim trace on 4 cores with an L2 and DDR4 gives functional mode's hits"
 awk 'BEGIN { print "# ox oy oz dx dy dz"; for (i = 0; i < 9000; i++) printf "278 273 -800 %.4f %.4f 1\n", (i % 97) / 200.0 - 0.24, int(i / 97) / 200.0 - 0.24 }' \
     >"$T/rays.txt"
