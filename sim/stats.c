@@ -297,6 +297,8 @@ FIG(cs_var_r) { UNUSED_FIG_ARGS; return cs(c)->var_r; }
 FIG(cs_sigma_a) { UNUSED_FIG_ARGS; return cs(c)->sigma_a; }
 FIG(cs_sigma_e) { UNUSED_FIG_ARGS; return cs(c)->sigma_e; }
 FIG(cs_tail_units) { UNUSED_FIG_ARGS; return cs(c)->tail_units; }
+FIG(cs_first_units) { UNUSED_FIG_ARGS; return cs(c)->first_units; }
+FIG(cs_mem_waves) { UNUSED_FIG_ARGS; return cs(c)->mem_waves; }
 FIG(cs_warm_units) { UNUSED_FIG_ARGS; return cs(c)->warm_units; }
 FIG(cs_record_step) { UNUSED_FIG_ARGS; return cs(c)->record_step; }
 FIG(cs_warm_seconds) { UNUSED_FIG_ARGS; return cs(c)->warm_seconds; }

@@ -206,6 +206,8 @@ typedef struct StatsChipSample {
     double var_jack, var_draws, var_r; /* the makespan's variance by part */
     double sigma_a, sigma_e;   /* tile effect and within-tile spread of the fit's relative residuals */
     uint32_t tail_units;       /* units timed for the makespan's tail, beyond phase 1's sample */
+    uint32_t first_units;      /* tiles' first passes timed for the memory figures, beyond phase 1's sample */
+    uint32_t mem_waves;        /* the waves the memory figures' correction came from (0: none) */
     uint32_t warm_units;       /* units whose lines the golden model recorded for the warming */
     uint32_t record_step;      /* the warming's first-reader record held every record_step-th pass (0: none) */
     double warm_seconds;       /* ... and its host time */

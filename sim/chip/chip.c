@@ -32,6 +32,7 @@ typedef struct ChipPort {        /* what core k's timing model sends through (ti
     InReq *out;                  /* sent while the core ran (its host thread's only), not yet in */
     size_t nout, capout;
     int oom;
+    uint64_t reads, writes, lat_sum; /* its requests in, and its reads' latencies (chip_core_stats) */
 } ChipPort;
 
 struct Chip {
@@ -48,6 +49,7 @@ struct Chip {
     ChipWoke woke;
     void *wctx;
     uint64_t reads, writes, lat_sum, lat_max;
+    uint64_t dram_line_bytes;    /* DRAM's bytes for a line: whole bursts */
     char err[256];
 };
 
@@ -162,6 +164,8 @@ Chip *chip_new(const CfgMachine *cfg, int cores, const MemWatch *watch, char *er
         return NULL;
     }
     c->top = dram_level(c->dl);
+    c->dram_line_bytes = ((uint64_t)cfg->scene_line_bytes + (uint64_t)dp.burst_bytes - 1) / (uint64_t)dp.burst_bytes *
+                         (uint64_t)dp.burst_bytes;
     if (watch_top(c, CHIP_LEVEL_DRAM, watch))
         goto oom;
     if (cfg->l2_size_kb > 0) {
@@ -346,6 +350,7 @@ static void answered(void *ctx, uint64_t id, uint64_t cycle)
     }
     const uint64_t lat = cycle - p->sent[fill];
     c->lat_sum += lat;
+    p->lat_sum += lat;
     if (lat > c->lat_max)
         c->lat_max = lat;
     timing_answer(p->t, fill, cycle, source);
@@ -358,10 +363,13 @@ void chip_step(Chip *c, uint64_t e, ChipWoke woke, void *ctx)
     while (c->n && c->h[0].at <= e) {
         const InReq r = in_pop(c);
         const int write = r.fill == UINT32_MAX;
-        if (write)
+        if (write) {
             c->writes++;
-        else
+            c->port[r.core].writes++;
+        } else {
             c->reads++;
+            c->port[r.core].reads++;
+        }
         c->top.push(c->top.self, r.addr, write, r.at, MEM_ID(r.core, write ? CHIP_WRITE | r.seq : r.fill));
     }
     c->woke = woke;
@@ -390,6 +398,26 @@ void chip_stats(const Chip *c, ChipMemStats *s)
     const DramParams *p = dram_get_params(c->dram);
     s->dram_clock_mhz = p->clock_mhz;
     s->dram_peak_gbs = (double)p->channels * (p->bus_bits / 8) * p->beats * p->clock_mhz * 1e6 / 1e9;
+}
+
+int chip_count_cores(Chip *c) { return c->l2 ? l2_count_cores(c->l2, c->cores) : 0; }
+
+void chip_core_stats(const Chip *c, int k, ChipCoreStats *s)
+{
+    memset(s, 0, sizeof *s);
+    if (k < 0 || k >= c->cores)
+        return;
+    const ChipPort *p = &c->port[k];
+    s->requests = p->reads;
+    s->read_latency = p->lat_sum;
+    const L2CoreStats *l = c->l2 ? l2_core_stats(c->l2, k) : NULL;
+    if (l) {
+        s->l2_accesses = l->accesses;
+        s->l2_hits = l->hits;
+        s->dram_bytes = l->below * c->dram_line_bytes;
+    } else if (!c->l2) {
+        s->dram_bytes = (p->reads + p->writes) * c->dram_line_bytes;
+    }
 }
 
 void chip_mem_figures(const ChipMemStats *s, double seconds, double out[CHIP_FIG_COUNT])

@@ -83,6 +83,18 @@ typedef struct ChipMemStats {
 } ChipMemStats;
 void chip_stats(const Chip *c, ChipMemStats *s);
 
+/* One core's share of the shared memory's work: its reads and their latency sum (as
+ * ChipMemStats.requests, .read_latency), and with an L2 counting cores (chip_count_cores) its
+ * accesses and hits there and DRAM's bytes for the lines the L2 sent below for it (a fill, the
+ * dirty line it evicted, a write through); without an L2, DRAM's bytes of its requests. A sampled
+ * chip's waves read it per unit (docs/sampling.md). Zero for k out of range. */
+typedef struct ChipCoreStats {
+    uint64_t requests, read_latency, l2_accesses, l2_hits, dram_bytes;
+} ChipCoreStats;
+/* Count the L2's work by core from now on; 0, or -1 when out of memory. */
+int chip_count_cores(Chip *c);
+void chip_core_stats(const Chip *c, int k, ChipCoreStats *s);
+
 /* The memory figures the report gives of a chip's counters over a frame of `seconds`
  * (docs/report.md): the average read latency below the L1s (cycles), the L2's hit rate and DRAM's
  * bandwidth (GB/s, 10^9 bytes); each -1 where it has no meaning (no request, no L2 or no access

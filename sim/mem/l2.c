@@ -61,6 +61,10 @@ struct L2 {
     uint64_t next_at;
     int next_ok, running;       /* (nothing is kept while l2_run changes the banks) */
     L2Stats st;
+    L2CoreStats *core;          /* l2_count_cores: ncores of them, else NULL */
+    int ncores;
+    L2CoreStats *cur;           /* the share of the request being taken (else a sink) */
+    L2CoreStats sink;
 };
 
 int l2_check(const L2Params *p, char *err, size_t errlen)
@@ -103,6 +107,7 @@ L2 *l2_new(const L2Params *p, MemLevel below, char *err, size_t errlen)
     }
     l->p = *p;
     l->below = below;
+    l->cur = &l->sink;
     l->sets = p->bytes / (p->line_bytes * p->ways * p->banks);
     while ((1 << l->shift) < p->line_bytes)
         l->shift++;
@@ -137,6 +142,7 @@ void l2_free(L2 *l)
     }
     free(l->live);
     free(l->bank);
+    free(l->core);
     free(l);
 }
 
@@ -166,6 +172,29 @@ void l2_reset(L2 *l)
 }
 
 const L2Stats *l2_stats(const L2 *l) { return &l->st; }
+
+int l2_count_cores(L2 *l, int cores)
+{
+    L2CoreStats *c = calloc(cores > 0 ? (size_t)cores : 1, sizeof *c);
+    if (!c)
+        return -1;
+    free(l->core);
+    l->core = c;
+    l->ncores = cores > 0 ? cores : 0;
+    return 0;
+}
+
+const L2CoreStats *l2_core_stats(const L2 *l, int k)
+{
+    return l->core && k >= 0 && k < l->ncores ? &l->core[k] : NULL;
+}
+
+/* The share a request counts into. */
+static L2CoreStats *share_of(L2 *l, uint64_t id)
+{
+    const uint32_t k = MEM_ID_CORE(id);
+    return l->core && k < (uint32_t)l->ncores ? &l->core[k] : &l->sink;
+}
 
 static int victim(const L2 *l, const L2Bank *b, size_t base);
 
@@ -268,6 +297,7 @@ static int victim(const L2 *l, const L2Bank *b, size_t base)
 static void write_below(L2 *l, uint64_t addr, uint64_t at)
 {
     l->st.writebacks++;
+    l->cur->below++;
     l->below.push(l->below.self, addr, 1, at, L2_BELOW_WRITE);
 }
 
@@ -314,6 +344,7 @@ static void mshr_wait_add(L2Mshr *m, uint64_t id, uint64_t cycle)
 static int take(L2 *l, L2Bank *b, int bi, const L2Req *r, uint64_t s)
 {
     const uint64_t line = r->addr >> l->shift, done = s + (uint64_t)l->p.hit_latency;
+    l->cur = share_of(l, r->id);
     const size_t base = (size_t)((line / (uint64_t)l->p.banks) % (uint64_t)l->sets) * (size_t)l->p.ways;
     int w = 0;
     while (w < l->p.ways && b->tag[base + (size_t)w] != line + 1)
@@ -322,6 +353,7 @@ static int take(L2 *l, L2Bank *b, int bi, const L2Req *r, uint64_t s)
     if (w < l->p.ways && b->pending[k]) { /* being filled: merge */
         L2Mshr *m = &b->mshr[mshr_of(l, b, k)];
         l->st.merged++;
+        l->cur->accesses++;
         if (r->write) {
             l->st.writes++;
             if (l->p.write_back)
@@ -337,6 +369,8 @@ static int take(L2 *l, L2Bank *b, int bi, const L2Req *r, uint64_t s)
     }
     if (w < l->p.ways) { /* a hit */
         l->st.hits++;
+        l->cur->accesses++;
+        l->cur->hits++;
         b->lru[k] = ++l->stamp;
         if (r->write) {
             l->st.writes++;
@@ -353,6 +387,7 @@ static int take(L2 *l, L2Bank *b, int bi, const L2Req *r, uint64_t s)
     }
     if (r->write && !l->p.write_back) { /* write-through, no allocate */
         l->st.writes++;
+        l->cur->accesses++;
         l->st.misses++;
         write_below(l, r->addr, done);
         answer(l, r->id, done);
@@ -364,6 +399,7 @@ static int take(L2 *l, L2Bank *b, int bi, const L2Req *r, uint64_t s)
         return 0;
     const size_t kv = base + (size_t)v;
     l->st.misses++;
+    l->cur->accesses++;
     evict(l, b, kv, done);
     b->tag[kv] = line + 1;
     b->lru[kv] = ++l->stamp;
@@ -384,6 +420,7 @@ static int take(L2 *l, L2Bank *b, int bi, const L2Req *r, uint64_t s)
     if (++b->mshr_busy > (int)l->st.mshr_max)
         l->st.mshr_max = (uint64_t)b->mshr_busy;
     l->st.fills++;
+    l->cur->below++;
     l->below.push(l->below.self, line << l->shift, 0, done, (uint64_t)bi * (uint64_t)l->p.mshrs + (uint64_t)m);
     return 1;
 }

@@ -54,6 +54,14 @@ typedef struct L2Stats {        /* uint64_t only */
     uint64_t mshr_max;          /* most registers of one bank busy at once */
 } L2Stats;
 
+/* One core's share of the L2's work (l2_count_cores): the requests whose ids name core k
+ * (MEM_ID_CORE), those that hit, and the lines sent below for them (a miss's fill, the dirty line
+ * it evicted, a write written through). Summed over the cores: reads + writes, hits, and fills +
+ * writebacks of L2Stats. */
+typedef struct L2CoreStats {    /* uint64_t only */
+    uint64_t accesses, hits, below;
+} L2CoreStats;
+
 typedef struct L2 L2;
 
 /* 0, or -1 with the reason in err (a geometry that does not divide: sizes, ways, banks). */
@@ -71,6 +79,11 @@ int l2_warm(L2 *l, uint64_t addr);
  * allocate on a write: then nothing changes and 0 is returned). */
 int l2_warm_written(L2 *l, uint64_t addr);
 const L2Stats *l2_stats(const L2 *l);
+/* Count each of `cores` cores' share too (a sampled chip's waves: docs/sampling.md), from zero;
+ * 0, or -1 when out of memory (nothing counted). Requests of a core >= cores are not counted. */
+int l2_count_cores(L2 *l, int cores);
+/* Core k's share, or NULL when not counted. */
+const L2CoreStats *l2_core_stats(const L2 *l, int k);
 /* The level interface (level.h). */
 void l2_push(L2 *l, uint64_t addr, int write, uint64_t cycle, uint64_t id);
 uint64_t l2_next(const L2 *l);

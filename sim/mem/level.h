@@ -16,6 +16,12 @@
 
 #include <stdint.h>
 
+/* The core a request id belongs to (bits 48..63), and the id of core c's n-th request: the chip
+ * stamps its requests so; a level may read the core (the network's ports, the L2's per-core
+ * counts) and keeps the id whole. */
+#define MEM_ID_CORE(id) ((uint32_t)((id) >> 48))
+#define MEM_ID(core, n) ((uint64_t)(core) << 48 | ((n) & (((uint64_t)1 << 48) - 1)))
+
 /* Set in an answer's id by a level that got the read's line from the level below it (an L2 miss
  * filled from DRAM); a level in front (the network) passes it on. Ids leave it clear. */
 #define MEM_FROM_BELOW ((uint64_t)1 << 46)

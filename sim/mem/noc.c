@@ -26,7 +26,9 @@ typedef struct Slot {           /* a read delivered behind, waiting for its answ
     uint32_t next_free;
 } Slot;
 
-#define NOC_WRITE ((uint64_t)1 << 62) /* a write's id behind: its answer needs nothing */
+/* A write's id behind (its answer needs nothing); a read's is its slot. Both carry the sender's core
+ * (MEM_ID), which the level behind may count by (the L2's per-core shares). */
+#define NOC_WRITE ((uint64_t)1 << 47)
 
 struct Noc {
     NocParams p;
@@ -220,10 +222,10 @@ static void step(Noc *n, Msg m)
     case AT_BANK_IN: arrive(n, &n->bank_in[m.bank], m, TO_BEHIND); break;
     case TO_BEHIND:
         if (m.write) {
-            n->behind.push(n->behind.self, m.addr, 1, m.cycle, NOC_WRITE);
+            n->behind.push(n->behind.self, m.addr, 1, m.cycle, MEM_ID(m.core, NOC_WRITE));
             n->answer(n->actx, m.id, m.cycle);
         } else {
-            n->behind.push(n->behind.self, m.addr, 0, m.cycle, slot_new(n, &m));
+            n->behind.push(n->behind.self, m.addr, 0, m.cycle, MEM_ID(m.core, slot_new(n, &m)));
         }
         break;
     case AT_BANK_OUT:
@@ -245,11 +247,11 @@ static void from_behind(void *ctx, uint64_t id, uint64_t x)
     if (id & NOC_WRITE)
         return;
     const uint64_t below = id & MEM_FROM_BELOW;
-    id &= ~MEM_FROM_BELOW;
-    Slot *s = &n->slot[id];
+    const uint32_t slot = (uint32_t)id; /* (below the core's bits and MEM_FROM_BELOW) */
+    Slot *s = &n->slot[slot];
     put(n, (Msg){x, 0, s->addr, s->id | below, s->core, s->bank, n->xfer, AT_BANK_OUT, 0});
     s->next_free = n->free_slot;
-    n->free_slot = (uint32_t)id;
+    n->free_slot = slot;
 }
 
 uint64_t noc_next(const Noc *n)

@@ -29,10 +29,6 @@
 
 #include "level.h"
 
-/* The core a request id belongs to (bits 48..63), and the id of core c's n-th request. */
-#define MEM_ID_CORE(id) ((uint32_t)((id) >> 48))
-#define MEM_ID(core, n) ((uint64_t)(core) << 48 | ((n) & (((uint64_t)1 << 48) - 1)))
-
 typedef struct NocParams {
     int cores, banks;           /* the ports at each side */
     int latency;                /* cycles from the start of a message on one port to its head at the other */

@@ -43,6 +43,10 @@ typedef struct CoreRun {
     int tr_oom;
     FuncUnit fu;                 /* the pass's timed figures so far */
     TimingStats before;
+    ChipCoreStats mem0;          /* a wave's: its share of the shared memory's work when the pass began */
+    ChipCoreStats mem1;          /* ... and when its last pass ended (that pass's is topped up at the end) */
+    uint64_t last_unit;          /* that pass's unit; UINT64_MAX: none yet */
+    uint32_t then_tile;          /* a wave's: the tile whose pass 0 it runs after its own (FuncParams.wave_next) */
 } CoreRun;
 
 /* Host threads over the cores that can run in a step: each takes the next core of the list until
@@ -92,6 +96,16 @@ int chip_run_wanted(const FuncParams *fp)
 static Timing *tm_of(const ChipRun *r, int k) { return r->job->workers[k].tc.tm; }
 static Core *core_of(const ChipRun *r, int k) { return r->job->workers[k].tc.core; }
 
+/* A unit's share of the shared memory's work (FuncStats.pass_mem): *u += now - then. */
+static void share_add(ChipCoreStats *u, const ChipCoreStats *now, const ChipCoreStats *then)
+{
+    u->requests += now->requests - then->requests;
+    u->read_latency += now->read_latency - then->read_latency;
+    u->l2_accesses += now->l2_accesses - then->l2_accesses;
+    u->l2_hits += now->l2_hits - then->l2_hits;
+    u->dram_bytes += now->dram_bytes - then->dram_bytes;
+}
+
 /* Pass cr->pass of the core's tile, from the cycle the core is at. */
 static void pass_begin(ChipRun *r, int k)
 {
@@ -107,6 +121,11 @@ static void pass_begin(ChipRun *r, int k)
     timing_continue(t, r->cold);
     cr->pass_at = timing_now(t);
     cr->before = *timing_stats(t);
+    if (r->job->pass_mem) { /* what came in since the core's last unit ended is that unit's */
+        chip_core_stats(r->chip, k, &cr->mem0);
+        if (cr->last_unit != UINT64_MAX)
+            share_add(&r->job->pass_mem[cr->last_unit], &cr->mem0, &cr->mem1);
+    }
     cr->instr0 = core_instructions(c);
     cr->done = 0;
     for (int s = 0; s < ISA_STAGE_COUNT; s++)
@@ -150,6 +169,11 @@ static int pass_finish(ChipRun *r, int k, CoreExit ex)
     ft->cycles += s->cycles - cr->before.cycles;
     if (r->job->pass_cycles)
         r->job->pass_cycles[(uint64_t)cr->tile * r->passes + cr->pass] = s->cycles - cr->before.cycles;
+    if (r->job->pass_mem) {
+        cr->last_unit = (uint64_t)cr->tile * r->passes + cr->pass;
+        chip_core_stats(r->chip, k, &cr->mem1);
+        share_add(&r->job->pass_mem[cr->last_unit], &cr->mem1, &cr->mem0);
+    }
     ft->busy += s->busy - cr->before.busy;
     for (int i = 0; i < TM_CAUSE_COUNT; i++)
         ft->stalls[i] += s->stalls[i] - cr->before.stalls[i];
@@ -436,9 +460,14 @@ static int shared_step(ChipRun *r)
         const int w = first_waiting(r);
         if (w >= 0 && r->cr[w].done_at < e && r->cr[w].done_at < r->xmin) {
             r->ntile--;
-            if (r->next_tile < r->job->ntiles) {
+            const uint32_t then = r->cr[w].then_tile;
+            if (r->next_tile < r->job->ntiles || then < r->job->ntiles) {
                 const uint64_t at = r->cr[w].done_at;
-                tile_begin(r, w, r->next_tile++, 0, r->passes);
+                r->cr[w].then_tile = UINT32_MAX;
+                if (then < r->job->ntiles) /* a wave's core: the next tile's first pass */
+                    tile_begin(r, w, then, 0, 1);
+                else
+                    tile_begin(r, w, r->next_tile++, 0, r->passes);
                 r->cr[w].wake = at;
                 r->runnable[r->nrunnable++] = w;
                 if (at < r->xmin)
@@ -552,6 +581,10 @@ uint32_t chip_run_frame(Job *j)
             free(r.runnable);
             return 0;
         }
+    for (int k = 0; k < r.k; k++) {
+        r.cr[k].then_tile = UINT32_MAX;
+        r.cr[k].last_unit = UINT64_MAX;
+    }
     atomic_init(&r.tiles_done, 0u);
     atomic_init(&r.opening_left, j->fp->opening ? (j->ntiles < (uint32_t)r.k ? j->ntiles : (uint32_t)r.k) : 0u);
     j->ncores = (uint32_t)r.k;
@@ -562,23 +595,35 @@ uint32_t chip_run_frame(Job *j)
         free(r.runnable);
         return 0;
     }
+    if (r.chip && j->fp->wave && j->pass_cycles && /* a wave's units' shares of the shared memory */
+        (chip_count_cores(r.chip) != 0 || !(j->pass_mem = calloc((size_t)j->ntiles * j->spp, sizeof *j->pass_mem)))) {
+        eng_fail(j, "out of memory for a wave's counts by core", 0);
+        chip_free(r.chip);
+        free(r.cr);
+        free(r.runnable);
+        return 0;
+    }
     const int threads = j->fp->threads < 1 ? 1 : j->fp->threads > r.k ? r.k : j->fp->threads;
     pool_open(&r.pool, &r, threads - 1);
     if (cores_open(&r) == 0) {
         if (j->fp->wave) { /* one wave: unit i on core i, on levels warmed first; no more tiles */
             if (r.chip) {
                 eng_warm_fb_tiles(j, r.chip, j->fp->wave_fb_lo, j->fp->wave_fb_hi, UINT32_MAX);
+                for (uint32_t i = 0; i < j->fp->nwave && i < (uint32_t)r.k; i++) /* (pass 1's: engine_int.h) */
+                    eng_warm_fb_shared(j, r.chip, (uint64_t)(j->fp->wave[i] / j->spp) * r.fb_tile, j->fp->wave[i], 1);
                 chip_warm(r.chip, j->fp->wave_warm, j->fp->nwave_warm);
             }
             r.next_tile = j->ntiles;
         }
         for (int k = 0; k < r.k; k++) {
             if (j->fp->wave && (uint32_t)k < j->fp->nwave) {
-                const uint32_t u = j->fp->wave[k];
-                tile_begin(&r, k, u / j->spp, u % j->spp, u % j->spp + 1);
+                const uint32_t u = j->fp->wave[k], p = u % j->spp;
+                tile_begin(&r, k, u / j->spp, p, p + (j->fp->wave_passes >= 2 && p + 1 < j->spp ? 2 : 1));
+                if (j->fp->wave_passes >= 2 && p + 1 == j->spp && j->fp->wave_next)
+                    r.cr[k].then_tile = j->fp->wave_next[k];
                 if (eng_warm_l1(j, tm_of(&r, k), u) != 0)
                     break;
-                eng_warm_fb_shared(j, r.chip, (uint64_t)(u / j->spp) * r.fb_tile, u);
+                eng_warm_fb_shared(j, r.chip, (uint64_t)(u / j->spp) * r.fb_tile, u, 0);
                 r.runnable[r.nrunnable++] = k;
             } else if (!j->fp->wave && r.next_tile < j->ntiles) {
                 tile_begin(&r, k, r.next_tile++, 0, r.passes);
@@ -601,6 +646,12 @@ uint32_t chip_run_frame(Job *j)
             if (go > 0)
                 go = shared_step(&r);
         }
+        for (int k = 0; j->pass_mem && k < r.k; k++) /* what reached the levels after a core's last unit */
+            if (r.cr[k].last_unit != UINT64_MAX) {
+                ChipCoreStats end;
+                chip_core_stats(r.chip, k, &end);
+                share_add(&j->pass_mem[r.cr[k].last_unit], &end, &r.cr[k].mem1);
+            }
         if (!atomic_load(&j->failed))
             figures(&r);
         if (!atomic_load(&j->failed) && j->fp->mem_trace)

@@ -415,47 +415,107 @@ static int sampler_close(ChipSampler *s, int rc)
 
 /* ---- the memory figures ------------------------------------------------------------------------ */
 
+/* F's extra units (chipmemest.h): the tiles' first passes outside the opening and the sample,
+ * drawn at random (a stream of the sample's seed of their own) until F has CHIPSAMPLED_FIRST_UNITS
+ * in the sample, into extra (*m of them). */
+static void first_extra(const ChipSampler *s, const uint32_t *order, const uint8_t *fpass, uint32_t *extra,
+                        uint32_t *m, uint32_t *perm)
+{
+    uint32_t have = 0, NF = 0;
+    for (uint32_t i = 0; i < s->n; i++)
+        have += fpass[order[i]];
+    for (uint32_t t = 0; t < s->ntiles; t++)
+        NF += fpass[t * s->spp];
+    *m = 0;
+    if (have >= CHIPSAMPLED_FIRST_UNITS || NF == 0)
+        return;
+    uint8_t *in_srs = calloc(s->ntiles, 1);
+    if (!in_srs)
+        return; /* (the estimate then has too few units of F and gives no figures) */
+    for (uint32_t i = 0; i < s->n; i++)
+        if (fpass[order[i]])
+            in_srs[order[i] / s->spp] = 1;
+    sample_order(s->ntiles, s->spec->sample_seed ^ 0x5f1257u, perm);
+    for (uint32_t i = 0; i < s->ntiles && have + *m < CHIPSAMPLED_FIRST_UNITS; i++) {
+        const uint32_t t = perm[i];
+        if (fpass[t * s->spp] && !in_srs[t])
+            extra[(*m)++] = t * s->spp;
+    }
+    free(in_srs);
+}
+
+void cs_unit_mem(const FuncUnit *u, double *y)
+{
+    y[CME_REQUESTS] = (double)u->mem_requests;
+    y[CME_LATENCY] = (double)u->mem_read_latency;
+    y[CME_L2_ACCESSES] = (double)u->l2_accesses;
+    y[CME_L2_HITS] = (double)u->l2_hits;
+    y[CME_DRAM_BYTES] = (double)u->dram_bytes;
+}
+
 /* The memory figures of a chip with shared memory into fr->chip (chipmemest.h): the opening's
  * traffic exact, the rest from phase 1's units (a simple random sample: the tail's are chosen on
- * the estimate and left out). Without them (no request below the L1s, too few units) they stay
- * unset and the report has none. */
-static void memory_figures(ChipSampler *s, const uint32_t *order, const SampleEstimate *makespan)
+ * the estimate and left out) and F's extra units, timed here. 0; -1 when timing those fails (err
+ * says). Without a fit (no request below the L1s, too few units) or with a partial record (step 4:
+ * lines left unwarmed make DRAM's traffic read high) the figures stay unset and the report has none. */
+static int memory_figures(ChipSampler *s, const uint32_t *order, const SampleEstimate *makespan)
 {
     StatsChipSample *cs = &s->fr->chip;
-    if (cs->record_step > 1) /* a partial record leaves lines unwarmed: DRAM's traffic reads high (step 4) */
-        return;
-    double *ys = malloc((size_t)(s->n ? s->n : 1) * CME_COUNT * sizeof *ys);
-    uint8_t *opened = malloc(s->N ? s->N : 1);
-    if (!s->shared || !ys || !opened) {
-        free(ys);
-        free(opened);
-        return;
+    if (!s->shared || cs->record_step > 1)
+        return 0;
+    const uint32_t cap = s->n + CHIPSAMPLED_FIRST_UNITS;
+    double *ys = malloc((size_t)cap * CME_COUNT * sizeof *ys);
+    uint8_t *opened = malloc(s->N ? s->N : 1), *fpass = malloc(s->N ? s->N : 1);
+    uint32_t *sample = malloc((size_t)cap * sizeof *sample);
+    uint32_t *perm = malloc((size_t)(s->ntiles ? s->ntiles : 1) * sizeof *perm);
+    FuncUnit *xu = calloc(CHIPSAMPLED_FIRST_UNITS, sizeof *xu);
+    int rc = 0;
+    if (!ys || !opened || !fpass || !sample || !perm || !xu) {
+        snprintf(s->err, s->errlen, "out of memory for the memory figures of %u units", s->N);
+        rc = -1;
+        goto out;
+    }
+    for (uint32_t u = 0; u < s->N; u++) {
+        opened[u] = s->exact[u] >= 0.0;
+        fpass[u] = u % s->spp == 0 && !opened[u];
     }
     for (uint32_t i = 0; i < s->n; i++) {
-        const FuncUnit *u = &s->units[i];
-        double *y = ys + (size_t)i * CME_COUNT;
-        y[CME_REQUESTS] = (double)u->mem_requests;
-        y[CME_LATENCY] = (double)u->mem_read_latency;
-        y[CME_L2_ACCESSES] = (double)u->l2_accesses;
-        y[CME_L2_HITS] = (double)u->l2_hits;
-        y[CME_DRAM_BYTES] = (double)u->dram_bytes;
+        sample[i] = order[i];
+        cs_unit_mem(&s->units[i], ys + (size_t)i * CME_COUNT);
     }
-    for (uint32_t u = 0; u < s->N; u++)
-        opened[u] = s->exact[u] >= 0.0;
-    ChipMemIn in = {.N = s->N, .x = s->x, .k = AUX_K, .first = s->first, .opened = opened, .sample = order,
-                    .ys = ys, .n = s->n, .makespan = makespan->total, .makespan_se = makespan->std_error,
-                    .clock_mhz = s->ucfg.core_clock_mhz, .has_l2 = s->ucfg.l2_size_kb > 0};
+    uint32_t m;
+    first_extra(s, order, fpass, sample + s->n, &m, perm);
+    if (m) {
+        cs_note(s, "timing %u more of the tiles' first passes alone (the memory figures' stratum of them)", m, 0, 0);
+        if ((rc = cs_time_alone(s, sample + s->n, m, xu)) != 0)
+            goto out;
+        for (uint32_t i = 0; i < m; i++)
+            cs_unit_mem(&xu[i], ys + (size_t)(s->n + i) * CME_COUNT);
+        cs->first_units = m;
+    }
+    ChipMemIn in = {.N = s->N, .x = s->x, .k = AUX_K, .first = s->first, .opened = opened, .first_pass = fpass,
+                    .sample = sample, .ys = ys, .n = s->n + m, .n_srs = s->n, .nwaves = s->nwave_md,
+                    .wave_diff = s->wave_md, .wave_units = s->wave_mn, .makespan = makespan->total,
+                    .makespan_se = makespan->std_error, .clock_mhz = s->ucfg.core_clock_mhz,
+                    .has_l2 = s->ucfg.l2_size_kb > 0};
     memcpy(in.open, s->open_mem, sizeof in.open);
-    ChipMemOut out;
-    if (chip_mem_estimate(&in, &out) == 0) {
-        cs->has_mem = out.has_mem;
-        cs->has_l2 = out.has_l2;
-        memcpy(cs->latency, out.latency, sizeof cs->latency);
-        memcpy(cs->l2_hit_rate, out.l2_hit_rate, sizeof cs->l2_hit_rate);
-        memcpy(cs->dram_gbs, out.dram_gbs, sizeof cs->dram_gbs);
+    ChipMemOut mo;
+    if (chip_mem_estimate(&in, &mo) == 0) {
+        cs->has_mem = mo.has_mem;
+        cs->mem_waves = mo.waves;
+        cs->has_l2 = mo.has_l2;
+        memcpy(cs->latency, mo.latency, sizeof cs->latency);
+        memcpy(cs->l2_hit_rate, mo.l2_hit_rate, sizeof cs->l2_hit_rate);
+        memcpy(cs->dram_gbs, mo.dram_gbs, sizeof cs->dram_gbs);
     }
+out:
     free(ys);
     free(opened);
+    free(fpass);
+    free(sample);
+    free(perm);
+    free(xu);
+    return rc;
 }
 
 /* ---- the makespan, and its tail ------------------------------------------------------------------ */
@@ -643,7 +703,8 @@ static int estimate(ChipSampler *s)
     cs->var_r = out.var_r;
     cs->sigma_a = out.sigma_a;
     cs->sigma_e = out.sigma_e;
-    memory_figures(s, order, &fr->est);
+    if (memory_figures(s, order, &fr->est) != 0)
+        goto out;
     fr->has_est = 1;
     rc = 0;
 out:

@@ -12,19 +12,24 @@
  *    on one core of the chip's memory (FuncParams.chip_unit), its L2 and DRAM rows warmed with the
  *    golden model's lines of the units that start before it in the predicted schedule
  *    (sim/run/chipwarm.h), after the framebuffer lines of the tiles that started before it (as
- *    written: dirty in the L2); the regression of their cycles on the golden counts.
+ *    written: dirty in the L2; its own tile's, for pass 1, before the scene's lines, for later
+ *    passes after them); the regression of their cycles on the golden counts.
  * 5. Phase 2, the other cores: waves at evenly spaced instants of the predicted schedule (a seeded
  *    offset): the K units running then timed together on the whole chip (FuncParams.wave), and up
- *    to CHIPSAMPLED_WAVE_ALONE of them alone; their ratio r, with a jackknife over waves.
+ *    to CHIPSAMPLED_WAVE_ALONE of them alone; their ratio r, with a jackknife over waves. Where the
+ *    memory figures are estimated, each core also runs the unit that follows its own in the
+ *    schedule (its tile's next pass, or its next tile's first), from the state the first left;
+ *    those second units, also timed alone, give step 8 its correction.
  * 6. The makespan: every tile's estimate (exact, sampled or predicted units, times r, with the
  *    tile-effect correction) list-scheduled, with its 95 % interval (sim/chipsampling.h).
  * 7. The tail (with --target-error): a first round, then more while that interval is wider than the
  *    target: units of the tiles the latest cores end with are timed alone too and join the fit
  *    (CHIPSAMPLED_TAIL_*).
- * 8. The memory figures (chip.memory = shared): the opening's traffic exactly, the rest from phase
- *    1's units alone, with each unit's first-read lines (the warming's table) as an auxiliary
- *    (sim/chipmemest.h): the average read latency, the L2's hit rate and DRAM's bandwidth, each
- *    with a 95 % interval.
+ * 8. The memory figures (chip.memory = shared): the opening's traffic exactly, the tiles' first
+ *    passes (at least CHIPSAMPLED_FIRST_UNITS of them timed alone) and the rest from phase 1's
+ *    units alone, with each unit's first-read lines (the warming's table) as an auxiliary, each
+ *    stratum corrected by the waves' second units' together less alone (sim/chipmemest.h): the
+ *    average read latency, the L2's hit rate and DRAM's bandwidth, each with a 95 % interval.
  * A chip whose cores have buses of their own (chip.memory = bus) has no shared level to warm or
  * contend for: its units are timed as sampled mode's (a cold core on its bus) and r = 1.
  *
@@ -57,7 +62,12 @@
  * record leaves the memory figures unestimated (docs/sampling.md, step 4). */
 #define CHIPSAMPLED_RECORD_PASSES 8u
 
-/* Waves timed on a chip of K cores: 4, or 2 above 64 cores (a wave costs K units). */
+/* The memory figures' stratum of the tiles' first passes outside the opening (sim/chipmemest.h):
+ * at least this many of them timed, phase 1's sample's and extra ones drawn at random. */
+#define CHIPSAMPLED_FIRST_UNITS 8u
+
+/* Waves timed on a chip of K cores: 4, or 2 above 64 cores (a wave costs K units); at most this many. */
+#define CHIPSAMPLED_MAX_WAVES 8u
 uint32_t chipsampled_waves(uint32_t cores);
 
 /* Whether a run on cfg is a chip's (sampled mode goes here rather than to sampled_frame). */

@@ -39,6 +39,11 @@ typedef struct ChipSampler {
     FuncUnit *units;           /* N: phase 1's units in sample order, n of them */
     double *instructions;      /* N: their instructions */
     uint32_t n, ntail;         /* phase 1's units (a simple random sample), the tail's after them */
+    /* Phase 2's waves' second units (chipwaves.c): per wave and stratum (0 the rest, 1 the tiles'
+     * first passes), their memory figures together less alone, summed, and how many (the memory
+     * figures' correction: chipmemest.h's wave_diff and wave_units) */
+    double wave_md[CHIPSAMPLED_MAX_WAVES * 2 * CME_COUNT];
+    uint32_t wave_mn[CHIPSAMPLED_MAX_WAVES * 2], nwave_md;
     double started;
     char *err;
     size_t errlen;
@@ -53,6 +58,8 @@ uint32_t cs_tiles_before(const ChipSampler *s, double at);
 /* The L1 warming lists of units[0..n) (and the L2's, when l2), and their release. */
 int cs_warm_lists(ChipSampler *s, const uint32_t *units, uint32_t n, int l2);
 void cs_warm_drop(ChipSampler *s, const uint32_t *units, uint32_t n);
+/* A unit's memory figures as chipmemest.h counts them (y[CME_COUNT]). */
+void cs_unit_mem(const FuncUnit *u, double *y);
 /* FuncParams.unit_warm_l1 on the lists made. */
 const uint64_t *cs_warm1_of(void *ctx, uint32_t unit, size_t *n);
 

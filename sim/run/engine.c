@@ -307,9 +307,10 @@ static void warm_fb_written(Job *j, Chip *chip, uint64_t base)
     }
 }
 
-void eng_warm_fb_shared(Job *j, Chip *chip, uint64_t base, uint32_t unit)
+void eng_warm_fb_shared(Job *j, Chip *chip, uint64_t base, uint32_t unit, int early)
 {
-    if (!j->fp->unit_warm_l1 || unit % j->spp == 0 || !chip)
+    const uint32_t pass = unit % j->spp;
+    if (!j->fp->unit_warm_l1 || pass == 0 || !chip || (early ? pass != 1 : pass == 1))
         return;
     warm_fb_written(j, chip, base);
 }
@@ -357,6 +358,8 @@ static int run_pass(Worker *w, Core *c, const FuncTile *ft, uint32_t unit, FuncU
             j->fp->unit_warm_tiles(j->fp->unit_warm_ctx, unit, &lo, &hi);
         eng_warm_fb_tiles(j, w->cu.chip, lo, hi, tile);
     }
+    if (w->cu.chip)
+        eng_warm_fb_shared(j, w->cu.chip, (uint64_t)tile * eng_fb_tile_bytes(j), unit, 1);
     if (w->cu.chip && j->fp->unit_warm) {
         size_t n = 0;
         const uint64_t *lines = j->fp->unit_warm(j->fp->unit_warm_ctx, unit, &n);
@@ -364,7 +367,7 @@ static int run_pass(Worker *w, Core *c, const FuncTile *ft, uint32_t unit, FuncU
             chipunit_warm(&w->cu, lines, n);
     }
     if (w->cu.chip)
-        eng_warm_fb_shared(j, w->cu.chip, (uint64_t)tile * eng_fb_tile_bytes(j), unit);
+        eng_warm_fb_shared(j, w->cu.chip, (uint64_t)tile * eng_fb_tile_bytes(j), unit, 0);
     if (w->cu.chip && eng_warm_l1(j, w->tc.tm, unit) != 0)
         return -1;
     const uint64_t limit = (uint64_t)j->fp->cfg->sim_max_instructions;
@@ -689,6 +692,7 @@ static void session_free(FuncSession *s)
     free(s->job.cores);
     free(s->job.chip_mem);
     free(s->job.pass_cycles);
+    free(s->job.pass_mem);
     free(s->job.trace);
     pthread_mutex_destroy(&s->job.lock);
     if (s->built)
@@ -811,6 +815,8 @@ static int session_finish(FuncSession *s, FuncStats *st, char *err, size_t errle
     st->pass_cycles = job->pass_cycles;
     st->pass_spp = job->pass_cycles ? job->spp : 0;
     job->pass_cycles = NULL;
+    st->pass_mem = job->pass_mem;
+    job->pass_mem = NULL;
     st->trace = job->trace;
     st->ntrace = job->ntrace;
     job->trace = NULL;
@@ -906,6 +912,8 @@ void func_stats_free(FuncStats *st)
     st->chip_mem = NULL;
     free(st->pass_cycles);
     st->pass_cycles = NULL;
+    free(st->pass_mem);
+    st->pass_mem = NULL;
     st->pass_spp = 0;
     free(st->trace);
     st->trace = NULL;

@@ -81,9 +81,17 @@ typedef struct FuncParams {
      * docs/sampling.md): unit wave[i] (tile * spp + pass; nwave <= chip.cores) starts on core i
      * at cycle 0, from a cleared launch block as a sampled unit does, after the shared levels are
      * warmed with wave_warm[0..nwave_warm) (oldest first; chip_warm); each core then stops.
-     * FuncStats.pass_cycles has the wave's units' cycles (the others 0). */
+     * FuncStats.pass_cycles has the wave's units' cycles (the others 0), FuncStats.pass_mem each
+     * one's share of the shared memory's work (chip_core_stats: what its core's requests did from
+     * the unit's start to the next's on the core, a core's last unit's to the run's end). With wave_passes = 2 a core whose
+     * unit is not its tile's last pass runs the tile's next pass after it, from the state the first
+     * left (its L1, the shared levels under the other cores' traffic), and one whose unit is its
+     * tile's last pass runs pass 0 of tile wave_next[i] (UINT32_MAX, or wave_next NULL: none);
+     * 0 or 1: one unit a core. */
     const uint32_t *wave;
     uint32_t nwave;
+    uint32_t wave_passes;
+    const uint32_t *wave_next;
     const uint64_t *wave_warm;
     size_t nwave_warm;
     uint32_t wave_fb_lo, wave_fb_hi; /* ... after the framebuffer lines of tiles [lo, hi) as unit_warm_tiles's */
@@ -168,6 +176,7 @@ typedef struct FuncStats {
      * start to its end, tile * pass_spp + pass; NULL otherwise */
     uint64_t *pass_cycles;
     uint32_t pass_spp;
+    struct ChipCoreStats *pass_mem;                 /* a wave's (FuncParams.wave), the same layout; else NULL */
     struct ChipMemStats *chip_mem;
     FuncMemRec *trace;                              /* FuncParams.mem_trace */
     size_t ntrace;

@@ -39,6 +39,7 @@ typedef struct Job {
     uint32_t ncores;
     uint64_t makespan;
     uint64_t *pass_cycles;     /* a chip's frame: tile t's pass p took pass_cycles[t * spp + p] */
+    struct ChipCoreStats *pass_mem; /* a wave's: each unit's share of the shared memory's work */
     struct ChipMemStats *chip_mem;
     FuncMemRec *trace;
     size_t ntrace;
@@ -74,9 +75,12 @@ void eng_tile_pixels(Job *j, Core *c, const FuncTile *ft, int to_fb);
  * (tile * spp + pass) after its reset. 0, or -1 after eng_fail. */
 int eng_warm_l1(Job *j, Timing *t, uint32_t unit);
 /* ... and past its tile's first pass, the tile's framebuffer lines (at base in the framebuffer's
- * space) into the chip's shared levels as written, after what they were warmed with
- * (chip_warm_written): its earlier passes left them there. */
-void eng_warm_fb_shared(Job *j, Chip *chip, uint64_t base, uint32_t unit);
+ * space) into the chip's shared levels as written (chip_warm_written): its earlier passes left
+ * them there. Where in the L2's recency (docs/sampling.md, step 4): pass 1 finds them as pass 0
+ * fetched them, at the tile's start (the L1 kept them; the L2 saw them no more), so they go in
+ * before the scene's lines (early = 1: only for pass 1); a later pass finds them as the L1 wrote
+ * them back during the passes before, so they go in after (early = 0: only for passes >= 2). */
+void eng_warm_fb_shared(Job *j, Chip *chip, uint64_t base, uint32_t unit, int early);
 /* The framebuffer lines of tiles [lo, hi) but tile `skip`, the last L2-capacity of them, into the
  * chip's shared levels as written, oldest first (FuncParams.unit_warm_tiles). */
 void eng_warm_fb_tiles(Job *j, Chip *chip, uint32_t lo, uint32_t hi, uint32_t skip);

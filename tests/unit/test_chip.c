@@ -694,3 +694,57 @@ Test(chip, a_wave_of_the_frames_units_is_the_frame)
     func_stats_free(&full);
     unload();
 }
+
+/* A wave of two units a core (FuncParams.wave_passes = 2: a sampled chip's memory correction,
+ * docs/sampling.md step 5): a core whose unit is not its tile's last pass runs the next pass after
+ * it, one whose unit is the last runs pass 0 of wave_next's tile; the units' shares of the shared
+ * memory's work (FuncStats.pass_mem: from a unit's start to the next's on its core, the last one's
+ * to the end) add up to the chip's counters exactly. The same on 1 and 2 host threads. The Cornell
+ * box at 128 x 64 x 2: 8 tiles, 16 units, on 4 cores. */
+Test(chip, a_wave_of_two_passes_a_core)
+{
+    load("scenes/cornell/scene.ini", 128, 64, 2);
+    CfgMachine chip;
+    small_frame(&chip);
+    shared_memory(&chip, 4);
+    chip.scene_cache_kb = 1;
+    static char err[65536];
+    const uint32_t wave[4] = {0, 3, 4, 7}, next[4] = {UINT32_MAX, 5, UINT32_MAX, UINT32_MAX};
+    FuncParams fp = {.cfg = &chip, .kernel_path = "kernels/pathtrace.s", .needs = scene.needs, .seed = 1,
+                     .threads = 2, .timed = 1, .wave = wave, .nwave = 4, .wave_passes = 2, .wave_next = next};
+    FuncStats w, w1;
+    cr_assert_eq(func_render(&packed, &fp, NULL, &w, err, sizeof err), 0, "%s", err);
+    fp.threads = 1;
+    cr_assert_eq(func_render(&packed, &fp, NULL, &w1, err, sizeof err), 0, "%s", err);
+    cr_assert(w.pass_cycles && w.pass_mem && w.chip_mem);
+    /* run: 0 then 1 (tile 0), 3 then 10 (tile 1's last pass, then tile 5's first), 4 then 5, 7 */
+    const int ran[16] = {1, 1, 0, 1, 1, 1, 0, 1, 0, 0, 1, 0, 0, 0, 0, 0};
+    uint64_t req = 0, lat = 0, acc = 0, hits = 0, bytes = 0;
+    for (uint32_t u = 0; u < 16; u++) {
+        cr_expect_eq(w.pass_cycles[u] > 0, ran[u], "unit %u: %llu cycles", u, (unsigned long long)w.pass_cycles[u]);
+        cr_expect_eq(w.pass_cycles[u], w1.pass_cycles[u], "unit %u on 1 and 2 threads", u);
+        req += w.pass_mem[u].requests;
+        lat += w.pass_mem[u].read_latency;
+        acc += w.pass_mem[u].l2_accesses;
+        hits += w.pass_mem[u].l2_hits;
+        bytes += w.pass_mem[u].dram_bytes;
+        cr_expect(ran[u] || w.pass_mem[u].requests == 0, "unit %u did not run but has requests", u);
+    }
+    const ChipMemStats *m = w.chip_mem;
+    cr_expect_gt(req, 0);
+    cr_expect_eq(req, m->requests);
+    cr_expect_eq(lat, m->read_latency, "latency %llu of %llu", (unsigned long long)lat, (unsigned long long)m->read_latency);
+    cr_expect_eq(acc, m->l2.reads + m->l2.writes);
+    cr_expect_eq(hits, m->l2.hits);
+    cr_expect_eq(bytes, m->dram.bytes);
+    cr_expect_gt(bytes, 0);
+    func_stats_free(&w);
+    func_stats_free(&w1);
+    /* one unit a core (wave_passes 0): units 1, 5 and 10 do not run */
+    fp.wave_passes = 0;
+    cr_assert_eq(func_render(&packed, &fp, NULL, &w, err, sizeof err), 0, "%s", err);
+    for (uint32_t u = 0; u < 16; u++)
+        cr_expect_eq(w.pass_cycles[u] > 0, ran[u] && u != 1 && u != 5 && u != 10, "unit %u", u);
+    func_stats_free(&w);
+    unload();
+}

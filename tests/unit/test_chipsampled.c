@@ -105,6 +105,7 @@ Test(chipsampled, covers_the_detailed_makespan, .init = shared16, .fini = teardo
                       "seed %u: the tail timed %u units, more than twice the sample's", seed, fr.chip.tail_units);
         covered += fr.est.lo <= M && M <= fr.est.hi;
         cr_assert(fr.chip.has_mem && fr.chip.has_l2, "seed %u: the memory figures were estimated", seed);
+        cr_expect_geq(fr.chip.mem_waves, 2, "seed %u: the waves' second units corrected them", seed);
         const double *f[3] = {fr.chip.latency, fr.chip.l2_hit_rate, fr.chip.dram_gbs};
         for (int m = 0; m < 3; m++) {
             cr_expect(f[m][1] <= f[m][0] && f[m][0] <= f[m][2], "seed %u: %s's interval holds it", seed, mem_name[m]);

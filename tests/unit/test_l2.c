@@ -264,3 +264,45 @@ Test(l2, a_line_warmed_as_written_is_written_back)
         l2_free(f.l2);
     }
 }
+
+static void count_answer(void *ctx, uint64_t id, uint64_t cycle)
+{
+    (void)id;
+    (void)cycle;
+    (*(int *)ctx)++;
+}
+
+/* Each core's share (l2_count_cores), by the core in the ids (MEM_ID): a_dirty_victim_is_written_back's
+ * requests, sent by two cores, and one more.
+ *   core 0 writes line 12: a miss, allocated dirty, nothing below       core 0: 1 access
+ *   core 1 reads line 28: a miss, its fill below                        core 1: 1 access, 1 below
+ *   core 1 reads line 44: a miss evicting dirty line 12: a write-back
+ *       and a fill below                                                core 1: 2 accesses, 3 below
+ *   core 0 reads line 44 again: a hit                                   core 0: 2 accesses, 1 hit
+ * Summed: reads + writes 4, hits 1, fills + writebacks 3. A core past the count is not counted. */
+Test(l2, each_cores_share_is_counted)
+{
+    Fix f;
+    open_fix(&f, params());
+    cr_assert_eq(l2_count_cores(f.l2, 2), 0);
+    cr_expect_null(l2_core_stats(f.l2, 2));
+    l2_push(f.l2, L(12), 1, 300, MEM_ID(0, 1));
+    l2_push(f.l2, L(28), 0, 310, MEM_ID(1, 2));
+    l2_push(f.l2, L(44), 0, 400, MEM_ID(1, 3));
+    l2_push(f.l2, L(44), 0, 500, MEM_ID(0, 4));
+    l2_push(f.l2, L(45), 0, 600, MEM_ID(7, 5)); /* core 7: a miss counted in the totals only */
+    int n = 0;
+    l2_run(f.l2, UINT64_MAX, count_answer, &n);
+    cr_expect_eq(n, 5);
+    const L2CoreStats *c0 = l2_core_stats(f.l2, 0), *c1 = l2_core_stats(f.l2, 1);
+    cr_assert(c0 && c1);
+    cr_expect(c0->accesses == 2 && c0->hits == 1 && c0->below == 0, "core 0: %llu %llu %llu",
+              (unsigned long long)c0->accesses, (unsigned long long)c0->hits, (unsigned long long)c0->below);
+    cr_expect(c1->accesses == 2 && c1->hits == 0 && c1->below == 3, "core 1: %llu %llu %llu",
+              (unsigned long long)c1->accesses, (unsigned long long)c1->hits, (unsigned long long)c1->below);
+    const L2Stats *s = l2_stats(f.l2);
+    cr_expect_eq(s->reads + s->writes, 5);
+    cr_expect_eq(s->hits, 1);
+    cr_expect_eq(s->fills + s->writebacks, 4);
+    l2_free(f.l2);
+}
