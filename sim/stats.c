@@ -432,15 +432,15 @@ FIG(chip_unused)
         n += c->f->cores[k].tiles == 0;
     return n;
 }
-/* A sampled chip's memory figure (sim/chipmemest.h): which 0 the latency, 1 the L2's hit rate, 2
- * DRAM's bandwidth; bound -1 the estimate, 0 / 1 its interval's low / high end. */
+/* A sampled chip's memory figure (sim/chipmemest.h) `which` (CHIP_FIG_*); bound -1 the estimate,
+ * 0 / 1 its interval's low / high end. */
 static double cs_mem(const StatsCtx *c, int which, int bound, int *na)
 {
     const StatsChipSample *s = cs(c);
     if (!s)
         return defined_if(0.0, 0, na);
-    const double *f = which == 0 ? s->latency : which == 1 ? s->l2_hit_rate : s->dram_gbs;
-    return defined_if(f[1 + bound], which == 1 ? s->has_l2 : s->has_mem, na);
+    const double *f = which == CHIP_FIG_LATENCY ? s->latency : which == CHIP_FIG_L2_HIT_RATE ? s->l2_hit_rate : s->dram_gbs;
+    return defined_if(f[1 + bound], which == CHIP_FIG_L2_HIT_RATE ? s->has_l2 : s->has_mem, na);
 }
 static int sampled(const StatsCtx *c) { return (c->mode & STATS_M_SAMP) != 0; }
 
@@ -456,7 +456,7 @@ static double mem_fig(const StatsCtx *c, int which, int *na)
     return defined_if(f[which] >= 0.0 ? f[which] : 0.0, f[which] >= 0.0, na);
 }
 FIG(mem_read_latency) { (void)idx; return mem_fig(c, CHIP_FIG_LATENCY, na); }
-FIG(mem_read_latency_ci95) { return cs_mem(c, 0, idx[0], na); }
+FIG(mem_read_latency_ci95) { return cs_mem(c, CHIP_FIG_LATENCY, idx[0], na); }
 FIG(scene_stall_l1)
 {
     UNUSED_FIG_ARGS;
@@ -477,9 +477,9 @@ FIG(l2_read_latency)
     const L2Stats *l = &mem_of(c)->l2;
     return defined_if(stats_ratio(l->read_latency, l->reads), l->reads > 0, na);
 }
-FIG(l2_hit_rate_ci95) { return cs_mem(c, 1, idx[0], na); }
+FIG(l2_hit_rate_ci95) { return cs_mem(c, CHIP_FIG_L2_HIT_RATE, idx[0], na); }
 FIG(dram_bandwidth) { (void)idx; return mem_fig(c, CHIP_FIG_DRAM_GBS, na); }
-FIG(dram_bandwidth_ci95) { return cs_mem(c, 2, idx[0], na); }
+FIG(dram_bandwidth_ci95) { return cs_mem(c, CHIP_FIG_DRAM_GBS, idx[0], na); }
 FIG(dram_peak) { UNUSED_FIG_ARGS; return mem_of(c)->dram_peak_gbs; }
 FIG(dram_utilization)
 {
