@@ -32,7 +32,9 @@ typedef struct ChipPort {        /* what core k's timing model sends through (ti
     InReq *out;                  /* sent while the core ran (its host thread's only), not yet in */
     size_t nout, capout;
     int oom;
-    uint64_t reads, writes, lat_sum; /* its requests in, and its reads' latencies (chip_core_stats) */
+    uint64_t reads, writes, lat_sum; /* its requests as they came in, its reads' latencies as they
+                                        were answered (chip_core_stats) */
+    uint64_t sent_lines;         /* its requests as its L1 sent them */
 } ChipPort;
 
 struct Chip {
@@ -304,6 +306,7 @@ static void chip_out(void *ctx, uint64_t addr, int write, uint64_t at, uint32_t 
     if (!write)
         p->sent[fill] = at;
     p->out[p->nout++] = (InReq){at + 1, addr, (uint32_t)p->core, write ? UINT32_MAX : fill, p->seq++};
+    p->sent_lines++; /* (on the core's own thread: chip_core_stats) */
 }
 
 void chip_collect(Chip *c, const int *cores, int n)
@@ -416,7 +419,7 @@ void chip_core_stats(const Chip *c, int k, ChipCoreStats *s)
         s->l2_hits = l->hits;
         s->dram_bytes = l->below * c->dram_line_bytes;
     } else if (!c->l2) {
-        s->dram_bytes = (p->reads + p->writes) * c->dram_line_bytes;
+        s->dram_bytes = p->sent_lines * c->dram_line_bytes;
     }
 }
 

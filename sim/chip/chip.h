@@ -83,11 +83,14 @@ typedef struct ChipMemStats {
 } ChipMemStats;
 void chip_stats(const Chip *c, ChipMemStats *s);
 
-/* One core's share of the shared memory's work: its reads and their latency sum (as
- * ChipMemStats.requests, .read_latency), and with an L2 counting cores (chip_count_cores) its
- * accesses and hits there and DRAM's bytes for the lines the L2 sent below for it (a fill, the
- * dirty line it evicted, a write through); without an L2, DRAM's bytes of its requests. A sampled
- * chip's waves read it per unit (docs/sampling.md). Zero for k out of range. */
+/* One core's share of the shared memory's work: its reads as they came in and their latency sum
+ * as they were answered (ChipMemStats.requests, .read_latency), and with an L2 counting cores
+ * (chip_count_cores) its accesses and hits there and DRAM's bytes for the lines the L2 sent below
+ * for it (a fill, the dirty line it evicted, a write through), as the L2 took its requests;
+ * without an L2, DRAM's bytes of its requests as its L1 sent them. A sampled chip's waves read it
+ * per unit (docs/sampling.md): a request sent as a unit ended counts for the next unit on its core,
+ * but in the DRAM bytes without an L2 (there a unit's last write-backs are many of its bytes, and
+ * the requests and their latencies are not in the same ratio). Zero for k out of range. */
 typedef struct ChipCoreStats {
     uint64_t requests, read_latency, l2_accesses, l2_hits, dram_bytes;
 } ChipCoreStats;

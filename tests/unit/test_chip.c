@@ -746,5 +746,22 @@ Test(chip, a_wave_of_two_passes_a_core)
     for (uint32_t u = 0; u < 16; u++)
         cr_expect_eq(w.pass_cycles[u] > 0, ran[u] && u != 1 && u != 5 && u != 10, "unit %u", u);
     func_stats_free(&w);
+    /* without an L2 every request is DRAM's: the units' reads add up to the chip's, and their
+     * bytes (counted as their L1s sent them) to those DRAM served, those that came in and those
+     * still on their way when the wave ended: served <= came in <= sent */
+    chip.l2_size_kb = 0;
+    fp.wave_passes = 2;
+    cr_assert_eq(func_render(&packed, &fp, NULL, &w, err, sizeof err), 0, "%s", err);
+    req = bytes = 0;
+    for (uint32_t u = 0; u < 16; u++) {
+        req += w.pass_mem[u].requests;
+        bytes += w.pass_mem[u].dram_bytes;
+        cr_expect_eq(w.pass_mem[u].l2_accesses, 0);
+    }
+    const uint64_t line = (uint64_t)chip.scene_line_bytes, in = w.chip_mem->requests + w.chip_mem->writes;
+    cr_expect_eq(req, w.chip_mem->requests);
+    cr_expect(w.chip_mem->dram.bytes <= in * line && in * line <= bytes && bytes > 0, "served %llu, in %llu, sent %llu",
+              (unsigned long long)w.chip_mem->dram.bytes, (unsigned long long)(in * line), (unsigned long long)bytes);
+    func_stats_free(&w);
     unload();
 }
